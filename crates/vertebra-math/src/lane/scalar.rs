@@ -1,0 +1,97 @@
+//! `f32` as a lane type of width 1: the reference every SIMD backend is
+//! compared with, bit for bit.
+
+use super::{Lane, Mask};
+
+impl Mask for bool {}
+
+/// 2^23: from here on every `f32` is an integer.
+const ROUND_LIMIT: f32 = 8_388_608.0;
+
+impl Lane for f32 {
+    type Mask = bool;
+    const WIDTH: usize = 1;
+
+    #[inline(always)]
+    fn splat(value: f32) -> Self {
+        value
+    }
+    #[inline(always)]
+    fn load(src: &[f32]) -> Self {
+        src[0]
+    }
+    #[inline(always)]
+    fn store(self, dst: &mut [f32]) {
+        dst[0] = self;
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    /// Ties-to-even by adding and subtracting 2^23: exact for |x| < 2^23,
+    /// and without the libm call that `f32::round_ties_even` becomes on
+    /// baseline x86_64 (no SSE4.1 `roundss`).
+    #[inline(always)]
+    fn round(self) -> Self {
+        let magnitude = f32::abs(self);
+        let rounded = (magnitude + ROUND_LIMIT) - ROUND_LIMIT;
+        // Large values are integers already; infinities and NaN pass through.
+        if magnitude < ROUND_LIMIT {
+            rounded.copysign(self)
+        } else {
+            self
+        }
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        if self < other { self } else { other }
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        if self > other { self } else { other }
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        f32::mul_add(self, a, b)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        f32::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn ge(self, other: Self) -> bool {
+        self >= other
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> bool {
+        self == other
+    }
+    #[inline(always)]
+    fn ne(self, other: Self) -> bool {
+        self != other
+    }
+    #[inline(always)]
+    fn select(mask: bool, on_true: Self, on_false: Self) -> Self {
+        if mask { on_true } else { on_false }
+    }
+    #[inline(always)]
+    fn reduce_add(self) -> f32 {
+        self
+    }
+}

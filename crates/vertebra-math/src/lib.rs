@@ -1,0 +1,31 @@
+//! The math layer of vertebra: lane-generic vectors, quaternions, symmetric
+//! matrices and polynomials, written once over the [`Lane`] trait and run
+//! as a scalar reference, 4-lane SSE4.1, 4- and 8-lane AVX2, or portable
+//! `wide` SIMD with bit-identical results.
+//!
+//! - [`lane`]: the trait, its exact semantics, and the backends' lane types.
+//! - [`Backend`]: run-time detection and entry into kernels.
+//! - [`Vec3`], [`Quat`], [`Sym3`]: the solver's types, one item per lane.
+//! - [`poly`]: `sin`, `cos`, `acos`, `asin`, `atan2` and `sin(x/2)/x`.
+//! - [`block`]: `bytemuck` lane blocks for structure-of-arrays storage.
+//! - [`map`]: one lane function applied across arrays on any backend.
+//! - [`check`]: comparing every backend with the scalar reference, bit for bit.
+//!
+//! Public values outside kernels are `glam` types; `Vec3<f32>` and
+//! `Quat<f32>` convert to and from them.
+
+pub mod backend;
+pub mod block;
+pub mod check;
+pub mod lane;
+pub mod map;
+pub mod poly;
+pub mod quat;
+pub mod sym3;
+pub mod vec3;
+
+pub use backend::{Backend, BackendChoice, BackendError, LaneKernel};
+pub use lane::{Lane, Mask};
+pub use quat::Quat;
+pub use sym3::Sym3;
+pub use vec3::Vec3;

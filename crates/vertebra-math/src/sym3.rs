@@ -1,0 +1,84 @@
+//! `Sym3<L>`: one symmetric 3x3 matrix per lane, for world-space inverse
+//! inertia tensors `R diag(I_body^-1) R^T`.
+
+use crate::lane::Lane;
+use crate::quat::Quat;
+use crate::vec3::Vec3;
+
+/// A symmetric 3x3 matrix in every lane, stored as its six distinct
+/// entries. Units are the caller's (kg^-1 m^-2 for an inverse inertia).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sym3<L> {
+    /// Entry (0, 0).
+    pub xx: L,
+    /// Entry (1, 1).
+    pub yy: L,
+    /// Entry (2, 2).
+    pub zz: L,
+    /// Entries (0, 1) and (1, 0).
+    pub xy: L,
+    /// Entries (0, 2) and (2, 0).
+    pub xz: L,
+    /// Entries (1, 2) and (2, 1).
+    pub yz: L,
+}
+
+impl<L: Lane> Sym3<L> {
+    /// The diagonal matrix `diag(d)`.
+    #[inline(always)]
+    pub fn diagonal(d: Vec3<L>) -> Self {
+        let zero = L::splat(0.0);
+        Self { xx: d.x, yy: d.y, zz: d.z, xy: zero, xz: zero, yz: zero }
+    }
+
+    /// `R diag(d) R^T` where `R` is the rotation of the unit quaternion `q`:
+    /// a body-frame diagonal tensor seen in the world frame.
+    #[inline(always)]
+    pub fn from_rotated_diagonal(q: Quat<L>, d: Vec3<L>) -> Self {
+        let one = L::splat(1.0);
+        let two = L::splat(2.0);
+        let (x, y, z, w) = (q.x, q.y, q.z, q.w);
+        // Rows of the rotation matrix.
+        let r0 = Vec3::new(
+            one - two * (y * y + z * z),
+            two * (x * y - w * z),
+            two * (x * z + w * y),
+        );
+        let r1 = Vec3::new(
+            two * (x * y + w * z),
+            one - two * (x * x + z * z),
+            two * (y * z - w * x),
+        );
+        let r2 = Vec3::new(
+            two * (x * z - w * y),
+            two * (y * z + w * x),
+            one - two * (x * x + y * y),
+        );
+        let weighted = |a: Vec3<L>, b: Vec3<L>| a.x * d.x * b.x + a.y * d.y * b.y + a.z * d.z * b.z;
+        Self {
+            xx: weighted(r0, r0),
+            yy: weighted(r1, r1),
+            zz: weighted(r2, r2),
+            xy: weighted(r0, r1),
+            xz: weighted(r0, r2),
+            yz: weighted(r1, r2),
+        }
+    }
+
+    /// The product `S v`.
+    #[inline(always)]
+    pub fn mul_vec(self, v: Vec3<L>) -> Vec3<L> {
+        Vec3::new(
+            self.xx * v.x + self.xy * v.y + self.xz * v.z,
+            self.xy * v.x + self.yy * v.y + self.yz * v.z,
+            self.xz * v.x + self.yz * v.y + self.zz * v.z,
+        )
+    }
+
+    /// The quadratic form `v^T S v` (a generalised inverse mass when `S` is
+    /// an inverse inertia and `v` a lever-arm cross product or an axis).
+    #[inline(always)]
+    pub fn quadratic(self, v: Vec3<L>) -> L {
+        v.dot(self.mul_vec(v))
+    }
+}

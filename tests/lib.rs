@@ -1,0 +1,1 @@
+//! Workspace-wide invariants live in `tidy.rs`; this library is empty.
