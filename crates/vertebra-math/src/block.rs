@@ -59,7 +59,11 @@ impl Vec3Block {
     /// Writes lanes to items `start .. start + L::WIDTH`.
     #[inline(always)]
     pub fn store<L: Lane>(&mut self, start: usize, v: Vec3<L>) {
-        v.store(&mut self.x[start..], &mut self.y[start..], &mut self.z[start..]);
+        v.store(
+            &mut self.x[start..],
+            &mut self.y[start..],
+            &mut self.z[start..],
+        );
     }
 }
 
@@ -77,7 +81,12 @@ impl QuatBlock {
     /// Items `start .. start + L::WIDTH` as lanes.
     #[inline(always)]
     pub fn load<L: Lane>(&self, start: usize) -> Quat<L> {
-        Quat::load(&self.x[start..], &self.y[start..], &self.z[start..], &self.w[start..])
+        Quat::load(
+            &self.x[start..],
+            &self.y[start..],
+            &self.z[start..],
+            &self.w[start..],
+        )
     }
 
     /// Writes lanes to items `start .. start + L::WIDTH`.

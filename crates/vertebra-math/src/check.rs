@@ -35,7 +35,7 @@ pub const ADVERSARIAL: &[f32] = &[
     core::f32::consts::FRAC_PI_2,
     core::f32::consts::PI,
     -core::f32::consts::PI,
-    3.141_593,
+    core::f32::consts::PI.next_up(),
     6.283_185_5,
     8192.0,
     -8192.0,

@@ -6,7 +6,7 @@ use crate::backend::{Backend, LaneKernel};
 use crate::lane::Lane;
 
 /// The most inputs or outputs a [`LaneMap`] may have.
-pub const MAX_ARGUMENTS: usize = 8;
+pub const MAX_ARGUMENTS: usize = 24;
 
 /// A function from `INPUTS` lane values to `OUTPUTS` lane values, lane by
 /// lane, written once for every lane type.
@@ -37,9 +37,20 @@ pub fn map_arrays<M: LaneMap>(
     assert_eq!(inputs.len(), M::INPUTS, "input array count");
     assert_eq!(outputs.len(), M::OUTPUTS, "output array count");
     let len = inputs.first().map_or(0, |a| a.len());
-    assert!(inputs.iter().all(|a| a.len() == len), "input lengths differ");
-    assert!(outputs.iter().all(|a| a.len() == len), "output lengths differ");
-    backend.dispatch(MapKernel { map, inputs, outputs, len });
+    assert!(
+        inputs.iter().all(|a| a.len() == len),
+        "input lengths differ"
+    );
+    assert!(
+        outputs.iter().all(|a| a.len() == len),
+        "output lengths differ"
+    );
+    backend.dispatch(MapKernel {
+        map,
+        inputs,
+        outputs,
+        len,
+    });
 }
 
 struct MapKernel<'a, 'b, M> {
@@ -56,21 +67,31 @@ impl<M: LaneMap> LaneKernel for MapKernel<'_, '_, M> {
     fn run<L: Lane>(self) {
         let mut lanes_in = [L::splat(0.0); MAX_ARGUMENTS];
         let mut lanes_out = [L::splat(0.0); MAX_ARGUMENTS];
-        let mut start = 0;
-        while start < self.len {
-            let count = L::WIDTH.min(self.len - start);
-            for (lane, array) in lanes_in.iter_mut().zip(self.inputs) {
-                let mut padded = [0.0f32; MAX_LANES];
-                padded[..count].copy_from_slice(&array[start..start + count]);
-                *lane = L::load(&padded);
+        let (ins, outs) = (&mut lanes_in[..M::INPUTS], &mut lanes_out[..M::OUTPUTS]);
+        let full = self.len - self.len % L::WIDTH;
+        for start in (0..full).step_by(L::WIDTH) {
+            for (lane, array) in ins.iter_mut().zip(self.inputs) {
+                *lane = L::load(&array[start..]);
             }
-            self.map.apply(&lanes_in[..M::INPUTS], &mut lanes_out[..M::OUTPUTS]);
-            for (lane, array) in lanes_out.iter().zip(self.outputs.iter_mut()) {
-                let mut padded = [0.0f32; MAX_LANES];
-                lane.store(&mut padded);
-                array[start..start + count].copy_from_slice(&padded[..count]);
+            self.map.apply(ins, outs);
+            for (lane, array) in outs.iter().zip(self.outputs.iter_mut()) {
+                lane.store(&mut array[start..]);
             }
-            start += L::WIDTH;
+        }
+        if full == self.len {
+            return;
+        }
+        // The tail: padded with zeros, whose results are dropped.
+        let count = self.len - full;
+        let mut padded = [0.0f32; MAX_LANES];
+        for (lane, array) in ins.iter_mut().zip(self.inputs) {
+            padded[..count].copy_from_slice(&array[full..]);
+            *lane = L::load(&padded);
+        }
+        self.map.apply(ins, outs);
+        for (lane, array) in outs.iter().zip(self.outputs.iter_mut()) {
+            lane.store(&mut padded);
+            array[full..].copy_from_slice(&padded[..count]);
         }
     }
 }

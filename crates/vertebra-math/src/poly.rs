@@ -42,7 +42,11 @@ const PI_LO: f32 = -8.742_278e-8;
 /// constant does not add to the rounding of the difference.
 #[inline(always)]
 pub(crate) fn pi_minus<L: Lane>(half: bool, a: L) -> L {
-    let (hi, lo) = if half { (FRAC_PI_2, 0.5 * PI_LO) } else { (PI, PI_LO) };
+    let (hi, lo) = if half {
+        (FRAC_PI_2, 0.5 * PI_LO)
+    } else {
+        (PI, PI_LO)
+    };
     (L::splat(lo) - a) + L::splat(hi)
 }
 

@@ -80,7 +80,8 @@ impl<L: Lane> Quat<L> {
     }
 
     /// Scaled to unit length; a lane of zero, NaN or infinite length
-    /// becomes the identity (the safe zero case, by a select).
+    /// becomes the identity (the safe zero case, by a select). As for
+    /// [`Vec3::normalize_or_zero`], the length comes from its square.
     #[inline(always)]
     pub fn normalize(self) -> Self {
         let length = self.dot(self).sqrt();

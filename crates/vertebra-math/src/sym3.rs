@@ -28,7 +28,14 @@ impl<L: Lane> Sym3<L> {
     #[inline(always)]
     pub fn diagonal(d: Vec3<L>) -> Self {
         let zero = L::splat(0.0);
-        Self { xx: d.x, yy: d.y, zz: d.z, xy: zero, xz: zero, yz: zero }
+        Self {
+            xx: d.x,
+            yy: d.y,
+            zz: d.z,
+            xy: zero,
+            xz: zero,
+            yz: zero,
+        }
     }
 
     /// `R diag(d) R^T` where `R` is the rotation of the unit quaternion `q`:

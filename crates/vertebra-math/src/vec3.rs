@@ -78,8 +78,9 @@ impl<L: Lane> Vec3<L> {
     }
 
     /// The unit vector along `self`, and the length. A lane whose length is
-    /// zero, NaN or infinite (|v| above 1.8e19 overflows the squared length)
-    /// gives the zero vector: the safe zero case, decided by a select.
+    /// zero, NaN or infinite gives the zero vector: the safe zero case,
+    /// decided by a select. The length comes from the squared length, so
+    /// |v| below about 1e-22 counts as zero and above 1.8e19 as infinite.
     #[inline(always)]
     pub fn normalize_or_zero(self) -> (Self, L) {
         let length = self.length();

@@ -85,8 +85,14 @@ fn min_max_clamp_agree_with_the_documented_nan_rule() {
     for (k, (&a, &b)) in args[0].iter().zip(&args[1]).enumerate() {
         let min = if a < b { a } else { b };
         let max = if a > b { a } else { b };
-        assert!(vertebra_math::check::same_bits(out[0][k], min), "min({a}, {b})");
-        assert!(vertebra_math::check::same_bits(out[1][k], max), "max({a}, {b})");
+        assert!(
+            vertebra_math::check::same_bits(out[0][k], min),
+            "min({a}, {b})"
+        );
+        assert!(
+            vertebra_math::check::same_bits(out[1][k], max),
+            "max({a}, {b})"
+        );
     }
     assert_agree(&ClampOp, &arguments(3, RANDOM, 4));
 }
@@ -96,7 +102,10 @@ fn round_is_ties_to_even_everywhere() {
     let args = arguments(1, RANDOM, 5);
     let out = assert_agree(&RoundOp, &args);
     for (x, r) in args[0].iter().zip(&out[0]) {
-        assert!(vertebra_math::check::same_bits(*r, x.round_ties_even()), "round({x:e}) = {r:e}");
+        assert!(
+            vertebra_math::check::same_bits(*r, x.round_ties_even()),
+            "round({x:e}) = {r:e}"
+        );
     }
 }
 
@@ -120,14 +129,19 @@ fn comparisons_and_masks_agree() {
 fn reduction_adds_in_lane_order() {
     // Within one backend the reduction is of one call's lanes; the map
     // applies it per chunk, so compare each backend with its own order.
-    let values: Vec<f32> = (0..64).map(|i| 1.0e8 * (-1.0f32).powi(i) + i as f32).collect();
+    let values: Vec<f32> = (0..64)
+        .map(|i| 1.0e8 * (-1.0f32).powi(i) + i as f32)
+        .collect();
     for backend in Backend::available() {
         let mut out = vec![0.0; values.len()];
         vertebra_math::map::map_arrays(backend, &ReduceOp, &[&values], &mut [&mut out]);
         let w = backend.lanes();
         for (chunk, sums) in values.chunks(w).zip(out.chunks(w)) {
             let expected = chunk.iter().skip(1).fold(chunk[0], |s, &x| s + x);
-            assert!(sums.iter().all(|&s| s.to_bits() == expected.to_bits()), "{backend}");
+            assert!(
+                sums.iter().all(|&s| s.to_bits() == expected.to_bits()),
+                "{backend}"
+            );
         }
     }
 }

@@ -39,7 +39,10 @@ fn max_error(xs: &[f32], got: &[f32], reference: impl Fn(f64) -> f64) -> (f64, f
 
 fn report(name: &str, bound: f64, (error, at): (f64, f32)) {
     eprintln!("{name}: max abs error {error:.3e} at {at:e} (bound {bound:.1e})");
-    assert!(error <= bound, "{name}: error {error:e} at {at:e} exceeds {bound:e}");
+    assert!(
+        error <= bound,
+        "{name}: error {error:e} at {at:e} exceeds {bound:e}"
+    );
 }
 
 #[test]
@@ -64,13 +67,16 @@ fn asin_and_acos_within_bound_on_their_domain() {
     // Near x = 1 acos is accurate relative to its small result as well.
     for (&x, &a) in xs.iter().zip(&out[3]).filter(|(x, _)| **x > 0.999) {
         let exact = (x as f64).acos();
-        assert!((a as f64 - exact).abs() <= 4.0 * f32::EPSILON as f64 * exact + 1e-30, "acos({x})");
+        assert!(
+            (a as f64 - exact).abs() <= 4.0 * f32::EPSILON as f64 * exact + 1e-30,
+            "acos({x})"
+        );
     }
 }
 
 #[test]
 fn atan2_within_bound_all_around_the_circle() {
-    let angles = grid(-3.141_592_7, 3.141_592_7, 1_000_000);
+    let angles = grid(-std::f32::consts::PI, std::f32::consts::PI, 1_000_000);
     let radii = [1.0e-30f32, 1.0e-3, 1.0, 7.5, 1.0e20];
     for r in radii {
         let y: Vec<f32> = angles.iter().map(|&a| r * a.sin()).collect();
@@ -116,7 +122,8 @@ fn special_values_follow_ieee_conventions() {
     for (k, c) in cases.iter().enumerate() {
         let expected = c.2;
         assert!(
-            (out[4][k] - expected).abs() <= 2.7e-7 && out[4][k].is_sign_negative() == expected.is_sign_negative(),
+            (out[4][k] - expected).abs() <= 2.7e-7
+                && out[4][k].is_sign_negative() == expected.is_sign_negative(),
             "atan2({}, {}) = {} (expected {})",
             c.0,
             c.1,
@@ -125,7 +132,11 @@ fn special_values_follow_ieee_conventions() {
         );
     }
     let exact = eval(&[1.0, -1.0, 0.0], &[0.0; 3]);
-    assert_eq!(exact[3], vec![0.0, PI, FRAC_PI_2], "acos(1), acos(-1), acos(0)");
+    assert_eq!(
+        exact[3],
+        vec![0.0, PI, FRAC_PI_2],
+        "acos(1), acos(-1), acos(0)"
+    );
     assert_eq!(exact[2][2], 0.0, "asin(0)");
     assert_eq!(exact[1][2], 1.0, "cos(0)");
 }
@@ -138,17 +149,37 @@ fn outside_the_domain_results_stay_finite_and_bounded() {
     for k in 0..args[0].len() {
         let (x, y) = (args[0][k], args[1][k]);
         if !x.is_finite() {
-            assert!(out[0][k].is_nan() && out[1][k].is_nan(), "sin/cos({x}) should be NaN");
+            assert!(
+                out[0][k].is_nan() && out[1][k].is_nan(),
+                "sin/cos({x}) should be NaN"
+            );
             continue;
         }
         for (f, name) in [(0, "sin"), (1, "cos")] {
-            assert!((-1.0..=1.0).contains(&out[f][k]), "{name}({x:e}) = {}", out[f][k]);
+            assert!(
+                (-1.0..=1.0).contains(&out[f][k]),
+                "{name}({x:e}) = {}",
+                out[f][k]
+            );
         }
-        assert!(out[2][k].abs() <= std::f32::consts::FRAC_PI_2, "asin({x:e})");
-        assert!((0.0..=std::f32::consts::PI).contains(&out[3][k]), "acos({x:e})");
-        assert!((0.0..=0.5).contains(&out[5][k]), "half_sinc({x:e}) = {}", out[5][k]);
+        assert!(
+            out[2][k].abs() <= std::f32::consts::FRAC_PI_2,
+            "asin({x:e})"
+        );
+        assert!(
+            (0.0..=std::f32::consts::PI).contains(&out[3][k]),
+            "acos({x:e})"
+        );
+        assert!(
+            (0.0..=0.5).contains(&out[5][k]),
+            "half_sinc({x:e}) = {}",
+            out[5][k]
+        );
         if y.is_finite() {
-            assert!(out[4][k].abs() <= std::f32::consts::PI, "atan2({x:e}, {y:e})");
+            assert!(
+                out[4][k].abs() <= std::f32::consts::PI,
+                "atan2({x:e}, {y:e})"
+            );
         }
     }
     // Clamping: beyond the domain the value at the domain's edge.

@@ -57,7 +57,9 @@ impl fmt::Debug for F32x8 {
 impl fmt::Debug for M32x8 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let bits = avx!(_mm256_movemask_ps(self.0));
-        f.debug_list().entries((0..8).map(|i| bits >> i & 1 == 1)).finish()
+        f.debug_list()
+            .entries((0..8).map(|i| bits >> i & 1 == 1))
+            .finish()
     }
 }
 

@@ -156,7 +156,9 @@ impl Lane for F32x4Portable {
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         let (s, a, b) = (self.0.to_array(), a.0.to_array(), b.0.to_array());
-        Self(f32x4::new(core::array::from_fn(|i| s[i].mul_add(a[i], b[i]))))
+        Self(f32x4::new(core::array::from_fn(|i| {
+            s[i].mul_add(a[i], b[i])
+        })))
     }
     #[inline(always)]
     fn copysign(self, sign: Self) -> Self {

@@ -55,7 +55,9 @@ impl fmt::Debug for F32x4 {
 impl fmt::Debug for M32x4 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let bits = sse41!(_mm_movemask_ps(self.0));
-        f.debug_list().entries((0..4).map(|i| bits >> i & 1 == 1)).finish()
+        f.debug_list()
+            .entries((0..4).map(|i| bits >> i & 1 == 1))
+            .finish()
     }
 }
 
@@ -79,7 +81,10 @@ impl Not for M32x4 {
     type Output = Self;
     #[inline(always)]
     fn not(self) -> Self {
-        Self(sse41!(_mm_xor_ps(self.0, _mm_castsi128_ps(_mm_set1_epi32(-1)))))
+        Self(sse41!(_mm_xor_ps(
+            self.0,
+            _mm_castsi128_ps(_mm_set1_epi32(-1))
+        )))
     }
 }
 
@@ -158,7 +163,9 @@ impl Lane for F32x4 {
     }
     #[inline(always)]
     fn round(self) -> Self {
-        Self(sse41!(_mm_round_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(self.0)))
+        Self(sse41!(_mm_round_ps::<
+            { _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC },
+        >(self.0)))
     }
     #[inline(always)]
     fn min(self, other: Self) -> Self {
@@ -172,12 +179,17 @@ impl Lane for F32x4 {
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         let (s, a, b) = (self.to_array(), a.to_array(), b.to_array());
-        Self::load(&core::array::from_fn::<f32, 4, _>(|i| s[i].mul_add(a[i], b[i])))
+        Self::load(&core::array::from_fn::<f32, 4, _>(|i| {
+            s[i].mul_add(a[i], b[i])
+        }))
     }
     #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
         let s = sign_bit();
-        Self(sse41!(_mm_or_ps(_mm_andnot_ps(s, self.0), _mm_and_ps(s, sign.0))))
+        Self(sse41!(_mm_or_ps(
+            _mm_andnot_ps(s, self.0),
+            _mm_and_ps(s, sign.0)
+        )))
     }
     #[inline(always)]
     fn lt(self, other: Self) -> M32x4 {

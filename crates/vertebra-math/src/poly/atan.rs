@@ -7,7 +7,12 @@ use crate::lane::Lane;
 /// tan(pi/8): above it, atan(a) = pi/4 + atan((a - 1) / (a + 1)).
 const TAN_PI_8: f32 = 0.414_213_57;
 /// atan(a) = a + a^3 P(a^2) for |a| <= tan(pi/8).
-const ATAN: [f32; 4] = [8.053_744_5e-2, -1.387_768_6e-1, 1.997_771_1e-1, -3.333_295e-1];
+const ATAN: [f32; 4] = [
+    8.053_744_5e-2,
+    -1.387_768_6e-1,
+    1.997_771_1e-1,
+    -3.333_295e-1,
+];
 
 /// The angle of the point `(x, y)` from the +x axis, in (-pi, pi], with
 /// IEEE-754 conventions for signed zeros and infinities
@@ -27,7 +32,11 @@ pub fn atan2<L: Lane>(y: L, x: L) -> L {
     let t = L::select(reduced, (a - one) / (a + one), a);
     let z = t * t;
     let octant = t + t * z * super::horner(z, &ATAN);
-    let angle = L::select(reduced, L::splat(core::f32::consts::FRAC_PI_4) + octant, octant);
+    let angle = L::select(
+        reduced,
+        L::splat(core::f32::consts::FRAC_PI_4) + octant,
+        octant,
+    );
 
     let angle = L::select(ay.gt(ax), super::pi_minus(true, angle), angle);
     let x_negative = one.copysign(x).lt(zero);

@@ -41,10 +41,13 @@ pub fn sin_cos<L: Lane>(x: L) -> (L, L) {
     let (sin, cos) = (L::select(odd, c, s), L::select(odd, s, c));
     let sin = L::select(q.ge(L::splat(2.0)), -sin, sin);
     let cos = L::select(q.eq(L::splat(1.0)) | q.eq(L::splat(2.0)), -cos, cos);
-    // Infinite or NaN input: NaN out (`x - x` is NaN exactly then).
-    let invalid = (x - x).is_nan();
-    let nan = x - x;
-    (L::select(invalid, nan, sin), L::select(invalid, nan, cos))
+    // Infinite or NaN input: NaN out (`0 x` is NaN exactly then).
+    let zero_times = x * L::splat(0.0);
+    let invalid = zero_times.is_nan();
+    (
+        L::select(invalid, zero_times, sin),
+        L::select(invalid, zero_times, cos),
+    )
 }
 
 /// Sine of `x` (radians); see [`sin_cos`].

@@ -33,21 +33,31 @@ pub fn random_float(rng: &mut StdRng) -> f32 {
         1 => rng.random_range(-10.0f32..10.0),
         _ => {
             let magnitude = 10f32.powf(rng.random_range(-20.0f32..20.0));
-            if rng.random::<bool>() { magnitude } else { -magnitude }
+            if rng.random::<bool>() {
+                magnitude
+            } else {
+                -magnitude
+            }
         }
     }
 }
 
 /// `count` random floats from `range`.
 pub fn uniform(rng: &mut StdRng, count: usize, range: core::ops::Range<f32>) -> Vec<f32> {
-    (0..count).map(|_| rng.random_range(range.clone())).collect()
+    (0..count)
+        .map(|_| rng.random_range(range.clone()))
+        .collect()
 }
 
 /// Argument tuples of `arity`: every combination of the adversarial values
 /// (for arity <= 2), then `random` tuples drawn from `random_float`.
 pub fn arguments(arity: usize, random: usize, seed: u64) -> Vec<Vec<f32>> {
     let mut columns = vec![Vec::new(); arity];
-    let combos = if arity <= 2 { ADVERSARIAL.len().pow(arity as u32) } else { 0 };
+    let combos = if arity <= 2 {
+        ADVERSARIAL.len().pow(arity as u32)
+    } else {
+        0
+    };
     for c in 0..combos {
         let mut k = c;
         for column in columns.iter_mut() {
@@ -60,7 +70,11 @@ pub fn arguments(arity: usize, random: usize, seed: u64) -> Vec<Vec<f32>> {
     for position in 0..arity {
         for &v in ADVERSARIAL {
             for (j, column) in columns.iter_mut().enumerate() {
-                column.push(if j == position { v } else { random_float(&mut rng) });
+                column.push(if j == position {
+                    v
+                } else {
+                    random_float(&mut rng)
+                });
             }
         }
     }

@@ -1,0 +1,174 @@
+//! Invariants of the workspace that no compiler checks, kept true by test
+//! (after rust-analyzer's tidy tests). Each names the rule from
+//! `docs/architecture.md` that it guards.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace root")
+        .to_path_buf()
+}
+
+/// Every `.rs` file of ours (not `target/`, not the fuzz build), relative
+/// to the root, with its text.
+fn sources() -> Vec<(String, String)> {
+    fn walk(dir: &Path, root: &Path, out: &mut Vec<(String, String)>) {
+        for entry in fs::read_dir(dir).expect("readable directory") {
+            let path = entry.expect("directory entry").path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if name.starts_with('.') || name == "target" {
+                continue;
+            }
+            if path.is_dir() {
+                walk(&path, root, out);
+            } else if name.ends_with(".rs") {
+                let rel = path
+                    .strip_prefix(root)
+                    .expect("under root")
+                    .to_string_lossy()
+                    .into_owned();
+                out.push((rel, fs::read_to_string(&path).expect("utf-8 source")));
+            }
+        }
+    }
+    let root = root();
+    let mut out = Vec::new();
+    for top in ["crates", "benches", "tests", "fuzz"] {
+        if root.join(top).is_dir() {
+            walk(&root.join(top), &root, &mut out);
+        }
+    }
+    assert!(out.len() > 10, "found the sources");
+    out
+}
+
+/// Intrinsics live in two places only: the lane types of the math layer
+/// and the body gather/scatter. Kernels never `use core::arch`.
+const INTRINSIC_FILES: &[&str] = &[
+    "crates/vertebra-math/src/lane/sse41.rs",
+    "crates/vertebra-math/src/lane/avx2.rs",
+    "crates/vertebra-math/src/backend.rs",
+];
+
+#[test]
+fn intrinsics_only_in_lane_types_and_gather_scatter() {
+    for (path, text) in sources() {
+        if INTRINSIC_FILES.contains(&path.as_str()) || path == "tests/tidy.rs" {
+            continue;
+        }
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            assert!(
+                !code.contains("arch::") && !code.contains("_mm_") && !code.contains("_mm256_"),
+                "{path}:{}: intrinsics belong in the lane types or the gather/scatter",
+                n + 1
+            );
+        }
+    }
+}
+
+#[test]
+fn every_unsafe_block_says_why_and_stays_where_intrinsics_are() {
+    for (path, text) in sources() {
+        if path == "tests/tidy.rs" {
+            continue;
+        }
+        let lines: Vec<&str> = text.lines().collect();
+        for (n, line) in lines.iter().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            if !code.contains("unsafe ") && !code.contains("unsafe{") {
+                continue;
+            }
+            if code.contains("unsafe_op_in_unsafe_fn") {
+                continue;
+            }
+            assert!(
+                INTRINSIC_FILES.contains(&path.as_str()),
+                "{path}:{}: `unsafe` only where intrinsics need it",
+                n + 1
+            );
+            let start = n.saturating_sub(3);
+            let said = lines[start..=n].iter().any(|l| l.contains("// SAFETY:"))
+                || (start..n).any(|k| {
+                    lines[k].trim_start().starts_with("//") && lines[k].contains("SAFETY")
+                });
+            assert!(said, "{path}:{}: unsafe without a `// SAFETY:` line", n + 1);
+        }
+    }
+}
+
+#[test]
+fn kernels_never_fuse_or_approximate() {
+    // Lane implementations define mul_add; nothing else calls it or any
+    // approximate reciprocal (see crates/vertebra-math/src/lane.rs).
+    for (path, text) in sources() {
+        let defines = path.starts_with("crates/vertebra-math/src/lane");
+        let is_test =
+            path.contains("/tests/") || path.starts_with("tests/") || path.starts_with("fuzz/");
+        if defines || is_test {
+            continue;
+        }
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            for banned in [".mul_add(", "recip", "rsqrt"] {
+                assert!(
+                    !code.contains(banned),
+                    "{path}:{}: `{banned}` breaks bit-for-bit",
+                    n + 1
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn no_ignored_tests_and_no_cpu_specific_builds() {
+    for (path, text) in sources() {
+        if path == "tests/tidy.rs" {
+            continue;
+        }
+        assert!(
+            !text.contains("#[ignore"),
+            "{path}: no #[ignore] to get green"
+        );
+    }
+    let config = root().join(".cargo/config.toml");
+    if let Ok(text) = fs::read_to_string(config) {
+        assert!(
+            !text.contains("target-cpu"),
+            "target-cpu would kill the binary on older CPUs"
+        );
+    }
+}
+
+#[test]
+fn the_architecture_map_names_every_crate() {
+    let map =
+        fs::read_to_string(root().join("docs/architecture.md")).expect("docs/architecture.md");
+    let mut crates: Vec<String> = fs::read_dir(root().join("crates"))
+        .expect("crates/")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    crates.extend(["vertebra-benches".into(), "vertebra-tidy".into()]);
+    for name in crates {
+        assert!(
+            map.contains(&format!("`{name}`")),
+            "docs/architecture.md does not describe `{name}`"
+        );
+    }
+    let workspace = fs::read_to_string(root().join("Cargo.toml")).expect("Cargo.toml");
+    for entry in fs::read_dir(root().join("crates")).expect("crates/") {
+        let name = entry
+            .expect("entry")
+            .file_name()
+            .to_string_lossy()
+            .into_owned();
+        assert!(
+            workspace.contains(&format!("crates/{name}")),
+            "crates/{name} is not a workspace member"
+        );
+    }
+}
