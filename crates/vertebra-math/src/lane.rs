@@ -49,6 +49,8 @@
 use core::fmt::Debug;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
+use crate::row::{ROW_LEN, Row};
+
 pub mod scalar;
 
 pub(crate) mod portable;
@@ -144,6 +146,21 @@ pub trait Lane:
 
     /// `if mask { on_true } else { on_false }`, lane by lane, by bits.
     fn select(mask: Self::Mask, on_true: Self, on_false: Self) -> Self;
+
+    /// Gathers body rows: lane `i` of element `k` is `rows[indices[i]][k]`
+    /// (the loads and the transpose; `indices` holds `WIDTH` entries).
+    ///
+    /// # Panics
+    /// If an index is out of bounds.
+    fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN];
+
+    /// The inverse of [`Lane::gather_rows`]: writes lane `i` of every
+    /// element back to `rows[indices[i]]`, except where the index is
+    /// [`NO_WRITE`](crate::row::NO_WRITE).
+    ///
+    /// # Panics
+    /// If an index other than `NO_WRITE` is out of bounds.
+    fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]);
 
     /// The sum of the lanes, added in lane order `((l0 + l1) + l2) + ...`.
     /// For metrics and tests; kernels never reduce across lanes (the order

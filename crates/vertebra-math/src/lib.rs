@@ -8,6 +8,7 @@
 //! - [`Vec3`], [`Quat`], [`Sym3`]: the solver's types, one item per lane.
 //! - [`poly`]: `sin`, `cos`, `acos`, `asin`, `atan2` and `sin(x/2)/x`.
 //! - [`block`]: `bytemuck` lane blocks for structure-of-arrays storage.
+//! - [`row`]: body rows, gathered into lanes and scattered back.
 //! - [`map`]: one lane function applied across arrays on any backend.
 //! - [`check`]: comparing every backend with the scalar reference, bit for bit.
 //!
@@ -21,6 +22,7 @@ pub mod lane;
 pub mod map;
 pub mod poly;
 pub mod quat;
+pub mod row;
 pub mod sym3;
 pub mod vec3;
 

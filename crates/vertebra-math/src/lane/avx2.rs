@@ -14,6 +14,7 @@ use core::fmt;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
 use super::{Lane, Mask};
+use crate::row::{NO_WRITE, ROW_LEN, Row};
 
 /// Eight `f32` lanes.
 #[derive(Clone, Copy)]
@@ -227,8 +228,62 @@ impl Lane for F32x8 {
         Self(avx!(_mm256_blendv_ps(on_false.0, on_true.0, mask.0)))
     }
     #[inline(always)]
+    fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
+        let ptrs: [*mut f32; 8] = core::array::from_fn(|i| rows[indices[i] as usize].as_ptr());
+        // SAFETY: each pointer is a live, 32-byte aligned row of eight
+        // floats (bounds-checked above); AVX was detected.
+        let loaded = unsafe { ptrs.map(|p| _mm256_load_ps(p)) };
+        transpose8(loaded).map(Self)
+    }
+    #[inline(always)]
+    fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]) {
+        let lanes = transpose8(values.map(|v| v.0));
+        for (lane, &index) in indices[..8].iter().enumerate() {
+            if index != NO_WRITE {
+                let p = rows[index as usize].as_ptr();
+                // SAFETY: `p` is a live, aligned row of eight floats that no
+                // other thread accesses during this colour (the colouring
+                // keeps written rows disjoint); AVX was detected.
+                unsafe { _mm256_store_ps(p, lanes[lane]) };
+            }
+        }
+    }
+    #[inline(always)]
     fn reduce_add(self) -> f32 {
         let a = self.to_array();
         a.iter().skip(1).fold(a[0], |sum, &x| sum + x)
     }
+}
+
+/// Transposes an 8x8 block: rows in, columns out (its own inverse).
+#[inline(always)]
+fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
+    avx!({
+        let t0 = _mm256_unpacklo_ps(r[0], r[1]);
+        let t1 = _mm256_unpackhi_ps(r[0], r[1]);
+        let t2 = _mm256_unpacklo_ps(r[2], r[3]);
+        let t3 = _mm256_unpackhi_ps(r[2], r[3]);
+        let t4 = _mm256_unpacklo_ps(r[4], r[5]);
+        let t5 = _mm256_unpackhi_ps(r[4], r[5]);
+        let t6 = _mm256_unpacklo_ps(r[6], r[7]);
+        let t7 = _mm256_unpackhi_ps(r[6], r[7]);
+        let s0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+        let s1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
+        let s2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+        let s3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
+        let s4 = _mm256_shuffle_ps::<0x44>(t4, t6);
+        let s5 = _mm256_shuffle_ps::<0xEE>(t4, t6);
+        let s6 = _mm256_shuffle_ps::<0x44>(t5, t7);
+        let s7 = _mm256_shuffle_ps::<0xEE>(t5, t7);
+        [
+            _mm256_permute2f128_ps::<0x20>(s0, s4),
+            _mm256_permute2f128_ps::<0x20>(s1, s5),
+            _mm256_permute2f128_ps::<0x20>(s2, s6),
+            _mm256_permute2f128_ps::<0x20>(s3, s7),
+            _mm256_permute2f128_ps::<0x31>(s0, s4),
+            _mm256_permute2f128_ps::<0x31>(s1, s5),
+            _mm256_permute2f128_ps::<0x31>(s2, s6),
+            _mm256_permute2f128_ps::<0x31>(s3, s7),
+        ]
+    })
 }

@@ -14,6 +14,7 @@ use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Su
 use wide::f32x4;
 
 use super::{Lane, Mask};
+use crate::row::{ROW_LEN, Row};
 
 /// Four `f32` lanes held in a `wide::f32x4`.
 #[derive(Clone, Copy)]
@@ -191,6 +192,14 @@ impl Lane for F32x4Portable {
     #[inline(always)]
     fn select(mask: M32x4Portable, on_true: Self, on_false: Self) -> Self {
         Self(mask.0.bitselect(on_true.0, on_false.0))
+    }
+    #[inline(always)]
+    fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
+        crate::row::gather_by_lane(rows, indices)
+    }
+    #[inline(always)]
+    fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]) {
+        crate::row::scatter_by_lane(values, rows, indices)
     }
     #[inline(always)]
     fn reduce_add(self) -> f32 {

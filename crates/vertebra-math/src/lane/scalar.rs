@@ -2,6 +2,7 @@
 //! compared with, bit for bit.
 
 use super::{Lane, Mask};
+use crate::row::{ROW_LEN, Row};
 
 impl Mask for bool {}
 
@@ -89,6 +90,14 @@ impl Lane for f32 {
     #[inline(always)]
     fn select(mask: bool, on_true: Self, on_false: Self) -> Self {
         if mask { on_true } else { on_false }
+    }
+    #[inline(always)]
+    fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
+        crate::row::gather_by_lane(rows, indices)
+    }
+    #[inline(always)]
+    fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]) {
+        crate::row::scatter_by_lane(values, rows, indices)
     }
     #[inline(always)]
     fn reduce_add(self) -> f32 {

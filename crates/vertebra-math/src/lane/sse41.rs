@@ -12,6 +12,7 @@ use core::fmt;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
 use super::{Lane, Mask};
+use crate::row::{NO_WRITE, ROW_LEN, Row};
 
 /// Four `f32` lanes.
 #[derive(Clone, Copy)]
@@ -220,8 +221,51 @@ impl Lane for F32x4 {
         Self(sse41!(_mm_blendv_ps(on_false.0, on_true.0, mask.0)))
     }
     #[inline(always)]
+    fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
+        let ptrs: [*mut f32; 4] = core::array::from_fn(|i| rows[indices[i] as usize].as_ptr());
+        // SAFETY: each pointer is a live, 32-byte aligned row of eight
+        // floats (bounds-checked above); SSE4.1 was detected.
+        let half = |offset: usize| unsafe { ptrs.map(|p| _mm_load_ps(p.add(offset))) };
+        let (lo, hi) = (transpose4(half(0)), transpose4(half(4)));
+        [lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]].map(Self)
+    }
+    #[inline(always)]
+    fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]) {
+        let lo = transpose4([values[0].0, values[1].0, values[2].0, values[3].0]);
+        let hi = transpose4([values[4].0, values[5].0, values[6].0, values[7].0]);
+        for (lane, &index) in indices[..4].iter().enumerate() {
+            if index != NO_WRITE {
+                let p = rows[index as usize].as_ptr();
+                // SAFETY: `p` is a live, aligned row of eight floats that no
+                // other thread accesses during this colour (the colouring
+                // keeps written rows disjoint); SSE4.1 was detected.
+                unsafe {
+                    _mm_store_ps(p, lo[lane]);
+                    _mm_store_ps(p.add(4), hi[lane]);
+                }
+            }
+        }
+    }
+    #[inline(always)]
     fn reduce_add(self) -> f32 {
         let a = self.to_array();
         ((a[0] + a[1]) + a[2]) + a[3]
     }
+}
+
+/// Transposes a 4x4 block: rows in, columns out (its own inverse).
+#[inline(always)]
+fn transpose4(r: [__m128; 4]) -> [__m128; 4] {
+    sse41!({
+        let t0 = _mm_unpacklo_ps(r[0], r[1]);
+        let t1 = _mm_unpacklo_ps(r[2], r[3]);
+        let t2 = _mm_unpackhi_ps(r[0], r[1]);
+        let t3 = _mm_unpackhi_ps(r[2], r[3]);
+        [
+            _mm_movelh_ps(t0, t1),
+            _mm_movehl_ps(t1, t0),
+            _mm_movelh_ps(t2, t3),
+            _mm_movehl_ps(t3, t2),
+        ]
+    })
 }
