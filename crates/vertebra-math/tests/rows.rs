@@ -28,9 +28,7 @@ impl LaneKernel for Shift<'_> {
                 v.store(&mut columns[k]);
                 *v += L::splat(k as f32 + 1.0);
             }
-            for lane in 0..L::WIDTH {
-                gathered.push(core::array::from_fn(|k| columns[k][lane]));
-            }
+            gathered.extend((0..L::WIDTH).map(|lane| core::array::from_fn(|k| columns[k][lane])));
             L::scatter_rows(&values, self.rows, &self.writes[start..]);
         }
         gathered
