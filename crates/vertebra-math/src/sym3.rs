@@ -72,6 +72,36 @@ impl<L: Lane> Sym3<L> {
         }
     }
 
+    /// `R S R^T`, with `R` the rotation of the unit quaternion `q`: a
+    /// body-frame tensor seen in the world frame.
+    #[inline(always)]
+    pub fn rotated(self, q: Quat<L>) -> Self {
+        // Columns of R S R^T are R S R^T e_k = R (S (R^T e_k)).
+        let column = |e: glam::Vec3| q.rotate(self.mul_vec(q.inverse_rotate(Vec3::splat(e))));
+        let (c0, c1, c2) = (column(glam::Vec3::X), column(glam::Vec3::Y), column(glam::Vec3::Z));
+        Self { xx: c0.x, yy: c1.y, zz: c2.z, xy: c1.x, xz: c2.x, yz: c2.y }
+    }
+
+    /// `self + s 1`: the matrix with `s` added to the diagonal.
+    #[inline(always)]
+    pub fn add_diagonal(self, s: L) -> Self {
+        Self { xx: self.xx + s, yy: self.yy + s, zz: self.zz + s, ..self }
+    }
+
+    /// The inverse by the adjugate, or the zero matrix in lanes whose
+    /// determinant is not positive (a singular or indefinite matrix: two
+    /// bodies of infinite mass, or padding), decided by a select.
+    #[inline(always)]
+    pub fn inverse_or_zero(self) -> Self {
+        let (a, b, c, d, e, f) = (self.xx, self.yy, self.zz, self.xy, self.xz, self.yz);
+        let (axx, ayy, azz) = (b * c - f * f, a * c - e * e, a * b - d * d);
+        let (axy, axz, ayz) = (e * f - d * c, d * f - e * b, d * e - a * f);
+        let det = a * axx + d * axy + e * axz;
+        let valid = det.gt(L::splat(0.0));
+        let inv = L::select(valid, L::splat(1.0) / L::select(valid, det, L::splat(1.0)), L::splat(0.0));
+        Self { xx: axx * inv, yy: ayy * inv, zz: azz * inv, xy: axy * inv, xz: axz * inv, yz: ayz * inv }
+    }
+
     /// The product `S v`.
     #[inline(always)]
     pub fn mul_vec(self, v: Vec3<L>) -> Vec3<L> {
@@ -87,5 +117,21 @@ impl<L: Lane> Sym3<L> {
     #[inline(always)]
     pub fn quadratic(self, v: Vec3<L>) -> L {
         v.dot(self.mul_vec(v))
+    }
+}
+
+impl<L: Lane> core::ops::Add for Sym3<L> {
+    type Output = Self;
+    /// Entry-wise sum.
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Self {
+            xx: self.xx + o.xx,
+            yy: self.yy + o.yy,
+            zz: self.zz + o.zz,
+            xy: self.xy + o.xy,
+            xz: self.xz + o.xz,
+            yz: self.yz + o.yz,
+        }
     }
 }

@@ -1,0 +1,173 @@
+//! Bodies as the kernels see them: three rows of eight floats per body,
+//! gathered by index into lanes.
+//!
+//! | row | floats |
+//! | --- | --- |
+//! | pose | `p.x p.y p.z inv_mass q.x q.y q.z q.w` (m, 1/kg, unit quaternion) |
+//! | inertia | `S.xx S.yy S.zz S.xy S.xz S.yz 0 0`: inverse inertia, body frame (1/(kg m^2)) |
+//! | velocity | `v.x v.y v.z 0 w.x w.y w.z 0` (m/s, rad/s, world) |
+//!
+//! Row 0 of every table is the *null row*: identity pose, zero inverse mass
+//! and inertia. Padding lanes read it and write nothing, so they do nothing.
+//! A body in slot `i` of the store has row `i + 1`.
+//!
+//! Generalised inverse masses (Müller et al. 2020, eqs. 2-3): a positional
+//! correction along unit `n` at lever arm `r` sees
+//! `w = 1/m + (r x n)^T I^-1 (r x n)`, a rotational one about `n` sees
+//! `w = n^T I^-1 n`, with `I^-1 = R S R^T` the world-space inverse inertia.
+
+use vertebra_math::row::{ROW_LEN, Row};
+use vertebra_math::{Lane, Quat, Sym3, Vec3};
+
+/// The solver's copy of every body, as rows.
+#[derive(Clone, Debug, Default)]
+pub struct BodyRows {
+    /// Pose rows.
+    pub pose: Vec<Row>,
+    /// Inverse-inertia rows.
+    pub inertia: Vec<Row>,
+    /// Velocity rows.
+    pub velocity: Vec<Row>,
+}
+
+impl BodyRows {
+    /// Tables for `bodies` bodies plus the null row.
+    pub fn with_bodies(bodies: usize) -> Self {
+        let null_pose = Row::new([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+        let mut rows = Self {
+            pose: vec![null_pose],
+            inertia: vec![Row::default()],
+            velocity: vec![Row::default()],
+        };
+        rows.pose.resize(bodies + 1, Row::new([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]));
+        rows.inertia.resize(bodies + 1, Row::default());
+        rows.velocity.resize(bodies + 1, Row::default());
+        rows
+    }
+
+    /// Packs a pose row.
+    pub fn pose_row(position: glam::Vec3, inverse_mass: f32, orientation: glam::Quat) -> [f32; ROW_LEN] {
+        let (p, q) = (position, orientation);
+        [p.x, p.y, p.z, inverse_mass, q.x, q.y, q.z, q.w]
+    }
+
+    /// Packs an inverse-inertia row from a symmetric body-frame matrix.
+    pub fn inertia_row(m: glam::Mat3) -> [f32; ROW_LEN] {
+        [m.x_axis.x, m.y_axis.y, m.z_axis.z, m.y_axis.x, m.z_axis.x, m.z_axis.y, 0.0, 0.0]
+    }
+
+    /// Packs a velocity row.
+    pub fn velocity_row(linear: glam::Vec3, angular: glam::Vec3) -> [f32; ROW_LEN] {
+        [linear.x, linear.y, linear.z, 0.0, angular.x, angular.y, angular.z, 0.0]
+    }
+}
+
+/// One body per lane: pose and body-frame inverse inertia.
+#[derive(Clone, Copy, Debug)]
+pub struct BodyLanes<L> {
+    /// Centre of mass (m, world).
+    pub p: Vec3<L>,
+    /// Inverse mass (1/kg).
+    pub inv_mass: L,
+    /// Orientation.
+    pub q: Quat<L>,
+    /// Inverse inertia, body frame.
+    pub inv_inertia: Sym3<L>,
+}
+
+impl<L: Lane> BodyLanes<L> {
+    /// Gathers the pose and inertia rows of `indices` (`L::WIDTH` of them).
+    #[inline(always)]
+    pub fn gather(rows: &BodyRows, indices: &[u32]) -> Self {
+        let [px, py, pz, inv_mass, qx, qy, qz, qw] = L::gather_rows(&rows.pose, indices);
+        let [xx, yy, zz, xy, xz, yz, _, _] = L::gather_rows(&rows.inertia, indices);
+        Self {
+            p: Vec3::new(px, py, pz),
+            inv_mass,
+            q: Quat::new(qx, qy, qz, qw),
+            inv_inertia: Sym3 { xx, yy, zz, xy, xz, yz },
+        }
+    }
+
+    /// Writes the pose back to the rows named by `write` (`NO_WRITE` lanes
+    /// are skipped).
+    #[inline(always)]
+    pub fn scatter_pose(&self, rows: &BodyRows, write: &[u32]) {
+        let (p, q) = (self.p, self.q);
+        L::scatter_rows(&[p.x, p.y, p.z, self.inv_mass, q.x, q.y, q.z, q.w], &rows.pose, write);
+    }
+
+    /// `I^-1 v` with the world-space inverse inertia `R S R^T`.
+    #[inline(always)]
+    pub fn inv_inertia_mul(&self, v: Vec3<L>) -> Vec3<L> {
+        self.q.rotate(self.inv_inertia.mul_vec(self.q.inverse_rotate(v)))
+    }
+
+    /// The world-space inverse inertia `R S R^T`.
+    #[inline(always)]
+    pub fn world_inv_inertia(&self) -> Sym3<L> {
+        self.inv_inertia.rotated(self.q)
+    }
+
+    /// `n^T I^-1 n`: the generalised inverse mass of a rotation about `n`.
+    #[inline(always)]
+    pub fn angular_weight(&self, n: Vec3<L>) -> L {
+        self.inv_inertia.quadratic(self.q.inverse_rotate(n))
+    }
+
+    /// `1/m + (r x n)^T I^-1 (r x n)`: the generalised inverse mass of a
+    /// positional correction along `n` at lever arm `r`.
+    #[inline(always)]
+    pub fn positional_weight(&self, r: Vec3<L>, n: Vec3<L>) -> L {
+        self.inv_mass + self.angular_weight(r.cross(n))
+    }
+
+    /// Applies a positional impulse `impulse` (kg m) at lever arm `r`:
+    /// `p += impulse / m`, `q += 1/2 (I^-1 (r x impulse), 0) q`.
+    #[inline(always)]
+    pub fn apply_impulse(&mut self, r: Vec3<L>, impulse: Vec3<L>) {
+        self.p += impulse.scale(self.inv_mass);
+        self.rotate(self.inv_inertia_mul(r.cross(impulse)));
+    }
+
+    /// Turns the body by the small rotation vector `theta` (rad, world):
+    /// `q += 1/2 (theta, 0) q`, renormalised.
+    #[inline(always)]
+    pub fn rotate(&mut self, theta: Vec3<L>) {
+        self.q = self.q.integrate(theta, L::splat(1.0));
+    }
+}
+
+/// One body per lane: velocities (for the velocity pass).
+#[derive(Clone, Copy, Debug)]
+pub struct VelocityLanes<L> {
+    /// Linear velocity (m/s, world).
+    pub v: Vec3<L>,
+    /// Angular velocity (rad/s, world).
+    pub w: Vec3<L>,
+}
+
+impl<L: Lane> VelocityLanes<L> {
+    /// Gathers the velocity rows of `indices`.
+    #[inline(always)]
+    pub fn gather(rows: &BodyRows, indices: &[u32]) -> Self {
+        let [vx, vy, vz, _, wx, wy, wz, _] = L::gather_rows(&rows.velocity, indices);
+        Self { v: Vec3::new(vx, vy, vz), w: Vec3::new(wx, wy, wz) }
+    }
+
+    /// Writes the velocities back (`NO_WRITE` lanes are skipped).
+    #[inline(always)]
+    pub fn scatter(&self, rows: &BodyRows, write: &[u32]) {
+        let z = L::splat(0.0);
+        let (v, w) = (self.v, self.w);
+        L::scatter_rows(&[v.x, v.y, v.z, z, w.x, w.y, w.z, z], &rows.velocity, write);
+    }
+}
+
+/// `numerator / denominator` where the denominator is positive, else 0: a
+/// correction between two bodies of infinite mass (or padding) is none.
+#[inline(always)]
+pub fn safe_ratio<L: Lane>(numerator: L, denominator: L) -> L {
+    let valid = denominator.gt(L::splat(0.0));
+    L::select(valid, numerator / L::select(valid, denominator, L::splat(1.0)), L::splat(0.0))
+}

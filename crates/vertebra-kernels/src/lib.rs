@@ -1,0 +1,21 @@
+//! The constraint kernels of vertebra, each one lane-generic body that runs
+//! on every backend with the scalar reference as its twin.
+//!
+//! - [`body`]: body rows (pose, inverse inertia, velocity), gathered into
+//!   [`body::BodyLanes`] and scattered back, and the generalised inverse
+//!   masses and corrections of XPBD for rigid bodies.
+//! - [`parts`]: the position-level constraint parts joints are composed of
+//!   (after Jolt's constraint parts): point, angle correction, swing cone,
+//!   twist range, angular drive. Each has its derivation in its header.
+//! - [`socket`]: the ball-and-socket joint: its lane block, its position
+//!   pass, its velocity (damping) pass, and its residual.
+//!
+//! Kernels never use `core::arch`: the lane types and the row gather and
+//! scatter in `vertebra-math` are the only places intrinsics live.
+
+pub mod body;
+pub mod parts;
+pub mod socket;
+
+/// The joint frame's twist axis: +X of a joint frame (as in Jolt).
+pub const TWIST_AXIS: glam::Vec3 = glam::Vec3::X;

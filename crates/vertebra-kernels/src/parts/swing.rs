@@ -1,0 +1,39 @@
+//! Swing part: a cone limit on the angle between the two joint frames'
+//! twist axes (hard, 1 degree of freedom when active).
+//!
+//! `t_a = q_a F_a x`, `t_b = q_b F_b x` (the frames' +X). The swing angle is
+//! `theta = atan2(|t_a x t_b|, t_a . t_b)` in [0, pi] (atan2 rather than
+//! acos: accurate at small angles) and the error `C = max(theta - max, 0)`
+//! about `n = (t_a x t_b) / |t_a x t_b|`: turning `b` about `n` moves `t_b`
+//! away from `t_a`. A limit of `pi` or more never binds, so a disabled
+//! limit is `max = pi` and costs no branch. At `theta = pi` exactly `n` is
+//! undefined and no correction is made.
+
+use vertebra_math::{Lane, Quat, Vec3, poly};
+
+use crate::body::BodyLanes;
+
+/// The swing axis `n` (unit, or zero) and angle `theta` (rad).
+#[inline(always)]
+pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, frame_a: Quat<L>, frame_b: Quat<L>) -> (Vec3<L>, L) {
+    let x = Vec3::splat(crate::TWIST_AXIS);
+    let ta = (a.q * frame_a).rotate(x);
+    let tb = (b.q * frame_b).rotate(x);
+    let (n, sin) = ta.cross(tb).normalize_or_zero();
+    (n, poly::atan2(sin, ta.dot(tb)))
+}
+
+/// How far the swing exceeds `max_angle` (rad, >= 0).
+#[inline(always)]
+pub fn overshoot<L: Lane>(theta: L, max_angle: L) -> L {
+    (theta - max_angle).max(L::splat(0.0))
+}
+
+/// Enforces the cone; returns the overshoot before the correction (rad).
+#[inline(always)]
+pub fn solve<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, frame_a: Quat<L>, frame_b: Quat<L>, max_angle: L) -> L {
+    let (n, theta) = measure(a, b, frame_a, frame_b);
+    let c = overshoot(theta, max_angle);
+    super::angle::correct(a, b, n, c, L::splat(0.0), L::splat(0.0));
+    c
+}

@@ -1,0 +1,46 @@
+//! Twist part: a range limit on the rotation about the twist axis (hard, 1
+//! degree of freedom when active).
+//!
+//! The relative rotation `r = (q_a F_a)* (q_b F_b)` splits as
+//! `r = swing twist` with `twist` about +X (`Quat::swing_twist`); the twist
+//! angle `phi` in [-pi, pi] is its angle. Outside `[lo, hi]` the error is
+//! `e = phi - clamp(phi, lo, hi)`, corrected about the world axis
+//! `t_b = q_b F_b x` with sign `sign(e)`: turning `b` by `x` about `t_b`
+//! multiplies `r` by a twist of `x` on the right, which adds exactly `x` to
+//! `phi`. A range of `[-pi, pi]` never binds: a disabled limit.
+
+use vertebra_math::{Lane, Quat, Vec3};
+
+use crate::body::BodyLanes;
+
+/// The world twist axis `t_b` and the twist angle `phi` (rad).
+#[inline(always)]
+pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, frame_a: Quat<L>, frame_b: Quat<L>) -> (Vec3<L>, L) {
+    let x = Vec3::splat(crate::TWIST_AXIS);
+    let fb = b.q * frame_b;
+    let relative = (a.q * frame_a).conjugate() * fb;
+    (fb.rotate(x), relative.twist_angle(x))
+}
+
+/// `phi - clamp(phi, lo, hi)`: signed excess beyond the range (rad).
+#[inline(always)]
+pub fn excess<L: Lane>(phi: L, lo: L, hi: L) -> L {
+    phi - phi.max(lo).min(hi)
+}
+
+/// Enforces the range; returns the |excess| before the correction (rad).
+#[inline(always)]
+pub fn solve<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+    lo: L,
+    hi: L,
+) -> L {
+    let (axis, phi) = measure(a, b, frame_a, frame_b);
+    let e = excess(phi, lo, hi);
+    let n = axis.scale(L::splat(1.0).copysign(e));
+    super::angle::correct(a, b, n, e.abs(), L::splat(0.0), L::splat(0.0));
+    e.abs()
+}

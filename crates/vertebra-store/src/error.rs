@@ -1,0 +1,91 @@
+//! The one error type of the public API: every rejected call says what was
+//! wrong with which input, and leaves the world as it was.
+
+use core::fmt;
+
+/// Why a call was rejected.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Error {
+    /// A value that must be finite was NaN or infinite.
+    NonFinite(&'static str),
+    /// A quaternion or direction that must have unit length did not
+    /// (|length - 1| above 1e-3), or had length zero.
+    NotNormalized(&'static str),
+    /// A mass, density or dimension that must be positive was not.
+    NonPositive(&'static str),
+    /// An inertia tensor that is not symmetric positive definite.
+    InvalidInertia,
+    /// A shape with no volume (a zero radius or extent).
+    DegenerateShape(&'static str),
+    /// A joint between a body and itself.
+    SameBody,
+    /// A handle whose body or constraint was removed, or that never existed.
+    StaleHandle(&'static str),
+    /// A body that other constraints still reference.
+    BodyInUse,
+    /// A joint between two bodies neither of which is dynamic.
+    NoDynamicBody,
+    /// A limit range whose lower end is above its upper end, or outside
+    /// the angle range it is measured in.
+    InvalidLimit(&'static str),
+    /// A solver setting out of its range.
+    InvalidConfig(&'static str),
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::NonFinite(what) => write!(f, "{what} is not finite"),
+            Error::NotNormalized(what) => write!(f, "{what} is not normalised"),
+            Error::NonPositive(what) => write!(f, "{what} must be positive"),
+            Error::InvalidInertia => write!(f, "inertia must be symmetric positive definite"),
+            Error::DegenerateShape(why) => write!(f, "degenerate shape: {why}"),
+            Error::SameBody => write!(f, "a joint needs two different bodies"),
+            Error::StaleHandle(what) => write!(f, "stale or unknown {what} handle"),
+            Error::BodyInUse => write!(f, "the body is still used by a joint; remove the joint first"),
+            Error::NoDynamicBody => write!(f, "a joint needs at least one dynamic body"),
+            Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
+            Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// `Ok(())` if every component of `values` is finite.
+pub(crate) fn finite(what: &'static str, values: &[f32]) -> Result<(), Error> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::NonFinite(what))
+    }
+}
+
+/// Checks a finite quaternion of unit length (within 1e-3).
+pub fn check_unit_quat(what: &'static str, q: glam::Quat) -> Result<(), Error> {
+    finite(what, &q.to_array())?;
+    if (q.length() - 1.0).abs() > 1e-3 {
+        return Err(Error::NotNormalized(what));
+    }
+    Ok(())
+}
+
+/// Checks a finite vector.
+pub fn check_finite(what: &'static str, v: glam::Vec3) -> Result<(), Error> {
+    finite(what, &v.to_array())
+}
+
+/// Checks a finite direction of unit length (within 1e-3).
+pub fn check_unit_vec(what: &'static str, v: glam::Vec3) -> Result<(), Error> {
+    check_finite(what, v)?;
+    if (v.length() - 1.0).abs() > 1e-3 {
+        return Err(Error::NotNormalized(what));
+    }
+    Ok(())
+}
+
+/// Checks a finite, strictly positive scalar.
+pub fn check_positive(what: &'static str, x: f32) -> Result<(), Error> {
+    finite(what, &[x])?;
+    if x > 0.0 { Ok(()) } else { Err(Error::NonPositive(what)) }
+}

@@ -1,0 +1,17 @@
+//! Rigid bodies for vertebra: shapes and their mass properties, stable
+//! generational handles, the structure-of-arrays body store, and the errors
+//! that bad input gets instead of a panic.
+//!
+//! Units: metres, kilograms, seconds, radians. Positions are of the centre
+//! of mass, in the world frame; inertia is about the centre of mass, in the
+//! body frame.
+
+mod error;
+mod handle;
+mod shape;
+mod store;
+
+pub use error::{Error, check_finite, check_positive, check_unit_quat, check_unit_vec};
+pub use handle::{Handle, Slots};
+pub use shape::{MassProperties, Shape};
+pub use store::{BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore};

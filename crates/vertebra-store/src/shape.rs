@@ -1,0 +1,160 @@
+//! Collision shapes as far as the solver needs them: mass and inertia of a
+//! uniform solid about its centre of mass.
+
+use core::f32::consts::PI;
+
+use glam::{Mat3, Vec3};
+
+use crate::error::{Error, check_finite, check_positive};
+
+/// A solid centred on its body's centre of mass, in the body frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A ball of `radius` metres.
+    Sphere {
+        /// Radius (m).
+        radius: f32,
+    },
+    /// A box of the given half extents along the body axes (m).
+    Box {
+        /// Half the size along x, y and z (m).
+        half_extents: Vec3,
+    },
+    /// A capsule: the segment from `-half_segment` to `+half_segment`
+    /// (body frame, m) swept by a ball of `radius` (m).
+    Capsule {
+        /// Half the core segment, from the centre to one end (m).
+        half_segment: Vec3,
+        /// Radius (m).
+        radius: f32,
+    },
+}
+
+/// Mass (kg) and inertia tensor (kg m^2, body frame, about the centre of
+/// mass) of a rigid body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MassProperties {
+    /// Mass (kg).
+    pub mass: f32,
+    /// Inertia tensor (kg m^2), body frame, about the centre of mass.
+    pub inertia: Mat3,
+}
+
+impl Shape {
+    /// A capsule between two points `a` and `b` of the body frame whose
+    /// midpoint is the centre of mass (m).
+    pub fn capsule(a: Vec3, b: Vec3, radius: f32) -> Self {
+        Shape::Capsule { half_segment: (b - a) * 0.5, radius }
+    }
+
+    /// Checks that the shape has finite, positive size.
+    pub fn validate(&self) -> Result<(), Error> {
+        match *self {
+            Shape::Sphere { radius } => positive_size("sphere radius", radius),
+            Shape::Box { half_extents } => {
+                check_finite("box half extents", half_extents)?;
+                if half_extents.min_element() > 0.0 {
+                    Ok(())
+                } else {
+                    Err(Error::DegenerateShape("box half extents must be positive"))
+                }
+            }
+            Shape::Capsule { half_segment, radius } => {
+                check_finite("capsule segment", half_segment)?;
+                positive_size("capsule radius", radius)
+            }
+        }
+    }
+
+    /// Volume (m^3).
+    pub fn volume(&self) -> f32 {
+        match *self {
+            Shape::Sphere { radius } => 4.0 / 3.0 * PI * radius.powi(3),
+            Shape::Box { half_extents: h } => 8.0 * h.x * h.y * h.z,
+            Shape::Capsule { half_segment, radius } => {
+                PI * radius * radius * (2.0 * half_segment.length()) + 4.0 / 3.0 * PI * radius.powi(3)
+            }
+        }
+    }
+
+    /// Mass properties at uniform `density` (kg/m^3).
+    pub fn mass_properties(&self, density: f32) -> Result<MassProperties, Error> {
+        self.validate()?;
+        check_positive("density", density)?;
+        Ok(self.unit_density_properties().scaled(density))
+    }
+
+    /// Mass properties of a uniform solid of total `mass` (kg).
+    pub fn mass_properties_with_mass(&self, mass: f32) -> Result<MassProperties, Error> {
+        self.validate()?;
+        check_positive("mass", mass)?;
+        let unit = self.unit_density_properties();
+        Ok(unit.scaled(mass / unit.mass))
+    }
+
+    fn unit_density_properties(&self) -> MassProperties {
+        match *self {
+            Shape::Sphere { radius } => {
+                let mass = self.volume();
+                MassProperties { mass, inertia: Mat3::from_diagonal(Vec3::splat(0.4 * mass * radius * radius)) }
+            }
+            Shape::Box { half_extents: h } => {
+                let mass = self.volume();
+                let sq = h * h;
+                let diagonal = Vec3::new(sq.y + sq.z, sq.x + sq.z, sq.x + sq.y) * (mass / 3.0);
+                MassProperties { mass, inertia: Mat3::from_diagonal(diagonal) }
+            }
+            Shape::Capsule { half_segment, radius: r } => {
+                let length = 2.0 * half_segment.length();
+                let cylinder = PI * r * r * length;
+                let caps = 4.0 / 3.0 * PI * r.powi(3);
+                let axial = cylinder * r * r / 2.0 + caps * 0.4 * r * r;
+                // Two hemispheres at the segment's ends (parallel axis theorem
+                // about their own centres of mass, 3r/8 from the flat face).
+                let across = cylinder * (length * length / 12.0 + r * r / 4.0)
+                    + caps * (0.4 * r * r + length * length / 4.0 + 3.0 * length * r / 8.0);
+                let d = half_segment.normalize_or(Vec3::Y);
+                let dd = Mat3::from_cols(d * d.x, d * d.y, d * d.z);
+                let inertia = (Mat3::IDENTITY - dd) * across + dd * axial;
+                MassProperties { mass: cylinder + caps, inertia }
+            }
+        }
+    }
+}
+
+fn positive_size(what: &'static str, x: f32) -> Result<(), Error> {
+    if !x.is_finite() {
+        return Err(Error::NonFinite(what));
+    }
+    if x > 0.0 { Ok(()) } else { Err(Error::DegenerateShape(what)) }
+}
+
+impl MassProperties {
+    /// Given directly: `mass` (kg) and the body-frame `inertia` (kg m^2).
+    pub fn new(mass: f32, inertia: Mat3) -> Result<Self, Error> {
+        let props = Self { mass, inertia };
+        props.validate()?;
+        Ok(props)
+    }
+
+    /// Checks a finite positive mass and a symmetric positive definite
+    /// inertia tensor (Sylvester's criterion on the leading minors).
+    pub fn validate(&self) -> Result<(), Error> {
+        check_positive("mass", self.mass)?;
+        let m = self.inertia;
+        if !m.to_cols_array().iter().all(|x| x.is_finite()) {
+            return Err(Error::NonFinite("inertia"));
+        }
+        let scale = m.to_cols_array().iter().fold(0.0f32, |a, x| a.max(x.abs()));
+        let asymmetric = (m - m.transpose()).to_cols_array().iter().any(|x| x.abs() > 1e-5 * scale);
+        let minor2 = m.x_axis.x * m.y_axis.y - m.x_axis.y * m.y_axis.x;
+        if asymmetric || m.x_axis.x <= 0.0 || minor2 <= 0.0 || m.determinant() <= 0.0 {
+            return Err(Error::InvalidInertia);
+        }
+        Ok(())
+    }
+
+    fn scaled(self, factor: f32) -> Self {
+        Self { mass: self.mass * factor, inertia: self.inertia * factor }
+    }
+}

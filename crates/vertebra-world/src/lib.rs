@@ -1,0 +1,239 @@
+//! The vertebra world: bodies and joints, stepped by the coloured XPBD
+//! solver at a fixed iteration count, with residual metrics and a hash of
+//! the full state after every step.
+//!
+//! ```
+//! use glam::{Quat, Vec3};
+//! use vertebra_world::{BodyDesc, Shape, SocketDesc, SolverConfig, World};
+//!
+//! let mut world = World::new(SolverConfig::default())?;
+//! let ground = world.add_body(BodyDesc::fixed())?;
+//! let shape = Shape::capsule(Vec3::new(0.0, -0.2, 0.0), Vec3::new(0.0, 0.2, 0.0), 0.05);
+//! let bob = world.add_body(
+//!     BodyDesc::dynamic(shape.mass_properties_with_mass(2.0)?).with_position(Vec3::new(0.0, -0.25, 0.0)),
+//! )?;
+//! let socket = SocketDesc::at_world_anchor(world.bodies(), ground, bob, Vec3::ZERO, -Vec3::Y)?
+//!     .with_swing_limit(0.5);
+//! world.add_socket(socket)?;
+//! for _ in 0..60 {
+//!     world.step(1.0 / 60.0)?;
+//! }
+//! assert!(world.residuals().eps_lin_cm < 0.01);
+//! # Ok::<(), vertebra_world::Error>(())
+//! ```
+
+mod config;
+mod layout;
+mod metrics;
+mod socket;
+mod step;
+
+use glam::{Quat, Vec3};
+use vertebra_kernels::body::BodyRows;
+use vertebra_math::Backend;
+use vertebra_scheduler::Colouring;
+use vertebra_store::{BodyKind, Slots};
+
+pub use config::SolverConfig;
+pub use metrics::{Residuals, SocketResidual};
+pub use socket::{AngularDrive, SocketDesc, SocketHandle};
+pub use vertebra_math::BackendChoice;
+pub use vertebra_store::{BodyDesc, BodyHandle, BodyState, BodyStore, Error, MassProperties, Shape};
+
+/// Bodies, joints and the solver that steps them.
+pub struct World {
+    config: SolverConfig,
+    backend: Backend,
+    pool: Option<rayon::ThreadPool>,
+    bodies: BodyStore,
+    joints_at: Vec<u32>,
+    socket_slots: Slots,
+    sockets: Vec<Option<socket::SocketDesc>>,
+    colouring: Colouring,
+    layout: layout::Layout,
+    layout_dirty: bool,
+    rows: BodyRows,
+    previous: Vec<(Vec3, Quat)>,
+    residuals: Residuals,
+}
+
+impl World {
+    /// An empty world; `Err` for an invalid config or a forced backend this
+    /// CPU lacks.
+    pub fn new(config: SolverConfig) -> Result<Self, Error> {
+        config.validate()?;
+        let backend = config
+            .backend
+            .resolve()
+            .map_err(|_| Error::InvalidConfig("the forced backend is not supported by this CPU"))?;
+        let pool = if config.threads > 1 {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(config.threads)
+                .build()
+                .map_err(|_| Error::InvalidConfig("could not start the worker threads"))?;
+            Some(pool)
+        } else {
+            None
+        };
+        Ok(Self {
+            config,
+            backend,
+            pool,
+            bodies: BodyStore::default(),
+            joints_at: Vec::new(),
+            socket_slots: Slots::default(),
+            sockets: Vec::new(),
+            colouring: Colouring::new(),
+            layout: layout::Layout::default(),
+            layout_dirty: false,
+            rows: BodyRows::default(),
+            previous: Vec::new(),
+            residuals: Residuals::default(),
+        })
+    }
+
+    /// The settings this world steps with.
+    pub fn config(&self) -> &SolverConfig {
+        &self.config
+    }
+
+    /// The backend the kernels run on.
+    pub fn backend(&self) -> Backend {
+        self.backend
+    }
+
+    /// Read access to every body's state (structure of arrays).
+    pub fn bodies(&self) -> &BodyStore {
+        &self.bodies
+    }
+
+    /// Adds a body; `Err` (and no change) for invalid input.
+    pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyHandle, Error> {
+        let handle = self.bodies.insert(&desc)?;
+        if self.joints_at.len() < self.bodies.capacity() {
+            self.joints_at.resize(self.bodies.capacity(), 0);
+        }
+        self.joints_at[handle.index()] = 0;
+        Ok(handle)
+    }
+
+    /// Removes a body that no joint uses.
+    pub fn remove_body(&mut self, handle: BodyHandle) -> Result<(), Error> {
+        let i = self.bodies.index(handle)?;
+        if self.joints_at[i] > 0 {
+            return Err(Error::BodyInUse);
+        }
+        self.bodies.remove(handle)
+    }
+
+    /// A body's position, orientation and velocities.
+    pub fn body(&self, handle: BodyHandle) -> Result<BodyState, Error> {
+        self.bodies.state(handle)
+    }
+
+    /// Teleports a body (centre of mass, m, world; unit orientation).
+    pub fn set_body_pose(&mut self, handle: BodyHandle, position: Vec3, orientation: Quat) -> Result<(), Error> {
+        self.bodies.set_pose(handle, position, orientation)
+    }
+
+    /// Sets a body's velocities (m/s, rad/s, world).
+    pub fn set_body_velocity(&mut self, handle: BodyHandle, linear: Vec3, angular: Vec3) -> Result<(), Error> {
+        self.bodies.set_velocity(handle, linear, angular)
+    }
+
+    /// Adds a force (N, world) through the centre of mass, for the next step.
+    pub fn add_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), Error> {
+        self.bodies.add_force(handle, force)
+    }
+
+    /// Adds a force (N, world) at a world point (m), for the next step.
+    pub fn add_force_at(&mut self, handle: BodyHandle, force: Vec3, point: Vec3) -> Result<(), Error> {
+        self.bodies.add_force_at(handle, force, point)
+    }
+
+    /// Adds a torque (N m, world), for the next step.
+    pub fn add_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), Error> {
+        self.bodies.add_torque(handle, torque)
+    }
+
+    /// Adds a socket joint; `Err` (and no change) for invalid input.
+    pub fn add_socket(&mut self, desc: SocketDesc) -> Result<SocketHandle, Error> {
+        desc.validate_with(&self.bodies)?;
+        let handle: SocketHandle = self.socket_slots.insert();
+        let slot = handle.index();
+        if slot == self.sockets.len() {
+            self.sockets.push(None);
+        }
+        self.sockets[slot] = Some(desc);
+        let dynamic = |h: BodyHandle| {
+            (self.bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
+        };
+        let bodies = [dynamic(desc.body_a), dynamic(desc.body_b)];
+        self.colouring.add(slot as u64, bodies);
+        self.joints_at[desc.body_a.index()] += 1;
+        self.joints_at[desc.body_b.index()] += 1;
+        self.layout_dirty = true;
+        Ok(handle)
+    }
+
+    /// Removes a socket joint.
+    pub fn remove_socket(&mut self, handle: SocketHandle) -> Result<(), Error> {
+        if !self.socket_slots.remove(handle) {
+            return Err(Error::StaleHandle("socket"));
+        }
+        let desc = self.sockets[handle.index()].take().expect("live socket has a description");
+        self.colouring.remove(handle.index() as u64);
+        self.joints_at[desc.body_a.index()] -= 1;
+        self.joints_at[desc.body_b.index()] -= 1;
+        self.layout_dirty = true;
+        Ok(())
+    }
+
+    /// A socket's description.
+    pub fn socket(&self, handle: SocketHandle) -> Result<SocketDesc, Error> {
+        if !self.socket_slots.contains(handle) {
+            return Err(Error::StaleHandle("socket"));
+        }
+        Ok(self.sockets[handle.index()].expect("live socket has a description"))
+    }
+
+    /// Sets or clears a socket's drive, in place (no re-colouring).
+    pub fn set_socket_drive(&mut self, handle: SocketHandle, drive: Option<AngularDrive>) -> Result<(), Error> {
+        let mut desc = self.socket(handle)?;
+        if let Some(d) = &drive {
+            socket::validate_drive(d)?;
+        }
+        desc.drive = drive;
+        self.sockets[handle.index()] = Some(desc);
+        if !self.layout_dirty {
+            let (block, lane) = self.layout.place[handle.index()];
+            let lambda = self.layout.blocks[block].drive_lambda.get(lane);
+            self.layout.blocks[block].set(lane, &layout::solver_lane(&desc, &self.bodies));
+            self.layout.blocks[block].drive_lambda.set(lane, lambda);
+        }
+        Ok(())
+    }
+
+    /// Residual joint error after the last step.
+    pub fn residuals(&self) -> &Residuals {
+        &self.residuals
+    }
+
+    /// A 64-bit hash of every live body's state, bit for bit: two worlds
+    /// with the same hash are (with overwhelming likelihood) identical.
+    pub fn state_hash(&self) -> u64 {
+        metrics::state_hash(&self.bodies)
+    }
+
+    /// Advances the world by `dt` seconds (finite, positive).
+    pub fn step(&mut self, dt: f32) -> Result<(), Error> {
+        vertebra_store::check_positive("time step", dt)?;
+        if self.layout_dirty {
+            self.layout = layout::Layout::build(&self.colouring, &self.sockets, &self.bodies);
+            self.layout_dirty = false;
+        }
+        step::step(self, dt);
+        self.residuals = metrics::residuals(self);
+        Ok(())
+    }
+}

@@ -1,0 +1,160 @@
+//! The socket joint's public description and its validation.
+
+use core::f32::consts::PI;
+
+use glam::{Quat, Vec3};
+use vertebra_store::{
+    BodyHandle, BodyKind, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
+};
+
+/// Marker for socket handles.
+#[derive(Debug)]
+pub enum SocketTag {}
+
+/// A stable reference to a socket joint.
+pub type SocketHandle = Handle<SocketTag>;
+
+/// Drives a socket's body b toward an orientation relative to body a.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngularDrive {
+    /// b's joint frame relative to a's joint frame (unit quaternion).
+    pub target: Quat,
+    /// Compliance (rad / (N m)), the inverse of stiffness; 0 is infinitely
+    /// stiff. Independent of the time step and iteration count (XPBD).
+    pub compliance: f32,
+    /// Damping rate (1/s) of the relative angular velocity.
+    pub damping: f32,
+}
+
+/// A ball-and-socket joint between two bodies.
+///
+/// Each body carries a joint frame (an anchor point and a rotation, in its
+/// body frame); the anchors are held together, and the frames' +X axes are
+/// the twist axes: the swing cone limits the angle between them, the twist
+/// range the rotation about them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SocketDesc {
+    /// The parent body.
+    pub body_a: BodyHandle,
+    /// The child body.
+    pub body_b: BodyHandle,
+    /// Anchor on a (m, a's body frame).
+    pub anchor_a: Vec3,
+    /// Anchor on b (m, b's body frame).
+    pub anchor_b: Vec3,
+    /// Joint frame rotation on a (a's body frame).
+    pub frame_a: Quat,
+    /// Joint frame rotation on b (b's body frame).
+    pub frame_b: Quat,
+    /// Swing cone half-angle (rad, in [0, pi]); `None` is unlimited.
+    pub swing_limit: Option<f32>,
+    /// Twist range `[min, max]` (rad, within [-pi, pi]); `None` is unlimited.
+    pub twist_limit: Option<[f32; 2]>,
+    /// The angular drive, if any.
+    pub drive: Option<AngularDrive>,
+}
+
+impl SocketDesc {
+    /// A socket whose anchor is the world point `anchor` and whose twist
+    /// axis is the world direction `twist_axis` (unit, pointing from a to b)
+    /// at the bodies' current poses. The frames are set so that the joint
+    /// is exactly satisfied, with zero swing and twist, right now.
+    pub fn at_world_anchor(
+        bodies: &BodyStore,
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        anchor: Vec3,
+        twist_axis: Vec3,
+    ) -> Result<Self, Error> {
+        check_finite("anchor", anchor)?;
+        check_unit_vec("twist axis", twist_axis)?;
+        let a = bodies.state(body_a)?;
+        let b = bodies.state(body_b)?;
+        let joint = Quat::from_rotation_arc(Vec3::X, twist_axis.normalize());
+        Ok(Self {
+            body_a,
+            body_b,
+            anchor_a: a.orientation.inverse() * (anchor - a.position),
+            anchor_b: b.orientation.inverse() * (anchor - b.position),
+            frame_a: a.orientation.inverse() * joint,
+            frame_b: b.orientation.inverse() * joint,
+            swing_limit: None,
+            twist_limit: None,
+            drive: None,
+        })
+    }
+
+    /// With a swing cone half-angle (rad).
+    pub fn with_swing_limit(mut self, half_angle: f32) -> Self {
+        self.swing_limit = Some(half_angle);
+        self
+    }
+
+    /// With a twist range (rad).
+    pub fn with_twist_limit(mut self, min: f32, max: f32) -> Self {
+        self.twist_limit = Some([min, max]);
+        self
+    }
+
+    /// With an angular drive.
+    pub fn with_drive(mut self, drive: AngularDrive) -> Self {
+        self.drive = Some(drive);
+        self
+    }
+
+    /// Checks everything but the handles' liveness.
+    pub fn validate(&self) -> Result<(), Error> {
+        if self.body_a == self.body_b {
+            return Err(Error::SameBody);
+        }
+        check_finite("anchor a", self.anchor_a)?;
+        check_finite("anchor b", self.anchor_b)?;
+        check_unit_quat("frame a", self.frame_a)?;
+        check_unit_quat("frame b", self.frame_b)?;
+        if let Some(s) = self.swing_limit {
+            if !s.is_finite() {
+                return Err(Error::NonFinite("swing limit"));
+            }
+            if !(0.0..=PI).contains(&s) {
+                return Err(Error::InvalidLimit("swing"));
+            }
+        }
+        if let Some([lo, hi]) = self.twist_limit {
+            if !lo.is_finite() || !hi.is_finite() {
+                return Err(Error::NonFinite("twist limit"));
+            }
+            if !(-PI <= lo && lo <= hi && hi <= PI) {
+                return Err(Error::InvalidLimit("twist"));
+            }
+        }
+        if let Some(d) = self.drive {
+            validate_drive(&d)?;
+        }
+        Ok(())
+    }
+
+    /// Checks the bodies too: live, and at least one dynamic.
+    pub(crate) fn validate_with(&self, bodies: &BodyStore) -> Result<(), Error> {
+        self.validate()?;
+        let ka = bodies.kind[bodies.index(self.body_a)?];
+        let kb = bodies.kind[bodies.index(self.body_b)?];
+        if ka != BodyKind::Dynamic && kb != BodyKind::Dynamic {
+            return Err(Error::NoDynamicBody);
+        }
+        Ok(())
+    }
+}
+
+/// Checks a drive's target, compliance and damping.
+pub(crate) fn validate_drive(d: &AngularDrive) -> Result<(), Error> {
+    check_unit_quat("drive target", d.target)?;
+    for (what, x) in [("drive compliance", d.compliance), ("drive damping", d.damping)] {
+        if !x.is_finite() {
+            return Err(Error::NonFinite(what));
+        }
+        if x < 0.0 {
+            return Err(Error::NonPositive(what));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,192 @@
+//! One step: for each substep, predict, iterate the coloured position
+//! passes, derive velocities, run the velocity pass, damp (XPBD for rigid
+//! bodies, Müller et al. 2020, algorithm 2).
+
+use glam::{Quat, Vec3};
+use rayon::prelude::*;
+use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::socket::{PositionPass, SocketBlock, VelocityPass};
+use vertebra_math::Backend;
+use vertebra_store::{BodyKind, BodyStore};
+
+use crate::World;
+
+pub(crate) fn step(world: &mut World, dt: f32) {
+    let h = dt / world.config.substeps as f32;
+    upload(&world.bodies, &mut world.rows);
+    world.previous.resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
+    for _ in 0..world.config.substeps {
+        predict(world, h);
+        for block in &mut world.layout.blocks {
+            block.drive_lambda = vertebra_math::block::Vec3Block::default();
+        }
+        for _ in 0..world.config.iterations {
+            solve_positions(world, h);
+        }
+        derive_velocities(world, h);
+        solve_velocities(world, h);
+        damp(&mut world.bodies, h);
+    }
+    let bodies = &mut world.bodies;
+    bodies.force.iter_mut().for_each(|f| *f = Vec3::ZERO);
+    bodies.torque.iter_mut().for_each(|t| *t = Vec3::ZERO);
+}
+
+/// Rows for every slot (stale slots hold harmless old data: no joint
+/// references them).
+fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
+    if rows.pose.len() != bodies.capacity() + 1 {
+        *rows = BodyRows::with_bodies(bodies.capacity());
+    }
+    for i in 0..bodies.capacity() {
+        rows.inertia[i + 1].set(BodyRows::inertia_row(bodies.inverse_inertia[i]));
+        rows.velocity[i + 1]
+            .set(BodyRows::velocity_row(bodies.linear_velocity[i], bodies.angular_velocity[i]));
+        rows.pose[i + 1].set(BodyRows::pose_row(bodies.position[i], bodies.inverse_mass[i], bodies.orientation[i]));
+    }
+}
+
+/// Integration of velocities (gravity, forces, the implicit gyroscopic
+/// term in the body frame) and positions; the previous pose is kept for
+/// deriving velocities afterwards.
+fn predict(world: &mut World, h: f32) {
+    let g = world.config.gravity;
+    let b = &mut world.bodies;
+    for i in 0..b.capacity() {
+        if !b.is_live(i) || b.kind[i] == BodyKind::Static {
+            continue;
+        }
+        if b.kind[i] == BodyKind::Dynamic {
+            b.linear_velocity[i] += (g + b.force[i] * b.inverse_mass[i]) * h;
+            let q = b.orientation[i];
+            let w_body = gyroscopic(q.inverse() * b.angular_velocity[i], b.inertia[i], h);
+            let torque_body = q.inverse() * b.torque[i];
+            b.angular_velocity[i] = q * (w_body + b.inverse_inertia[i] * torque_body * h);
+        }
+        world.previous[i] = (b.position[i], b.orientation[i]);
+        b.position[i] += b.linear_velocity[i] * h;
+        b.orientation[i] = integrate(b.orientation[i], b.angular_velocity[i], h);
+        world.rows.pose[i + 1].set(BodyRows::pose_row(b.position[i], b.inverse_mass[i], b.orientation[i]));
+    }
+}
+
+/// The gyroscopic term, implicitly: `I (w' - w) + h w' x I w' = 0` in the
+/// body frame, solved by one Newton step from `w` (as Bullet's implicit
+/// gyroscopic body solver). The explicit term `-h I^-1 (w x I w)` gains
+/// energy and lets the angular momentum drift; this does not blow up.
+fn gyroscopic(w: Vec3, inertia: glam::Mat3, h: f32) -> Vec3 {
+    let skew = |v: Vec3| glam::Mat3::from_cols(Vec3::new(0.0, v.z, -v.y), Vec3::new(-v.z, 0.0, v.x), Vec3::new(v.y, -v.x, 0.0));
+    let residual = w.cross(inertia * w) * h;
+    let jacobian = inertia + (skew(w) * inertia - skew(inertia * w)) * h;
+    if jacobian.determinant().abs() > f32::MIN_POSITIVE {
+        w - jacobian.inverse() * residual
+    } else {
+        w
+    }
+}
+
+/// Turns `q` at angular velocity `w` for `h` seconds exactly:
+/// `exp(w h / 2) q`. The first-order `q + h/2 (w, 0) q` turns by
+/// `2 atan(|w| h / 2)` instead, and together with deriving `w` from the
+/// quaternion difference it bleeds spin at `(|w| h)^2 / 8` per substep.
+/// Through the math layer's polynomials, so every platform agrees.
+fn integrate(q: Quat, w: Vec3, h: f32) -> Quat {
+    let (axis, speed) = vertebra_math::Vec3::<f32>::from(w).normalize_or_zero();
+    let turn = vertebra_math::Quat::<f32>::from_axis_angle(axis, speed * h);
+    glam::Quat::from(turn * q.into()).normalize()
+}
+
+/// The angular velocity that turns `q0` into `q` in `h` seconds, exactly
+/// (the inverse of [`integrate`]): `log(q q0*) / h`, shortest arc.
+fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
+    let turn = vertebra_math::Quat::<f32>::from(q * q0.conjugate());
+    Vec3::from(turn.to_rotation_vector()) / h
+}
+
+/// Runs one pass over every colour in order, then the overflow set on the
+/// scalar kernel. Inside a colour, blocks are independent: they go to the
+/// thread pool when there are enough of them.
+fn for_each_colour(world: &mut World, mut pass: impl FnMut(&mut [SocketBlock], &BodyRows, Backend)) {
+    let ranges = world.layout.colours.clone();
+    for range in ranges {
+        pass(&mut world.layout.blocks[range], &world.rows, world.backend);
+    }
+    let overflow = world.layout.overflow.clone();
+    pass(&mut world.layout.blocks[overflow], &world.rows, Backend::Scalar);
+}
+
+/// Splits `blocks` over the pool when it is worth it.
+fn parallel_or_not(
+    pool: Option<&rayon::ThreadPool>,
+    min_blocks: usize,
+    blocks: &mut [SocketBlock],
+    run: impl Fn(&mut [SocketBlock]) + Sync,
+) {
+    match pool {
+        Some(pool) if blocks.len() >= min_blocks => {
+            let chunk = blocks.len().div_ceil(pool.current_num_threads() * 2);
+            pool.install(|| blocks.par_chunks_mut(chunk).for_each(&run));
+        }
+        _ => run(blocks),
+    }
+}
+
+fn solve_positions(world: &mut World, h: f32) {
+    let inv_h2 = 1.0 / (h * h);
+    let pool = world.pool.take();
+    let min_blocks = world.config.parallel_min_blocks;
+    for_each_colour(world, |blocks, rows, backend| {
+        parallel_or_not(pool.as_ref(), min_blocks, blocks, |chunk| {
+            backend.dispatch(PositionPass { blocks: chunk, rows, inv_h2 })
+        });
+    });
+    world.pool = pool;
+}
+
+fn solve_velocities(world: &mut World, h: f32) {
+    let pool = world.pool.take();
+    let min_blocks = world.config.parallel_min_blocks;
+    for_each_colour(world, |blocks, rows, backend| {
+        parallel_or_not(pool.as_ref(), min_blocks, blocks, |chunk| {
+            backend.dispatch(VelocityPass { blocks: chunk, rows, h })
+        });
+    });
+    world.pool = pool;
+    let b = &mut world.bodies;
+    for i in 0..b.capacity() {
+        if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
+            let [vx, vy, vz, _, wx, wy, wz, _] = world.rows.velocity[i + 1].get();
+            b.linear_velocity[i] = Vec3::new(vx, vy, vz);
+            b.angular_velocity[i] = Vec3::new(wx, wy, wz);
+        }
+    }
+}
+
+/// Reads the solved poses back and derives velocities from the motion:
+/// `v = (p - p0) / h`, `w = log(q q0*) / h` (shortest arc).
+fn derive_velocities(world: &mut World, h: f32) {
+    let b = &mut world.bodies;
+    for i in 0..b.capacity() {
+        if !b.is_live(i) || b.kind[i] != BodyKind::Dynamic {
+            continue;
+        }
+        let [px, py, pz, _, qx, qy, qz, qw] = world.rows.pose[i + 1].get();
+        let (p, q) = (Vec3::new(px, py, pz), Quat::from_xyzw(qx, qy, qz, qw));
+        let (p0, q0) = world.previous[i];
+        b.position[i] = p;
+        b.orientation[i] = q;
+        b.linear_velocity[i] = (p - p0) / h;
+        b.angular_velocity[i] = angular_velocity(q, q0, h);
+        world.rows.velocity[i + 1].set(BodyRows::velocity_row(b.linear_velocity[i], b.angular_velocity[i]));
+    }
+}
+
+/// Linear and angular damping: `v /= 1 + h c`.
+fn damp(b: &mut BodyStore, h: f32) {
+    for i in 0..b.capacity() {
+        if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
+            b.linear_velocity[i] /= 1.0 + h * b.linear_damping[i];
+            b.angular_velocity[i] /= 1.0 + h * b.angular_damping[i];
+        }
+    }
+}
