@@ -1,6 +1,10 @@
 //! Workloads shared by the criterion (time) and iai-callgrind (instruction
 //! count) benchmarks, so both measure exactly the same work.
 
+use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
+use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane};
+use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::map::{LaneMap, map_arrays};
 use vertebra_math::{Backend, Lane, Quat, Vec3, poly};
 
@@ -104,5 +108,83 @@ impl LaneMap for QuatRotate {
         let q = Quat::new(i[0], i[1], i[2], i[3]).normalize();
         let v = q.rotate(Vec3::new(i[4], i[5], i[6]));
         (o[0], o[1], o[2]) = (v.x, v.y, v.z);
+    }
+}
+
+/// A batch of socket joints with every part active (point, swing cone,
+/// twist range, drive), each lane on its own two dynamic bodies (as one
+/// colour is), the joints violated so every correction does work.
+pub struct SocketWorkload {
+    backend: Backend,
+    rows: BodyRows,
+    blocks: Vec<SocketBlock>,
+}
+
+impl SocketWorkload {
+    /// `sockets` joints (a multiple of 8) on `backend`.
+    pub fn new(backend: Backend, sockets: usize) -> Self {
+        if !backend.is_available() {
+            eprintln!("warning: {backend} is not available here; it runs as scalar");
+        }
+        let blocks = sockets.div_ceil(BLOCK_LANES);
+        let rows = BodyRows::with_bodies(blocks * BLOCK_LANES * 2);
+        let spread = |k: usize, c: f32| (k as f32 * (0.618_034 + c)).fract() - 0.5;
+        for body in 0..blocks * BLOCK_LANES * 2 {
+            let q = GQuat::from_euler(
+                glam::EulerRot::XYZ,
+                spread(body, 0.1),
+                spread(body, 0.2),
+                spread(body, 0.3),
+            );
+            let p = GVec3::new(
+                body as f32 * 0.1,
+                spread(body, 0.4),
+                spread(body, 0.5) * 0.1,
+            );
+            let inertia = Mat3::from_diagonal(GVec3::new(20.0, 30.0, 60.0));
+            rows.pose[body + 1].set(BodyRows::pose_row(p, 1.0, q));
+            rows.inertia[body + 1].set(BodyRows::inertia_row(inertia));
+        }
+        let mut out = vec![SocketBlock::padding(); blocks];
+        for k in 0..blocks * BLOCK_LANES {
+            let lane = SocketLane {
+                body_a: (2 * k + 1) as u32,
+                body_b: (2 * k + 2) as u32,
+                dynamic_a: true,
+                dynamic_b: true,
+                anchor_a: GVec3::new(0.05, 0.1, 0.0),
+                anchor_b: GVec3::new(-0.05, -0.1, 0.0),
+                frame_a: GQuat::IDENTITY,
+                frame_b: GQuat::from_rotation_z(0.3),
+                swing_max: 0.2,
+                twist: [-0.1, 0.1],
+                drive: Some((GQuat::from_rotation_x(0.2), 0.001, 1.0)),
+            };
+            out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
+        }
+        Self {
+            backend,
+            rows,
+            blocks: out,
+        }
+    }
+
+    /// One position iteration over every joint.
+    pub fn iterate(&mut self) {
+        self.backend.dispatch(PositionPass {
+            blocks: &mut self.blocks,
+            rows: &self.rows,
+            inv_h2: 3600.0,
+        });
+    }
+
+    /// The joints in the batch.
+    pub fn sockets(&self) -> usize {
+        self.blocks.len() * BLOCK_LANES
+    }
+
+    /// A value that depends on the work (to keep it observable).
+    pub fn probe(&self) -> f32 {
+        self.rows.pose[1].get()[0]
     }
 }

@@ -124,6 +124,44 @@ fn kernels_never_fuse_or_approximate() {
     }
 }
 
+/// Lane-generic code has no closures: a closure does not inherit the
+/// kernel entry's target features (see crates/vertebra-math/src/lane.rs).
+#[test]
+fn lane_code_has_no_closures() {
+    let lane_code = |path: &str| {
+        path.starts_with("crates/vertebra-kernels/src/")
+            || [
+                "vec3.rs",
+                "quat.rs",
+                "sym3.rs",
+                "poly.rs",
+                "poly/",
+                "lane/sse41.rs",
+                "lane/avx2.rs",
+            ]
+            .iter()
+            .any(|f| path.starts_with(&format!("crates/vertebra-math/src/{f}")))
+    };
+    for (path, text) in sources() {
+        if !lane_code(&path) {
+            continue;
+        }
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            let closure = ["(|", "= |", ", |", "move |"]
+                .iter()
+                .any(|p| code.contains(p));
+            // Debug formatting is not lane code.
+            if closure && !code.contains(".entries(") {
+                panic!(
+                    "{path}:{}: a closure in lane code loses the kernel's target features",
+                    n + 1
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn no_ignored_tests_and_no_cpu_specific_builds() {
     for (path, text) in sources() {

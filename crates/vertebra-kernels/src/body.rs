@@ -39,26 +39,37 @@ impl BodyRows {
             inertia: vec![Row::default()],
             velocity: vec![Row::default()],
         };
-        rows.pose.resize(bodies + 1, Row::new([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]));
+        rows.pose.resize(
+            bodies + 1,
+            Row::new([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]),
+        );
         rows.inertia.resize(bodies + 1, Row::default());
         rows.velocity.resize(bodies + 1, Row::default());
         rows
     }
 
     /// Packs a pose row.
-    pub fn pose_row(position: glam::Vec3, inverse_mass: f32, orientation: glam::Quat) -> [f32; ROW_LEN] {
+    pub fn pose_row(
+        position: glam::Vec3,
+        inverse_mass: f32,
+        orientation: glam::Quat,
+    ) -> [f32; ROW_LEN] {
         let (p, q) = (position, orientation);
         [p.x, p.y, p.z, inverse_mass, q.x, q.y, q.z, q.w]
     }
 
     /// Packs an inverse-inertia row from a symmetric body-frame matrix.
     pub fn inertia_row(m: glam::Mat3) -> [f32; ROW_LEN] {
-        [m.x_axis.x, m.y_axis.y, m.z_axis.z, m.y_axis.x, m.z_axis.x, m.z_axis.y, 0.0, 0.0]
+        [
+            m.x_axis.x, m.y_axis.y, m.z_axis.z, m.y_axis.x, m.z_axis.x, m.z_axis.y, 0.0, 0.0,
+        ]
     }
 
     /// Packs a velocity row.
     pub fn velocity_row(linear: glam::Vec3, angular: glam::Vec3) -> [f32; ROW_LEN] {
-        [linear.x, linear.y, linear.z, 0.0, angular.x, angular.y, angular.z, 0.0]
+        [
+            linear.x, linear.y, linear.z, 0.0, angular.x, angular.y, angular.z, 0.0,
+        ]
     }
 }
 
@@ -85,7 +96,14 @@ impl<L: Lane> BodyLanes<L> {
             p: Vec3::new(px, py, pz),
             inv_mass,
             q: Quat::new(qx, qy, qz, qw),
-            inv_inertia: Sym3 { xx, yy, zz, xy, xz, yz },
+            inv_inertia: Sym3 {
+                xx,
+                yy,
+                zz,
+                xy,
+                xz,
+                yz,
+            },
         }
     }
 
@@ -94,13 +112,18 @@ impl<L: Lane> BodyLanes<L> {
     #[inline(always)]
     pub fn scatter_pose(&self, rows: &BodyRows, write: &[u32]) {
         let (p, q) = (self.p, self.q);
-        L::scatter_rows(&[p.x, p.y, p.z, self.inv_mass, q.x, q.y, q.z, q.w], &rows.pose, write);
+        L::scatter_rows(
+            &[p.x, p.y, p.z, self.inv_mass, q.x, q.y, q.z, q.w],
+            &rows.pose,
+            write,
+        );
     }
 
     /// `I^-1 v` with the world-space inverse inertia `R S R^T`.
     #[inline(always)]
     pub fn inv_inertia_mul(&self, v: Vec3<L>) -> Vec3<L> {
-        self.q.rotate(self.inv_inertia.mul_vec(self.q.inverse_rotate(v)))
+        self.q
+            .rotate(self.inv_inertia.mul_vec(self.q.inverse_rotate(v)))
     }
 
     /// The world-space inverse inertia `R S R^T`.
@@ -152,7 +175,10 @@ impl<L: Lane> VelocityLanes<L> {
     #[inline(always)]
     pub fn gather(rows: &BodyRows, indices: &[u32]) -> Self {
         let [vx, vy, vz, _, wx, wy, wz, _] = L::gather_rows(&rows.velocity, indices);
-        Self { v: Vec3::new(vx, vy, vz), w: Vec3::new(wx, wy, wz) }
+        Self {
+            v: Vec3::new(vx, vy, vz),
+            w: Vec3::new(wx, wy, wz),
+        }
     }
 
     /// Writes the velocities back (`NO_WRITE` lanes are skipped).
@@ -169,5 +195,9 @@ impl<L: Lane> VelocityLanes<L> {
 #[inline(always)]
 pub fn safe_ratio<L: Lane>(numerator: L, denominator: L) -> L {
     let valid = denominator.gt(L::splat(0.0));
-    L::select(valid, numerator / L::select(valid, denominator, L::splat(1.0)), L::splat(0.0))
+    L::select(
+        valid,
+        numerator / L::select(valid, denominator, L::splat(1.0)),
+        L::splat(0.0),
+    )
 }

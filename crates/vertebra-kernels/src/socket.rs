@@ -161,19 +161,45 @@ impl LaneKernel for PositionPass<'_> {
 fn solve_positions<L: Lane>(block: &mut SocketBlock, start: usize, rows: &BodyRows, inv_h2: L) {
     let mut a = BodyLanes::<L>::gather(rows, &block.body_a[start..]);
     let mut b = BodyLanes::<L>::gather(rows, &block.body_b[start..]);
-    let (frame_a, frame_b) = (block.frame_a.load::<L>(start), block.frame_b.load::<L>(start));
+    let (frame_a, frame_b) = (
+        block.frame_a.load::<L>(start),
+        block.frame_b.load::<L>(start),
+    );
 
     let lambda = block.drive_lambda.load::<L>(start);
     let alpha_tilde = L::load(&block.drive_compliance[start..]) * inv_h2;
     let enabled = L::load(&block.drive_enabled[start..]);
     let target = block.drive_target.load::<L>(start);
-    let lambda = drive::solve(&mut a, &mut b, frame_a, frame_b, target, enabled, alpha_tilde, lambda);
+    let lambda = drive::solve(
+        &mut a,
+        &mut b,
+        frame_a,
+        frame_b,
+        target,
+        enabled,
+        alpha_tilde,
+        lambda,
+    );
     block.drive_lambda.store(start, lambda);
 
-    swing::solve(&mut a, &mut b, frame_a, frame_b, L::load(&block.swing_max[start..]));
-    let (lo, hi) = (L::load(&block.twist_min[start..]), L::load(&block.twist_max[start..]));
+    swing::solve(
+        &mut a,
+        &mut b,
+        frame_a,
+        frame_b,
+        L::load(&block.swing_max[start..]),
+    );
+    let (lo, hi) = (
+        L::load(&block.twist_min[start..]),
+        L::load(&block.twist_max[start..]),
+    );
     twist::solve(&mut a, &mut b, frame_a, frame_b, lo, hi);
-    point::solve(&mut a, &mut b, block.anchor_a.load(start), block.anchor_b.load(start));
+    point::solve(
+        &mut a,
+        &mut b,
+        block.anchor_a.load(start),
+        block.anchor_b.load(start),
+    );
 
     a.scatter_pose(rows, &block.write_a[start..]);
     b.scatter_pose(rows, &block.write_b[start..]);
@@ -201,7 +227,8 @@ impl LaneKernel for VelocityPass<'_> {
                 let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
                 let mut va = VelocityLanes::<L>::gather(self.rows, &block.body_a[start..]);
                 let mut vb = VelocityLanes::<L>::gather(self.rows, &block.body_b[start..]);
-                let rate = L::load(&block.drive_damping[start..]) * L::load(&block.drive_enabled[start..]);
+                let rate =
+                    L::load(&block.drive_damping[start..]) * L::load(&block.drive_enabled[start..]);
                 let fraction = (rate * h).min(L::splat(1.0));
                 drive::damp(&a, &b, &mut va, &mut vb, fraction);
                 va.scatter(self.rows, &block.write_a[start..]);
@@ -232,8 +259,16 @@ impl LaneKernel for ResidualPass<'_> {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
                 let a = BodyLanes::<L>::gather(self.rows, &block.body_a[start..]);
                 let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
-                let (fa, fb) = (block.frame_a.load::<L>(start), block.frame_b.load::<L>(start));
-                let (_, _, d) = point::separation(&a, &b, block.anchor_a.load(start), block.anchor_b.load(start));
+                let (fa, fb) = (
+                    block.frame_a.load::<L>(start),
+                    block.frame_b.load::<L>(start),
+                );
+                let (_, _, d) = point::separation(
+                    &a,
+                    &b,
+                    block.anchor_a.load(start),
+                    block.anchor_b.load(start),
+                );
                 let (_, theta) = swing::measure(&a, &b, fa, fb);
                 let (_, phi) = twist::measure(&a, &b, fa, fb);
                 let lo = L::load(&block.twist_min[start..]);

@@ -37,6 +37,15 @@
 //! cross-backend tests treat every NaN as one value and compare every other
 //! result by its bits, signed zeros and subnormals included.
 //!
+//! # No closures in lane code
+//!
+//! A closure does not inherit the `#[target_feature]`s of the function it
+//! is written in. If LLVM leaves one out of line, every AVX intrinsic in it
+//! becomes a function call: a closure in `Sym3::rotated` once made the
+//! 8-lane socket kernel four times slower than the 4-lane one. Lane-generic
+//! code (vectors, quaternions, polynomials, kernels) uses loops and
+//! `#[inline(always)]` functions instead; `tests/tidy.rs` checks it.
+//!
 //! # Why kernels do not use `mul_add`
 //!
 //! SSE4.1 has no fused multiply-add and `wide`'s portable fallback may lack

@@ -54,9 +54,10 @@ pub(crate) fn pi_minus<L: Lane>(half: bool, a: L) -> L {
 /// `x` by Horner's rule, unfused: `((c0 x + c1) x + c2) ...`.
 #[inline(always)]
 pub(crate) fn horner<L: Lane>(x: L, coefficients: &[f32]) -> L {
-    let (first, rest) = coefficients
-        .split_first()
-        .expect("a polynomial has a coefficient");
-    rest.iter()
-        .fold(L::splat(*first), |acc, &c| acc * x + L::splat(c))
+    // A loop, not a fold: lane code has no closures (see `crate::lane`).
+    let mut acc = L::splat(coefficients[0]);
+    for &c in &coefficients[1..] {
+        acc = acc * x + L::splat(c);
+    }
+    acc
 }

@@ -38,54 +38,32 @@ impl<L: Lane> Sym3<L> {
         }
     }
 
-    /// `R diag(d) R^T` where `R` is the rotation of the unit quaternion `q`:
-    /// a body-frame diagonal tensor seen in the world frame.
-    #[inline(always)]
-    pub fn from_rotated_diagonal(q: Quat<L>, d: Vec3<L>) -> Self {
-        let one = L::splat(1.0);
-        let two = L::splat(2.0);
-        let (x, y, z, w) = (q.x, q.y, q.z, q.w);
-        // Rows of the rotation matrix.
-        let r0 = Vec3::new(
-            one - two * (y * y + z * z),
-            two * (x * y - w * z),
-            two * (x * z + w * y),
-        );
-        let r1 = Vec3::new(
-            two * (x * y + w * z),
-            one - two * (x * x + z * z),
-            two * (y * z - w * x),
-        );
-        let r2 = Vec3::new(
-            two * (x * z - w * y),
-            two * (y * z + w * x),
-            one - two * (x * x + y * y),
-        );
-        let weighted = |a: Vec3<L>, b: Vec3<L>| a.x * d.x * b.x + a.y * d.y * b.y + a.z * d.z * b.z;
-        Self {
-            xx: weighted(r0, r0),
-            yy: weighted(r1, r1),
-            zz: weighted(r2, r2),
-            xy: weighted(r0, r1),
-            xz: weighted(r0, r2),
-            yz: weighted(r1, r2),
-        }
-    }
-
     /// `R S R^T`, with `R` the rotation of the unit quaternion `q`: a
-    /// body-frame tensor seen in the world frame.
+    /// body-frame tensor seen in the world frame. With the rows `r_i` of
+    /// `R`, entry `(i, j)` is `(S r_i) . r_j`.
     #[inline(always)]
     pub fn rotated(self, q: Quat<L>) -> Self {
-        // Columns of R S R^T are R S R^T e_k = R (S (R^T e_k)).
-        let column = |e: glam::Vec3| q.rotate(self.mul_vec(q.inverse_rotate(Vec3::splat(e))));
-        let (c0, c1, c2) = (column(glam::Vec3::X), column(glam::Vec3::Y), column(glam::Vec3::Z));
-        Self { xx: c0.x, yy: c1.y, zz: c2.z, xy: c1.x, xz: c2.x, yz: c2.y }
+        let [r0, r1, r2] = rotation_rows(q);
+        let (u0, u1, u2) = (self.mul_vec(r0), self.mul_vec(r1), self.mul_vec(r2));
+        Self {
+            xx: u0.dot(r0),
+            yy: u1.dot(r1),
+            zz: u2.dot(r2),
+            xy: u0.dot(r1),
+            xz: u0.dot(r2),
+            yz: u1.dot(r2),
+        }
     }
 
     /// `self + s 1`: the matrix with `s` added to the diagonal.
     #[inline(always)]
     pub fn add_diagonal(self, s: L) -> Self {
-        Self { xx: self.xx + s, yy: self.yy + s, zz: self.zz + s, ..self }
+        Self {
+            xx: self.xx + s,
+            yy: self.yy + s,
+            zz: self.zz + s,
+            ..self
+        }
     }
 
     /// The inverse by the adjugate, or the zero matrix in lanes whose
@@ -98,8 +76,19 @@ impl<L: Lane> Sym3<L> {
         let (axy, axz, ayz) = (e * f - d * c, d * f - e * b, d * e - a * f);
         let det = a * axx + d * axy + e * axz;
         let valid = det.gt(L::splat(0.0));
-        let inv = L::select(valid, L::splat(1.0) / L::select(valid, det, L::splat(1.0)), L::splat(0.0));
-        Self { xx: axx * inv, yy: ayy * inv, zz: azz * inv, xy: axy * inv, xz: axz * inv, yz: ayz * inv }
+        let inv = L::select(
+            valid,
+            L::splat(1.0) / L::select(valid, det, L::splat(1.0)),
+            L::splat(0.0),
+        );
+        Self {
+            xx: axx * inv,
+            yy: ayy * inv,
+            zz: azz * inv,
+            xy: axy * inv,
+            xz: axz * inv,
+            yz: ayz * inv,
+        }
     }
 
     /// The product `S v`.
@@ -118,6 +107,31 @@ impl<L: Lane> Sym3<L> {
     pub fn quadratic(self, v: Vec3<L>) -> L {
         v.dot(self.mul_vec(v))
     }
+}
+
+/// The rows of the rotation matrix of the unit quaternion `q`.
+#[inline(always)]
+fn rotation_rows<L: Lane>(q: Quat<L>) -> [Vec3<L>; 3] {
+    let one = L::splat(1.0);
+    let two = L::splat(2.0);
+    let (x, y, z, w) = (q.x, q.y, q.z, q.w);
+    [
+        Vec3::new(
+            one - two * (y * y + z * z),
+            two * (x * y - w * z),
+            two * (x * z + w * y),
+        ),
+        Vec3::new(
+            two * (x * y + w * z),
+            one - two * (x * x + z * z),
+            two * (y * z - w * x),
+        ),
+        Vec3::new(
+            two * (x * z - w * y),
+            two * (y * z + w * x),
+            one - two * (x * x + y * y),
+        ),
+    ]
 }
 
 impl<L: Lane> core::ops::Add for Sym3<L> {

@@ -65,7 +65,7 @@ lane_map!(QuatOps, 17 -> 16, |i, o| {
     let (swing, twist) = q1.swing_twist(axis);
     let recomposed = swing * twist;
     let round_trip = Quat::from_axis_angle(axis, q2.twist_angle(axis));
-    let sym = Sym3::from_rotated_diagonal(q1, d).mul_vec(v);
+    let sym = Sym3::diagonal(d).rotated(q1).mul_vec(v);
     let rv = q1.to_rotation_vector();
     let outputs = [
         composed.x, composed.y, composed.z,

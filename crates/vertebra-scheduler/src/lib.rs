@@ -41,7 +41,10 @@ pub struct Colouring {
 impl Colouring {
     /// An empty colouring.
     pub fn new() -> Self {
-        Self { members: vec![BTreeSet::new(); MAX_COLOURS], ..Self::default() }
+        Self {
+            members: vec![BTreeSet::new(); MAX_COLOURS],
+            ..Self::default()
+        }
     }
 
     /// Colours constraint `key` over its dynamic bodies (`None` for a
@@ -50,10 +53,16 @@ impl Colouring {
     /// # Panics
     /// If `key` is already coloured.
     pub fn add(&mut self, key: u64, bodies: [Option<u32>; 2]) -> Slot {
-        assert!(!self.placed.contains_key(&key), "constraint {key} coloured twice");
+        assert!(
+            !self.placed.contains_key(&key),
+            "constraint {key} coloured twice"
+        );
         let highest = bodies.iter().flatten().max().map_or(0, |&b| b as usize + 1);
         self.reserve_bodies(highest);
-        let used = bodies.iter().flatten().fold(0u32, |acc, &b| acc | self.colours_of(b));
+        let used = bodies
+            .iter()
+            .flatten()
+            .fold(0u32, |acc, &b| acc | self.colours_of(b));
         let slot = match (0..MAX_COLOURS).find(|&c| used & (1 << c) == 0) {
             Some(c) => {
                 for &b in bodies.iter().flatten() {
@@ -148,7 +157,10 @@ mod tests {
         let mut edges = BTreeMap::new();
         for step in 0..5000u64 {
             if rng.random_bool(0.35) && !edges.is_empty() {
-                let key = *edges.keys().nth(rng.random_range(0..edges.len())).expect("a key");
+                let key = *edges
+                    .keys()
+                    .nth(rng.random_range(0..edges.len()))
+                    .expect("a key");
                 edges.remove(&key);
                 assert!(c.remove(key).is_some());
             } else {
@@ -170,9 +182,15 @@ mod tests {
         // 30 constraints on one body: 24 colours, then overflow.
         let mut c = Colouring::new();
         c.reserve_bodies(31);
-        let slots: Vec<Slot> = (0..30).map(|k| c.add(k, [Some(0), Some(k as u32 + 1)])).collect();
+        let slots: Vec<Slot> = (0..30)
+            .map(|k| c.add(k, [Some(0), Some(k as u32 + 1)]))
+            .collect();
         for (k, s) in slots.iter().enumerate() {
-            let expected = if k < MAX_COLOURS { Slot::Colour(k as u8) } else { Slot::Overflow };
+            let expected = if k < MAX_COLOURS {
+                Slot::Colour(k as u8)
+            } else {
+                Slot::Overflow
+            };
             assert_eq!(*s, expected);
         }
         assert_eq!(c.overflow().len(), 30 - MAX_COLOURS);
@@ -185,8 +203,14 @@ mod tests {
     fn a_chain_needs_two_colours() {
         let mut c = Colouring::new();
         c.reserve_bodies(11);
-        let slots: Vec<Slot> = (0..10).map(|k| c.add(k, [Some(k as u32), Some(k as u32 + 1)])).collect();
-        assert!(slots.iter().all(|s| matches!(s, Slot::Colour(0) | Slot::Colour(1))));
+        let slots: Vec<Slot> = (0..10)
+            .map(|k| c.add(k, [Some(k as u32), Some(k as u32 + 1)]))
+            .collect();
+        assert!(
+            slots
+                .iter()
+                .all(|s| matches!(s, Slot::Colour(0) | Slot::Colour(1)))
+        );
         // Static ends take no bit.
         assert_eq!(c.add(50, [None, Some(0)]), Slot::Colour(1));
         assert_eq!(c.colours_of(0), 0b11);

@@ -42,7 +42,10 @@ impl fmt::Display for Error {
             Error::DegenerateShape(why) => write!(f, "degenerate shape: {why}"),
             Error::SameBody => write!(f, "a joint needs two different bodies"),
             Error::StaleHandle(what) => write!(f, "stale or unknown {what} handle"),
-            Error::BodyInUse => write!(f, "the body is still used by a joint; remove the joint first"),
+            Error::BodyInUse => write!(
+                f,
+                "the body is still used by a joint; remove the joint first"
+            ),
             Error::NoDynamicBody => write!(f, "a joint needs at least one dynamic body"),
             Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
             Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
@@ -87,5 +90,9 @@ pub fn check_unit_vec(what: &'static str, v: glam::Vec3) -> Result<(), Error> {
 /// Checks a finite, strictly positive scalar.
 pub fn check_positive(what: &'static str, x: f32) -> Result<(), Error> {
     finite(what, &[x])?;
-    if x > 0.0 { Ok(()) } else { Err(Error::NonPositive(what)) }
+    if x > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::NonPositive(what))
+    }
 }

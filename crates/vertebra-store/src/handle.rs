@@ -63,7 +63,11 @@ impl Slots {
             }
         };
         self.live[index as usize] = true;
-        Handle { index, generation: self.generation[index as usize], _kind: PhantomData }
+        Handle {
+            index,
+            generation: self.generation[index as usize],
+            _kind: PhantomData,
+        }
     }
 
     /// Whether `handle` names a live item.
@@ -96,8 +100,11 @@ impl Slots {
 
     /// The live handle at `index`, if any.
     pub fn handle_at<T>(&self, index: usize) -> Option<Handle<T>> {
-        self.is_live(index)
-            .then(|| Handle { index: index as u32, generation: self.generation[index], _kind: PhantomData })
+        self.is_live(index).then(|| Handle {
+            index: index as u32,
+            generation: self.generation[index],
+            _kind: PhantomData,
+        })
     }
 
     /// Live items.

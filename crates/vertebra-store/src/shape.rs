@@ -44,7 +44,10 @@ impl Shape {
     /// A capsule between two points `a` and `b` of the body frame whose
     /// midpoint is the centre of mass (m).
     pub fn capsule(a: Vec3, b: Vec3, radius: f32) -> Self {
-        Shape::Capsule { half_segment: (b - a) * 0.5, radius }
+        Shape::Capsule {
+            half_segment: (b - a) * 0.5,
+            radius,
+        }
     }
 
     /// Checks that the shape has finite, positive size.
@@ -59,7 +62,10 @@ impl Shape {
                     Err(Error::DegenerateShape("box half extents must be positive"))
                 }
             }
-            Shape::Capsule { half_segment, radius } => {
+            Shape::Capsule {
+                half_segment,
+                radius,
+            } => {
                 check_finite("capsule segment", half_segment)?;
                 positive_size("capsule radius", radius)
             }
@@ -71,8 +77,12 @@ impl Shape {
         match *self {
             Shape::Sphere { radius } => 4.0 / 3.0 * PI * radius.powi(3),
             Shape::Box { half_extents: h } => 8.0 * h.x * h.y * h.z,
-            Shape::Capsule { half_segment, radius } => {
-                PI * radius * radius * (2.0 * half_segment.length()) + 4.0 / 3.0 * PI * radius.powi(3)
+            Shape::Capsule {
+                half_segment,
+                radius,
+            } => {
+                PI * radius * radius * (2.0 * half_segment.length())
+                    + 4.0 / 3.0 * PI * radius.powi(3)
             }
         }
     }
@@ -96,15 +106,24 @@ impl Shape {
         match *self {
             Shape::Sphere { radius } => {
                 let mass = self.volume();
-                MassProperties { mass, inertia: Mat3::from_diagonal(Vec3::splat(0.4 * mass * radius * radius)) }
+                MassProperties {
+                    mass,
+                    inertia: Mat3::from_diagonal(Vec3::splat(0.4 * mass * radius * radius)),
+                }
             }
             Shape::Box { half_extents: h } => {
                 let mass = self.volume();
                 let sq = h * h;
                 let diagonal = Vec3::new(sq.y + sq.z, sq.x + sq.z, sq.x + sq.y) * (mass / 3.0);
-                MassProperties { mass, inertia: Mat3::from_diagonal(diagonal) }
+                MassProperties {
+                    mass,
+                    inertia: Mat3::from_diagonal(diagonal),
+                }
             }
-            Shape::Capsule { half_segment, radius: r } => {
+            Shape::Capsule {
+                half_segment,
+                radius: r,
+            } => {
                 let length = 2.0 * half_segment.length();
                 let cylinder = PI * r * r * length;
                 let caps = 4.0 / 3.0 * PI * r.powi(3);
@@ -116,7 +135,10 @@ impl Shape {
                 let d = half_segment.normalize_or(Vec3::Y);
                 let dd = Mat3::from_cols(d * d.x, d * d.y, d * d.z);
                 let inertia = (Mat3::IDENTITY - dd) * across + dd * axial;
-                MassProperties { mass: cylinder + caps, inertia }
+                MassProperties {
+                    mass: cylinder + caps,
+                    inertia,
+                }
             }
         }
     }
@@ -126,7 +148,11 @@ fn positive_size(what: &'static str, x: f32) -> Result<(), Error> {
     if !x.is_finite() {
         return Err(Error::NonFinite(what));
     }
-    if x > 0.0 { Ok(()) } else { Err(Error::DegenerateShape(what)) }
+    if x > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::DegenerateShape(what))
+    }
 }
 
 impl MassProperties {
@@ -146,7 +172,10 @@ impl MassProperties {
             return Err(Error::NonFinite("inertia"));
         }
         let scale = m.to_cols_array().iter().fold(0.0f32, |a, x| a.max(x.abs()));
-        let asymmetric = (m - m.transpose()).to_cols_array().iter().any(|x| x.abs() > 1e-5 * scale);
+        let asymmetric = (m - m.transpose())
+            .to_cols_array()
+            .iter()
+            .any(|x| x.abs() > 1e-5 * scale);
         let minor2 = m.x_axis.x * m.y_axis.y - m.x_axis.y * m.y_axis.x;
         if asymmetric || m.x_axis.x <= 0.0 || minor2 <= 0.0 || m.determinant() <= 0.0 {
             return Err(Error::InvalidInertia);
@@ -155,6 +184,9 @@ impl MassProperties {
     }
 
     fn scaled(self, factor: f32) -> Self {
-        Self { mass: self.mass * factor, inertia: self.inertia * factor }
+        Self {
+            mass: self.mass * factor,
+            inertia: self.inertia * factor,
+        }
     }
 }

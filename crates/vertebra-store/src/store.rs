@@ -50,7 +50,10 @@ pub struct BodyDesc {
 impl BodyDesc {
     /// A dynamic body at the origin, at rest, with the given mass properties.
     pub fn dynamic(mass: MassProperties) -> Self {
-        Self { mass: Some(mass), ..Self::of_kind(BodyKind::Dynamic) }
+        Self {
+            mass: Some(mass),
+            ..Self::of_kind(BodyKind::Dynamic)
+        }
     }
 
     /// A kinematic body at the origin, at rest.
@@ -108,7 +111,10 @@ impl BodyDesc {
         check_unit_quat("orientation", self.orientation)?;
         check_finite("linear velocity", self.linear_velocity)?;
         check_finite("angular velocity", self.angular_velocity)?;
-        for (what, d) in [("linear damping", self.linear_damping), ("angular damping", self.angular_damping)] {
+        for (what, d) in [
+            ("linear damping", self.linear_damping),
+            ("angular damping", self.angular_damping),
+        ] {
             if !d.is_finite() {
                 return Err(Error::NonFinite(what));
             }
@@ -196,7 +202,11 @@ impl BodyStore {
         self.mass[i] = mass;
         self.inverse_mass[i] = if dynamic { 1.0 / mass } else { 0.0 };
         self.inertia[i] = inertia;
-        self.inverse_inertia[i] = if dynamic { inertia.inverse() } else { Mat3::ZERO };
+        self.inverse_inertia[i] = if dynamic {
+            inertia.inverse()
+        } else {
+            Mat3::ZERO
+        };
         self.force[i] = Vec3::ZERO;
         self.torque[i] = Vec3::ZERO;
         self.linear_damping[i] = desc.linear_damping;
@@ -222,12 +232,20 @@ impl BodyStore {
 
     /// Removes a body; `StaleHandle` if it was already gone.
     pub fn remove(&mut self, handle: BodyHandle) -> Result<(), Error> {
-        if self.slots.remove(handle) { Ok(()) } else { Err(Error::StaleHandle("body")) }
+        if self.slots.remove(handle) {
+            Ok(())
+        } else {
+            Err(Error::StaleHandle("body"))
+        }
     }
 
     /// `Ok(slot index)` for a live handle.
     pub fn index(&self, handle: BodyHandle) -> Result<usize, Error> {
-        if self.slots.contains(handle) { Ok(handle.index()) } else { Err(Error::StaleHandle("body")) }
+        if self.slots.contains(handle) {
+            Ok(handle.index())
+        } else {
+            Err(Error::StaleHandle("body"))
+        }
     }
 
     /// Whether `handle` names a live body.
@@ -272,7 +290,12 @@ impl BodyStore {
     }
 
     /// Teleports a body (centre of mass in m, world; unit orientation).
-    pub fn set_pose(&mut self, handle: BodyHandle, position: Vec3, orientation: Quat) -> Result<(), Error> {
+    pub fn set_pose(
+        &mut self,
+        handle: BodyHandle,
+        position: Vec3,
+        orientation: Quat,
+    ) -> Result<(), Error> {
         let i = self.index(handle)?;
         check_finite("position", position)?;
         check_unit_quat("orientation", orientation)?;
@@ -282,7 +305,12 @@ impl BodyStore {
     }
 
     /// Sets a body's velocities (m/s and rad/s, world); a static body keeps zero.
-    pub fn set_velocity(&mut self, handle: BodyHandle, linear: Vec3, angular: Vec3) -> Result<(), Error> {
+    pub fn set_velocity(
+        &mut self,
+        handle: BodyHandle,
+        linear: Vec3,
+        angular: Vec3,
+    ) -> Result<(), Error> {
         let i = self.index(handle)?;
         check_finite("linear velocity", linear)?;
         check_finite("angular velocity", angular)?;
@@ -302,7 +330,12 @@ impl BodyStore {
     }
 
     /// Adds a force (N, world) at a world point (m) for the next step.
-    pub fn add_force_at(&mut self, handle: BodyHandle, force: Vec3, point: Vec3) -> Result<(), Error> {
+    pub fn add_force_at(
+        &mut self,
+        handle: BodyHandle,
+        force: Vec3,
+        point: Vec3,
+    ) -> Result<(), Error> {
         let i = self.index(handle)?;
         check_finite("force", force)?;
         check_finite("point", point)?;

@@ -49,7 +49,9 @@ impl SolverConfig {
             return Err(Error::InvalidConfig("threads must be at least 1"));
         }
         if self.parallel_min_blocks == 0 {
-            return Err(Error::InvalidConfig("parallel_min_blocks must be at least 1"));
+            return Err(Error::InvalidConfig(
+                "parallel_min_blocks must be at least 1",
+            ));
         }
         check_finite("gravity", self.gravity)
     }

@@ -31,8 +31,15 @@ pub(crate) struct Layout {
 
 impl Layout {
     /// Lays out every coloured socket; `sockets[slot]` is `Some` when live.
-    pub fn build(colouring: &Colouring, sockets: &[Option<SocketDesc>], bodies: &BodyStore) -> Self {
-        let mut layout = Self { place: vec![(0, 0); sockets.len()], ..Self::default() };
+    pub fn build(
+        colouring: &Colouring,
+        sockets: &[Option<SocketDesc>],
+        bodies: &BodyStore,
+    ) -> Self {
+        let mut layout = Self {
+            place: vec![(0, 0); sockets.len()],
+            ..Self::default()
+        };
         for c in 0..MAX_COLOURS {
             let range = layout.append(colouring.colour(c).iter(), sockets, bodies);
             if !range.is_empty() {
@@ -82,6 +89,8 @@ pub(crate) fn solver_lane(desc: &SocketDesc, bodies: &BodyStore) -> SocketLane {
         frame_b: desc.frame_b.normalize(),
         swing_max: desc.swing_limit.unwrap_or(PI),
         twist: desc.twist_limit.unwrap_or([-PI, PI]),
-        drive: desc.drive.map(|d| (d.target.normalize(), d.compliance, d.damping)),
+        drive: desc
+            .drive
+            .map(|d| (d.target.normalize(), d.compliance, d.damping)),
     }
 }

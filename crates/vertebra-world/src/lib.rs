@@ -38,7 +38,9 @@ pub use config::SolverConfig;
 pub use metrics::{Residuals, SocketResidual};
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
-pub use vertebra_store::{BodyDesc, BodyHandle, BodyState, BodyStore, Error, MassProperties, Shape};
+pub use vertebra_store::{
+    BodyDesc, BodyHandle, BodyState, BodyStore, Error, MassProperties, Shape,
+};
 
 /// Bodies, joints and the solver that steps them.
 pub struct World {
@@ -132,12 +134,22 @@ impl World {
     }
 
     /// Teleports a body (centre of mass, m, world; unit orientation).
-    pub fn set_body_pose(&mut self, handle: BodyHandle, position: Vec3, orientation: Quat) -> Result<(), Error> {
+    pub fn set_body_pose(
+        &mut self,
+        handle: BodyHandle,
+        position: Vec3,
+        orientation: Quat,
+    ) -> Result<(), Error> {
         self.bodies.set_pose(handle, position, orientation)
     }
 
     /// Sets a body's velocities (m/s, rad/s, world).
-    pub fn set_body_velocity(&mut self, handle: BodyHandle, linear: Vec3, angular: Vec3) -> Result<(), Error> {
+    pub fn set_body_velocity(
+        &mut self,
+        handle: BodyHandle,
+        linear: Vec3,
+        angular: Vec3,
+    ) -> Result<(), Error> {
         self.bodies.set_velocity(handle, linear, angular)
     }
 
@@ -147,7 +159,12 @@ impl World {
     }
 
     /// Adds a force (N, world) at a world point (m), for the next step.
-    pub fn add_force_at(&mut self, handle: BodyHandle, force: Vec3, point: Vec3) -> Result<(), Error> {
+    pub fn add_force_at(
+        &mut self,
+        handle: BodyHandle,
+        force: Vec3,
+        point: Vec3,
+    ) -> Result<(), Error> {
         self.bodies.add_force_at(handle, force, point)
     }
 
@@ -181,7 +198,9 @@ impl World {
         if !self.socket_slots.remove(handle) {
             return Err(Error::StaleHandle("socket"));
         }
-        let desc = self.sockets[handle.index()].take().expect("live socket has a description");
+        let desc = self.sockets[handle.index()]
+            .take()
+            .expect("live socket has a description");
         self.colouring.remove(handle.index() as u64);
         self.joints_at[desc.body_a.index()] -= 1;
         self.joints_at[desc.body_b.index()] -= 1;
@@ -198,7 +217,11 @@ impl World {
     }
 
     /// Sets or clears a socket's drive, in place (no re-colouring).
-    pub fn set_socket_drive(&mut self, handle: SocketHandle, drive: Option<AngularDrive>) -> Result<(), Error> {
+    pub fn set_socket_drive(
+        &mut self,
+        handle: SocketHandle,
+        drive: Option<AngularDrive>,
+    ) -> Result<(), Error> {
         let mut desc = self.socket(handle)?;
         if let Some(d) = &drive {
             socket::validate_drive(d)?;
@@ -212,6 +235,17 @@ impl World {
             self.layout.blocks[block].drive_lambda.set(lane, lambda);
         }
         Ok(())
+    }
+
+    /// How many colours the joints use (after the last step's layout).
+    pub fn colour_count(&self) -> usize {
+        self.layout.colours.len()
+    }
+
+    /// How many joints are in the overflow set (solved one at a time by
+    /// the scalar kernel because their bodies used every colour).
+    pub fn overflow_count(&self) -> usize {
+        self.colouring.overflow().len()
     }
 
     /// Residual joint error after the last step.

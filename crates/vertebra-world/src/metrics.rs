@@ -36,7 +36,11 @@ pub struct Residuals {
 pub(crate) fn residuals(world: &World) -> Residuals {
     let blocks = &world.layout.blocks;
     let mut per_lane = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
-    world.backend.dispatch(ResidualPass { blocks, rows: &world.rows, out: &mut per_lane });
+    world.backend.dispatch(ResidualPass {
+        blocks,
+        rows: &world.rows,
+        out: &mut per_lane,
+    });
     let mut sockets: Vec<SocketResidual> = world
         .layout
         .lane_socket
@@ -44,7 +48,10 @@ pub(crate) fn residuals(world: &World) -> Residuals {
         .zip(&per_lane)
         .filter(|(slot, _)| **slot != EMPTY)
         .map(|(&slot, &[lin, ang])| SocketResidual {
-            socket: world.socket_slots.handle_at(slot as usize).expect("laid-out sockets are live"),
+            socket: world
+                .socket_slots
+                .handle_at(slot as usize)
+                .expect("laid-out sockets are live"),
             linear_cm: lin * 100.0,
             angular_rad: ang,
         })

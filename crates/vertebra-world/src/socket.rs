@@ -148,7 +148,10 @@ impl SocketDesc {
 /// Checks a drive's target, compliance and damping.
 pub(crate) fn validate_drive(d: &AngularDrive) -> Result<(), Error> {
     check_unit_quat("drive target", d.target)?;
-    for (what, x) in [("drive compliance", d.compliance), ("drive damping", d.damping)] {
+    for (what, x) in [
+        ("drive compliance", d.compliance),
+        ("drive damping", d.damping),
+    ] {
         if !x.is_finite() {
             return Err(Error::NonFinite(what));
         }

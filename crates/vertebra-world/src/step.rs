@@ -14,7 +14,9 @@ use crate::World;
 pub(crate) fn step(world: &mut World, dt: f32) {
     let h = dt / world.config.substeps as f32;
     upload(&world.bodies, &mut world.rows);
-    world.previous.resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
+    world
+        .previous
+        .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
     for _ in 0..world.config.substeps {
         predict(world, h);
         for block in &mut world.layout.blocks {
@@ -40,9 +42,15 @@ fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
     }
     for i in 0..bodies.capacity() {
         rows.inertia[i + 1].set(BodyRows::inertia_row(bodies.inverse_inertia[i]));
-        rows.velocity[i + 1]
-            .set(BodyRows::velocity_row(bodies.linear_velocity[i], bodies.angular_velocity[i]));
-        rows.pose[i + 1].set(BodyRows::pose_row(bodies.position[i], bodies.inverse_mass[i], bodies.orientation[i]));
+        rows.velocity[i + 1].set(BodyRows::velocity_row(
+            bodies.linear_velocity[i],
+            bodies.angular_velocity[i],
+        ));
+        rows.pose[i + 1].set(BodyRows::pose_row(
+            bodies.position[i],
+            bodies.inverse_mass[i],
+            bodies.orientation[i],
+        ));
     }
 }
 
@@ -66,7 +74,11 @@ fn predict(world: &mut World, h: f32) {
         world.previous[i] = (b.position[i], b.orientation[i]);
         b.position[i] += b.linear_velocity[i] * h;
         b.orientation[i] = integrate(b.orientation[i], b.angular_velocity[i], h);
-        world.rows.pose[i + 1].set(BodyRows::pose_row(b.position[i], b.inverse_mass[i], b.orientation[i]));
+        world.rows.pose[i + 1].set(BodyRows::pose_row(
+            b.position[i],
+            b.inverse_mass[i],
+            b.orientation[i],
+        ));
     }
 }
 
@@ -75,7 +87,13 @@ fn predict(world: &mut World, h: f32) {
 /// gyroscopic body solver). The explicit term `-h I^-1 (w x I w)` gains
 /// energy and lets the angular momentum drift; this does not blow up.
 fn gyroscopic(w: Vec3, inertia: glam::Mat3, h: f32) -> Vec3 {
-    let skew = |v: Vec3| glam::Mat3::from_cols(Vec3::new(0.0, v.z, -v.y), Vec3::new(-v.z, 0.0, v.x), Vec3::new(v.y, -v.x, 0.0));
+    let skew = |v: Vec3| {
+        glam::Mat3::from_cols(
+            Vec3::new(0.0, v.z, -v.y),
+            Vec3::new(-v.z, 0.0, v.x),
+            Vec3::new(v.y, -v.x, 0.0),
+        )
+    };
     let residual = w.cross(inertia * w) * h;
     let jacobian = inertia + (skew(w) * inertia - skew(inertia * w)) * h;
     if jacobian.determinant().abs() > f32::MIN_POSITIVE {
@@ -106,13 +124,20 @@ fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
 /// Runs one pass over every colour in order, then the overflow set on the
 /// scalar kernel. Inside a colour, blocks are independent: they go to the
 /// thread pool when there are enough of them.
-fn for_each_colour(world: &mut World, mut pass: impl FnMut(&mut [SocketBlock], &BodyRows, Backend)) {
+fn for_each_colour(
+    world: &mut World,
+    mut pass: impl FnMut(&mut [SocketBlock], &BodyRows, Backend),
+) {
     let ranges = world.layout.colours.clone();
     for range in ranges {
         pass(&mut world.layout.blocks[range], &world.rows, world.backend);
     }
     let overflow = world.layout.overflow.clone();
-    pass(&mut world.layout.blocks[overflow], &world.rows, Backend::Scalar);
+    pass(
+        &mut world.layout.blocks[overflow],
+        &world.rows,
+        Backend::Scalar,
+    );
 }
 
 /// Splits `blocks` over the pool when it is worth it.
@@ -137,7 +162,11 @@ fn solve_positions(world: &mut World, h: f32) {
     let min_blocks = world.config.parallel_min_blocks;
     for_each_colour(world, |blocks, rows, backend| {
         parallel_or_not(pool.as_ref(), min_blocks, blocks, |chunk| {
-            backend.dispatch(PositionPass { blocks: chunk, rows, inv_h2 })
+            backend.dispatch(PositionPass {
+                blocks: chunk,
+                rows,
+                inv_h2,
+            })
         });
     });
     world.pool = pool;
@@ -148,7 +177,11 @@ fn solve_velocities(world: &mut World, h: f32) {
     let min_blocks = world.config.parallel_min_blocks;
     for_each_colour(world, |blocks, rows, backend| {
         parallel_or_not(pool.as_ref(), min_blocks, blocks, |chunk| {
-            backend.dispatch(VelocityPass { blocks: chunk, rows, h })
+            backend.dispatch(VelocityPass {
+                blocks: chunk,
+                rows,
+                h,
+            })
         });
     });
     world.pool = pool;
@@ -177,7 +210,10 @@ fn derive_velocities(world: &mut World, h: f32) {
         b.orientation[i] = q;
         b.linear_velocity[i] = (p - p0) / h;
         b.angular_velocity[i] = angular_velocity(q, q0, h);
-        world.rows.velocity[i + 1].set(BodyRows::velocity_row(b.linear_velocity[i], b.angular_velocity[i]));
+        world.rows.velocity[i + 1].set(BodyRows::velocity_row(
+            b.linear_velocity[i],
+            b.angular_velocity[i],
+        ));
     }
 }
 

@@ -21,7 +21,11 @@ fn compound_pendulum_period_matches_the_closed_form() {
     let theta0 = 0.1f32;
     let rotation = Quat::from_rotation_z(theta0);
     let bob = w
-        .add_body(BodyDesc::dynamic(props).with_position(rotation * Vec3::new(0.0, -d, 0.0)).with_orientation(rotation))
+        .add_body(
+            BodyDesc::dynamic(props)
+                .with_position(rotation * Vec3::new(0.0, -d, 0.0))
+                .with_orientation(rotation),
+        )
         .unwrap();
     let socket = SocketDesc {
         body_a: pivot_body,
@@ -57,18 +61,30 @@ fn compound_pendulum_period_matches_the_closed_form() {
     assert!(crossings.len() >= 5, "{crossings:?}");
     let measured = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f32;
     let error = (measured - period).abs() / period;
-    eprintln!("period {measured:.4} s, closed form {period:.4} s, error {:.3}%", error * 100.0);
+    eprintln!(
+        "period {measured:.4} s, closed form {period:.4} s, error {:.3}%",
+        error * 100.0
+    );
     assert!(error < 0.005, "period {measured} vs {period}");
 }
 
 /// A box with three distinct principal moments, spinning about `axis`
 /// (body frame) at 6 rad/s with a 1% perturbation on another axis.
 fn spinning_box(axis: Vec3) -> (World, vertebra_world::BodyHandle, Mat3) {
-    let mut w = World::new(SolverConfig { substeps: 8, gravity: Vec3::ZERO, ..SolverConfig::default() }).unwrap();
-    let shape = Shape::Box { half_extents: Vec3::new(0.05, 0.2, 0.4) };
+    let mut w = World::new(SolverConfig {
+        substeps: 8,
+        gravity: Vec3::ZERO,
+        ..SolverConfig::default()
+    })
+    .unwrap();
+    let shape = Shape::Box {
+        half_extents: Vec3::new(0.05, 0.2, 0.4),
+    };
     let props = shape.mass_properties(1000.0).unwrap();
     let spin = axis * 6.0 + Vec3::new(axis.y, axis.z, axis.x) * 0.06;
-    let body = w.add_body(BodyDesc::dynamic(props).with_velocity(Vec3::ZERO, spin)).unwrap();
+    let body = w
+        .add_body(BodyDesc::dynamic(props).with_velocity(Vec3::ZERO, spin))
+        .unwrap();
     (w, body, props.inertia)
 }
 
@@ -93,7 +109,10 @@ fn a_free_body_flips_about_its_intermediate_axis_only() {
             lowest = lowest.min((q * axis).dot(axis));
             drift = drift.max((angular_momentum(&w, body, inertia) - l0).length() / l0.length());
         }
-        eprintln!("axis {axis}: lowest alignment {lowest:.3}, momentum drift {:.2}%", drift * 100.0);
+        eprintln!(
+            "axis {axis}: lowest alignment {lowest:.3}, momentum drift {:.2}%",
+            drift * 100.0
+        );
         // Bounds at h = 1/480 s: the exact exponential map keeps a steady
         // spin's momentum; through the flips the one-step implicit
         // gyroscopic update loses a little (2.6% measured over 8 s).
@@ -104,7 +123,11 @@ fn a_free_body_flips_about_its_intermediate_axis_only() {
             assert!(lowest > 0.95, "a major or minor axis spin should stay put");
             0.002
         };
-        assert!(drift < bound, "angular momentum drifted {:.2}%", drift * 100.0);
+        assert!(
+            drift < bound,
+            "angular momentum drifted {:.2}%",
+            drift * 100.0
+        );
     }
 }
 
@@ -131,14 +154,21 @@ fn joint_error_falls_as_iterations_grow() {
     let errors: Vec<f32> = [1, 2, 5, 10, 20, 40].into_iter().map(mean_error).collect();
     eprintln!("mean eps_lin (cm) at 1, 2, 5, 10, 20, 40 iterations: {errors:?}");
     for pair in errors.windows(2) {
-        assert!(pair[1] < pair[0], "error must fall with iterations: {errors:?}");
+        assert!(
+            pair[1] < pair[0],
+            "error must fall with iterations: {errors:?}"
+        );
     }
     assert!(errors[5] < errors[0] / 10.0, "{errors:?}");
 }
 
 #[test]
 fn internal_corrections_conserve_linear_momentum() {
-    let mut w = World::new(SolverConfig { gravity: Vec3::ZERO, ..SolverConfig::default() }).unwrap();
+    let mut w = World::new(SolverConfig {
+        gravity: Vec3::ZERO,
+        ..SolverConfig::default()
+    })
+    .unwrap();
     // A free-floating chain, joints violated at the start, bodies moving.
     let mut bodies = Vec::new();
     for k in 0..8 {
@@ -147,31 +177,56 @@ fn internal_corrections_conserve_linear_momentum() {
     }
     for k in 1..8 {
         let anchor = Vec3::new(0.0, -0.25 * k as f32 + 0.025, 0.0);
-        let desc = SocketDesc::at_world_anchor(w.bodies(), bodies[k - 1], bodies[k], anchor, -Vec3::Y).unwrap();
+        let desc =
+            SocketDesc::at_world_anchor(w.bodies(), bodies[k - 1], bodies[k], anchor, -Vec3::Y)
+                .unwrap();
         w.add_socket(desc).unwrap();
     }
     for (k, &b) in bodies.iter().enumerate() {
-        let v = Vec3::new((k as f32 * 1.3).sin(), (k as f32 * 0.7).cos(), 0.5 * k as f32 - 2.0);
-        w.set_body_velocity(b, v, Vec3::new(0.3 * k as f32, -1.0, 0.5)).unwrap();
+        let v = Vec3::new(
+            (k as f32 * 1.3).sin(),
+            (k as f32 * 0.7).cos(),
+            0.5 * k as f32 - 2.0,
+        );
+        w.set_body_velocity(b, v, Vec3::new(0.3 * k as f32, -1.0, 0.5))
+            .unwrap();
     }
     let momentum = |w: &World| -> Vec3 {
-        bodies.iter().map(|&b| w.body(b).unwrap().linear_velocity * w.bodies().mass[b.index()]).sum()
+        bodies
+            .iter()
+            .map(|&b| w.body(b).unwrap().linear_velocity * w.bodies().mass[b.index()])
+            .sum()
     };
     let p0 = momentum(&w);
     for _ in 0..120 {
         w.step(DT).unwrap();
     }
     let p1 = momentum(&w);
-    let scale: f32 = bodies.iter().map(|&b| w.bodies().mass[b.index()]).sum::<f32>() * 2.0;
+    let scale: f32 = bodies
+        .iter()
+        .map(|&b| w.bodies().mass[b.index()])
+        .sum::<f32>()
+        * 2.0;
     eprintln!("momentum before {p0}, after {p1}");
     assert!((p1 - p0).length() < 1e-3 * scale, "{p0} -> {p1}");
     // The joints closed their initial gaps.
-    assert!(w.residuals().eps_lin_cm < 0.05, "{}", w.residuals().eps_lin_cm);
+    assert!(
+        w.residuals().eps_lin_cm < 0.05,
+        "{}",
+        w.residuals().eps_lin_cm
+    );
 }
 
 /// A static parent at the origin and a 0.4 m capsule child along `dir`
 /// from it, joined at the origin with the twist axis along `dir`.
-fn arm(w: &mut World, dir: Vec3) -> (vertebra_world::BodyHandle, vertebra_world::BodyHandle, SocketDesc) {
+fn arm(
+    w: &mut World,
+    dir: Vec3,
+) -> (
+    vertebra_world::BodyHandle,
+    vertebra_world::BodyHandle,
+    SocketDesc,
+) {
     let parent = w.add_body(BodyDesc::fixed()).unwrap();
     let child = capsule(w, dir * 0.05, dir * 0.45, 2.0);
     let desc = SocketDesc::at_world_anchor(w.bodies(), parent, child, Vec3::ZERO, dir).unwrap();
@@ -193,9 +248,16 @@ fn the_swing_cone_holds_a_horizontal_arm_at_its_limit() {
     }
     let axis = w.body(child).unwrap().orientation * Vec3::X;
     let swing = axis.angle_between(Vec3::X);
-    eprintln!("swing {:.3} deg (limit 30), worst overshoot {worst:.2e} rad", swing.to_degrees());
+    eprintln!(
+        "swing {:.3} deg (limit 30), worst overshoot {worst:.2e} rad",
+        swing.to_degrees()
+    );
     assert!(axis.y < 0.0, "gravity pulled the arm down");
-    assert!((swing - limit).abs() < 0.2f32.to_radians(), "rests at the limit: {}", swing.to_degrees());
+    assert!(
+        (swing - limit).abs() < 0.2f32.to_radians(),
+        "rests at the limit: {}",
+        swing.to_degrees()
+    );
     assert!(worst < 1e-3, "overshoot {worst}");
 }
 
@@ -210,7 +272,10 @@ fn the_twist_range_holds_against_a_steady_torque() {
     }
     let q = w.body(child).unwrap().orientation;
     let twist = 2.0 * (q.y * q.w.signum()).atan2(q.w.abs());
-    eprintln!("twist {twist:.4} rad (range [-0.3, 0.3]), overshoot {:.2e}", w.residuals().eps_ang_rad);
+    eprintln!(
+        "twist {twist:.4} rad (range [-0.3, 0.3]), overshoot {:.2e}",
+        w.residuals().eps_ang_rad
+    );
     // Torque about -Y twists the child negatively about its twist axis -Y... in
     // world terms a rotation about +Y of -angle; either way it stops at 0.3.
     assert!((twist.abs() - 0.3).abs() < 2e-3, "twist {twist}");
@@ -223,9 +288,18 @@ fn push_driven_arm(compliance: f32) -> (f32, f32, f32) {
     let mut w = world(1, 20);
     let (_, child, desc) = arm(&mut w, -Vec3::Y);
     let target = Quat::from_rotation_z(0.6);
-    let drive = AngularDrive { target, compliance, damping: 5.0 };
+    let drive = AngularDrive {
+        target,
+        compliance,
+        damping: 5.0,
+    };
     w.add_socket(desc.with_drive(drive)).unwrap();
-    let error = |w: &World| angle_between(w.body(child).unwrap().orientation * desc.frame_b, desc.frame_a * target);
+    let error = |w: &World| {
+        angle_between(
+            w.body(child).unwrap().orientation * desc.frame_b,
+            desc.frame_a * target,
+        )
+    };
     for _ in 0..120 {
         w.step(DT).unwrap();
     }
@@ -244,7 +318,9 @@ fn push_driven_arm(compliance: f32) -> (f32, f32, f32) {
 #[test]
 fn a_stiff_drive_holds_its_pose_through_a_push() {
     let (settled, pushed, returned) = push_driven_arm(0.0);
-    eprintln!("stiff drive error: settled {settled:.2e}, pushed {pushed:.2e}, after {returned:.2e} rad");
+    eprintln!(
+        "stiff drive error: settled {settled:.2e}, pushed {pushed:.2e}, after {returned:.2e} rad"
+    );
     // At rest it holds to rounding; under a 200 N push at 20 iterations a
     // little is left (5.6e-4 rad measured), gone once the push ends.
     assert!(settled < 1e-5 && returned < 1e-5, "{settled} {returned}");
@@ -254,11 +330,16 @@ fn a_stiff_drive_holds_its_pose_through_a_push() {
 #[test]
 fn a_compliant_drive_gives_way_and_returns() {
     let (settled, pushed, returned) = push_driven_arm(0.02);
-    eprintln!("compliant drive error: settled {settled:.2e}, pushed {pushed:.2e}, after {returned:.2e} rad");
+    eprintln!(
+        "compliant drive error: settled {settled:.2e}, pushed {pushed:.2e}, after {returned:.2e} rad"
+    );
     // Gravity's torque (about 2 kg * 9.81 * 0.25 m * sin 0.6) times the
     // compliance is the steady sag: about 0.055 rad.
     let sag = 0.02 * 2.0 * 9.81 * 0.25 * 0.6f32.sin();
     assert!((settled - sag).abs() < 0.2 * sag, "sag {settled} vs {sag}");
     assert!(pushed > settled + 0.1, "the push bends it: {pushed}");
-    assert!((returned - settled).abs() < 1e-3, "returns to its sag: {returned} vs {settled}");
+    assert!(
+        (returned - settled).abs() < 1e-3,
+        "returns to its sag: {returned} vs {settled}"
+    );
 }

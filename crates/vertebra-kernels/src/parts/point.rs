@@ -29,7 +29,12 @@ pub fn separation<L: Lane>(
 /// Moves `a` and `b` so that their anchors coincide (to first order in the
 /// rotations). Returns the separation before the correction (m).
 #[inline(always)]
-pub fn solve<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, local_a: Vec3<L>, local_b: Vec3<L>) -> L {
+pub fn solve<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    local_a: Vec3<L>,
+    local_b: Vec3<L>,
+) -> L {
     let (ra, rb, d) = separation(a, b, local_a, local_b);
     let (n, c) = d.normalize_or_zero();
     let w = a.positional_weight(ra, n) + b.positional_weight(rb, n);

@@ -15,7 +15,12 @@ use crate::body::BodyLanes;
 
 /// The swing axis `n` (unit, or zero) and angle `theta` (rad).
 #[inline(always)]
-pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, frame_a: Quat<L>, frame_b: Quat<L>) -> (Vec3<L>, L) {
+pub fn measure<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+) -> (Vec3<L>, L) {
     let x = Vec3::splat(crate::TWIST_AXIS);
     let ta = (a.q * frame_a).rotate(x);
     let tb = (b.q * frame_b).rotate(x);
@@ -31,7 +36,13 @@ pub fn overshoot<L: Lane>(theta: L, max_angle: L) -> L {
 
 /// Enforces the cone; returns the overshoot before the correction (rad).
 #[inline(always)]
-pub fn solve<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, frame_a: Quat<L>, frame_b: Quat<L>, max_angle: L) -> L {
+pub fn solve<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+    max_angle: L,
+) -> L {
     let (n, theta) = measure(a, b, frame_a, frame_b);
     let c = overshoot(theta, max_angle);
     super::angle::correct(a, b, n, c, L::splat(0.0), L::splat(0.0));

@@ -15,7 +15,12 @@ use crate::body::BodyLanes;
 
 /// The world twist axis `t_b` and the twist angle `phi` (rad).
 #[inline(always)]
-pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, frame_a: Quat<L>, frame_b: Quat<L>) -> (Vec3<L>, L) {
+pub fn measure<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+) -> (Vec3<L>, L) {
     let x = Vec3::splat(crate::TWIST_AXIS);
     let fb = b.q * frame_b;
     let relative = (a.q * frame_a).conjugate() * fb;

@@ -229,15 +229,22 @@ impl Lane for F32x8 {
     }
     #[inline(always)]
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
-        let ptrs: [*mut f32; 8] = core::array::from_fn(|i| rows[indices[i] as usize].as_ptr());
-        // SAFETY: each pointer is a live, 32-byte aligned row of eight
-        // floats (bounds-checked above); AVX was detected.
-        let loaded = unsafe { ptrs.map(|p| _mm256_load_ps(p)) };
+        let mut loaded = [avx!(_mm256_setzero_ps()); 8];
+        for (lane, &index) in loaded.iter_mut().zip(&indices[..8]) {
+            let p = rows[index as usize].as_ptr();
+            // SAFETY: `p` is a live, 32-byte aligned row of eight floats
+            // (bounds-checked above); AVX was detected.
+            *lane = unsafe { _mm256_load_ps(p) };
+        }
         transpose8(loaded).map(Self)
     }
     #[inline(always)]
     fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]) {
-        let lanes = transpose8(values.map(|v| v.0));
+        let mut columns = [avx!(_mm256_setzero_ps()); 8];
+        for (column, value) in columns.iter_mut().zip(values) {
+            *column = value.0;
+        }
+        let lanes = transpose8(columns);
         for (lane, &index) in indices[..8].iter().enumerate() {
             if index != NO_WRITE {
                 let p = rows[index as usize].as_ptr();
@@ -251,7 +258,11 @@ impl Lane for F32x8 {
     #[inline(always)]
     fn reduce_add(self) -> f32 {
         let a = self.to_array();
-        a.iter().skip(1).fold(a[0], |sum, &x| sum + x)
+        let mut sum = a[0];
+        for x in &a[1..] {
+            sum += x;
+        }
+        sum
     }
 }
 

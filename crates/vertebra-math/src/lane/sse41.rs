@@ -179,10 +179,11 @@ impl Lane for F32x4 {
     /// SSE4.1 has no fused multiply-add: lane by lane through `f32::mul_add`.
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
-        let (s, a, b) = (self.to_array(), a.to_array(), b.to_array());
-        Self::load(&core::array::from_fn::<f32, 4, _>(|i| {
-            s[i].mul_add(a[i], b[i])
-        }))
+        let (mut s, a, b) = (self.to_array(), a.to_array(), b.to_array());
+        for i in 0..4 {
+            s[i] = s[i].mul_add(a[i], b[i]);
+        }
+        Self::load(&s)
     }
     #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
@@ -222,11 +223,17 @@ impl Lane for F32x4 {
     }
     #[inline(always)]
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
-        let ptrs: [*mut f32; 4] = core::array::from_fn(|i| rows[indices[i] as usize].as_ptr());
-        // SAFETY: each pointer is a live, 32-byte aligned row of eight
-        // floats (bounds-checked above); SSE4.1 was detected.
-        let half = |offset: usize| unsafe { ptrs.map(|p| _mm_load_ps(p.add(offset))) };
-        let (lo, hi) = (transpose4(half(0)), transpose4(half(4)));
+        let (mut lo, mut hi) = ([sse41!(_mm_setzero_ps()); 4], [sse41!(_mm_setzero_ps()); 4]);
+        for lane in 0..4 {
+            let p = rows[indices[lane] as usize].as_ptr();
+            // SAFETY: `p` is a live, 32-byte aligned row of eight floats
+            // (bounds-checked above); SSE4.1 was detected.
+            unsafe {
+                lo[lane] = _mm_load_ps(p);
+                hi[lane] = _mm_load_ps(p.add(4));
+            }
+        }
+        let (lo, hi) = (transpose4(lo), transpose4(hi));
         [lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]].map(Self)
     }
     #[inline(always)]

@@ -9,14 +9,25 @@ use vertebra_world::{BodyDesc, BodyHandle, Shape, SocketDesc, SocketHandle, Solv
 pub fn capsule(world: &mut World, top: Vec3, bottom: Vec3, mass: f32) -> BodyHandle {
     let centre = (top + bottom) * 0.5;
     let shape = Shape::capsule(top - centre, bottom - centre, 0.05);
-    let props = shape.mass_properties_with_mass(mass).expect("valid capsule");
-    world.add_body(BodyDesc::dynamic(props).with_position(centre)).expect("valid body")
+    let props = shape
+        .mass_properties_with_mass(mass)
+        .expect("valid capsule");
+    world
+        .add_body(BodyDesc::dynamic(props).with_position(centre))
+        .expect("valid body")
 }
 
 /// A vertical chain of `links` capsules of `length` m hanging from a static
 /// body at `top`, each joined by a socket with the twist axis down.
-pub fn hanging_chain(world: &mut World, top: Vec3, links: usize, length: f32) -> (Vec<BodyHandle>, Vec<SocketHandle>) {
-    let anchor_body = world.add_body(BodyDesc::fixed().with_position(top)).expect("static body");
+pub fn hanging_chain(
+    world: &mut World,
+    top: Vec3,
+    links: usize,
+    length: f32,
+) -> (Vec<BodyHandle>, Vec<SocketHandle>) {
+    let anchor_body = world
+        .add_body(BodyDesc::fixed().with_position(top))
+        .expect("static body");
     let mut bodies = vec![anchor_body];
     let mut sockets = Vec::new();
     for k in 0..links {
@@ -24,7 +35,8 @@ pub fn hanging_chain(world: &mut World, top: Vec3, links: usize, length: f32) ->
         let lower = upper - Vec3::Y * length;
         let body = capsule(world, upper, lower, 1.0);
         let parent = *bodies.last().expect("a parent");
-        let desc = SocketDesc::at_world_anchor(world.bodies(), parent, body, upper, -Vec3::Y).expect("socket");
+        let desc = SocketDesc::at_world_anchor(world.bodies(), parent, body, upper, -Vec3::Y)
+            .expect("socket");
         sockets.push(world.add_socket(desc).expect("valid socket"));
         bodies.push(body);
     }
@@ -33,7 +45,12 @@ pub fn hanging_chain(world: &mut World, top: Vec3, links: usize, length: f32) ->
 
 /// A world with `substeps` and `iterations`, otherwise default.
 pub fn world(substeps: u32, iterations: u32) -> World {
-    World::new(SolverConfig { substeps, iterations, ..SolverConfig::default() }).expect("valid config")
+    World::new(SolverConfig {
+        substeps,
+        iterations,
+        ..SolverConfig::default()
+    })
+    .expect("valid config")
 }
 
 /// The angle (rad) between two orientations, accurate near zero (atan2 of

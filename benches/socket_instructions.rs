@@ -1,0 +1,34 @@
+//! Instructions per socket joint per backend (callgrind): one position
+//! iteration over 256 joints, every part active. Divide by 256.
+//! Needs valgrind and `iai-callgrind-runner` 0.16.1 (see the README).
+
+// The iai-callgrind macros generate undocumented modules and items.
+#![allow(missing_docs)]
+
+use std::hint::black_box;
+
+use iai_callgrind::{library_benchmark, library_benchmark_group, main};
+use vertebra_benches::SocketWorkload;
+use vertebra_math::Backend;
+
+const BACKENDS: [Backend; 4] = [
+    Backend::Scalar,
+    Backend::Portable,
+    Backend::Sse41,
+    Backend::Avx2,
+];
+
+fn workload(backend: usize) -> SocketWorkload {
+    SocketWorkload::new(BACKENDS[backend], 256)
+}
+
+// Argument k is BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
+#[library_benchmark]
+#[benches::backend(args = [0, 1, 2, 3], setup = workload)]
+fn socket_iteration(mut work: SocketWorkload) -> f32 {
+    work.iterate();
+    black_box(work.probe())
+}
+
+library_benchmark_group!(name = socket; benchmarks = socket_iteration);
+main!(library_benchmark_groups = socket);

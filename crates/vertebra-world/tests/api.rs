@@ -1,0 +1,295 @@
+//! Bad input gets a clear error, never a panic, and a rejected call leaves
+//! the world exactly as it was.
+
+mod common;
+
+use common::capsule;
+use glam::{Mat3, Quat, Vec3};
+use vertebra_world::{
+    AngularDrive, BackendChoice, BodyDesc, Error, MassProperties, Shape, SocketDesc, SolverConfig,
+    World,
+};
+
+fn unit_mass() -> MassProperties {
+    Shape::Sphere { radius: 0.1 }
+        .mass_properties_with_mass(1.0)
+        .unwrap()
+}
+
+/// A small world with two joined bodies, stepped once.
+fn world() -> (
+    World,
+    vertebra_world::BodyHandle,
+    vertebra_world::BodyHandle,
+    vertebra_world::SocketHandle,
+) {
+    let mut w = World::new(SolverConfig::default()).unwrap();
+    let a = w.add_body(BodyDesc::fixed()).unwrap();
+    let b = capsule(&mut w, Vec3::ZERO, -Vec3::Y * 0.4, 1.0);
+    let s = w
+        .add_socket(SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, -Vec3::Y).unwrap())
+        .unwrap();
+    w.step(1.0 / 60.0).unwrap();
+    (w, a, b, s)
+}
+
+/// Runs `bad`, expects `expected`, and checks nothing changed: the state
+/// hash, the counts, and the next step's result.
+fn rejected(expected: Error, bad: impl FnOnce(&mut World) -> Result<(), Error>) {
+    let (mut w, ..) = world();
+    let (mut reference, ..) = world();
+    let before = (w.state_hash(), w.bodies().len());
+    assert_eq!(bad(&mut w), Err(expected.clone()), "expected {expected}");
+    assert_eq!(
+        (w.state_hash(), w.bodies().len()),
+        before,
+        "a rejected call changed the world"
+    );
+    w.step(1.0 / 60.0).unwrap();
+    reference.step(1.0 / 60.0).unwrap();
+    assert_eq!(
+        w.state_hash(),
+        reference.state_hash(),
+        "the world steps on as if nothing happened"
+    );
+    assert!(!expected.to_string().is_empty());
+}
+
+#[test]
+fn bad_bodies_are_refused_with_the_field_named() {
+    let nan = f32::NAN;
+    rejected(Error::NonFinite("position"), |w| {
+        w.add_body(BodyDesc::dynamic(unit_mass()).with_position(Vec3::new(nan, 0.0, 0.0)))
+            .map(drop)
+    });
+    rejected(Error::NotNormalized("orientation"), |w| {
+        w.add_body(
+            BodyDesc::dynamic(unit_mass()).with_orientation(Quat::from_xyzw(0.0, 0.0, 0.0, 2.0)),
+        )
+        .map(drop)
+    });
+    rejected(Error::NonFinite("linear velocity"), |w| {
+        w.add_body(
+            BodyDesc::dynamic(unit_mass()).with_velocity(Vec3::splat(f32::INFINITY), Vec3::ZERO),
+        )
+        .map(drop)
+    });
+    rejected(Error::NonPositive("mass"), |w| {
+        w.add_body(BodyDesc::dynamic(MassProperties {
+            mass: -1.0,
+            inertia: Mat3::IDENTITY,
+        }))
+        .map(drop)
+    });
+    rejected(Error::NonPositive("mass"), |w| {
+        w.add_body(BodyDesc::dynamic(MassProperties {
+            mass: 0.0,
+            inertia: Mat3::IDENTITY,
+        }))
+        .map(drop)
+    });
+    rejected(Error::InvalidInertia, |w| {
+        let inertia = Mat3::from_diagonal(Vec3::new(1.0, -1.0, 1.0));
+        w.add_body(BodyDesc::dynamic(MassProperties { mass: 1.0, inertia }))
+            .map(drop)
+    });
+    rejected(Error::InvalidInertia, |w| {
+        let inertia = Mat3::from_cols(Vec3::X, Vec3::new(0.5, 1.0, 0.0), Vec3::Z);
+        w.add_body(BodyDesc::dynamic(MassProperties { mass: 1.0, inertia }))
+            .map(drop)
+    });
+    rejected(Error::NonPositive("linear damping"), |w| {
+        w.add_body(BodyDesc::dynamic(unit_mass()).with_damping(-1.0, 0.0))
+            .map(drop)
+    });
+    assert_eq!(
+        Shape::Sphere { radius: 0.0 }.mass_properties(1.0),
+        Err(Error::DegenerateShape("sphere radius"))
+    );
+    assert_eq!(
+        Shape::Sphere { radius: nan }.mass_properties(1.0),
+        Err(Error::NonFinite("sphere radius"))
+    );
+    assert!(matches!(
+        Shape::Box {
+            half_extents: Vec3::new(1.0, 0.0, 1.0)
+        }
+        .mass_properties(1.0),
+        Err(Error::DegenerateShape(_))
+    ));
+    assert_eq!(
+        Shape::capsule(Vec3::ZERO, Vec3::Y, -0.1).mass_properties(1.0),
+        Err(Error::DegenerateShape("capsule radius"))
+    );
+    assert_eq!(
+        Shape::Sphere { radius: 1.0 }.mass_properties(-5.0),
+        Err(Error::NonPositive("density"))
+    );
+}
+
+#[test]
+fn bad_joints_are_refused() {
+    rejected(Error::SameBody, |w| {
+        let b = w.bodies().handle_at(1).unwrap();
+        w.add_socket(SocketDesc::at_world_anchor(
+            w.bodies(),
+            b,
+            b,
+            Vec3::ZERO,
+            Vec3::X,
+        )?)
+        .map(drop)
+    });
+    rejected(Error::NoDynamicBody, |w| {
+        let a = w.bodies().handle_at(0).unwrap();
+        let c = w.add_body(BodyDesc::fixed())?;
+        w.remove_body(c)?;
+        let k = w.add_body(BodyDesc::kinematic())?;
+        let result = w
+            .add_socket(SocketDesc::at_world_anchor(
+                w.bodies(),
+                a,
+                k,
+                Vec3::ZERO,
+                Vec3::X,
+            )?)
+            .map(drop);
+        w.remove_body(k)?;
+        result
+    });
+    rejected(Error::InvalidLimit("swing"), |w| {
+        let (a, b) = (
+            w.bodies().handle_at(0).unwrap(),
+            w.bodies().handle_at(1).unwrap(),
+        );
+        w.add_socket(
+            SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
+                .with_swing_limit(4.0),
+        )
+        .map(drop)
+    });
+    rejected(Error::InvalidLimit("twist"), |w| {
+        let (a, b) = (
+            w.bodies().handle_at(0).unwrap(),
+            w.bodies().handle_at(1).unwrap(),
+        );
+        w.add_socket(
+            SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
+                .with_twist_limit(0.5, -0.5),
+        )
+        .map(drop)
+    });
+    rejected(Error::NotNormalized("twist axis"), |w| {
+        let (a, b) = (
+            w.bodies().handle_at(0).unwrap(),
+            w.bodies().handle_at(1).unwrap(),
+        );
+        w.add_socket(SocketDesc::at_world_anchor(
+            w.bodies(),
+            a,
+            b,
+            Vec3::ZERO,
+            Vec3::ZERO,
+        )?)
+        .map(drop)
+    });
+    rejected(Error::NonPositive("drive compliance"), |w| {
+        let s = w.residuals().sockets[0].socket;
+        let drive = AngularDrive {
+            target: Quat::IDENTITY,
+            compliance: -1.0,
+            damping: 0.0,
+        };
+        w.set_socket_drive(s, Some(drive))
+    });
+    rejected(Error::NotNormalized("drive target"), |w| {
+        let s = w.residuals().sockets[0].socket;
+        let drive = AngularDrive {
+            target: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+            compliance: 0.0,
+            damping: 0.0,
+        };
+        w.set_socket_drive(s, Some(drive))
+    });
+}
+
+#[test]
+fn stale_handles_are_refused() {
+    let (mut w, a, b, s) = world();
+    w.remove_socket(s).unwrap();
+    assert_eq!(w.remove_socket(s), Err(Error::StaleHandle("socket")));
+    assert_eq!(w.socket(s), Err(Error::StaleHandle("socket")));
+    w.remove_body(b).unwrap();
+    assert_eq!(w.body(b), Err(Error::StaleHandle("body")));
+    assert_eq!(
+        w.set_body_pose(b, Vec3::ZERO, Quat::IDENTITY),
+        Err(Error::StaleHandle("body"))
+    );
+    assert_eq!(w.add_force(b, Vec3::X), Err(Error::StaleHandle("body")));
+    // The slot is reused, but the old handle stays stale.
+    let c = w.add_body(BodyDesc::dynamic(unit_mass())).unwrap();
+    assert_eq!(c.index(), b.index());
+    assert_ne!(c, b);
+    assert_eq!(w.body(b), Err(Error::StaleHandle("body")));
+    assert!(SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X).is_err());
+    w.step(1.0 / 60.0).unwrap();
+}
+
+#[test]
+fn a_body_in_use_cannot_be_removed_and_bad_steps_are_refused() {
+    rejected(Error::BodyInUse, |w| {
+        w.remove_body(w.bodies().handle_at(1).unwrap())
+    });
+    rejected(Error::NonPositive("time step"), |w| w.step(0.0));
+    rejected(Error::NonFinite("time step"), |w| w.step(f32::NAN));
+    rejected(Error::NonFinite("force"), |w| {
+        w.add_force(w.bodies().handle_at(1).unwrap(), Vec3::splat(f32::NAN))
+    });
+    rejected(Error::NotNormalized("orientation"), |w| {
+        w.set_body_pose(
+            w.bodies().handle_at(1).unwrap(),
+            Vec3::ZERO,
+            Quat::from_xyzw(1.0, 1.0, 0.0, 0.0),
+        )
+    });
+}
+
+#[test]
+fn bad_configs_are_refused() {
+    let bad = |c: SolverConfig| World::new(c).err();
+    assert_eq!(
+        bad(SolverConfig {
+            iterations: 0,
+            ..SolverConfig::default()
+        }),
+        Some(Error::InvalidConfig("iterations must be at least 1"))
+    );
+    assert_eq!(
+        bad(SolverConfig {
+            substeps: 0,
+            ..SolverConfig::default()
+        }),
+        Some(Error::InvalidConfig("substeps must be at least 1"))
+    );
+    assert_eq!(
+        bad(SolverConfig {
+            threads: 0,
+            ..SolverConfig::default()
+        }),
+        Some(Error::InvalidConfig("threads must be at least 1"))
+    );
+    assert_eq!(
+        bad(SolverConfig {
+            gravity: Vec3::NAN,
+            ..SolverConfig::default()
+        }),
+        Some(Error::NonFinite("gravity"))
+    );
+    for backend in vertebra_math::Backend::ALL {
+        let result = World::new(SolverConfig {
+            backend: BackendChoice::Forced(backend),
+            ..SolverConfig::default()
+        });
+        assert_eq!(result.is_ok(), backend.is_available(), "{backend}");
+    }
+}
