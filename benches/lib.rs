@@ -111,18 +111,19 @@ impl LaneMap for QuatRotate {
     }
 }
 
-/// A batch of socket joints with every part active (point, swing cone,
-/// twist range, drive), each lane on its own two dynamic bodies (as one
-/// colour is), the joints violated so every correction does work.
+/// A batch of socket joints, each lane on its own two dynamic bodies (as
+/// one colour is), the joints violated so every correction does work: point,
+/// swing cone and twist range always, the angular drive when `drive`.
 pub struct SocketWorkload {
     backend: Backend,
+    drive: bool,
     rows: BodyRows,
     blocks: Vec<SocketBlock>,
 }
 
 impl SocketWorkload {
     /// `sockets` joints (a multiple of 8) on `backend`.
-    pub fn new(backend: Backend, sockets: usize) -> Self {
+    pub fn new(backend: Backend, sockets: usize, drive: bool) -> Self {
         if !backend.is_available() {
             eprintln!("warning: {backend} is not available here; it runs as scalar");
         }
@@ -158,12 +159,13 @@ impl SocketWorkload {
                 frame_b: GQuat::from_rotation_z(0.3),
                 swing_max: 0.2,
                 twist: [-0.1, 0.1],
-                drive: Some((GQuat::from_rotation_x(0.2), 0.001, 1.0)),
+                drive: drive.then_some((GQuat::from_rotation_x(0.2), 0.001, 1.0)),
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }
         Self {
             backend,
+            drive,
             rows,
             blocks: out,
         }
@@ -171,11 +173,20 @@ impl SocketWorkload {
 
     /// One position iteration over every joint.
     pub fn iterate(&mut self) {
-        self.backend.dispatch(PositionPass {
-            blocks: &mut self.blocks,
-            rows: &self.rows,
-            inv_h2: 3600.0,
-        });
+        let (blocks, rows) = (&mut self.blocks, &self.rows);
+        if self.drive {
+            self.backend.dispatch(PositionPass::<true> {
+                blocks,
+                rows,
+                inv_h2: 3600.0,
+            });
+        } else {
+            self.backend.dispatch(PositionPass::<false> {
+                blocks,
+                rows,
+                inv_h2: 3600.0,
+            });
+        }
     }
 
     /// The joints in the batch.

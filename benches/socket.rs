@@ -1,5 +1,6 @@
 //! Nanoseconds per socket joint per backend: one position iteration over a
-//! batch of 1024 joints (2048 bodies, in cache), every part active.
+//! batch of 1024 joints (2048 bodies, in cache): point, swing cone and
+//! twist range, with and without the angular drive.
 //! `cargo bench -p vertebra-benches --bench socket`
 
 use std::hint::black_box;
@@ -9,9 +10,15 @@ use vertebra_benches::SocketWorkload;
 use vertebra_math::Backend;
 
 fn socket(c: &mut Criterion) {
-    let mut group = c.benchmark_group("socket_position_iteration");
+    for (name, drive) in [("socket_limits_drive", true), ("socket_limits", false)] {
+        bench_sockets(c, name, drive);
+    }
+}
+
+fn bench_sockets(c: &mut Criterion, name: &str, drive: bool) {
+    let mut group = c.benchmark_group(name);
     for backend in Backend::available() {
-        let mut work = SocketWorkload::new(backend, 1024);
+        let mut work = SocketWorkload::new(backend, 1024, drive);
         group.throughput(Throughput::Elements(work.sockets() as u64));
         group.bench_function(backend.name(), |b| {
             b.iter(|| {

@@ -1,5 +1,6 @@
 //! Instructions per socket joint per backend (callgrind): one position
-//! iteration over 256 joints, every part active. Divide by 256.
+//! iteration over 256 joints (point, cone, twist; with and without the
+//! drive). Divide by 256.
 //! Needs valgrind and `iai-callgrind-runner` 0.16.1 (see the README).
 
 // The iai-callgrind macros generate undocumented modules and items.
@@ -18,17 +19,28 @@ const BACKENDS: [Backend; 4] = [
     Backend::Avx2,
 ];
 
-fn workload(backend: usize) -> SocketWorkload {
-    SocketWorkload::new(BACKENDS[backend], 256)
+fn with_drive(backend: usize) -> SocketWorkload {
+    SocketWorkload::new(BACKENDS[backend], 256, true)
+}
+
+fn without_drive(backend: usize) -> SocketWorkload {
+    SocketWorkload::new(BACKENDS[backend], 256, false)
 }
 
 // Argument k is BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
 #[library_benchmark]
-#[benches::backend(args = [0, 1, 2, 3], setup = workload)]
-fn socket_iteration(mut work: SocketWorkload) -> f32 {
+#[benches::backend(args = [0, 1, 2, 3], setup = with_drive)]
+fn socket_limits_drive(mut work: SocketWorkload) -> f32 {
     work.iterate();
     black_box(work.probe())
 }
 
-library_benchmark_group!(name = socket; benchmarks = socket_iteration);
+#[library_benchmark]
+#[benches::backend(args = [0, 1, 2, 3], setup = without_drive)]
+fn socket_limits(mut work: SocketWorkload) -> f32 {
+    work.iterate();
+    black_box(work.probe())
+}
+
+library_benchmark_group!(name = socket; benchmarks = socket_limits_drive, socket_limits);
 main!(library_benchmark_groups = socket);

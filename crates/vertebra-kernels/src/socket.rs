@@ -134,8 +134,11 @@ impl SocketBlock {
 
 /// One XPBD iteration over `blocks`: every socket's parts, in the order
 /// drive, swing, twist, point (the point last, so that anchors are closest
-/// at the end of an iteration).
-pub struct PositionPass<'a> {
+/// at the end of an iteration). `DRIVE` says whether the blocks' sockets
+/// have drives: the layout keeps driven and plain sockets in separate
+/// blocks, so a plain socket never pays for a drive multiplied by zero, and
+/// the choice is made at compile time, not per lane.
+pub struct PositionPass<'a, const DRIVE: bool> {
     /// The blocks to solve (one colour's, or the overflow set).
     pub blocks: &'a mut [SocketBlock],
     /// Body rows, read and written.
@@ -144,43 +147,48 @@ pub struct PositionPass<'a> {
     pub inv_h2: f32,
 }
 
-impl LaneKernel for PositionPass<'_> {
+impl<const DRIVE: bool> LaneKernel for PositionPass<'_, DRIVE> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
         let inv_h2 = L::splat(self.inv_h2);
         for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions(block, start, self.rows, inv_h2);
+                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h2);
             }
         }
     }
 }
 
 #[inline(always)]
-fn solve_positions<L: Lane>(block: &mut SocketBlock, start: usize, rows: &BodyRows, inv_h2: L) {
+fn solve_positions<L: Lane, const DRIVE: bool>(
+    block: &mut SocketBlock,
+    start: usize,
+    rows: &BodyRows,
+    inv_h2: L,
+) {
     let mut a = BodyLanes::<L>::gather(rows, &block.body_a[start..]);
     let mut b = BodyLanes::<L>::gather(rows, &block.body_b[start..]);
-    let (frame_a, frame_b) = (
-        block.frame_a.load::<L>(start),
-        block.frame_b.load::<L>(start),
-    );
+    let frame_a = block.frame_a.load::<L>(start);
+    let frame_b = block.frame_b.load::<L>(start);
 
-    let lambda = block.drive_lambda.load::<L>(start);
-    let alpha_tilde = L::load(&block.drive_compliance[start..]) * inv_h2;
-    let enabled = L::load(&block.drive_enabled[start..]);
-    let target = block.drive_target.load::<L>(start);
-    let lambda = drive::solve(
-        &mut a,
-        &mut b,
-        frame_a,
-        frame_b,
-        target,
-        enabled,
-        alpha_tilde,
-        lambda,
-    );
-    block.drive_lambda.store(start, lambda);
+    if DRIVE {
+        let lambda = block.drive_lambda.load::<L>(start);
+        let alpha_tilde = L::load(&block.drive_compliance[start..]) * inv_h2;
+        let enabled = L::load(&block.drive_enabled[start..]);
+        let target = block.drive_target.load::<L>(start);
+        let lambda = drive::solve(
+            &mut a,
+            &mut b,
+            frame_a,
+            frame_b,
+            target,
+            enabled,
+            alpha_tilde,
+            lambda,
+        );
+        block.drive_lambda.store(start, lambda);
+    }
 
     swing::solve(
         &mut a,
@@ -206,7 +214,8 @@ fn solve_positions<L: Lane>(block: &mut SocketBlock, start: usize, rows: &BodyRo
 }
 
 /// The velocity pass: drive damping, `min(damping h, 1)` of the relative
-/// angular velocity removed per substep of `h` seconds.
+/// angular velocity removed per substep of `h` seconds. Only driven blocks
+/// need it.
 pub struct VelocityPass<'a> {
     /// The blocks (one colour's, or the overflow set).
     pub blocks: &'a [SocketBlock],

@@ -172,8 +172,15 @@ fn to_rows(raw: &[[[f32; 8]; 3]]) -> BodyRows {
 fn run(backend: Backend, raw: &[[[f32; 8]; 3]], blocks: &[SocketBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
-    for _ in 0..4 {
-        backend.dispatch(PositionPass {
+    // Both kernel variants: with the drive part (disabled lanes multiply
+    // it by zero) and without.
+    for _ in 0..2 {
+        backend.dispatch(PositionPass::<true> {
+            blocks: &mut blocks,
+            rows: &rows,
+            inv_h2: 3600.0,
+        });
+        backend.dispatch(PositionPass::<false> {
             blocks: &mut blocks,
             rows: &rows,
             inv_h2: 3600.0,

@@ -15,14 +15,24 @@ use crate::socket::SocketDesc;
 /// No socket in this lane.
 pub(crate) const EMPTY: u32 = u32::MAX;
 
+/// One colour's (or the overflow set's) blocks: driven sockets first, then
+/// plain ones, each group in blocks of its own.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Group {
+    /// Blocks of sockets with a drive.
+    pub driven: Range<usize>,
+    /// Blocks of sockets without.
+    pub plain: Range<usize>,
+}
+
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Layout {
     /// All socket blocks: colour 0's, colour 1's, ..., then overflow.
     pub blocks: Vec<SocketBlock>,
-    /// Block ranges of the non-empty colours, in colour order.
-    pub colours: Vec<Range<usize>>,
-    /// Block range of the overflow set (solved by the scalar kernel).
-    pub overflow: Range<usize>,
+    /// The non-empty colours, in colour order.
+    pub colours: Vec<Group>,
+    /// The overflow set (solved by the scalar kernel).
+    pub overflow: Group,
     /// For each block lane, the socket slot it holds, or `EMPTY`.
     pub lane_socket: Vec<u32>,
     /// For each socket slot, its (block, lane).
@@ -41,13 +51,30 @@ impl Layout {
             ..Self::default()
         };
         for c in 0..MAX_COLOURS {
-            let range = layout.append(colouring.colour(c).iter(), sockets, bodies);
-            if !range.is_empty() {
-                layout.colours.push(range);
+            let group = layout.append_group(colouring.colour(c), sockets, bodies);
+            if !(group.driven.is_empty() && group.plain.is_empty()) {
+                layout.colours.push(group);
             }
         }
-        layout.overflow = layout.append(colouring.overflow().iter(), sockets, bodies);
+        layout.overflow = layout.append_group(colouring.overflow(), sockets, bodies);
         layout
+    }
+
+    fn append_group(
+        &mut self,
+        keys: &std::collections::BTreeSet<u64>,
+        sockets: &[Option<SocketDesc>],
+        bodies: &BodyStore,
+    ) -> Group {
+        let driven = |key: &&u64| {
+            sockets[**key as usize]
+                .as_ref()
+                .is_some_and(|s| s.drive.is_some())
+        };
+        Group {
+            driven: self.append(keys.iter().filter(driven), sockets, bodies),
+            plain: self.append(keys.iter().filter(|k| !driven(k)), sockets, bodies),
+        }
     }
 
     fn append<'k>(

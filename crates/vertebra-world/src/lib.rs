@@ -216,7 +216,9 @@ impl World {
         Ok(self.sockets[handle.index()].expect("live socket has a description"))
     }
 
-    /// Sets or clears a socket's drive, in place (no re-colouring).
+    /// Sets or clears a socket's drive. Changing a drive's settings is done
+    /// in place; adding or removing one moves the socket to other blocks at
+    /// the next step (no re-colouring).
     pub fn set_socket_drive(
         &mut self,
         handle: SocketHandle,
@@ -226,9 +228,13 @@ impl World {
         if let Some(d) = &drive {
             socket::validate_drive(d)?;
         }
+        let regroup = desc.drive.is_some() != drive.is_some();
         desc.drive = drive;
         self.sockets[handle.index()] = Some(desc);
-        if !self.layout_dirty {
+        if regroup {
+            // Driven and plain sockets live in different blocks.
+            self.layout_dirty = true;
+        } else if !self.layout_dirty {
             let (block, lane) = self.layout.place[handle.index()];
             let lambda = self.layout.blocks[block].drive_lambda.get(lane);
             self.layout.blocks[block].set(lane, &layout::solver_lane(&desc, &self.bodies));

@@ -121,70 +121,63 @@ fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
     Vec3::from(turn.to_rotation_vector()) / h
 }
 
-/// Runs one pass over every colour in order, then the overflow set on the
-/// scalar kernel. Inside a colour, blocks are independent: they go to the
-/// thread pool when there are enough of them.
+/// Runs `pass` over every colour in order, then over the overflow set with
+/// the scalar kernel. Inside a colour, blocks are independent: they go to
+/// the thread pool when there are enough of them. `pass` gets the blocks,
+/// whether they are the driven ones, the rows and the backend.
 fn for_each_colour(
     world: &mut World,
-    mut pass: impl FnMut(&mut [SocketBlock], &BodyRows, Backend),
+    pass: impl Fn(&mut [SocketBlock], bool, &BodyRows, Backend) + Sync,
 ) {
-    let ranges = world.layout.colours.clone();
-    for range in ranges {
-        pass(&mut world.layout.blocks[range], &world.rows, world.backend);
-    }
-    let overflow = world.layout.overflow.clone();
-    pass(
-        &mut world.layout.blocks[overflow],
-        &world.rows,
-        Backend::Scalar,
-    );
-}
-
-/// Splits `blocks` over the pool when it is worth it.
-fn parallel_or_not(
-    pool: Option<&rayon::ThreadPool>,
-    min_blocks: usize,
-    blocks: &mut [SocketBlock],
-    run: impl Fn(&mut [SocketBlock]) + Sync,
-) {
-    match pool {
-        Some(pool) if blocks.len() >= min_blocks => {
-            let chunk = blocks.len().div_ceil(pool.current_num_threads() * 2);
-            pool.install(|| blocks.par_chunks_mut(chunk).for_each(&run));
+    let pool = world.pool.take();
+    let min_blocks = world.config.parallel_min_blocks;
+    let groups = world.layout.colours.iter().map(|g| (g, world.backend));
+    let overflow = core::iter::once((&world.layout.overflow, Backend::Scalar));
+    for (group, backend) in groups.chain(overflow) {
+        for (range, driven) in [(group.driven.clone(), true), (group.plain.clone(), false)] {
+            let blocks = &mut world.layout.blocks[range];
+            let rows = &world.rows;
+            match pool.as_ref() {
+                Some(pool) if blocks.len() >= min_blocks && backend != Backend::Scalar => {
+                    let chunk = blocks.len().div_ceil(pool.current_num_threads() * 2);
+                    pool.install(|| {
+                        blocks
+                            .par_chunks_mut(chunk)
+                            .for_each(|c| pass(c, driven, rows, backend))
+                    });
+                }
+                _ => pass(blocks, driven, rows, backend),
+            }
         }
-        _ => run(blocks),
     }
+    world.pool = pool;
 }
 
 fn solve_positions(world: &mut World, h: f32) {
     let inv_h2 = 1.0 / (h * h);
-    let pool = world.pool.take();
-    let min_blocks = world.config.parallel_min_blocks;
-    for_each_colour(world, |blocks, rows, backend| {
-        parallel_or_not(pool.as_ref(), min_blocks, blocks, |chunk| {
-            backend.dispatch(PositionPass {
-                blocks: chunk,
+    for_each_colour(world, |blocks, driven, rows, backend| {
+        if driven {
+            backend.dispatch(PositionPass::<true> {
+                blocks,
                 rows,
                 inv_h2,
-            })
-        });
+            });
+        } else {
+            backend.dispatch(PositionPass::<false> {
+                blocks,
+                rows,
+                inv_h2,
+            });
+        }
     });
-    world.pool = pool;
 }
 
 fn solve_velocities(world: &mut World, h: f32) {
-    let pool = world.pool.take();
-    let min_blocks = world.config.parallel_min_blocks;
-    for_each_colour(world, |blocks, rows, backend| {
-        parallel_or_not(pool.as_ref(), min_blocks, blocks, |chunk| {
-            backend.dispatch(VelocityPass {
-                blocks: chunk,
-                rows,
-                h,
-            })
-        });
+    for_each_colour(world, |blocks, driven, rows, backend| {
+        if driven {
+            backend.dispatch(VelocityPass { blocks, rows, h });
+        }
     });
-    world.pool = pool;
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
