@@ -343,3 +343,33 @@ fn a_compliant_drive_gives_way_and_returns() {
         "returns to its sag: {returned} vs {settled}"
     );
 }
+
+#[test]
+fn a_kinematic_body_carries_its_joints_and_ignores_them() {
+    let mut w = world(1, 20);
+    let carrier = w
+        .add_body(BodyDesc::kinematic().with_velocity(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO))
+        .unwrap();
+    let bob = capsule(&mut w, Vec3::ZERO, -Vec3::Y * 0.4, 1.0);
+    let desc = SocketDesc::at_world_anchor(w.bodies(), carrier, bob, Vec3::ZERO, -Vec3::Y).unwrap();
+    w.add_socket(desc).unwrap();
+    for _ in 0..120 {
+        w.step(DT).unwrap();
+    }
+    let c = w.body(carrier).unwrap();
+    // The carrier moved exactly by its own velocity, whatever hangs on it.
+    assert!(
+        (c.position - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-4,
+        "{}",
+        c.position
+    );
+    assert_eq!(c.linear_velocity, Vec3::new(1.0, 0.0, 0.0));
+    // The bob hangs from it, trailing, and the joint holds.
+    let b = w.body(bob).unwrap();
+    assert!(b.position.x > 1.5, "{}", b.position);
+    assert!(
+        w.residuals().eps_lin_cm < 0.01,
+        "{}",
+        w.residuals().eps_lin_cm
+    );
+}
