@@ -9,12 +9,15 @@
 //!   twist range, angular drive. Each has its derivation in its header.
 //! - [`socket`]: the ball-and-socket joint: its lane block, its position
 //!   pass, its velocity (damping) pass, and its residual.
+//! - [`rod`]: the paper's rod constraint: curve, length, bending, twisting
+//!   and limits in one kernel, its lane block and its residual.
 //!
 //! Kernels never use `core::arch`: the lane types and the row gather and
 //! scatter in `vertebra-math` are the only places intrinsics live.
 
 pub mod body;
 pub mod parts;
+pub mod rod;
 pub mod socket;
 
 /// The joint frame's twist axis: +X of a joint frame (as in Jolt).

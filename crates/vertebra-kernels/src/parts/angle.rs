@@ -1,32 +1,63 @@
-//! Angle part: one rotational correction about a world axis (1 degree of
-//! freedom), hard or soft. Every angular part reduces to it.
+//! Angle part: one rotational correction (1 degree of freedom), hard or
+//! soft. Every angular part reduces to it.
 //!
-//! The caller measures an angle error `C >= 0` and a unit axis `n` such
-//! that turning `b` by `+x` about `n` (or `a` by `-x`) grows `C` by `x`.
-//! Then `w = n^T I_a^-1 n + n^T I_b^-1 n` and
-//! `dlambda = (-C - alpha~ lambda) / (w + alpha~)`; `b` turns by
-//! `I_b^-1 (dlambda n)` and `a` by `-I_a^-1 (dlambda n)` (Müller et al.
-//! 2020, sec. 3.3.2). `n = 0` or `C = 0` gives no correction.
+//! The caller measures an angle error `C` and the axes along which it
+//! changes: turning `b` by a small `x` about `n_b` grows `C` by `x`, and
+//! turning `a` by `x` about `n_a` shrinks it by `x` (so `dC/dtheta_b = n_b`,
+//! `dC/dtheta_a = -n_a`). For a plain relative angle `n_a = n_b`; the rod's
+//! curve and twist have different axes on each side. Then
+//! `w = n_a^T I_a^-1 n_a + n_b^T I_b^-1 n_b` and
+//! `dlambda = (-beta C - alpha~ lambda) / (w + alpha~)`; `b` turns by
+//! `I_b^-1 n_b dlambda` and `a` by `-I_a^-1 n_a dlambda` (Müller et al.
+//! 2020, sec. 3.3.2). `beta` is 1 for XPBD; a PBD relaxation factor in
+//! [0, 1] otherwise (then `alpha~ = 0`). A zero axis or `C = 0` gives no
+//! correction.
 
 use vertebra_math::{Lane, Vec3};
 
 use crate::body::{BodyLanes, safe_ratio};
 
-/// Applies the correction; returns `dlambda` (N m s^2), to be added to the
-/// part's accumulated `lambda` by soft parts.
+/// How hard a correction pulls: XPBD compliance, or a PBD relaxation
+/// factor, per lane.
+#[derive(Clone, Copy, Debug)]
+pub struct Softness<L> {
+    /// `compliance / h^2` (0 for hard parts and for relaxation).
+    pub alpha_tilde: L,
+    /// The fraction of the error removed per iteration (1 for XPBD).
+    pub relaxation: L,
+}
+
+impl<L: Lane> Softness<L> {
+    /// A hard part.
+    #[inline(always)]
+    pub fn hard() -> Self {
+        Self { alpha_tilde: L::splat(0.0), relaxation: L::splat(1.0) }
+    }
+}
+
+/// Applies the correction with the same axis on both bodies; returns
+/// `dlambda`.
 #[inline(always)]
-pub fn correct<L: Lane>(
+pub fn correct<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, n: Vec3<L>, c: L, alpha_tilde: L, lambda: L) -> L {
+    let soft = Softness { alpha_tilde, relaxation: L::splat(1.0) };
+    correct_axes(a, b, n, n, c, soft, lambda)
+}
+
+/// Applies the correction with axis `n_a` on `a` and `n_b` on `b`; returns
+/// `dlambda`, to be added to the part's accumulated `lambda` by soft parts.
+#[inline(always)]
+pub fn correct_axes<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    n: Vec3<L>,
+    n_a: Vec3<L>,
+    n_b: Vec3<L>,
     c: L,
-    alpha_tilde: L,
+    soft: Softness<L>,
     lambda: L,
 ) -> L {
-    let w = a.angular_weight(n) + b.angular_weight(n);
-    let dlambda = safe_ratio(-c - alpha_tilde * lambda, w + alpha_tilde);
-    let turn = n.scale(dlambda);
-    b.rotate(b.inv_inertia_mul(turn));
-    a.rotate(a.inv_inertia_mul(-turn));
+    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
+    let dlambda = safe_ratio(-soft.relaxation * c - soft.alpha_tilde * lambda, w + soft.alpha_tilde);
+    b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
+    a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
     dlambda
 }

@@ -8,9 +8,13 @@
 //! generalised inverse masses `w` of `crate::body`. Hard parts have
 //! `alpha~ = 0` and need no `lambda`. Every part is branch-free: an
 //! inactive limit has `C = 0`, and a zero correction moves nothing.
+//!
+//! The socket uses `point`, `swing`, `twist` and `drive`; the rod its own
+//! `rod` parts (curve, length, bend, twist), built on `angle`.
 
 pub mod angle;
 pub mod drive;
 pub mod point;
+pub mod rod;
 pub mod swing;
 pub mod twist;

@@ -1,0 +1,272 @@
+//! The rod constraint (Lewin et al., sections 5-7): an inextensible
+//! Kirchhoff rod between the centres of mass of two bodies, held to a
+//! circular arc, with soft bending and twisting and hard limits, solved in
+//! one lane-generic kernel that shares the frames' measurement between its
+//! parts (paper section 7).
+//!
+//! Part order per iteration: soft bend, soft twist, bend limit, twist
+//! limit, curve, length. The hard geometric parts come last so that the arc
+//! is closest to admissible at the end of an iteration; the length last of
+//! all, because the curve changes `psi` and so the chord the length aims at.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Quat as GQuat, Vec3 as GVec3};
+use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::row::NO_WRITE;
+use vertebra_math::{Lane, LaneKernel};
+
+use crate::body::{BodyLanes, BodyRows};
+use crate::parts::angle::Softness;
+use crate::parts::rod::{bend, curve, frames, length, twist};
+
+/// Eight rods, field by field.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C, align(32))]
+pub struct RodBlock {
+    /// Row read for body a.
+    pub body_a: [u32; BLOCK_LANES],
+    /// Row read for body b.
+    pub body_b: [u32; BLOCK_LANES],
+    /// Row written for body a (`NO_WRITE` unless dynamic).
+    pub write_a: [u32; BLOCK_LANES],
+    /// Row written for body b (`NO_WRITE` unless dynamic).
+    pub write_b: [u32; BLOCK_LANES],
+    /// `F_a`: the material frame at a, in a's body frame (+X: tangent).
+    pub frame_a: QuatBlock,
+    /// `F_b`: the material frame at b, in b's body frame.
+    pub frame_b: QuatBlock,
+    /// Rest bend direction of `t_b`, in a's material frame (unit).
+    pub bend_rest: Vec3Block,
+    /// Rest length `l0` (m).
+    pub rest_length: [f32; BLOCK_LANES],
+    /// Rest twist (rad).
+    pub twist_rest: [f32; BLOCK_LANES],
+    /// Bending compliance `l0 / k_b` (rad / (N m)).
+    pub bend_compliance: [f32; BLOCK_LANES],
+    /// Twisting compliance `l0 / k_t` (rad / (N m)).
+    pub twist_compliance: [f32; BLOCK_LANES],
+    /// Bending relaxation factor (1 for XPBD, 0 for none).
+    pub bend_relaxation: [f32; BLOCK_LANES],
+    /// Twisting relaxation factor (1 for XPBD, 0 for none).
+    pub twist_relaxation: [f32; BLOCK_LANES],
+    /// Largest bend angle (rad); pi disables the limit.
+    pub bend_max: [f32; BLOCK_LANES],
+    /// Lowest twist (rad).
+    pub twist_min: [f32; BLOCK_LANES],
+    /// Highest twist (rad).
+    pub twist_max: [f32; BLOCK_LANES],
+    /// Bending's accumulated multiplier, reset every substep.
+    pub bend_lambda: [f32; BLOCK_LANES],
+    /// Twisting's accumulated multiplier, reset every substep.
+    pub twist_lambda: [f32; BLOCK_LANES],
+}
+
+/// How a soft part is set: XPBD compliance, or the paper's relaxation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RodSoftness {
+    /// XPBD compliance (rad / (N m)); independent of step and iterations.
+    Compliance(f32),
+    /// The fraction of the error removed per iteration, in [0, 1] (the
+    /// paper's relaxation factor); 0 turns the part off.
+    Relaxation(f32),
+}
+
+impl RodSoftness {
+    /// (compliance, relaxation) as the kernel reads them.
+    pub fn lanes(self) -> (f32, f32) {
+        match self {
+            RodSoftness::Compliance(c) => (c, 1.0),
+            RodSoftness::Relaxation(r) => (0.0, r),
+        }
+    }
+}
+
+/// One rod's solver data (one lane of a block).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RodLane {
+    /// Row of body a.
+    pub body_a: u32,
+    /// Row of body b.
+    pub body_b: u32,
+    /// Whether body a is dynamic (written).
+    pub dynamic_a: bool,
+    /// Whether body b is dynamic (written).
+    pub dynamic_b: bool,
+    /// Material frame at a (a's body frame).
+    pub frame_a: GQuat,
+    /// Material frame at b (b's body frame).
+    pub frame_b: GQuat,
+    /// Rest length (m).
+    pub rest_length: f32,
+    /// Rest bend direction of `t_b` in a's material frame (unit).
+    pub bend_rest: GVec3,
+    /// Rest twist (rad).
+    pub twist_rest: f32,
+    /// Bending softness.
+    pub bend: RodSoftness,
+    /// Twisting softness.
+    pub twist: RodSoftness,
+    /// Largest bend (rad), pi when unlimited.
+    pub bend_max: f32,
+    /// Twist range (rad), `[-pi, pi]` when unlimited.
+    pub twist_range: [f32; 2],
+}
+
+impl RodBlock {
+    /// A block of padding lanes.
+    pub fn padding() -> Self {
+        let mut block = Self::zeroed();
+        for lane in 0..BLOCK_LANES {
+            block.clear(lane);
+        }
+        block
+    }
+
+    /// Makes `lane` a padding lane: null rows, no writes, nothing pulls.
+    pub fn clear(&mut self, lane: usize) {
+        self.set(
+            lane,
+            &RodLane {
+                body_a: 0,
+                body_b: 0,
+                dynamic_a: false,
+                dynamic_b: false,
+                frame_a: GQuat::IDENTITY,
+                frame_b: GQuat::IDENTITY,
+                rest_length: 0.0,
+                bend_rest: GVec3::X,
+                twist_rest: 0.0,
+                bend: RodSoftness::Relaxation(0.0),
+                twist: RodSoftness::Relaxation(0.0),
+                bend_max: core::f32::consts::PI,
+                twist_range: [-core::f32::consts::PI, core::f32::consts::PI],
+            },
+        );
+    }
+
+    /// Writes one rod into `lane`.
+    pub fn set(&mut self, lane: usize, r: &RodLane) {
+        self.body_a[lane] = r.body_a;
+        self.body_b[lane] = r.body_b;
+        self.write_a[lane] = if r.dynamic_a { r.body_a } else { NO_WRITE };
+        self.write_b[lane] = if r.dynamic_b { r.body_b } else { NO_WRITE };
+        self.frame_a.set(lane, r.frame_a);
+        self.frame_b.set(lane, r.frame_b);
+        self.bend_rest.set(lane, r.bend_rest);
+        self.rest_length[lane] = r.rest_length;
+        self.twist_rest[lane] = r.twist_rest;
+        (self.bend_compliance[lane], self.bend_relaxation[lane]) = r.bend.lanes();
+        (self.twist_compliance[lane], self.twist_relaxation[lane]) = r.twist.lanes();
+        self.bend_max[lane] = r.bend_max;
+        (self.twist_min[lane], self.twist_max[lane]) = (r.twist_range[0], r.twist_range[1]);
+        self.bend_lambda[lane] = 0.0;
+        self.twist_lambda[lane] = 0.0;
+    }
+
+    /// Resets the soft parts' multipliers (every substep).
+    pub fn reset_lambdas(&mut self) {
+        self.bend_lambda = [0.0; BLOCK_LANES];
+        self.twist_lambda = [0.0; BLOCK_LANES];
+    }
+}
+
+/// One XPBD iteration over `blocks` of rods.
+pub struct PositionPass<'a> {
+    /// The blocks (one colour's, or the overflow set).
+    pub blocks: &'a mut [RodBlock],
+    /// Body rows, read and written.
+    pub rows: &'a BodyRows,
+    /// `1 / h^2` for the substep `h` (s^-2).
+    pub inv_h2: f32,
+}
+
+impl LaneKernel for PositionPass<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let inv_h2 = L::splat(self.inv_h2);
+        for block in self.blocks.iter_mut() {
+            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
+                solve_positions(block, start, self.rows, inv_h2);
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn soft<L: Lane>(compliance: &[f32], relaxation: &[f32], inv_h2: L) -> Softness<L> {
+    Softness { alpha_tilde: L::load(compliance) * inv_h2, relaxation: L::load(relaxation) }
+}
+
+#[inline(always)]
+fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows, inv_h2: L) {
+    let mut a = BodyLanes::<L>::gather(rows, &block.body_a[start..]);
+    let mut b = BodyLanes::<L>::gather(rows, &block.body_b[start..]);
+    let (frame_a, frame_b) = (block.frame_a.load::<L>(start), block.frame_b.load::<L>(start));
+
+    let bend_soft = soft(&block.bend_compliance[start..], &block.bend_relaxation[start..], inv_h2);
+    let f = frames(&a, &b, frame_a, frame_b);
+    let lambda = L::load(&block.bend_lambda[start..]);
+    let lambda = bend::solve(&mut a, &mut b, &f, block.bend_rest.load(start), bend_soft, lambda);
+    lambda.store(&mut block.bend_lambda[start..]);
+
+    let twist_soft = soft(&block.twist_compliance[start..], &block.twist_relaxation[start..], inv_h2);
+    let f = frames(&a, &b, frame_a, frame_b);
+    let lambda = L::load(&block.twist_lambda[start..]);
+    let rest = L::load(&block.twist_rest[start..]);
+    let lambda = twist::solve(&mut a, &mut b, &f, rest, twist_soft, lambda);
+    lambda.store(&mut block.twist_lambda[start..]);
+
+    let f = frames(&a, &b, frame_a, frame_b);
+    bend::limit(&mut a, &mut b, &f, L::load(&block.bend_max[start..]));
+    let f = frames(&a, &b, frame_a, frame_b);
+    let (lo, hi) = (L::load(&block.twist_min[start..]), L::load(&block.twist_max[start..]));
+    twist::limit(&mut a, &mut b, &f, lo, hi);
+
+    let f = frames(&a, &b, frame_a, frame_b);
+    curve::solve(&mut a, &mut b, &f);
+    let f = frames(&a, &b, frame_a, frame_b);
+    length::solve(&mut a, &mut b, &f, L::load(&block.rest_length[start..]));
+
+    a.scatter_pose(rows, &block.write_a[start..]);
+    b.scatter_pose(rows, &block.write_b[start..]);
+}
+
+/// Residual error of every lane, as the design brief defines it for a rod:
+/// linear `|C_len|` (m), angular the curve error (the angle between `t_b`
+/// and the reflection of `t_a`) plus limit overshoot (rad).
+pub struct ResidualPass<'a> {
+    /// The blocks.
+    pub blocks: &'a [RodBlock],
+    /// Body rows (poses read).
+    pub rows: &'a BodyRows,
+    /// Per lane of every block: (|C_len| m, angular rad).
+    pub out: &'a mut [[f32; 2]],
+}
+
+impl LaneKernel for ResidualPass<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let mut linear = [0.0f32; BLOCK_LANES];
+        let mut angular = [0.0f32; BLOCK_LANES];
+        for (block, out) in self.blocks.iter().zip(self.out.chunks_mut(BLOCK_LANES)) {
+            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
+                let a = BodyLanes::<L>::gather(self.rows, &block.body_a[start..]);
+                let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
+                let f = frames(&a, &b, block.frame_a.load::<L>(start), block.frame_b.load::<L>(start));
+                let (_, c_len) = length::measure(&a, &b, &f, L::load(&block.rest_length[start..]));
+                let (_, _, c_curve) = curve::measure(&a, &b, &f);
+                let (_, bend_over) = bend::overshoot(&f, L::load(&block.bend_max[start..]));
+                let lo = L::load(&block.twist_min[start..]);
+                let hi = L::load(&block.twist_max[start..]);
+                let twist_over = crate::parts::twist::excess(twist::measure(&f), lo, hi).abs();
+                c_len.abs().store(&mut linear[start..]);
+                (c_curve + bend_over + twist_over).store(&mut angular[start..]);
+            }
+            for (lane, o) in out.iter_mut().enumerate() {
+                *o = [linear[lane], angular[lane]];
+            }
+        }
+    }
+}
