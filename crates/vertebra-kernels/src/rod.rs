@@ -256,7 +256,7 @@ impl LaneKernel for ResidualPass<'_> {
                 let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
                 let f = frames(&a, &b, block.frame_a.load::<L>(start), block.frame_b.load::<L>(start));
                 let (_, c_len) = length::measure(&a, &b, &f, L::load(&block.rest_length[start..]));
-                let (_, _, c_curve) = curve::measure(&a, &b, &f);
+                let c_curve = curve::measure(&a, &b, &f).theta;
                 let (_, bend_over) = bend::overshoot(&f, L::load(&block.bend_max[start..]));
                 let lo = L::load(&block.twist_min[start..]);
                 let hi = L::load(&block.twist_max[start..]);

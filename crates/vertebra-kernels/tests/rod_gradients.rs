@@ -78,13 +78,16 @@ fn curve_gradients_match_finite_differences() {
     let mut r = StdRng::seed_from_u64(1);
     for _ in 0..300 {
         let (a, b, fa, fb) = configuration(&mut r);
-        let (n_a, n_b, theta) = curve::measure(&a, &b, &f(&a, &b, fa, fb));
-        if theta < 0.05 || theta > 3.0 {
+        let m = curve::measure(&a, &b, &f(&a, &b, fa, fb));
+        if m.theta < 0.05 || m.theta > 3.0 {
             continue; // the axis is ill-defined near 0 and pi
         }
-        let c = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| curve::measure(a, b, &f(a, b, fa, fb)).2;
-        check("curve / b", n_b.into(), numeric_gradient(c, &a, &b, true, true), 1.0);
-        check("curve / a", -GVec3::from(n_a), numeric_gradient(c, &a, &b, false, true), 1.0);
+        let c = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| curve::measure(a, b, &f(a, b, fa, fb)).theta;
+        check("curve / b", m.n_b.into(), numeric_gradient(c, &a, &b, true, true), 1.0);
+        check("curve / a", -GVec3::from(m.n_a), numeric_gradient(c, &a, &b, false, true), 1.0);
+        let scale = GVec3::from(m.g).length();
+        check("curve / p_b", m.g.into(), numeric_gradient(c, &a, &b, true, false), scale);
+        check("curve / p_a", -GVec3::from(m.g), numeric_gradient(c, &a, &b, false, false), scale);
     }
 }
 

@@ -25,6 +25,7 @@
 mod config;
 mod layout;
 mod metrics;
+mod rod;
 mod socket;
 mod step;
 
@@ -35,7 +36,8 @@ use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyKind, Slots};
 
 pub use config::SolverConfig;
-pub use metrics::{Residuals, SocketResidual};
+pub use metrics::{JointResidual, Residuals};
+pub use rod::{RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
@@ -51,6 +53,8 @@ pub struct World {
     joints_at: Vec<u32>,
     socket_slots: Slots,
     sockets: Vec<Option<socket::SocketDesc>>,
+    rod_slots: Slots,
+    rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
     layout: layout::Layout,
     layout_dirty: bool,
@@ -85,6 +89,8 @@ impl World {
             joints_at: Vec::new(),
             socket_slots: Slots::default(),
             sockets: Vec::new(),
+            rod_slots: Slots::default(),
+            rods: Vec::new(),
             colouring: Colouring::new(),
             layout: layout::Layout::default(),
             layout_dirty: false,
@@ -182,14 +188,7 @@ impl World {
             self.sockets.push(None);
         }
         self.sockets[slot] = Some(desc);
-        let dynamic = |h: BodyHandle| {
-            (self.bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
-        };
-        let bodies = [dynamic(desc.body_a), dynamic(desc.body_b)];
-        self.colouring.add(slot as u64, bodies);
-        self.joints_at[desc.body_a.index()] += 1;
-        self.joints_at[desc.body_b.index()] += 1;
-        self.layout_dirty = true;
+        self.connect(slot as u64, desc.body_a, desc.body_b);
         Ok(handle)
     }
 
@@ -206,6 +205,55 @@ impl World {
         self.joints_at[desc.body_b.index()] -= 1;
         self.layout_dirty = true;
         Ok(())
+    }
+
+    /// Adds a rod constraint; `Err` (and no change) for invalid input.
+    pub fn add_rod(&mut self, desc: RodDesc) -> Result<RodHandle, Error> {
+        desc.validate_with(&self.bodies)?;
+        let handle: RodHandle = self.rod_slots.insert();
+        let slot = handle.index();
+        if slot == self.rods.len() {
+            self.rods.push(None);
+        }
+        self.rods[slot] = Some(desc);
+        self.connect(slot as u64 + layout::ROD_KEY, desc.body_a, desc.body_b);
+        Ok(handle)
+    }
+
+    /// Removes a rod constraint.
+    pub fn remove_rod(&mut self, handle: RodHandle) -> Result<(), Error> {
+        if !self.rod_slots.remove(handle) {
+            return Err(Error::StaleHandle("rod"));
+        }
+        let desc = self.rods[handle.index()].take().expect("live rod has a description");
+        self.disconnect(handle.index() as u64 + layout::ROD_KEY, desc.body_a, desc.body_b);
+        Ok(())
+    }
+
+    /// A rod's description.
+    pub fn rod(&self, handle: RodHandle) -> Result<RodDesc, Error> {
+        if !self.rod_slots.contains(handle) {
+            return Err(Error::StaleHandle("rod"));
+        }
+        Ok(self.rods[handle.index()].expect("live rod has a description"))
+    }
+
+    /// Colours a new joint and counts it at its bodies.
+    fn connect(&mut self, key: u64, a: BodyHandle, b: BodyHandle) {
+        let dynamic = |h: BodyHandle| (self.bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32);
+        let bodies = [dynamic(a), dynamic(b)];
+        self.colouring.add(key, bodies);
+        self.joints_at[a.index()] += 1;
+        self.joints_at[b.index()] += 1;
+        self.layout_dirty = true;
+    }
+
+    /// The inverse of [`World::connect`].
+    fn disconnect(&mut self, key: u64, a: BodyHandle, b: BodyHandle) {
+        self.colouring.remove(key);
+        self.joints_at[a.index()] -= 1;
+        self.joints_at[b.index()] -= 1;
+        self.layout_dirty = true;
     }
 
     /// A socket's description.
@@ -235,10 +283,11 @@ impl World {
             // Driven and plain sockets live in different blocks.
             self.layout_dirty = true;
         } else if !self.layout_dirty {
-            let (block, lane) = self.layout.place[handle.index()];
-            let lambda = self.layout.blocks[block].drive_lambda.get(lane);
-            self.layout.blocks[block].set(lane, &layout::solver_lane(&desc, &self.bodies));
-            self.layout.blocks[block].drive_lambda.set(lane, lambda);
+            let (block, lane) = self.layout.sockets.place[handle.index()];
+            let block = &mut self.layout.sockets.blocks[block];
+            let lambda = block.drive_lambda.get(lane);
+            block.set(lane, &layout::socket_lane(&desc, &self.bodies));
+            block.drive_lambda.set(lane, lambda);
         }
         Ok(())
     }
@@ -269,7 +318,7 @@ impl World {
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         if self.layout_dirty {
-            self.layout = layout::Layout::build(&self.colouring, &self.sockets, &self.bodies);
+            self.layout = layout::Layout::build(&self.colouring, &self.sockets, &self.rods, &self.bodies);
             self.layout_dirty = false;
         }
         step::step(self, dt);

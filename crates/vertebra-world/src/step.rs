@@ -5,6 +5,7 @@
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::rod::{self, RodBlock};
 use vertebra_kernels::socket::{PositionPass, SocketBlock, VelocityPass};
 use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
@@ -19,9 +20,10 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
     for _ in 0..world.config.substeps {
         predict(world, h);
-        for block in &mut world.layout.blocks {
+        for block in &mut world.layout.sockets.blocks {
             block.drive_lambda = vertebra_math::block::Vec3Block::default();
         }
+        world.layout.rods.blocks.iter_mut().for_each(RodBlock::reset_lambdas);
         for _ in 0..world.config.iterations {
             solve_positions(world, h);
         }
@@ -121,63 +123,86 @@ fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
     Vec3::from(turn.to_rotation_vector()) / h
 }
 
+/// One kind of pass over one group's blocks of one type.
+trait Pass: Sync {
+    /// Sockets (`driven` says which blocks).
+    fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend);
+    /// Rods.
+    fn rods(&self, blocks: &mut [RodBlock], rows: &BodyRows, backend: Backend);
+}
+
 /// Runs `pass` over every colour in order, then over the overflow set with
-/// the scalar kernel. Inside a colour, blocks are independent: they go to
-/// the thread pool when there are enough of them. `pass` gets the blocks,
-/// whether they are the driven ones, the rows and the backend.
-fn for_each_colour(
-    world: &mut World,
-    pass: impl Fn(&mut [SocketBlock], bool, &BodyRows, Backend) + Sync,
-) {
+/// the scalar kernel. Inside a colour, joints share no dynamic body, so
+/// blocks go to the thread pool (in chunks) when there are enough of them.
+fn for_each_colour(world: &mut World, pass: &impl Pass) {
     let pool = world.pool.take();
     let min_blocks = world.config.parallel_min_blocks;
-    let groups = world.layout.colours.iter().map(|g| (g, world.backend));
-    let overflow = core::iter::once((&world.layout.overflow, Backend::Scalar));
-    for (group, backend) in groups.chain(overflow) {
-        for (range, driven) in [(group.driven.clone(), true), (group.plain.clone(), false)] {
-            let blocks = &mut world.layout.blocks[range];
-            let rows = &world.rows;
-            match pool.as_ref() {
-                Some(pool) if blocks.len() >= min_blocks && backend != Backend::Scalar => {
-                    let chunk = blocks.len().div_ceil(pool.current_num_threads() * 2);
-                    pool.install(|| {
-                        blocks
-                            .par_chunks_mut(chunk)
-                            .for_each(|c| pass(c, driven, rows, backend))
-                    });
-                }
-                _ => pass(blocks, driven, rows, backend),
-            }
+    let layout = &mut world.layout;
+    let groups: Vec<_> = layout.colours.iter().map(|g| (g.clone(), world.backend)).collect();
+    let overflow = (layout.overflow.clone(), Backend::Scalar);
+    let rows = &world.rows;
+    for (group, backend) in groups.into_iter().chain(core::iter::once(overflow)) {
+        let parallel = pool.as_ref().filter(|_| backend != Backend::Scalar);
+        for (range, driven) in [(group.driven, true), (group.plain, false)] {
+            let blocks = &mut layout.sockets.blocks[range];
+            chunked(parallel, min_blocks, blocks, |c| pass.sockets(c, driven, rows, backend));
         }
+        let blocks = &mut layout.rods.blocks[group.rods];
+        chunked(parallel, min_blocks, blocks, |c| pass.rods(c, rows, backend));
     }
     world.pool = pool;
 }
 
-fn solve_positions(world: &mut World, h: f32) {
-    let inv_h2 = 1.0 / (h * h);
-    for_each_colour(world, |blocks, driven, rows, backend| {
-        if driven {
-            backend.dispatch(PositionPass::<true> {
-                blocks,
-                rows,
-                inv_h2,
-            });
-        } else {
-            backend.dispatch(PositionPass::<false> {
-                blocks,
-                rows,
-                inv_h2,
-            });
+/// Runs `run` on all `blocks`, split over `pool` when there are enough.
+fn chunked<B: Send>(pool: Option<&rayon::ThreadPool>, min_blocks: usize, blocks: &mut [B], run: impl Fn(&mut [B]) + Sync) {
+    match pool {
+        Some(pool) if blocks.len() >= min_blocks => {
+            let chunk = blocks.len().div_ceil(pool.current_num_threads() * 2);
+            pool.install(|| blocks.par_chunks_mut(chunk).for_each(&run));
         }
-    });
+        _ => run(blocks),
+    }
+}
+
+/// The position iteration.
+struct Positions {
+    inv_h2: f32,
+}
+
+impl Pass for Positions {
+    fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
+        let inv_h2 = self.inv_h2;
+        if driven {
+            backend.dispatch(PositionPass::<true> { blocks, rows, inv_h2 });
+        } else {
+            backend.dispatch(PositionPass::<false> { blocks, rows, inv_h2 });
+        }
+    }
+    fn rods(&self, blocks: &mut [RodBlock], rows: &BodyRows, backend: Backend) {
+        backend.dispatch(rod::PositionPass { blocks, rows, inv_h2: self.inv_h2 });
+    }
+}
+
+/// The velocity pass (drive damping; rods have none).
+struct Velocities {
+    h: f32,
+}
+
+impl Pass for Velocities {
+    fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
+        if driven {
+            backend.dispatch(VelocityPass { blocks, rows, h: self.h });
+        }
+    }
+    fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
+}
+
+fn solve_positions(world: &mut World, h: f32) {
+    for_each_colour(world, &Positions { inv_h2: 1.0 / (h * h) });
 }
 
 fn solve_velocities(world: &mut World, h: f32) {
-    for_each_colour(world, |blocks, driven, rows, backend| {
-        if driven {
-            backend.dispatch(VelocityPass { blocks, rows, h });
-        }
-    });
+    for_each_colour(world, &Velocities { h });
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {

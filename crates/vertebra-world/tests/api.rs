@@ -194,7 +194,7 @@ fn bad_joints_are_refused() {
         .map(drop)
     });
     rejected(Error::NonPositive("drive compliance"), |w| {
-        let s = w.residuals().sockets[0].socket;
+        let s = w.residuals().sockets[0].joint;
         let drive = AngularDrive {
             target: Quat::IDENTITY,
             compliance: -1.0,
@@ -203,7 +203,7 @@ fn bad_joints_are_refused() {
         w.set_socket_drive(s, Some(drive))
     });
     rejected(Error::NotNormalized("drive target"), |w| {
-        let s = w.residuals().sockets[0].socket;
+        let s = w.residuals().sockets[0].joint;
         let drive = AngularDrive {
             target: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
             compliance: 0.0,

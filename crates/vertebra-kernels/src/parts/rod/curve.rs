@@ -4,37 +4,71 @@
 //!
 //! The reflection `r = 2 (t_a . o) o - t_a` is a half turn about `o`. The
 //! error is the angle `theta = atan2(|r x t_b|, r . t_b)` about
-//! `n = (r x t_b)/|r x t_b|`; turning `b` about `n` grows it
-//! (`dtheta/dtheta_b = n`). Turning `a` by `x` about `u` turns `r` by `x`
-//! about the reflected axis `2 (u . o) o - u`, which shrinks `theta` by
-//! `x (R_o u) . n = x u . (R_o n)`: so `dtheta/dtheta_a = -n_a` with
-//! `n_a = 2 (n . o) o - n`. The correction is by rotation only (positions,
-//! hence `o`, are the length part's), one angle per iteration, as the
-//! angle part does. `theta = 0` where the ends coincide (no chord) or the
-//! axis is undefined (`t_b = -r`).
+//! `n = (r x t_b)/|r x t_b|`, one angle per iteration as the angle part
+//! does. Its gradients (checked against finite differences in
+//! `tests/rod_gradients.rs`; derived in `docs/rod-constraint.md`):
+//!
+//! - turning `b` about `n` grows it: `dtheta/dtheta_b = n`;
+//! - turning `a` by `x` about `u` turns `r` by `x` about the reflected axis
+//!   `2 (u . o) o - u`: `dtheta/dtheta_a = -n_a`, `n_a = 2 (n . o) o - n`;
+//! - moving `b` turns `o`, hence `r`: with `e = n x r` (the unit direction
+//!   from `r` toward `t_b`),
+//!   `dtheta/dp_b = -(2/|d|) (1 - o o^T) ((e . o) t_a + (t_a . o) e) = g`
+//!   and `dtheta/dp_a = -g`.
+//!
+//! The positional gradient matters: without it nothing holds the bodies on
+//! the arc sideways (the length part moves them along `o` only), and a
+//! cantilevered rod swings down like a pendulum on a string. With it, the
+//! generalised inverse mass is
+//! `w = n_a^T I_a^-1 n_a + n_b^T I_b^-1 n_b + |g|^2 (1/m_a + 1/m_b)`.
+//! `theta = 0` (and no correction) where the ends coincide or the axis is
+//! undefined (`t_b = -r`).
 
 use vertebra_math::{Lane, Vec3, poly};
 
 use super::Frames;
-use crate::body::BodyLanes;
-use crate::parts::angle::{self, Softness};
+use crate::body::{BodyLanes, safe_ratio};
 
-/// The axes `(n_a, n_b)` and the curve error `theta` (rad).
-#[inline(always)]
-pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>) -> (Vec3<L>, Vec3<L>, L) {
-    let (o, distance) = (b.p - a.p).normalize_or_zero();
-    let r = o.scale(L::splat(2.0) * f.ta.dot(o)) - f.ta;
-    let (n, sin) = r.cross(f.tb).normalize_or_zero();
-    let theta = L::select(distance.gt(L::splat(0.0)), poly::atan2(sin, r.dot(f.tb)), L::splat(0.0));
-    let n_a = o.scale(L::splat(2.0) * n.dot(o)) - n;
-    (n_a, n, theta)
+/// The curve error and its gradients.
+#[derive(Clone, Copy, Debug)]
+pub struct Curve<L> {
+    /// `theta` (rad).
+    pub theta: L,
+    /// `-dtheta/dtheta_a`.
+    pub n_a: Vec3<L>,
+    /// `dtheta/dtheta_b`.
+    pub n_b: Vec3<L>,
+    /// `dtheta/dp_b` (1/m); `dtheta/dp_a` is its negative.
+    pub g: Vec3<L>,
 }
 
-/// Turns the bodies toward an admissible arc; returns the error before
-/// the correction (rad).
+/// Measures the curve error and its gradients.
+#[inline(always)]
+pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>) -> Curve<L> {
+    let two = L::splat(2.0);
+    let (o, distance) = (b.p - a.p).normalize_or_zero();
+    let apart = distance.gt(L::splat(0.0));
+    let ta_o = f.ta.dot(o);
+    let r = o.scale(two * ta_o) - f.ta;
+    let (n, sin) = r.cross(f.tb).normalize_or_zero();
+    let theta = L::select(apart, poly::atan2(sin, r.dot(f.tb)), L::splat(0.0));
+    let e = n.cross(r);
+    let along = f.ta.scale(e.dot(o)) + e.scale(ta_o);
+    let across = along - o.scale(along.dot(o));
+    let g = across.scale(-safe_ratio(two, distance));
+    Curve { theta, n_a: o.scale(two * n.dot(o)) - n, n_b: n, g: Vec3::select(apart, g, Vec3::zero()) }
+}
+
+/// Moves and turns the bodies toward an admissible arc; returns the error
+/// before the correction (rad).
 #[inline(always)]
 pub fn solve<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, f: &Frames<L>) -> L {
-    let (n_a, n_b, theta) = measure(a, b, f);
-    angle::correct_axes(a, b, n_a, n_b, theta, Softness::hard(), L::splat(0.0));
-    theta
+    let c = measure(a, b, f);
+    let w = a.angular_weight(c.n_a) + b.angular_weight(c.n_b) + c.g.length_squared() * (a.inv_mass + b.inv_mass);
+    let dlambda = safe_ratio(-c.theta, w);
+    b.rotate(b.inv_inertia_mul(c.n_b.scale(dlambda)));
+    a.rotate(a.inv_inertia_mul(c.n_a.scale(-dlambda)));
+    b.p += c.g.scale(dlambda * b.inv_mass);
+    a.p -= c.g.scale(dlambda * a.inv_mass);
+    c.theta
 }
