@@ -195,22 +195,43 @@ impl LaneKernel for PositionPass<'_> {
 
 #[inline(always)]
 fn soft<L: Lane>(compliance: &[f32], relaxation: &[f32], inv_h2: L) -> Softness<L> {
-    Softness { alpha_tilde: L::load(compliance) * inv_h2, relaxation: L::load(relaxation) }
+    Softness {
+        alpha_tilde: L::load(compliance) * inv_h2,
+        relaxation: L::load(relaxation),
+    }
 }
 
 #[inline(always)]
 fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows, inv_h2: L) {
     let mut a = BodyLanes::<L>::gather(rows, &block.body_a[start..]);
     let mut b = BodyLanes::<L>::gather(rows, &block.body_b[start..]);
-    let (frame_a, frame_b) = (block.frame_a.load::<L>(start), block.frame_b.load::<L>(start));
+    let (frame_a, frame_b) = (
+        block.frame_a.load::<L>(start),
+        block.frame_b.load::<L>(start),
+    );
 
-    let bend_soft = soft(&block.bend_compliance[start..], &block.bend_relaxation[start..], inv_h2);
+    let bend_soft = soft(
+        &block.bend_compliance[start..],
+        &block.bend_relaxation[start..],
+        inv_h2,
+    );
     let f = frames(&a, &b, frame_a, frame_b);
     let lambda = L::load(&block.bend_lambda[start..]);
-    let lambda = bend::solve(&mut a, &mut b, &f, block.bend_rest.load(start), bend_soft, lambda);
+    let lambda = bend::solve(
+        &mut a,
+        &mut b,
+        &f,
+        block.bend_rest.load(start),
+        bend_soft,
+        lambda,
+    );
     lambda.store(&mut block.bend_lambda[start..]);
 
-    let twist_soft = soft(&block.twist_compliance[start..], &block.twist_relaxation[start..], inv_h2);
+    let twist_soft = soft(
+        &block.twist_compliance[start..],
+        &block.twist_relaxation[start..],
+        inv_h2,
+    );
     let f = frames(&a, &b, frame_a, frame_b);
     let lambda = L::load(&block.twist_lambda[start..]);
     let rest = L::load(&block.twist_rest[start..]);
@@ -220,7 +241,10 @@ fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows,
     let f = frames(&a, &b, frame_a, frame_b);
     bend::limit(&mut a, &mut b, &f, L::load(&block.bend_max[start..]));
     let f = frames(&a, &b, frame_a, frame_b);
-    let (lo, hi) = (L::load(&block.twist_min[start..]), L::load(&block.twist_max[start..]));
+    let (lo, hi) = (
+        L::load(&block.twist_min[start..]),
+        L::load(&block.twist_max[start..]),
+    );
     twist::limit(&mut a, &mut b, &f, lo, hi);
 
     let f = frames(&a, &b, frame_a, frame_b);
@@ -254,7 +278,12 @@ impl LaneKernel for ResidualPass<'_> {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
                 let a = BodyLanes::<L>::gather(self.rows, &block.body_a[start..]);
                 let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
-                let f = frames(&a, &b, block.frame_a.load::<L>(start), block.frame_b.load::<L>(start));
+                let f = frames(
+                    &a,
+                    &b,
+                    block.frame_a.load::<L>(start),
+                    block.frame_b.load::<L>(start),
+                );
                 let (_, c_len) = length::measure(&a, &b, &f, L::load(&block.rest_length[start..]));
                 let c_curve = curve::measure(&a, &b, &f).theta;
                 let (_, bend_over) = bend::overshoot(&f, L::load(&block.bend_max[start..]));

@@ -53,12 +53,21 @@ pub(crate) struct Blocks<B> {
 
 impl<B> Default for Blocks<B> {
     fn default() -> Self {
-        Self { blocks: Vec::new(), lane_slot: Vec::new(), place: Vec::new() }
+        Self {
+            blocks: Vec::new(),
+            lane_slot: Vec::new(),
+            place: Vec::new(),
+        }
     }
 }
 
 impl<B: Copy> Blocks<B> {
-    fn append(&mut self, slots: impl Iterator<Item = usize>, padding: B, mut set: impl FnMut(&mut B, usize, usize)) -> Range<usize> {
+    fn append(
+        &mut self,
+        slots: impl Iterator<Item = usize>,
+        padding: B,
+        mut set: impl FnMut(&mut B, usize, usize),
+    ) -> Range<usize> {
         let start = self.blocks.len();
         for (k, slot) in slots.enumerate() {
             let lane = k % BLOCK_LANES;
@@ -91,7 +100,12 @@ pub(crate) struct Layout {
 impl Layout {
     /// Lays out every coloured joint; `sockets[slot]`, `rods[slot]` are
     /// `Some` when live.
-    pub fn build(colouring: &Colouring, sockets: &[Option<SocketDesc>], rods: &[Option<RodDesc>], bodies: &BodyStore) -> Self {
+    pub fn build(
+        colouring: &Colouring,
+        sockets: &[Option<SocketDesc>],
+        rods: &[Option<RodDesc>],
+        bodies: &BodyStore,
+    ) -> Self {
         let mut layout = Self::default();
         for c in 0..MAX_COLOURS {
             let group = layout.append(colouring.colour(c), sockets, rods, bodies);
@@ -103,19 +117,43 @@ impl Layout {
         layout
     }
 
-    fn append(&mut self, keys: &BTreeSet<u64>, sockets: &[Option<SocketDesc>], rods: &[Option<RodDesc>], bodies: &BodyStore) -> Group {
+    fn append(
+        &mut self,
+        keys: &BTreeSet<u64>,
+        sockets: &[Option<SocketDesc>],
+        rods: &[Option<RodDesc>],
+        bodies: &BodyStore,
+    ) -> Group {
         let socket = |slot: usize| sockets[slot].as_ref().expect("coloured sockets are live");
         let socket_slots = || keys.iter().filter(|&&k| k < ROD_KEY).map(|&k| k as usize);
         let driven = socket_slots().filter(|&s| socket(s).drive.is_some());
         let plain = socket_slots().filter(|&s| socket(s).drive.is_none());
-        let set_socket = |block: &mut SocketBlock, lane: usize, slot: usize| block.set(lane, &socket_lane(socket(slot), bodies));
-        let driven = self.sockets.append(driven, SocketBlock::padding(), set_socket);
-        let plain = self.sockets.append(plain, SocketBlock::padding(), set_socket);
-        let rod_slots = keys.iter().filter(|&&k| k >= ROD_KEY).map(|&k| (k - ROD_KEY) as usize);
-        let rods = self.rods.append(rod_slots, RodBlock::padding(), |block, lane, slot| {
-            block.set(lane, &rod_lane(rods[slot].as_ref().expect("coloured rods are live"), bodies));
-        });
-        Group { driven, plain, rods }
+        let set_socket = |block: &mut SocketBlock, lane: usize, slot: usize| {
+            block.set(lane, &socket_lane(socket(slot), bodies))
+        };
+        let driven = self
+            .sockets
+            .append(driven, SocketBlock::padding(), set_socket);
+        let plain = self
+            .sockets
+            .append(plain, SocketBlock::padding(), set_socket);
+        let rod_slots = keys
+            .iter()
+            .filter(|&&k| k >= ROD_KEY)
+            .map(|&k| (k - ROD_KEY) as usize);
+        let rods = self
+            .rods
+            .append(rod_slots, RodBlock::padding(), |block, lane, slot| {
+                block.set(
+                    lane,
+                    &rod_lane(rods[slot].as_ref().expect("coloured rods are live"), bodies),
+                );
+            });
+        Group {
+            driven,
+            plain,
+            rods,
+        }
     }
 }
 
@@ -140,7 +178,9 @@ pub(crate) fn socket_lane(desc: &SocketDesc, bodies: &BodyStore) -> SocketLane {
         frame_b: desc.frame_b.normalize(),
         swing_max: desc.swing_limit.unwrap_or(PI),
         twist: desc.twist_limit.unwrap_or([-PI, PI]),
-        drive: desc.drive.map(|d| (d.target.normalize(), d.compliance, d.damping)),
+        drive: desc
+            .drive
+            .map(|d| (d.target.normalize(), d.compliance, d.damping)),
     }
 }
 

@@ -225,8 +225,14 @@ impl World {
         if !self.rod_slots.remove(handle) {
             return Err(Error::StaleHandle("rod"));
         }
-        let desc = self.rods[handle.index()].take().expect("live rod has a description");
-        self.disconnect(handle.index() as u64 + layout::ROD_KEY, desc.body_a, desc.body_b);
+        let desc = self.rods[handle.index()]
+            .take()
+            .expect("live rod has a description");
+        self.disconnect(
+            handle.index() as u64 + layout::ROD_KEY,
+            desc.body_a,
+            desc.body_b,
+        );
         Ok(())
     }
 
@@ -240,7 +246,9 @@ impl World {
 
     /// Colours a new joint and counts it at its bodies.
     fn connect(&mut self, key: u64, a: BodyHandle, b: BodyHandle) {
-        let dynamic = |h: BodyHandle| (self.bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32);
+        let dynamic = |h: BodyHandle| {
+            (self.bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
+        };
         let bodies = [dynamic(a), dynamic(b)];
         self.colouring.add(key, bodies);
         self.joints_at[a.index()] += 1;
@@ -318,7 +326,8 @@ impl World {
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         if self.layout_dirty {
-            self.layout = layout::Layout::build(&self.colouring, &self.sockets, &self.rods, &self.bodies);
+            self.layout =
+                layout::Layout::build(&self.colouring, &self.sockets, &self.rods, &self.bodies);
             self.layout_dirty = false;
         }
         step::step(self, dt);

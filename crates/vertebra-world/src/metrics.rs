@@ -39,14 +39,25 @@ pub struct Residuals {
 }
 
 /// Per-lane residuals to per-joint ones, in slot order.
-fn collect<H>(lane_slot: &[u32], per_lane: &[[f32; 2]], handle: impl Fn(usize) -> Option<H>) -> Vec<JointResidual<H>> {
+fn collect<H>(
+    lane_slot: &[u32],
+    per_lane: &[[f32; 2]],
+    handle: impl Fn(usize) -> Option<H>,
+) -> Vec<JointResidual<H>> {
     let mut joints: Vec<(u32, JointResidual<H>)> = lane_slot
         .iter()
         .zip(per_lane)
         .filter(|(slot, _)| **slot != EMPTY)
         .map(|(&slot, &[lin, ang])| {
             let joint = handle(slot as usize).expect("laid-out joints are live");
-            (slot, JointResidual { joint, linear_cm: lin * 100.0, angular_rad: ang })
+            (
+                slot,
+                JointResidual {
+                    joint,
+                    linear_cm: lin * 100.0,
+                    angular_rad: ang,
+                },
+            )
         })
         .collect();
     joints.sort_by_key(|j| j.0);
@@ -56,14 +67,37 @@ fn collect<H>(lane_slot: &[u32], per_lane: &[[f32; 2]], handle: impl Fn(usize) -
 pub(crate) fn residuals(world: &World) -> Residuals {
     let (sockets, rods, rows) = (&world.layout.sockets, &world.layout.rods, &world.rows);
     let mut socket_lanes = vec![[0.0f32; 2]; sockets.blocks.len() * BLOCK_LANES];
-    world.backend.dispatch(ResidualPass { blocks: &sockets.blocks, rows, out: &mut socket_lanes });
+    world.backend.dispatch(ResidualPass {
+        blocks: &sockets.blocks,
+        rows,
+        out: &mut socket_lanes,
+    });
     let mut rod_lanes = vec![[0.0f32; 2]; rods.blocks.len() * BLOCK_LANES];
-    world.backend.dispatch(rod::ResidualPass { blocks: &rods.blocks, rows, out: &mut rod_lanes });
-    let sockets = collect(&sockets.lane_slot, &socket_lanes, |s| world.socket_slots.handle_at(s));
-    let rods = collect(&rods.lane_slot, &rod_lanes, |s| world.rod_slots.handle_at(s));
-    let lin = sockets.iter().map(|j| j.linear_cm).chain(rods.iter().map(|j| j.linear_cm));
-    let ang = sockets.iter().map(|j| j.angular_rad).chain(rods.iter().map(|j| j.angular_rad));
-    Residuals { eps_lin_cm: lin.sum(), eps_ang_rad: ang.sum(), sockets, rods }
+    world.backend.dispatch(rod::ResidualPass {
+        blocks: &rods.blocks,
+        rows,
+        out: &mut rod_lanes,
+    });
+    let sockets = collect(&sockets.lane_slot, &socket_lanes, |s| {
+        world.socket_slots.handle_at(s)
+    });
+    let rods = collect(&rods.lane_slot, &rod_lanes, |s| {
+        world.rod_slots.handle_at(s)
+    });
+    let lin = sockets
+        .iter()
+        .map(|j| j.linear_cm)
+        .chain(rods.iter().map(|j| j.linear_cm));
+    let ang = sockets
+        .iter()
+        .map(|j| j.angular_rad)
+        .chain(rods.iter().map(|j| j.angular_rad));
+    Residuals {
+        eps_lin_cm: lin.sum(),
+        eps_ang_rad: ang.sum(),
+        sockets,
+        rods,
+    }
 }
 
 /// xxh3 over the bits of every live body's slot, position, orientation and

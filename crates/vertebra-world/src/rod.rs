@@ -5,7 +5,9 @@ use core::f32::consts::PI;
 
 use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
-use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec};
+use vertebra_store::{
+    BodyHandle, BodyKind, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
+};
 
 /// Marker for rod handles.
 #[derive(Debug)]
@@ -77,7 +79,12 @@ impl RodDesc {
     /// Errors: stale handles, non-finite points, ends closer than 1e-4 m,
     /// and bones that bend the arc by pi or more (no chord-and-tangent rod
     /// can represent it).
-    pub fn from_pose(bodies: &BodyStore, body_a: BodyHandle, body_b: BodyHandle, through: &[Vec3]) -> Result<Self, Error> {
+    pub fn from_pose(
+        bodies: &BodyStore,
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        through: &[Vec3],
+    ) -> Result<Self, Error> {
         if body_a == body_b {
             return Err(Error::SameBody);
         }
@@ -98,7 +105,9 @@ impl RodDesc {
         // The tangent-chord angle is half the arc's angle.
         let psi = 2.0 * ta.angle_between(o);
         if psi >= PI - 1e-3 {
-            return Err(Error::InvalidLimit("bend: the bones bend the arc by pi or more"));
+            return Err(Error::InvalidLimit(
+                "bend: the bones bend the arc by pi or more",
+            ));
         }
         let tb = 2.0 * ta.dot(o) * o - ta;
         let rest_length = chord.length() / (2.0 * half_sinc(psi));
@@ -150,7 +159,10 @@ impl RodDesc {
         if !self.twist_rest.is_finite() {
             return Err(Error::NonFinite("rod rest twist"));
         }
-        for (what, s) in [("rod bending", self.bending), ("rod twisting", self.twisting)] {
+        for (what, s) in [
+            ("rod bending", self.bending),
+            ("rod twisting", self.twisting),
+        ] {
             match s {
                 RodStiffness::Kirchhoff(k) if k.is_nan() => return Err(Error::NonFinite(what)),
                 RodStiffness::Kirchhoff(k) if k < 0.0 => return Err(Error::NonPositive(what)),
@@ -208,7 +220,9 @@ pub fn arc_tangent(a: Vec3, m: Vec3, b: Vec3) -> Option<Vec3> {
         return None;
     }
     // Circumcentre: a + (|u|^2 (v x w) + |v|^2 (w x u)) / (2 |w|^2).
-    let centre = a + (u.length_squared() * v.cross(w) + v.length_squared() * w.cross(u)) / (2.0 * w.length_squared());
+    let centre = a
+        + (u.length_squared() * v.cross(w) + v.length_squared() * w.cross(u))
+            / (2.0 * w.length_squared());
     let t = w.cross(a - centre).normalize();
     Some(if t.dot(u) >= 0.0 { t } else { -t })
 }

@@ -23,7 +23,12 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         for block in &mut world.layout.sockets.blocks {
             block.drive_lambda = vertebra_math::block::Vec3Block::default();
         }
-        world.layout.rods.blocks.iter_mut().for_each(RodBlock::reset_lambdas);
+        world
+            .layout
+            .rods
+            .blocks
+            .iter_mut()
+            .for_each(RodBlock::reset_lambdas);
         for _ in 0..world.config.iterations {
             solve_positions(world, h);
         }
@@ -138,23 +143,36 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
     let pool = world.pool.take();
     let min_blocks = world.config.parallel_min_blocks;
     let layout = &mut world.layout;
-    let groups: Vec<_> = layout.colours.iter().map(|g| (g.clone(), world.backend)).collect();
+    let groups: Vec<_> = layout
+        .colours
+        .iter()
+        .map(|g| (g.clone(), world.backend))
+        .collect();
     let overflow = (layout.overflow.clone(), Backend::Scalar);
     let rows = &world.rows;
     for (group, backend) in groups.into_iter().chain(core::iter::once(overflow)) {
         let parallel = pool.as_ref().filter(|_| backend != Backend::Scalar);
         for (range, driven) in [(group.driven, true), (group.plain, false)] {
             let blocks = &mut layout.sockets.blocks[range];
-            chunked(parallel, min_blocks, blocks, |c| pass.sockets(c, driven, rows, backend));
+            chunked(parallel, min_blocks, blocks, |c| {
+                pass.sockets(c, driven, rows, backend)
+            });
         }
         let blocks = &mut layout.rods.blocks[group.rods];
-        chunked(parallel, min_blocks, blocks, |c| pass.rods(c, rows, backend));
+        chunked(parallel, min_blocks, blocks, |c| {
+            pass.rods(c, rows, backend)
+        });
     }
     world.pool = pool;
 }
 
 /// Runs `run` on all `blocks`, split over `pool` when there are enough.
-fn chunked<B: Send>(pool: Option<&rayon::ThreadPool>, min_blocks: usize, blocks: &mut [B], run: impl Fn(&mut [B]) + Sync) {
+fn chunked<B: Send>(
+    pool: Option<&rayon::ThreadPool>,
+    min_blocks: usize,
+    blocks: &mut [B],
+    run: impl Fn(&mut [B]) + Sync,
+) {
     match pool {
         Some(pool) if blocks.len() >= min_blocks => {
             let chunk = blocks.len().div_ceil(pool.current_num_threads() * 2);
@@ -173,13 +191,25 @@ impl Pass for Positions {
     fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
         let inv_h2 = self.inv_h2;
         if driven {
-            backend.dispatch(PositionPass::<true> { blocks, rows, inv_h2 });
+            backend.dispatch(PositionPass::<true> {
+                blocks,
+                rows,
+                inv_h2,
+            });
         } else {
-            backend.dispatch(PositionPass::<false> { blocks, rows, inv_h2 });
+            backend.dispatch(PositionPass::<false> {
+                blocks,
+                rows,
+                inv_h2,
+            });
         }
     }
     fn rods(&self, blocks: &mut [RodBlock], rows: &BodyRows, backend: Backend) {
-        backend.dispatch(rod::PositionPass { blocks, rows, inv_h2: self.inv_h2 });
+        backend.dispatch(rod::PositionPass {
+            blocks,
+            rows,
+            inv_h2: self.inv_h2,
+        });
     }
 }
 
@@ -191,14 +221,23 @@ struct Velocities {
 impl Pass for Velocities {
     fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
         if driven {
-            backend.dispatch(VelocityPass { blocks, rows, h: self.h });
+            backend.dispatch(VelocityPass {
+                blocks,
+                rows,
+                h: self.h,
+            });
         }
     }
     fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
 }
 
 fn solve_positions(world: &mut World, h: f32) {
-    for_each_colour(world, &Positions { inv_h2: 1.0 / (h * h) });
+    for_each_colour(
+        world,
+        &Positions {
+            inv_h2: 1.0 / (h * h),
+        },
+    );
 }
 
 fn solve_velocities(world: &mut World, h: f32) {

@@ -1,11 +1,14 @@
-//! Whole worlds are bit-identical across backends and thread counts.
+//! Whole worlds of sockets and rods are bit-identical across backends and
+//! thread counts.
 
 mod common;
 
 use common::capsule;
 use glam::{Quat, Vec3};
 use vertebra_math::Backend;
-use vertebra_world::{AngularDrive, BackendChoice, BodyDesc, SocketDesc, SolverConfig, World};
+use vertebra_world::{
+    AngularDrive, BackendChoice, BodyDesc, RodDesc, RodStiffness, SocketDesc, SolverConfig, World,
+};
 
 /// 30 branching chains (hundreds of bodies and sockets, several colours),
 /// plus a hub body with 30 sockets so that the overflow set is used, some
@@ -49,6 +52,34 @@ fn build(backend: Backend, threads: usize) -> World {
             parents = next;
         }
     }
+    // Rods: a spine-like rod from each tree's top body to a new body above
+    // it, bent, with limits and stiffness (some as relaxation factors).
+    let tops: Vec<_> = (0..w.bodies().capacity())
+        .filter_map(|i| w.bodies().handle_at(i))
+        .skip(1)
+        .step_by(9)
+        .collect();
+    for (k, &top) in tops.iter().enumerate() {
+        let p = w.body(top).unwrap().position;
+        let chest = capsule(
+            &mut w,
+            p + Vec3::new(0.1, 0.45, 0.0),
+            p + Vec3::new(0.1, 0.55, 0.0),
+            3.0,
+        );
+        let bones = [p + Vec3::new(0.08, 0.25, 0.02)];
+        let stiffness = if k % 2 == 0 {
+            RodStiffness::Kirchhoff(2.0)
+        } else {
+            RodStiffness::Relaxation(0.3)
+        };
+        let rod = RodDesc::from_pose(w.bodies(), top, chest, &bones)
+            .unwrap()
+            .with_stiffness(stiffness, RodStiffness::Kirchhoff(2.0))
+            .with_bend_limit(1.0)
+            .with_twist_limit(-0.5, 0.5);
+        w.add_rod(rod).unwrap();
+    }
     // The hub: 30 spokes on one dynamic body exceed the 24 colours.
     let hub = capsule(
         &mut w,
@@ -88,6 +119,11 @@ fn the_world_uses_many_colours_and_the_overflow_set() {
     let mut w = w;
     w.step(1.0 / 60.0).unwrap();
     assert!(w.residuals().sockets.len() > 200);
+    assert!(
+        w.residuals().rods.len() >= 10,
+        "rods: {}",
+        w.residuals().rods.len()
+    );
     assert!(w.colour_count() >= 3, "colours: {}", w.colour_count());
     assert!(w.overflow_count() >= 6, "overflow: {}", w.overflow_count());
 }

@@ -31,15 +31,28 @@ impl<L: Lane> Softness<L> {
     /// A hard part.
     #[inline(always)]
     pub fn hard() -> Self {
-        Self { alpha_tilde: L::splat(0.0), relaxation: L::splat(1.0) }
+        Self {
+            alpha_tilde: L::splat(0.0),
+            relaxation: L::splat(1.0),
+        }
     }
 }
 
 /// Applies the correction with the same axis on both bodies; returns
 /// `dlambda`.
 #[inline(always)]
-pub fn correct<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, n: Vec3<L>, c: L, alpha_tilde: L, lambda: L) -> L {
-    let soft = Softness { alpha_tilde, relaxation: L::splat(1.0) };
+pub fn correct<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    n: Vec3<L>,
+    c: L,
+    alpha_tilde: L,
+    lambda: L,
+) -> L {
+    let soft = Softness {
+        alpha_tilde,
+        relaxation: L::splat(1.0),
+    };
     correct_axes(a, b, n, n, c, soft, lambda)
 }
 
@@ -56,7 +69,10 @@ pub fn correct_axes<L: Lane>(
     lambda: L,
 ) -> L {
     let w = a.angular_weight(n_a) + b.angular_weight(n_b);
-    let dlambda = safe_ratio(-soft.relaxation * c - soft.alpha_tilde * lambda, w + soft.alpha_tilde);
+    let dlambda = safe_ratio(
+        -soft.relaxation * c - soft.alpha_tilde * lambda,
+        w + soft.alpha_tilde,
+    );
     b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
     a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
     dlambda

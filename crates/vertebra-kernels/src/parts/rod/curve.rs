@@ -56,7 +56,12 @@ pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>) -> Cu
     let along = f.ta.scale(e.dot(o)) + e.scale(ta_o);
     let across = along - o.scale(along.dot(o));
     let g = across.scale(-safe_ratio(two, distance));
-    Curve { theta, n_a: o.scale(two * n.dot(o)) - n, n_b: n, g: Vec3::select(apart, g, Vec3::zero()) }
+    Curve {
+        theta,
+        n_a: o.scale(two * n.dot(o)) - n,
+        n_b: n,
+        g: Vec3::select(apart, g, Vec3::zero()),
+    }
 }
 
 /// Moves and turns the bodies toward an admissible arc; returns the error
@@ -64,7 +69,9 @@ pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>) -> Cu
 #[inline(always)]
 pub fn solve<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, f: &Frames<L>) -> L {
     let c = measure(a, b, f);
-    let w = a.angular_weight(c.n_a) + b.angular_weight(c.n_b) + c.g.length_squared() * (a.inv_mass + b.inv_mass);
+    let w = a.angular_weight(c.n_a)
+        + b.angular_weight(c.n_b)
+        + c.g.length_squared() * (a.inv_mass + b.inv_mass);
     let dlambda = safe_ratio(-c.theta, w);
     b.rotate(b.inv_inertia_mul(c.n_b.scale(dlambda)));
     a.rotate(a.inv_inertia_mul(c.n_a.scale(-dlambda)));

@@ -22,7 +22,12 @@ pub fn chord<L: Lane>(rest_length: L, psi: L) -> L {
 
 /// The chord direction `o` and the length error `C` (m).
 #[inline(always)]
-pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>, rest_length: L) -> (Vec3<L>, L) {
+pub fn measure<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    f: &Frames<L>,
+    rest_length: L,
+) -> (Vec3<L>, L) {
     let (o, distance) = (b.p - a.p).normalize_or_zero();
     let (_, psi) = bend_angle(f.ta, f.tb);
     (o, distance - chord(rest_length, psi))
@@ -31,7 +36,12 @@ pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>, rest_
 /// Moves the bodies along the chord to the arc's length; returns the error
 /// before the correction (m).
 #[inline(always)]
-pub fn solve<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, f: &Frames<L>, rest_length: L) -> L {
+pub fn solve<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    f: &Frames<L>,
+    rest_length: L,
+) -> L {
     let (o, c) = measure(a, b, f, rest_length);
     let dlambda = safe_ratio(-c, a.inv_mass + b.inv_mass);
     b.p += o.scale(dlambda * b.inv_mass);

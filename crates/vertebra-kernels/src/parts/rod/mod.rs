@@ -33,10 +33,20 @@ pub struct Frames<L> {
 
 /// Measures the material frames at the bodies' current orientations.
 #[inline(always)]
-pub fn frames<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, frame_a: Quat<L>, frame_b: Quat<L>) -> Frames<L> {
+pub fn frames<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+) -> Frames<L> {
     let x = Vec3::splat(crate::TWIST_AXIS);
     let (fa, fb) = (a.q * frame_a, b.q * frame_b);
-    Frames { fa, fb, ta: fa.rotate(x), tb: fb.rotate(x) }
+    Frames {
+        fa,
+        fb,
+        ta: fa.rotate(x),
+        tb: fb.rotate(x),
+    }
 }
 
 /// The bend axis (unit, or zero when straight or folded back) and the bend

@@ -33,8 +33,14 @@ use crate::parts::twist::excess;
 /// is undefined there, and the limits keep rods well away from it.
 #[inline(always)]
 pub fn axes<L: Lane>(f: &Frames<L>) -> (Vec3<L>, Vec3<L>) {
-    let k = f.ta.cross(f.tb).scale(safe_ratio(L::splat(1.0), L::splat(1.0) + f.ta.dot(f.tb)));
-    let k = Vec3::select((L::splat(1.0) + f.ta.dot(f.tb)).gt(L::splat(1e-6)), k, Vec3::zero());
+    let k =
+        f.ta.cross(f.tb)
+            .scale(safe_ratio(L::splat(1.0), L::splat(1.0) + f.ta.dot(f.tb)));
+    let k = Vec3::select(
+        (L::splat(1.0) + f.ta.dot(f.tb)).gt(L::splat(1e-6)),
+        k,
+        Vec3::zero(),
+    );
     (f.ta - f.ta.cross(k), f.tb + f.tb.cross(k))
 }
 
@@ -65,7 +71,13 @@ pub fn solve<L: Lane>(
 
 /// Enforces `lo <= tau <= hi`; returns |excess| before the correction.
 #[inline(always)]
-pub fn limit<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, f: &Frames<L>, lo: L, hi: L) -> L {
+pub fn limit<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    f: &Frames<L>,
+    lo: L,
+    hi: L,
+) -> L {
     let e = excess(measure(f), lo, hi);
     let (n_a, n_b) = axes(f);
     angle::correct_axes(a, b, n_a, n_b, e, Softness::hard(), L::splat(0.0));

@@ -1,0 +1,133 @@
+//! Random and adversarial scenes shared by the kernels' cross-backend tests.
+#![allow(dead_code)]
+
+use glam::{Mat3, Quat, Vec3};
+use rand::RngExt;
+use rand::rngs::StdRng;
+use vertebra_kernels::body::BodyRows;
+use vertebra_math::Backend;
+use vertebra_math::check::same_bits;
+
+/// Body rows as plain floats: pose, inverse inertia, velocity.
+pub type RawRows = Vec<[[f32; 8]; 3]>;
+
+pub fn unit_quat(r: &mut StdRng) -> Quat {
+    Quat::from_xyzw(
+        r.random_range(-1.0..1.0),
+        r.random_range(-1.0..1.0),
+        r.random_range(-1.0..1.0),
+        r.random_range(-1.0..1.0),
+    )
+    .normalize()
+}
+
+pub fn vec(r: &mut StdRng, scale: f32) -> Vec3 {
+    Vec3::new(
+        r.random_range(-scale..scale),
+        r.random_range(-scale..scale),
+        r.random_range(-scale..scale),
+    )
+}
+
+/// A random symmetric positive definite inverse inertia.
+pub fn inverse_inertia(r: &mut StdRng) -> Mat3 {
+    let q = Mat3::from_quat(unit_quat(r));
+    let d = Vec3::new(
+        r.random_range(0.1..50.0),
+        r.random_range(0.1..50.0),
+        r.random_range(0.1..50.0),
+    );
+    q * Mat3::from_diagonal(d) * q.transpose()
+}
+
+/// Rows for `lanes` joints with two own bodies each, plus `statics` fixed
+/// bodies at the end (row 0 is the null row). `adversarial` adds zero
+/// masses and identity orientations.
+pub fn rows(r: &mut StdRng, lanes: usize, statics: usize, adversarial: bool) -> RawRows {
+    let bodies = lanes * 2 + statics;
+    let mut rows = vec![[[0.0f32; 8]; 3]; bodies + 1];
+    rows[0] = [
+        BodyRows::pose_row(Vec3::ZERO, 0.0, Quat::IDENTITY),
+        [0.0; 8],
+        [0.0; 8],
+    ];
+    for (i, row) in rows.iter_mut().enumerate().skip(1) {
+        let fixed = i > bodies - statics || (adversarial && r.random_bool(0.1));
+        let inv_mass = if fixed {
+            0.0
+        } else {
+            r.random_range(0.01..10.0)
+        };
+        let inertia = if fixed {
+            Mat3::ZERO
+        } else {
+            inverse_inertia(r)
+        };
+        let q = if adversarial && r.random_bool(0.2) {
+            Quat::IDENTITY
+        } else {
+            unit_quat(r)
+        };
+        *row = [
+            BodyRows::pose_row(vec(r, 3.0), inv_mass, q),
+            BodyRows::inertia_row(inertia),
+            BodyRows::velocity_row(vec(r, 5.0), vec(r, 5.0)),
+        ];
+    }
+    rows
+}
+
+/// The two body rows of joint `lane` (its own, or a static one on one
+/// side), as the colouring allows: a written row is used by one lane only.
+pub fn lane_bodies(r: &mut StdRng, rows: &RawRows, lane: usize, statics: usize) -> (u32, u32) {
+    let own = |k: usize| (1 + lane * 2 + k) as u32;
+    let static_row = (rows.len() - 1 - r.random_range(0..statics)) as u32;
+    match r.random_range(0..4) {
+        0 => (static_row, own(1)),
+        1 => (own(0), static_row),
+        _ => (own(0), own(1)),
+    }
+}
+
+/// Whether a row's body is dynamic.
+pub fn dynamic(rows: &RawRows, row: u32) -> bool {
+    rows[row as usize][0][3] > 0.0
+}
+
+pub fn to_rows(raw: &RawRows) -> BodyRows {
+    let rows = BodyRows::with_bodies(raw.len() - 1);
+    for (i, r) in raw.iter().enumerate() {
+        rows.pose[i].set(r[0]);
+        rows.inertia[i].set(r[1]);
+        rows.velocity[i].set(r[2]);
+    }
+    rows
+}
+
+/// Every row's pose and velocity, flattened.
+pub fn flatten(rows: &BodyRows) -> Vec<f32> {
+    let mut out = Vec::new();
+    for i in 0..rows.pose.len() {
+        out.extend(rows.pose[i].get());
+        out.extend(rows.velocity[i].get());
+    }
+    out
+}
+
+/// Runs `run` on every backend and compares with the scalar reference.
+pub fn assert_backends_agree(seed: u64, run: impl Fn(Backend) -> Vec<f32>) {
+    let expected = run(Backend::Scalar);
+    assert!(
+        expected.iter().all(|x| x.is_finite()),
+        "seed {seed}: the scalar reference produced a non-finite value"
+    );
+    for backend in Backend::available() {
+        let actual = run(backend);
+        if let Some(k) = (0..expected.len()).find(|&k| !same_bits(expected[k], actual[k])) {
+            panic!(
+                "seed {seed}: {backend} differs at float {k}: {:e} vs scalar {:e}",
+                actual[k], expected[k]
+            );
+        }
+    }
+}

@@ -1,0 +1,149 @@
+//! The rod kernel gives the scalar reference's bits on every backend, for
+//! random and adversarial rods: straight, folded back, coincident ends,
+//! huge and tiny stiffness, relaxation and compliance.
+
+mod common;
+
+use common::{
+    RawRows, assert_backends_agree, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat,
+};
+use glam::{Quat, Vec3};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use vertebra_kernels::rod::{PositionPass, ResidualPass, RodBlock, RodLane, RodSoftness};
+use vertebra_math::Backend;
+use vertebra_math::block::BLOCK_LANES;
+
+const STATICS: usize = 4;
+
+fn softness(r: &mut StdRng) -> RodSoftness {
+    match r.random_range(0..5) {
+        0 => RodSoftness::Compliance(0.0),
+        1 => RodSoftness::Compliance(1e-9),
+        2 => RodSoftness::Compliance(1e9),
+        3 => RodSoftness::Relaxation(r.random_range(0.0..1.0)),
+        _ => RodSoftness::Compliance(r.random_range(0.0..0.5)),
+    }
+}
+
+fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>) {
+    let mut r = StdRng::seed_from_u64(seed);
+    let mut rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
+    let mut out = Vec::new();
+    for block_index in 0..blocks {
+        let mut block = RodBlock::padding();
+        for lane in 0..BLOCK_LANES {
+            if r.random_bool(0.1) {
+                continue;
+            }
+            let (body_a, body_b) =
+                lane_bodies(&mut r, &rows, block_index * BLOCK_LANES + lane, STATICS);
+            let mut frame_a = unit_quat(&mut r);
+            let mut frame_b = unit_quat(&mut r);
+            let pose = |rows: &RawRows, row: u32| rows[row as usize][0];
+            if adversarial {
+                let qa = Quat::from_slice(&pose(&rows, body_a)[4..]);
+                let qb = Quat::from_slice(&pose(&rows, body_b)[4..]);
+                match r.random_range(0..4) {
+                    // Straight: both tangents along the chord.
+                    0 => {
+                        let pa = Vec3::from_slice(&pose(&rows, body_a)[..3]);
+                        let pb = Vec3::from_slice(&pose(&rows, body_b)[..3]);
+                        let o = (pb - pa).normalize_or(Vec3::X);
+                        frame_a = qa.inverse() * Quat::from_rotation_arc(Vec3::X, o);
+                        frame_b = qb.inverse() * Quat::from_rotation_arc(Vec3::X, o);
+                    }
+                    // Folded back: t_b = -t_a.
+                    1 => {
+                        frame_b = qb.inverse()
+                            * qa
+                            * frame_a
+                            * Quat::from_rotation_y(core::f32::consts::PI)
+                    }
+                    // Coincident ends (only where b's row is its own).
+                    2 if dynamic(&rows, body_b) && body_b as usize <= blocks * BLOCK_LANES * 2 => {
+                        let pa: [f32; 3] = pose(&rows, body_a)[..3].try_into().unwrap();
+                        rows[body_b as usize][0][..3].copy_from_slice(&pa);
+                    }
+                    _ => {}
+                }
+            }
+            let pi = core::f32::consts::PI;
+            block.set(
+                lane,
+                &RodLane {
+                    body_a,
+                    body_b,
+                    dynamic_a: dynamic(&rows, body_a),
+                    dynamic_b: dynamic(&rows, body_b),
+                    frame_a,
+                    frame_b,
+                    rest_length: if adversarial && r.random_bool(0.1) {
+                        1e-6
+                    } else {
+                        r.random_range(0.1..2.0)
+                    },
+                    bend_rest: (Quat::from_rotation_z(r.random_range(0.0..2.0)) * Vec3::X)
+                        .normalize(),
+                    twist_rest: r.random_range(-0.5..0.5),
+                    bend: softness(&mut r),
+                    twist: softness(&mut r),
+                    bend_max: if r.random_bool(0.7) {
+                        r.random_range(0.0..pi)
+                    } else {
+                        pi
+                    },
+                    twist_range: if r.random_bool(0.7) {
+                        let lo = r.random_range(-3.0..0.5f32);
+                        [lo, r.random_range(lo..3.1)]
+                    } else {
+                        [-pi, pi]
+                    },
+                },
+            );
+        }
+        out.push(block);
+    }
+    (rows, out)
+}
+
+fn run(backend: Backend, raw: &RawRows, blocks: &[RodBlock]) -> Vec<f32> {
+    let rows = to_rows(raw);
+    let mut blocks = blocks.to_vec();
+    for _ in 0..4 {
+        backend.dispatch(PositionPass {
+            blocks: &mut blocks,
+            rows: &rows,
+            inv_h2: 3600.0,
+        });
+    }
+    let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+    backend.dispatch(ResidualPass {
+        blocks: &blocks,
+        rows: &rows,
+        out: &mut residual,
+    });
+    let mut out = flatten(&rows);
+    for b in &blocks {
+        out.extend(b.bend_lambda);
+        out.extend(b.twist_lambda);
+    }
+    out.extend(residual.iter().flatten());
+    out
+}
+
+#[test]
+fn random_rods_agree_on_every_backend() {
+    for seed in 0..40 {
+        let (rows, blocks) = scene(seed, 6, false);
+        assert_backends_agree(seed, |b| run(b, &rows, &blocks));
+    }
+}
+
+#[test]
+fn adversarial_rods_agree_on_every_backend_and_stay_finite() {
+    for seed in 200..280 {
+        let (rows, blocks) = scene(seed, 6, true);
+        assert_backends_agree(seed, |b| run(b, &rows, &blocks));
+    }
+}
