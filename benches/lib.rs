@@ -3,6 +3,7 @@
 
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
 use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::map::{LaneMap, map_arrays};
@@ -191,6 +192,68 @@ impl SocketWorkload {
 
     /// The joints in the batch.
     pub fn sockets(&self) -> usize {
+        self.blocks.len() * BLOCK_LANES
+    }
+
+    /// A value that depends on the work (to keep it observable).
+    pub fn probe(&self) -> f32 {
+        self.rows.pose[1].get()[0]
+    }
+}
+
+/// A batch of rods laid out as [`SocketWorkload`]'s joints: each lane on
+/// its own two dynamic bodies, every rod bent, twisted and off its arc, with
+/// bending and twisting stiffness and both limits, so every part works.
+pub struct RodWorkload {
+    backend: Backend,
+    rows: BodyRows,
+    blocks: Vec<RodBlock>,
+}
+
+impl RodWorkload {
+    /// `rods` rods (a multiple of 8) on `backend`.
+    pub fn new(backend: Backend, rods: usize) -> Self {
+        let blocks = rods.div_ceil(BLOCK_LANES);
+        // The same bodies as the socket workload, so the costs compare.
+        let sockets = SocketWorkload::new(backend, blocks * BLOCK_LANES, false);
+        let mut out = vec![RodBlock::padding(); blocks];
+        for k in 0..blocks * BLOCK_LANES {
+            let lane = RodLane {
+                body_a: (2 * k + 1) as u32,
+                body_b: (2 * k + 2) as u32,
+                dynamic_a: true,
+                dynamic_b: true,
+                frame_a: GQuat::from_rotation_z(0.1),
+                frame_b: GQuat::from_rotation_z(0.5),
+                rest_length: 0.12,
+                bend_rest: GVec3::X,
+                twist_rest: 0.0,
+                bend: RodSoftness::Compliance(0.06),
+                twist: RodSoftness::Compliance(0.06),
+                bend_max: 0.3,
+                twist_range: [-0.1, 0.1],
+            };
+            out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
+        }
+        Self {
+            backend,
+            rows: sockets.rows,
+            blocks: out,
+        }
+    }
+
+    /// One position iteration over every rod.
+    pub fn iterate(&mut self) {
+        let (blocks, rows) = (&mut self.blocks, &self.rows);
+        self.backend.dispatch(rod::PositionPass {
+            blocks,
+            rows,
+            inv_h2: 3600.0,
+        });
+    }
+
+    /// The rods in the batch.
+    pub fn rods(&self) -> usize {
         self.blocks.len() * BLOCK_LANES
     }
 

@@ -169,7 +169,7 @@ fn bend_gradients_match_finite_differences() {
         let rest: Vec3<f32> =
             (GQuat::from_scaled_axis(unit(&mut r) * r.random_range(0.0..0.8)) * GVec3::X).into();
         let (n, angle) = bend::measure(&f(&a, &b, fa, fb), rest);
-        if angle < 0.05 || angle > 3.0 {
+        if !(0.05..=3.0).contains(&angle) {
             continue;
         }
         let c = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| bend::measure(&f(a, b, fa, fb), rest).1;

@@ -293,3 +293,77 @@ fn bad_configs_are_refused() {
         assert_eq!(result.is_ok(), backend.is_available(), "{backend}");
     }
 }
+
+#[test]
+fn bad_rods_are_refused() {
+    use vertebra_world::{RodDesc, RodStiffness};
+    // A rod between the first dynamic body and a new one above it.
+    let rod = |w: &mut World| -> Result<RodDesc, Error> {
+        let b = w.bodies().handle_at(1).unwrap();
+        let c =
+            w.add_body(BodyDesc::dynamic(unit_mass()).with_position(Vec3::new(0.0, 0.5, 0.0)))?;
+        RodDesc::from_pose(w.bodies(), b, c, &[])
+    };
+    rejected(Error::NotNormalized("rod frame a"), |w| {
+        let mut r = rod(w)?;
+        r.frame_a = Quat::from_xyzw(0.0, 0.0, 0.0, 3.0);
+        let result = w.add_rod(r).map(drop);
+        w.remove_body(r.body_b)?;
+        result
+    });
+    rejected(Error::NonPositive("rod rest length"), |w| {
+        let mut r = rod(w)?;
+        r.rest_length = -0.1;
+        let result = w.add_rod(r).map(drop);
+        w.remove_body(r.body_b)?;
+        result
+    });
+    rejected(
+        Error::InvalidLimit("relaxation factor (must be in [0, 1])"),
+        |w| {
+            let r =
+                rod(w)?.with_stiffness(RodStiffness::Relaxation(1.5), RodStiffness::Kirchhoff(1.0));
+            let result = w.add_rod(r).map(drop);
+            w.remove_body(r.body_b)?;
+            result
+        },
+    );
+    rejected(Error::NonPositive("rod bending"), |w| {
+        let r = rod(w)?.with_stiffness(RodStiffness::Kirchhoff(-2.0), RodStiffness::Kirchhoff(1.0));
+        let result = w.add_rod(r).map(drop);
+        w.remove_body(r.body_b)?;
+        result
+    });
+    rejected(Error::InvalidLimit("bend"), |w| {
+        let r = rod(w)?.with_bend_limit(4.0);
+        let result = w.add_rod(r).map(drop);
+        w.remove_body(r.body_b)?;
+        result
+    });
+    rejected(Error::DegenerateShape("the rod's ends coincide"), |w| {
+        let b = w.bodies().handle_at(1).unwrap();
+        let at = w.body(b)?.position;
+        let c = w.add_body(BodyDesc::dynamic(unit_mass()).with_position(at))?;
+        let result = RodDesc::from_pose(w.bodies(), b, c, &[]).map(drop);
+        w.remove_body(c)?;
+        result
+    });
+}
+
+#[test]
+fn a_body_with_a_rod_cannot_be_removed_until_the_rod_is() {
+    use vertebra_world::RodDesc;
+    let (mut w, _, b, _) = world();
+    let c = w
+        .add_body(BodyDesc::dynamic(unit_mass()).with_position(Vec3::new(0.0, 0.5, 0.0)))
+        .unwrap();
+    let rod = w
+        .add_rod(RodDesc::from_pose(w.bodies(), b, c, &[]).unwrap())
+        .unwrap();
+    assert_eq!(w.remove_body(c), Err(Error::BodyInUse));
+    w.remove_rod(rod).unwrap();
+    assert_eq!(w.remove_rod(rod), Err(Error::StaleHandle("rod")));
+    assert_eq!(w.rod(rod), Err(Error::StaleHandle("rod")));
+    w.remove_body(c).unwrap();
+    w.step(1.0 / 60.0).unwrap();
+}

@@ -9,7 +9,7 @@
 use std::hint::black_box;
 
 use iai_callgrind::{library_benchmark, library_benchmark_group, main};
-use vertebra_benches::SocketWorkload;
+use vertebra_benches::{RodWorkload, SocketWorkload};
 use vertebra_math::Backend;
 
 const BACKENDS: [Backend; 4] = [
@@ -42,5 +42,16 @@ fn socket_limits(mut work: SocketWorkload) -> f32 {
     black_box(work.probe())
 }
 
-library_benchmark_group!(name = socket; benchmarks = socket_limits_drive, socket_limits);
-main!(library_benchmark_groups = socket);
+fn rods(backend: usize) -> RodWorkload {
+    RodWorkload::new(BACKENDS[backend], 256)
+}
+
+#[library_benchmark]
+#[benches::backend(args = [0, 1, 2, 3], setup = rods)]
+fn rod(mut work: RodWorkload) -> f32 {
+    work.iterate();
+    black_box(work.probe())
+}
+
+library_benchmark_group!(name = joints; benchmarks = socket_limits_drive, socket_limits, rod);
+main!(library_benchmark_groups = joints);
