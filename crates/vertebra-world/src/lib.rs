@@ -236,6 +236,25 @@ impl World {
         Ok(())
     }
 
+    /// Changes a rod's rest shape, stiffness and limits in place (its bodies
+    /// must stay the same): how a powered ragdoll drives its spine.
+    pub fn set_rod(&mut self, handle: RodHandle, desc: RodDesc) -> Result<(), Error> {
+        let old = self.rod(handle)?;
+        if (old.body_a, old.body_b) != (desc.body_a, desc.body_b) {
+            return Err(Error::InvalidConfig("set_rod cannot change a rod's bodies"));
+        }
+        desc.validate_with(&self.bodies)?;
+        self.rods[handle.index()] = Some(desc);
+        if !self.layout_dirty {
+            let (block, lane) = self.layout.rods.place[handle.index()];
+            let block = &mut self.layout.rods.blocks[block];
+            let lambdas = (block.bend_lambda[lane], block.twist_lambda[lane]);
+            block.set(lane, &layout::rod_lane(&desc, &self.bodies));
+            (block.bend_lambda[lane], block.twist_lambda[lane]) = lambdas;
+        }
+        Ok(())
+    }
+
     /// A rod's description.
     pub fn rod(&self, handle: RodHandle) -> Result<RodDesc, Error> {
         if !self.rod_slots.contains(handle) {
@@ -309,6 +328,23 @@ impl World {
     /// the scalar kernel because their bodies used every colour).
     pub fn overflow_count(&self) -> usize {
         self.colouring.overflow().len()
+    }
+
+    /// Residual joint error of the current poses, without stepping (e.g.
+    /// right after building a ragdoll).
+    pub fn measure_residuals(&mut self) -> &Residuals {
+        self.refresh_layout();
+        step::upload(&self.bodies, &mut self.rows);
+        self.residuals = metrics::residuals(self);
+        &self.residuals
+    }
+
+    fn refresh_layout(&mut self) {
+        if self.layout_dirty {
+            self.layout =
+                layout::Layout::build(&self.colouring, &self.sockets, &self.rods, &self.bodies);
+            self.layout_dirty = false;
+        }
     }
 
     /// Residual joint error after the last step.

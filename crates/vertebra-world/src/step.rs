@@ -43,7 +43,7 @@ pub(crate) fn step(world: &mut World, dt: f32) {
 
 /// Rows for every slot (stale slots hold harmless old data: no joint
 /// references them).
-fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
+pub(crate) fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
     if rows.pose.len() != bodies.capacity() + 1 {
         *rows = BodyRows::with_bodies(bodies.capacity());
     }

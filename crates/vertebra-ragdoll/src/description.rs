@@ -1,0 +1,442 @@
+//! The ragdoll description format (`docs/ragdolls.md`): TOML with bodies as
+//! capsules, ball-and-socket joints with swing and twist limits, and an
+//! optional `[spine]` chain that the simplified ragdoll replaces by a rod.
+//! Units in the file: metres, kilograms, degrees; here: metres, kilograms,
+//! radians.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+use serde::Deserialize;
+
+use crate::error::RagdollError;
+
+/// The reference humanoid, shipped with the crate: 13 bodies, 12 joints,
+/// a 4-body spine.
+pub const REFERENCE_HUMANOID: &str = include_str!("../models/humanoid.toml");
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    name: String,
+    total_mass: Option<f32>,
+    body: Vec<RawBody>,
+    #[serde(default)]
+    joint: Vec<RawJoint>,
+    spine: Option<RawSpine>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBody {
+    name: String,
+    segment: [[f32; 3]; 2],
+    radius: f32,
+    mass: f32,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawJoint {
+    name: String,
+    parent: String,
+    child: String,
+    anchor: [f32; 3],
+    axis: [f32; 3],
+    swing: f32,
+    twist: [f32; 2],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSpine {
+    bodies: Vec<String>,
+    bend_limit: f32,
+    twist_limit: [f32; 2],
+    bend_stiffness: f32,
+    twist_stiffness: f32,
+}
+
+/// A body: a capsule in bind pose (world frame, identity orientation, so
+/// its centre of mass is the segment's midpoint).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyDef {
+    /// Unique name; also the animation bone's name.
+    pub name: String,
+    /// The capsule's core segment, bind pose, world (m).
+    pub segment: [Vec3; 2],
+    /// Capsule radius (m).
+    pub radius: f32,
+    /// Mass (kg).
+    pub mass: f32,
+}
+
+impl BodyDef {
+    /// The centre of mass at bind pose (m, world).
+    pub fn centre(&self) -> Vec3 {
+        (self.segment[0] + self.segment[1]) * 0.5
+    }
+}
+
+/// A ball-and-socket joint between a parent and a child body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointDef {
+    /// Unique name.
+    pub name: String,
+    /// Index of the parent body.
+    pub parent: usize,
+    /// Index of the child body.
+    pub child: usize,
+    /// The pivot at bind pose (m, world).
+    pub anchor: Vec3,
+    /// The twist axis at bind pose, from parent to child (unit, world).
+    pub axis: Vec3,
+    /// Swing cone half-angle (rad).
+    pub swing: f32,
+    /// Twist range (rad).
+    pub twist: [f32; 2],
+}
+
+/// The chain a rod replaces in the simplified ragdoll.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpineDef {
+    /// Body indices from the base (hips) to the top (chest).
+    pub bodies: Vec<usize>,
+    /// Indices of the chain's joints, in order.
+    pub joints: Vec<usize>,
+    /// Largest bend (rad).
+    pub bend_limit: f32,
+    /// Twist range (rad).
+    pub twist_limit: [f32; 2],
+    /// Kirchhoff bending stiffness (N m^2).
+    pub bend_stiffness: f32,
+    /// Kirchhoff twisting stiffness (N m^2).
+    pub twist_stiffness: f32,
+}
+
+/// A validated ragdoll description: names unique, joints a tree over the
+/// bodies rooted at body `root`, every number finite and in range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RagdollDesc {
+    /// The model's name.
+    pub name: String,
+    /// Bodies (and animation bones), in file order.
+    pub bodies: Vec<BodyDef>,
+    /// Joints, in file order.
+    pub joints: Vec<JointDef>,
+    /// The spine chain, if the file has one.
+    pub spine: Option<SpineDef>,
+    /// The body no joint has as its child.
+    pub root: usize,
+    /// For each body, the joint whose child it is (`None` for the root).
+    pub parent_joint: Vec<Option<usize>>,
+}
+
+fn finite(context: &str, field: &'static str, values: &[f32]) -> Result<(), RagdollError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(RagdollError::NonFinite {
+            context: context.to_owned(),
+            field,
+        })
+    }
+}
+
+fn range(context: &str, field: &'static str, ok: bool, reason: &str) -> Result<(), RagdollError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(RagdollError::OutOfRange {
+            context: context.to_owned(),
+            field,
+            reason: reason.to_owned(),
+        })
+    }
+}
+
+impl RagdollDesc {
+    /// The reference humanoid (`models/humanoid.toml`).
+    pub fn reference_humanoid() -> Self {
+        Self::from_toml(REFERENCE_HUMANOID).expect("the shipped reference humanoid is valid")
+    }
+
+    /// Parses and validates a description.
+    pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
+        let raw: RawFile = toml::from_str(text)
+            .map_err(|e| RagdollError::Syntax(e.to_string().trim().to_owned()))?;
+        let bodies = raw.body.iter().map(body).collect::<Result<Vec<_>, _>>()?;
+        let index = names(
+            &raw.body.iter().map(|b| b.name.as_str()).collect::<Vec<_>>(),
+            "body",
+        )?;
+        names(
+            &raw.joint
+                .iter()
+                .map(|j| j.name.as_str())
+                .collect::<Vec<_>>(),
+            "joint",
+        )?;
+        let joints = raw
+            .joint
+            .iter()
+            .map(|j| joint(j, &index))
+            .collect::<Result<Vec<_>, _>>()?;
+        let (root, parent_joint) = tree(&bodies, &joints)?;
+        let spine = raw
+            .spine
+            .as_ref()
+            .map(|s| spine(s, &index, &joints, &parent_joint))
+            .transpose()?;
+        if let Some(total) = raw.total_mass {
+            finite("ragdoll", "total_mass", &[total])?;
+            let sum: f32 = bodies.iter().map(|b| b.mass).sum();
+            range(
+                "ragdoll",
+                "total_mass",
+                (sum - total).abs() <= 1e-3 * total.abs().max(1.0),
+                &format!("is {total} but the bodies weigh {sum}"),
+            )?;
+        }
+        Ok(Self {
+            name: raw.name,
+            bodies,
+            joints,
+            spine,
+            root,
+            parent_joint,
+        })
+    }
+
+    /// The body index of `name`.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Total mass (kg).
+    pub fn total_mass(&self) -> f32 {
+        self.bodies.iter().map(|b| b.mass).sum()
+    }
+}
+
+fn names(names: &[&str], kind: &'static str) -> Result<HashMap<String, usize>, RagdollError> {
+    let mut index = HashMap::new();
+    for (i, &n) in names.iter().enumerate() {
+        if index.insert(n.to_owned(), i).is_some() {
+            return Err(RagdollError::DuplicateName {
+                kind,
+                name: n.to_owned(),
+            });
+        }
+    }
+    Ok(index)
+}
+
+fn body(b: &RawBody) -> Result<BodyDef, RagdollError> {
+    let context = format!("body `{}`", b.name);
+    finite(&context, "segment", b.segment.as_flattened())?;
+    finite(&context, "radius", &[b.radius])?;
+    finite(&context, "mass", &[b.mass])?;
+    range(&context, "mass", b.mass > 0.0, "must be positive")?;
+    range(&context, "radius", b.radius > 0.0, "must be positive")?;
+    Ok(BodyDef {
+        name: b.name.clone(),
+        segment: b.segment.map(Vec3::from),
+        radius: b.radius,
+        mass: b.mass,
+    })
+}
+
+fn joint(j: &RawJoint, index: &HashMap<String, usize>) -> Result<JointDef, RagdollError> {
+    let context = format!("joint `{}`", j.name);
+    let lookup = |field: &'static str, name: &str| {
+        index
+            .get(name)
+            .copied()
+            .ok_or_else(|| RagdollError::UnknownBody {
+                context: context.clone(),
+                field,
+                name: name.to_owned(),
+            })
+    };
+    let (parent, child) = (lookup("parent", &j.parent)?, lookup("child", &j.child)?);
+    finite(&context, "anchor", &j.anchor)?;
+    finite(&context, "axis", &j.axis)?;
+    finite(&context, "swing", &[j.swing])?;
+    finite(&context, "twist", &j.twist)?;
+    let axis = Vec3::from(j.axis);
+    if axis.length() <= 1e-6 {
+        return Err(RagdollError::ZeroAxis {
+            joint: j.name.clone(),
+        });
+    }
+    range(
+        &context,
+        "swing",
+        (0.0..=180.0).contains(&j.swing),
+        "must be in [0, 180] degrees",
+    )?;
+    let [lo, hi] = j.twist;
+    range(
+        &context,
+        "twist",
+        -180.0 <= lo && lo <= hi && hi <= 180.0,
+        "must be [min, max] within [-180, 180] degrees",
+    )?;
+    Ok(JointDef {
+        name: j.name.clone(),
+        parent,
+        child,
+        anchor: Vec3::from(j.anchor),
+        axis: axis.normalize(),
+        swing: j.swing.to_radians(),
+        twist: [lo.to_radians(), hi.to_radians()],
+    })
+}
+
+/// Checks the joints form one tree over all bodies; returns the root and
+/// each body's parent joint.
+fn tree(
+    bodies: &[BodyDef],
+    joints: &[JointDef],
+) -> Result<(usize, Vec<Option<usize>>), RagdollError> {
+    let mut parent_joint = vec![None; bodies.len()];
+    for (k, j) in joints.iter().enumerate() {
+        if j.parent == j.child {
+            return Err(RagdollError::NotATree(format!(
+                "joint `{}` joins `{}` to itself",
+                j.name, bodies[j.child].name
+            )));
+        }
+        if let Some(other) = parent_joint[j.child].replace(k) {
+            return Err(RagdollError::NotATree(format!(
+                "body `{}` is the child of both `{}` and `{}`",
+                bodies[j.child].name, joints[other].name, j.name
+            )));
+        }
+    }
+    // Every body must reach the root by parent links, without a cycle.
+    for start in 0..bodies.len() {
+        let (mut body, mut steps) = (start, 0);
+        while let Some(k) = parent_joint[body] {
+            body = joints[k].parent;
+            steps += 1;
+            if steps > bodies.len() {
+                return Err(RagdollError::NotATree(format!(
+                    "a cycle runs through body `{}`",
+                    bodies[start].name
+                )));
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..bodies.len())
+        .filter(|&b| parent_joint[b].is_none())
+        .collect();
+    match roots.as_slice() {
+        [root] => Ok((*root, parent_joint)),
+        [] => Err(RagdollError::NotATree("no root body".to_owned())),
+        many => Err(RagdollError::NotATree(format!(
+            "{} bodies have no parent ({}); one root is needed",
+            many.len(),
+            many.iter()
+                .map(|&b| format!("`{}`", bodies[b].name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))),
+    }
+}
+
+fn spine(
+    s: &RawSpine,
+    index: &HashMap<String, usize>,
+    joints: &[JointDef],
+    parent_joint: &[Option<usize>],
+) -> Result<SpineDef, RagdollError> {
+    let context = "[spine]";
+    let bodies = s
+        .bodies
+        .iter()
+        .map(|n| {
+            index
+                .get(n)
+                .copied()
+                .ok_or_else(|| RagdollError::UnknownBody {
+                    context: context.to_owned(),
+                    field: "bodies",
+                    name: n.clone(),
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    if bodies.len() < 2 {
+        return Err(RagdollError::SpineNotChain(
+            "needs at least two bodies".to_owned(),
+        ));
+    }
+    let mut chain = Vec::new();
+    for pair in bodies.windows(2) {
+        let joint = parent_joint[pair[1]]
+            .filter(|&k| joints[k].parent == pair[0])
+            .ok_or_else(|| {
+                RagdollError::SpineNotChain(format!(
+                    "no joint has parent `{}` and child `{}`",
+                    s.bodies[chain.len()],
+                    s.bodies[chain.len() + 1]
+                ))
+            })?;
+        chain.push(joint);
+    }
+    // The interior bodies disappear in the simplified ragdoll: nothing but
+    // the chain may hang from them.
+    for &interior in &bodies[1..bodies.len() - 1] {
+        if let Some(j) = joints
+            .iter()
+            .find(|j| j.parent == interior && !chain.iter().any(|&k| joints[k].name == j.name))
+        {
+            return Err(RagdollError::SpineNotChain(format!(
+                "joint `{}` hangs from an interior spine body; only the chain may",
+                j.name
+            )));
+        }
+    }
+    for (field, v) in [
+        ("bend_limit", s.bend_limit),
+        ("bend_stiffness", s.bend_stiffness),
+        ("twist_stiffness", s.twist_stiffness),
+    ] {
+        finite(context, field, &[v])?;
+    }
+    finite(context, "twist_limit", &s.twist_limit)?;
+    range(
+        context,
+        "bend_limit",
+        (0.0..=180.0).contains(&s.bend_limit),
+        "must be in [0, 180] degrees",
+    )?;
+    let [lo, hi] = s.twist_limit;
+    range(
+        context,
+        "twist_limit",
+        -180.0 <= lo && lo <= hi && hi <= 180.0,
+        "must be [min, max] within [-180, 180] degrees",
+    )?;
+    range(
+        context,
+        "bend_stiffness",
+        s.bend_stiffness >= 0.0,
+        "must not be negative",
+    )?;
+    range(
+        context,
+        "twist_stiffness",
+        s.twist_stiffness >= 0.0,
+        "must not be negative",
+    )?;
+    Ok(SpineDef {
+        bodies,
+        joints: chain,
+        bend_limit: s.bend_limit.to_radians(),
+        twist_limit: [lo.to_radians(), hi.to_radians()],
+        bend_stiffness: s.bend_stiffness,
+        twist_stiffness: s.twist_stiffness,
+    })
+}

@@ -1,0 +1,314 @@
+//! Building a ragdoll in a world: standard (every body and joint) or
+//! simplified (the spine chain replaced by one rod, paper section 6).
+
+use glam::{Quat, Vec3};
+use vertebra_world::{
+    BodyDesc, BodyHandle, RodDesc, RodHandle, RodStiffness, Shape, SocketDesc, SocketHandle, World,
+};
+
+use crate::description::RagdollDesc;
+use crate::error::RagdollError;
+use crate::pose::Pose;
+
+/// How the spine is simulated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SpineMode {
+    /// The standard ragdoll: every spine body and its socket joints.
+    Sockets,
+    /// The simplified ragdoll: the spine's interior bodies removed (their
+    /// mass split equally onto the two ends) and one rod between the ends.
+    Rod,
+}
+
+/// Options for [`Ragdoll::build`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildOptions {
+    /// Standard or simplified.
+    pub spine: SpineMode,
+    /// Opt-in stabilisation (after Jolt's `Ragdoll::Stabilize`, which
+    /// follows Strunk): the largest allowed mass ratio across a joint, and
+    /// between a body's largest and smallest principal inertia. `None`
+    /// keeps the file's masses.
+    pub stabilise: Option<f32>,
+}
+
+impl BuildOptions {
+    /// Standard or simplified, not stabilised.
+    pub fn new(spine: SpineMode) -> Self {
+        Self {
+            spine,
+            stabilise: None,
+        }
+    }
+}
+
+/// A ragdoll living in a [`World`]: the handles of its bodies and joints.
+#[derive(Clone, Debug)]
+pub struct Ragdoll {
+    pub(crate) desc: RagdollDesc,
+    pub(crate) options: BuildOptions,
+    /// Per described body: its handle, or `None` for a spine interior body
+    /// of a simplified ragdoll (an animation-only bone).
+    pub bodies: Vec<Option<BodyHandle>>,
+    /// Per described joint: its socket, or `None` for a spine joint of a
+    /// simplified ragdoll.
+    pub sockets: Vec<Option<SocketHandle>>,
+    /// The spine rod of a simplified ragdoll.
+    pub rod: Option<RodHandle>,
+    /// The rod as created (its rest shape), to return to after driving.
+    pub(crate) rod_rest: Option<RodDesc>,
+}
+
+/// Masses per described body for `options` (interior spine masses moved to
+/// the ends in rod mode; stabilised if asked), total unchanged.
+pub fn body_masses(desc: &RagdollDesc, options: &BuildOptions) -> Vec<f32> {
+    let mut masses: Vec<f32> = desc.bodies.iter().map(|b| b.mass).collect();
+    if let (SpineMode::Rod, Some(spine)) = (options.spine, &desc.spine) {
+        let (first, last) = (spine.bodies[0], *spine.bodies.last().expect("a chain"));
+        for &interior in &spine.bodies[1..spine.bodies.len() - 1] {
+            let half = masses[interior] / 2.0;
+            masses[first] += half;
+            masses[last] += half;
+            masses[interior] = 0.0;
+        }
+    }
+    if let Some(ratio) = options.stabilise {
+        stabilise_masses(desc, &mut masses, ratio);
+    }
+    masses
+}
+
+/// Moves mass across joints until no joint's heavier side outweighs its
+/// lighter side by more than `ratio` (total mass unchanged). Joints whose
+/// child was removed (mass 0) are skipped.
+fn stabilise_masses(desc: &RagdollDesc, masses: &mut [f32], ratio: f32) {
+    for _ in 0..64 {
+        let mut changed = false;
+        for j in &desc.joints {
+            let (a, b) = (masses[j.parent], masses[j.child]);
+            if a <= 0.0 || b <= 0.0 {
+                continue;
+            }
+            let (heavy, light) = if a > b {
+                (j.parent, j.child)
+            } else {
+                (j.child, j.parent)
+            };
+            if masses[heavy] > ratio * masses[light] * (1.0 + 1e-4) {
+                let sum = masses[heavy] + masses[light];
+                masses[light] = sum / (1.0 + ratio);
+                masses[heavy] = sum - masses[light];
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+}
+
+impl Ragdoll {
+    /// Creates the ragdoll at `pose`, at rest, or moving as the animation
+    /// did from `previous` (a pose `dt` seconds earlier) to `pose`. Every
+    /// joint holds exactly at creation; the rod is instantiated from the
+    /// pose and the spine bones between its ends. On error nothing is added
+    /// to the world.
+    pub fn build(
+        world: &mut World,
+        desc: &RagdollDesc,
+        options: BuildOptions,
+        pose: &Pose,
+        previous: Option<(&Pose, f32)>,
+    ) -> Result<Self, RagdollError> {
+        pose.validate(desc)?;
+        if let Some((p, dt)) = previous {
+            p.validate(desc)?;
+            if !(dt.is_finite() && dt > 0.0) {
+                return Err(RagdollError::BadPose(
+                    "the time between the two poses must be positive".to_owned(),
+                ));
+            }
+        }
+        let mut ragdoll = Self {
+            desc: desc.clone(),
+            options,
+            bodies: vec![None; desc.bodies.len()],
+            sockets: vec![None; desc.joints.len()],
+            rod: None,
+            rod_rest: None,
+        };
+        match ragdoll.populate(world, pose, previous) {
+            Ok(()) => Ok(ragdoll),
+            Err(e) => {
+                ragdoll.remove(world)?;
+                Err(e)
+            }
+        }
+    }
+
+    fn populate(
+        &mut self,
+        world: &mut World,
+        pose: &Pose,
+        previous: Option<(&Pose, f32)>,
+    ) -> Result<(), RagdollError> {
+        let desc = &self.desc;
+        let masses = body_masses(desc, &self.options);
+        let removed_joint = |k: usize| {
+            self.options.spine == SpineMode::Rod
+                && desc.spine.as_ref().is_some_and(|s| s.joints.contains(&k))
+        };
+        for (i, b) in desc.bodies.iter().enumerate() {
+            if masses[i] <= 0.0 {
+                continue; // an interior spine body of the simplified ragdoll
+            }
+            let centre = b.centre();
+            let shape = Shape::capsule(b.segment[0] - centre, b.segment[1] - centre, b.radius);
+            let mut props = shape.mass_properties_with_mass(masses[i])?;
+            if let Some(ratio) = self.options.stabilise {
+                props.inertia = clamp_inertia(props.inertia, ratio);
+            }
+            let (p, q) = pose.bones[i];
+            let (v, w) = previous.map_or((Vec3::ZERO, Vec3::ZERO), |(prev, dt)| {
+                velocities(prev.bones[i], (p, q), dt)
+            });
+            self.bodies[i] = Some(
+                world.add_body(
+                    BodyDesc::dynamic(props)
+                        .with_position(p)
+                        .with_orientation(q)
+                        .with_velocity(v, w),
+                )?,
+            );
+        }
+        for (k, j) in desc.joints.iter().enumerate() {
+            if removed_joint(k) {
+                continue;
+            }
+            let (a, b) = (
+                self.bodies[j.parent].expect("built"),
+                self.bodies[j.child].expect("built"),
+            );
+            // Joint frames from bind pose (bodies unrotated there): +X along
+            // the twist axis; limits are measured from bind pose.
+            let frame = Quat::from_rotation_arc(Vec3::X, j.axis);
+            let socket = SocketDesc {
+                body_a: a,
+                body_b: b,
+                anchor_a: j.anchor - desc.bodies[j.parent].centre(),
+                anchor_b: j.anchor - desc.bodies[j.child].centre(),
+                frame_a: frame,
+                frame_b: frame,
+                swing_limit: Some(j.swing),
+                twist_limit: Some(j.twist),
+                drive: None,
+            };
+            self.sockets[k] = Some(world.add_socket(socket)?);
+        }
+        if let (SpineMode::Rod, Some(spine)) = (self.options.spine, &desc.spine) {
+            let (first, last) = (spine.bodies[0], *spine.bodies.last().expect("a chain"));
+            let bones: Vec<Vec3> = spine.bodies[1..spine.bodies.len() - 1]
+                .iter()
+                .map(|&b| pose.bones[b].0)
+                .collect();
+            let rod = RodDesc::from_pose(
+                world.bodies(),
+                self.bodies[first].expect("built"),
+                self.bodies[last].expect("built"),
+                &bones,
+            )?
+            .with_stiffness(
+                RodStiffness::Kirchhoff(spine.bend_stiffness),
+                RodStiffness::Kirchhoff(spine.twist_stiffness),
+            )
+            .with_bend_limit(spine.bend_limit)
+            .with_twist_limit(spine.twist_limit[0], spine.twist_limit[1]);
+            self.rod = Some(world.add_rod(rod)?);
+            self.rod_rest = Some(rod);
+        }
+        Ok(())
+    }
+
+    /// Removes every joint and body of the ragdoll from `world`.
+    pub fn remove(&mut self, world: &mut World) -> Result<(), RagdollError> {
+        if let Some(rod) = self.rod.take() {
+            world.remove_rod(rod)?;
+        }
+        for socket in self.sockets.iter_mut().filter_map(Option::take) {
+            world.remove_socket(socket)?;
+        }
+        for body in self.bodies.iter_mut().filter_map(Option::take) {
+            world.remove_body(body)?;
+        }
+        Ok(())
+    }
+
+    /// Re-creates the ragdoll at `pose` (the transition from animation to
+    /// physics): the old bodies and joints go, new ones come, the rod
+    /// re-instantiated to hold exactly at the new pose. On error the
+    /// ragdoll is unchanged.
+    pub fn recreate(
+        &mut self,
+        world: &mut World,
+        pose: &Pose,
+        previous: Option<(&Pose, f32)>,
+    ) -> Result<(), RagdollError> {
+        pose.validate(&self.desc)?;
+        let fresh = Self::build(world, &self.desc.clone(), self.options, pose, previous)?;
+        let mut old = core::mem::replace(self, fresh);
+        old.remove(world)
+    }
+
+    /// The description it was built from.
+    pub fn description(&self) -> &RagdollDesc {
+        &self.desc
+    }
+
+    /// How it was built.
+    pub fn options(&self) -> BuildOptions {
+        self.options
+    }
+
+    /// Pairs of bodies that must never collide: every joint's (and the
+    /// rod's) two bodies.
+    pub fn non_colliding_pairs(&self) -> Vec<(BodyHandle, BodyHandle)> {
+        let mut pairs: Vec<_> = self
+            .desc
+            .joints
+            .iter()
+            .zip(&self.sockets)
+            .filter(|(_, s)| s.is_some())
+            .map(|(j, _)| {
+                (
+                    self.bodies[j.parent].expect("built"),
+                    self.bodies[j.child].expect("built"),
+                )
+            })
+            .collect();
+        if let (Some(rest), Some(_)) = (self.rod_rest, self.rod) {
+            pairs.push((rest.body_a, rest.body_b));
+        }
+        pairs
+    }
+}
+
+/// Velocities that carry `from` to `to` in `dt` seconds.
+fn velocities(from: (Vec3, Quat), to: (Vec3, Quat), dt: f32) -> (Vec3, Vec3) {
+    let turn = vertebra_math::Quat::<f32>::from(to.1 * from.1.conjugate());
+    (
+        (to.0 - from.0) / dt,
+        Vec3::from(turn.to_rotation_vector()) / dt,
+    )
+}
+
+/// Raises the smaller principal moments of a diagonal inertia to at least
+/// the largest divided by `ratio` (capsules along a body axis are
+/// diagonal; a tilted capsule's tensor is left as it is).
+fn clamp_inertia(inertia: glam::Mat3, ratio: f32) -> glam::Mat3 {
+    let off = [inertia.x_axis.y, inertia.x_axis.z, inertia.y_axis.z];
+    if off.iter().any(|x| x.abs() > 1e-6 * inertia.x_axis.x) {
+        return inertia;
+    }
+    let d = inertia.diagonal();
+    glam::Mat3::from_diagonal(d.max(Vec3::splat(d.max_element() / ratio)))
+}
