@@ -5,6 +5,37 @@
 //! result back onto an animation skeleton that has more bones than the
 //! ragdoll has bodies. The format and the mapping modes are documented in
 //! `docs/ragdolls.md`.
+//!
+//! How an engine wires it in, once per character:
+//!
+//! ```
+//! use vertebra_ragdoll::{
+//!     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMapping, SpineMode, Strength,
+//! };
+//! use vertebra_world::{SolverConfig, World};
+//!
+//! # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
+//! let desc = RagdollDesc::reference_humanoid(); // or RagdollDesc::from_toml(&file_text)?
+//! let mut world = World::new(SolverConfig::default())?;
+//!
+//! // The transition from animation to physics: the last two animation
+//! // poses give the ragdoll its pose and its velocities.
+//! let previous = Pose::bind(&desc);
+//! let current = previous.moved(glam::Vec3::ZERO, glam::Quat::IDENTITY, glam::Vec3::new(0.0, 0.0, 0.01));
+//! let ragdoll = Ragdoll::build(&mut world, &desc, BuildOptions::new(SpineMode::Rod), &current, Some((&previous, 1.0 / 60.0)))?;
+//!
+//! // Optionally powered: follow the animation with stiff joints.
+//! ragdoll.drive_to(&mut world, &current, &DriveSettings::uniform(Strength::Compliance(1e-3)))?;
+//!
+//! for _ in 0..60 {
+//!     world.step(1.0 / 60.0)?;
+//!     // Every animation bone, the spine's in-between bones included.
+//!     let skeleton = ragdoll.skeleton_pose(&world, SpineMapping::Arc)?;
+//!     assert_eq!(skeleton.bones.len(), desc.bodies.len());
+//! }
+//! # Ok(())
+//! # }
+//! ```
 
 mod description;
 mod drive;
