@@ -9,25 +9,17 @@
 use std::hint::black_box;
 
 use iai_callgrind::{library_benchmark, library_benchmark_group, main};
-use vertebra_benches::{RodWorkload, SocketWorkload};
-use vertebra_math::Backend;
-
-const BACKENDS: [Backend; 4] = [
-    Backend::Scalar,
-    Backend::Portable,
-    Backend::Sse41,
-    Backend::Avx2,
-];
+use vertebra_benches::{INSTRUCTION_BACKENDS, RodWorkload, SocketWorkload};
 
 fn with_drive(backend: usize) -> SocketWorkload {
-    SocketWorkload::new(BACKENDS[backend], 256, true)
+    SocketWorkload::new(INSTRUCTION_BACKENDS[backend], 256, true)
 }
 
 fn without_drive(backend: usize) -> SocketWorkload {
-    SocketWorkload::new(BACKENDS[backend], 256, false)
+    SocketWorkload::new(INSTRUCTION_BACKENDS[backend], 256, false)
 }
 
-// Argument k is BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
+// Argument k is INSTRUCTION_BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
 #[library_benchmark]
 #[benches::backend(args = [0, 1, 2, 3], setup = with_drive)]
 fn socket_limits_drive(mut work: SocketWorkload) -> f32 {
@@ -43,7 +35,7 @@ fn socket_limits(mut work: SocketWorkload) -> f32 {
 }
 
 fn rods(backend: usize) -> RodWorkload {
-    RodWorkload::new(BACKENDS[backend], 256)
+    RodWorkload::new(INSTRUCTION_BACKENDS[backend], 256)
 }
 
 #[library_benchmark]

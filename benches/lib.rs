@@ -9,6 +9,15 @@ use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::map::{LaneMap, map_arrays};
 use vertebra_math::{Backend, Lane, Quat, Vec3, poly};
 
+/// The backends the instruction-count benches measure, by argument index:
+/// 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
+pub const INSTRUCTION_BACKENDS: [Backend; 4] = [
+    Backend::Scalar,
+    Backend::Portable,
+    Backend::Sse41,
+    Backend::Avx2,
+];
+
 /// Elements per workload: 4 KiB per array, in L1 with room to spare.
 pub const ELEMENTS: usize = 1024;
 

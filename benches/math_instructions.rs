@@ -9,30 +9,27 @@
 use std::hint::black_box;
 
 use iai_callgrind::{library_benchmark, library_benchmark_group, main};
-use vertebra_benches::{Acos, Atan2, HalfSinc, SinCos, Workload};
-use vertebra_math::Backend;
-
-const BACKENDS: [Backend; 4] = [
-    Backend::Scalar,
-    Backend::Portable,
-    Backend::Sse41,
-    Backend::Avx2,
-];
+use vertebra_benches::{Acos, Atan2, HalfSinc, INSTRUCTION_BACKENDS, SinCos, Workload};
 
 fn sin_cos_on(backend: usize) -> Workload {
-    Workload::new(BACKENDS[backend], &SinCos, -8.0, 8.0)
+    Workload::new(INSTRUCTION_BACKENDS[backend], &SinCos, -8.0, 8.0)
 }
 fn acos_on(backend: usize) -> Workload {
-    Workload::new(BACKENDS[backend], &Acos, -1.0, 1.0)
+    Workload::new(INSTRUCTION_BACKENDS[backend], &Acos, -1.0, 1.0)
 }
 fn atan2_on(backend: usize) -> Workload {
-    Workload::new(BACKENDS[backend], &Atan2, -2.0, 2.0)
+    Workload::new(INSTRUCTION_BACKENDS[backend], &Atan2, -2.0, 2.0)
 }
 fn half_sinc_on(backend: usize) -> Workload {
-    Workload::new(BACKENDS[backend], &HalfSinc, 0.0, std::f32::consts::PI)
+    Workload::new(
+        INSTRUCTION_BACKENDS[backend],
+        &HalfSinc,
+        0.0,
+        std::f32::consts::PI,
+    )
 }
 
-// Argument k is BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
+// Argument k is INSTRUCTION_BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
 #[library_benchmark]
 #[benches::backend(args = [0, 1, 2, 3], setup = sin_cos_on)]
 fn sin_cos(mut work: Workload) -> f32 {

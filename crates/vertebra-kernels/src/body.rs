@@ -16,7 +16,9 @@
 //! `w = 1/m + (r x n)^T I^-1 (r x n)`, a rotational one about `n` sees
 //! `w = n^T I^-1 n`, with `I^-1 = R S R^T` the world-space inverse inertia.
 
-use vertebra_math::row::{ROW_LEN, Row};
+use bytemuck::{Pod, Zeroable};
+use vertebra_math::block::BLOCK_LANES;
+use vertebra_math::row::{NO_WRITE, ROW_LEN, Row};
 use vertebra_math::{Lane, Quat, Sym3, Vec3};
 
 /// The solver's copy of every body, as rows.
@@ -200,4 +202,52 @@ pub fn safe_ratio<L: Lane>(numerator: L, denominator: L) -> L {
         numerator / L::select(valid, denominator, L::splat(1.0)),
         L::splat(0.0),
     )
+}
+
+/// The two bodies of eight joints: the rows each lane reads, and the rows
+/// it writes (`NO_WRITE` for a static or kinematic body, or padding). Every
+/// joint block starts with one.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C, align(32))]
+pub struct BodyPairs {
+    /// Row read for body a.
+    pub body_a: [u32; BLOCK_LANES],
+    /// Row read for body b.
+    pub body_b: [u32; BLOCK_LANES],
+    /// Row written for body a (`NO_WRITE` unless dynamic).
+    pub write_a: [u32; BLOCK_LANES],
+    /// Row written for body b (`NO_WRITE` unless dynamic).
+    pub write_b: [u32; BLOCK_LANES],
+}
+
+impl BodyPairs {
+    /// Sets lane `lane`: rows `a` and `b`, written where dynamic.
+    pub fn set(&mut self, lane: usize, a: u32, b: u32, dynamic_a: bool, dynamic_b: bool) {
+        self.body_a[lane] = a;
+        self.body_b[lane] = b;
+        self.write_a[lane] = if dynamic_a { a } else { NO_WRITE };
+        self.write_b[lane] = if dynamic_b { b } else { NO_WRITE };
+    }
+
+    /// Gathers both bodies of lanes `start .. start + L::WIDTH`.
+    #[inline(always)]
+    pub fn gather<L: Lane>(&self, rows: &BodyRows, start: usize) -> (BodyLanes<L>, BodyLanes<L>) {
+        (
+            BodyLanes::gather(rows, &self.body_a[start..]),
+            BodyLanes::gather(rows, &self.body_b[start..]),
+        )
+    }
+
+    /// Writes both bodies' poses back.
+    #[inline(always)]
+    pub fn scatter<L: Lane>(
+        &self,
+        rows: &BodyRows,
+        start: usize,
+        a: &BodyLanes<L>,
+        b: &BodyLanes<L>,
+    ) {
+        a.scatter_pose(rows, &self.write_a[start..]);
+        b.scatter_pose(rows, &self.write_b[start..]);
+    }
 }

@@ -9,6 +9,7 @@
 //!   twist range, angular drive. Each has its derivation in its header.
 //! - [`socket`]: the ball-and-socket joint: its lane block, its position
 //!   pass, its velocity (damping) pass, and its residual.
+//! - [`residual`]: one pass that measures any joint block's residual error.
 //! - [`rod`]: the paper's rod constraint: curve, length, bending, twisting
 //!   and limits in one kernel, its lane block and its residual.
 //!
@@ -17,6 +18,7 @@
 
 pub mod body;
 pub mod parts;
+pub mod residual;
 pub mod rod;
 pub mod socket;
 

@@ -12,25 +12,19 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
-use vertebra_math::row::NO_WRITE;
 use vertebra_math::{Lane, LaneKernel};
 
-use crate::body::{BodyLanes, BodyRows};
+use crate::body::{BodyPairs, BodyRows};
 use crate::parts::angle::Softness;
 use crate::parts::rod::{bend, curve, frames, length, twist};
+use crate::residual::Residual;
 
 /// Eight rods, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 #[repr(C, align(32))]
 pub struct RodBlock {
-    /// Row read for body a.
-    pub body_a: [u32; BLOCK_LANES],
-    /// Row read for body b.
-    pub body_b: [u32; BLOCK_LANES],
-    /// Row written for body a (`NO_WRITE` unless dynamic).
-    pub write_a: [u32; BLOCK_LANES],
-    /// Row written for body b (`NO_WRITE` unless dynamic).
-    pub write_b: [u32; BLOCK_LANES],
+    /// The two bodies of each lane.
+    pub bodies: BodyPairs,
     /// `F_a`: the material frame at a, in a's body frame (+X: tangent).
     pub frame_a: QuatBlock,
     /// `F_b`: the material frame at b, in b's body frame.
@@ -146,10 +140,8 @@ impl RodBlock {
 
     /// Writes one rod into `lane`.
     pub fn set(&mut self, lane: usize, r: &RodLane) {
-        self.body_a[lane] = r.body_a;
-        self.body_b[lane] = r.body_b;
-        self.write_a[lane] = if r.dynamic_a { r.body_a } else { NO_WRITE };
-        self.write_b[lane] = if r.dynamic_b { r.body_b } else { NO_WRITE };
+        self.bodies
+            .set(lane, r.body_a, r.body_b, r.dynamic_a, r.dynamic_b);
         self.frame_a.set(lane, r.frame_a);
         self.frame_b.set(lane, r.frame_b);
         self.bend_rest.set(lane, r.bend_rest);
@@ -203,8 +195,7 @@ fn soft<L: Lane>(compliance: &[f32], relaxation: &[f32], inv_h2: L) -> Softness<
 
 #[inline(always)]
 fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows, inv_h2: L) {
-    let mut a = BodyLanes::<L>::gather(rows, &block.body_a[start..]);
-    let mut b = BodyLanes::<L>::gather(rows, &block.body_b[start..]);
+    let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
     let (frame_a, frame_b) = (
         block.frame_a.load::<L>(start),
         block.frame_b.load::<L>(start),
@@ -252,50 +243,30 @@ fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows,
     let f = frames(&a, &b, frame_a, frame_b);
     length::solve(&mut a, &mut b, &f, L::load(&block.rest_length[start..]));
 
-    a.scatter_pose(rows, &block.write_a[start..]);
-    b.scatter_pose(rows, &block.write_b[start..]);
+    block.bodies.scatter(rows, start, &a, &b);
 }
 
-/// Residual error of every lane, as the design brief defines it for a rod:
-/// linear `|C_len|` (m), angular the curve error (the angle between `t_b`
-/// and the reflection of `t_a`) plus limit overshoot (rad).
-pub struct ResidualPass<'a> {
-    /// The blocks.
-    pub blocks: &'a [RodBlock],
-    /// Body rows (poses read).
-    pub rows: &'a BodyRows,
-    /// Per lane of every block: (|C_len| m, angular rad).
-    pub out: &'a mut [[f32; 2]],
-}
-
-impl LaneKernel for ResidualPass<'_> {
-    type Output = ();
+/// A rod's residual error, as the design brief defines it: linear
+/// `|C_len|` (m), angular the curve error (the angle between `t_b` and the
+/// reflection of `t_a`) plus limit overshoot (rad).
+impl Residual for RodBlock {
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        let mut linear = [0.0f32; BLOCK_LANES];
-        let mut angular = [0.0f32; BLOCK_LANES];
-        for (block, out) in self.blocks.iter().zip(self.out.chunks_mut(BLOCK_LANES)) {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let a = BodyLanes::<L>::gather(self.rows, &block.body_a[start..]);
-                let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
-                let f = frames(
-                    &a,
-                    &b,
-                    block.frame_a.load::<L>(start),
-                    block.frame_b.load::<L>(start),
-                );
-                let (_, c_len) = length::measure(&a, &b, &f, L::load(&block.rest_length[start..]));
-                let c_curve = curve::measure(&a, &b, &f).theta;
-                let (_, bend_over) = bend::overshoot(&f, L::load(&block.bend_max[start..]));
-                let lo = L::load(&block.twist_min[start..]);
-                let hi = L::load(&block.twist_max[start..]);
-                let twist_over = crate::parts::twist::excess(twist::measure(&f), lo, hi).abs();
-                c_len.abs().store(&mut linear[start..]);
-                (c_curve + bend_over + twist_over).store(&mut angular[start..]);
-            }
-            for (lane, o) in out.iter_mut().enumerate() {
-                *o = [linear[lane], angular[lane]];
-            }
-        }
+    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
+        let (a, b) = self.bodies.gather::<L>(rows, start);
+        let f = frames(
+            &a,
+            &b,
+            self.frame_a.load::<L>(start),
+            self.frame_b.load::<L>(start),
+        );
+        let (_, c_len) = length::measure(&a, &b, &f, L::load(&self.rest_length[start..]));
+        let c_curve = curve::measure(&a, &b, &f).theta;
+        let (_, bend_over) = bend::overshoot(&f, L::load(&self.bend_max[start..]));
+        let (lo, hi) = (
+            L::load(&self.twist_min[start..]),
+            L::load(&self.twist_max[start..]),
+        );
+        let twist_over = crate::parts::twist::excess(twist::measure(&f), lo, hi).abs();
+        (c_len.abs(), c_curve + bend_over + twist_over)
     }
 }

@@ -9,24 +9,18 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
-use vertebra_math::row::NO_WRITE;
 use vertebra_math::{Lane, LaneKernel};
 
-use crate::body::{BodyLanes, BodyRows, VelocityLanes};
+use crate::body::{BodyPairs, BodyRows, VelocityLanes};
 use crate::parts::{drive, point, swing, twist};
+use crate::residual::Residual;
 
 /// Eight sockets, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 #[repr(C, align(32))]
 pub struct SocketBlock {
-    /// Row read for body a.
-    pub body_a: [u32; BLOCK_LANES],
-    /// Row read for body b.
-    pub body_b: [u32; BLOCK_LANES],
-    /// Row written for body a (`NO_WRITE` unless dynamic).
-    pub write_a: [u32; BLOCK_LANES],
-    /// Row written for body b (`NO_WRITE` unless dynamic).
-    pub write_b: [u32; BLOCK_LANES],
+    /// The two bodies of each lane.
+    pub bodies: BodyPairs,
     /// Anchor on a, a's body frame (m).
     pub anchor_a: Vec3Block,
     /// Anchor on b, b's body frame (m).
@@ -113,10 +107,8 @@ impl SocketBlock {
 
     /// Writes one socket into `lane`.
     pub fn set(&mut self, lane: usize, s: &SocketLane) {
-        self.body_a[lane] = s.body_a;
-        self.body_b[lane] = s.body_b;
-        self.write_a[lane] = if s.dynamic_a { s.body_a } else { NO_WRITE };
-        self.write_b[lane] = if s.dynamic_b { s.body_b } else { NO_WRITE };
+        self.bodies
+            .set(lane, s.body_a, s.body_b, s.dynamic_a, s.dynamic_b);
         self.anchor_a.set(lane, s.anchor_a);
         self.anchor_b.set(lane, s.anchor_b);
         self.frame_a.set(lane, s.frame_a);
@@ -167,8 +159,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     rows: &BodyRows,
     inv_h2: L,
 ) {
-    let mut a = BodyLanes::<L>::gather(rows, &block.body_a[start..]);
-    let mut b = BodyLanes::<L>::gather(rows, &block.body_b[start..]);
+    let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
     let frame_a = block.frame_a.load::<L>(start);
     let frame_b = block.frame_b.load::<L>(start);
 
@@ -209,8 +200,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
         block.anchor_b.load(start),
     );
 
-    a.scatter_pose(rows, &block.write_a[start..]);
-    b.scatter_pose(rows, &block.write_b[start..]);
+    block.bodies.scatter(rows, start, &a, &b);
 }
 
 /// The velocity pass: drive damping, `min(damping h, 1)` of the relative
@@ -232,64 +222,37 @@ impl LaneKernel for VelocityPass<'_> {
         let h = L::splat(self.h);
         for block in self.blocks {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let a = BodyLanes::<L>::gather(self.rows, &block.body_a[start..]);
-                let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
-                let mut va = VelocityLanes::<L>::gather(self.rows, &block.body_a[start..]);
-                let mut vb = VelocityLanes::<L>::gather(self.rows, &block.body_b[start..]);
+                let (a, b) = block.bodies.gather::<L>(self.rows, start);
+                let mut va = VelocityLanes::<L>::gather(self.rows, &block.bodies.body_a[start..]);
+                let mut vb = VelocityLanes::<L>::gather(self.rows, &block.bodies.body_b[start..]);
                 let rate =
                     L::load(&block.drive_damping[start..]) * L::load(&block.drive_enabled[start..]);
                 let fraction = (rate * h).min(L::splat(1.0));
                 drive::damp(&a, &b, &mut va, &mut vb, fraction);
-                va.scatter(self.rows, &block.write_a[start..]);
-                vb.scatter(self.rows, &block.write_b[start..]);
+                va.scatter(self.rows, &block.bodies.write_a[start..]);
+                vb.scatter(self.rows, &block.bodies.write_b[start..]);
             }
         }
     }
 }
 
-/// Residual error of every lane: anchor separation (m) and angular limit
+/// A socket's residual error: anchor separation (m) and angular limit
 /// overshoot (swing + twist, rad), as the paper's figure 8 counts them.
-pub struct ResidualPass<'a> {
-    /// The blocks.
-    pub blocks: &'a [SocketBlock],
-    /// Body rows (poses read).
-    pub rows: &'a BodyRows,
-    /// Per lane of every block: (separation m, overshoot rad).
-    pub out: &'a mut [[f32; 2]],
-}
-
-impl LaneKernel for ResidualPass<'_> {
-    type Output = ();
+impl Residual for SocketBlock {
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        let mut linear = [0.0f32; BLOCK_LANES];
-        let mut angular = [0.0f32; BLOCK_LANES];
-        for (block, out) in self.blocks.iter().zip(self.out.chunks_mut(BLOCK_LANES)) {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let a = BodyLanes::<L>::gather(self.rows, &block.body_a[start..]);
-                let b = BodyLanes::<L>::gather(self.rows, &block.body_b[start..]);
-                let (fa, fb) = (
-                    block.frame_a.load::<L>(start),
-                    block.frame_b.load::<L>(start),
-                );
-                let (_, _, d) = point::separation(
-                    &a,
-                    &b,
-                    block.anchor_a.load(start),
-                    block.anchor_b.load(start),
-                );
-                let (_, theta) = swing::measure(&a, &b, fa, fb);
-                let (_, phi) = twist::measure(&a, &b, fa, fb);
-                let lo = L::load(&block.twist_min[start..]);
-                let hi = L::load(&block.twist_max[start..]);
-                let overshoot = swing::overshoot(theta, L::load(&block.swing_max[start..]))
-                    + twist::excess(phi, lo, hi).abs();
-                d.length().store(&mut linear[start..]);
-                overshoot.store(&mut angular[start..]);
-            }
-            for (lane, o) in out.iter_mut().enumerate() {
-                *o = [linear[lane], angular[lane]];
-            }
-        }
+    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
+        let (a, b) = self.bodies.gather::<L>(rows, start);
+        let (fa, fb) = (self.frame_a.load::<L>(start), self.frame_b.load::<L>(start));
+        let (_, _, d) =
+            point::separation(&a, &b, self.anchor_a.load(start), self.anchor_b.load(start));
+        let (_, theta) = swing::measure(&a, &b, fa, fb);
+        let (_, phi) = twist::measure(&a, &b, fa, fb);
+        let (lo, hi) = (
+            L::load(&self.twist_min[start..]),
+            L::load(&self.twist_max[start..]),
+        );
+        let overshoot = swing::overshoot(theta, L::load(&self.swing_max[start..]))
+            + twist::excess(phi, lo, hi).abs();
+        (d.length(), overshoot)
     }
 }

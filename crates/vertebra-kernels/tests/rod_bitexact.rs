@@ -10,7 +10,8 @@ use common::{
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::rod::{PositionPass, ResidualPass, RodBlock, RodLane, RodSoftness};
+use vertebra_kernels::residual::ResidualPass;
+use vertebra_kernels::rod::{PositionPass, RodBlock, RodLane, RodSoftness};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 

@@ -9,7 +9,8 @@ use common::{
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::socket::{PositionPass, ResidualPass, SocketBlock, SocketLane, VelocityPass};
+use vertebra_kernels::residual::ResidualPass;
+use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane, VelocityPass};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 

@@ -22,6 +22,7 @@
 //! # Ok::<(), vertebra_world::Error>(())
 //! ```
 
+mod checks;
 mod config;
 mod layout;
 mod metrics;

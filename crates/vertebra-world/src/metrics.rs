@@ -1,8 +1,7 @@
 //! What a step reports: residual joint error (the paper's figure 8 metric)
 //! and a hash of the full state.
 
-use vertebra_kernels::rod;
-use vertebra_kernels::socket::ResidualPass;
+use vertebra_kernels::residual::ResidualPass;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_store::BodyStore;
 
@@ -73,7 +72,7 @@ pub(crate) fn residuals(world: &World) -> Residuals {
         out: &mut socket_lanes,
     });
     let mut rod_lanes = vec![[0.0f32; 2]; rods.blocks.len() * BLOCK_LANES];
-    world.backend.dispatch(rod::ResidualPass {
+    world.backend.dispatch(ResidualPass {
         blocks: &rods.blocks,
         rows,
         out: &mut rod_lanes,

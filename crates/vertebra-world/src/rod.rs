@@ -6,7 +6,7 @@ use core::f32::consts::PI;
 use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
 use vertebra_store::{
-    BodyHandle, BodyKind, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
+    BodyHandle, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
 };
 
 /// Marker for rod handles.
@@ -172,33 +172,13 @@ impl RodDesc {
                 _ => {}
             }
         }
-        if let Some(m) = self.bend_limit {
-            if !m.is_finite() {
-                return Err(Error::NonFinite("bend limit"));
-            }
-            if !(0.0..=PI).contains(&m) {
-                return Err(Error::InvalidLimit("bend"));
-            }
-        }
-        if let Some([lo, hi]) = self.twist_limit {
-            if !lo.is_finite() || !hi.is_finite() {
-                return Err(Error::NonFinite("twist limit"));
-            }
-            if !(-PI <= lo && lo <= hi && hi <= PI) {
-                return Err(Error::InvalidLimit("twist"));
-            }
-        }
-        Ok(())
+        crate::checks::max_angle(self.bend_limit, "bend")?;
+        crate::checks::twist_range(self.twist_limit)
     }
 
     pub(crate) fn validate_with(&self, bodies: &BodyStore) -> Result<(), Error> {
         self.validate()?;
-        let ka = bodies.kind[bodies.index(self.body_a)?];
-        let kb = bodies.kind[bodies.index(self.body_b)?];
-        if ka != BodyKind::Dynamic && kb != BodyKind::Dynamic {
-            return Err(Error::NoDynamicBody);
-        }
-        Ok(())
+        crate::checks::joint_bodies(bodies, self.body_a, self.body_b)
     }
 
     /// The kernel's softness for a stiffness of this rod.

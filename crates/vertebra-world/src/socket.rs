@@ -1,10 +1,8 @@
 //! The socket joint's public description and its validation.
 
-use core::f32::consts::PI;
-
 use glam::{Quat, Vec3};
 use vertebra_store::{
-    BodyHandle, BodyKind, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
+    BodyHandle, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
 };
 
 /// Marker for socket handles.
@@ -111,22 +109,8 @@ impl SocketDesc {
         check_finite("anchor b", self.anchor_b)?;
         check_unit_quat("frame a", self.frame_a)?;
         check_unit_quat("frame b", self.frame_b)?;
-        if let Some(s) = self.swing_limit {
-            if !s.is_finite() {
-                return Err(Error::NonFinite("swing limit"));
-            }
-            if !(0.0..=PI).contains(&s) {
-                return Err(Error::InvalidLimit("swing"));
-            }
-        }
-        if let Some([lo, hi]) = self.twist_limit {
-            if !lo.is_finite() || !hi.is_finite() {
-                return Err(Error::NonFinite("twist limit"));
-            }
-            if !(-PI <= lo && lo <= hi && hi <= PI) {
-                return Err(Error::InvalidLimit("twist"));
-            }
-        }
+        crate::checks::max_angle(self.swing_limit, "swing")?;
+        crate::checks::twist_range(self.twist_limit)?;
         if let Some(d) = self.drive {
             validate_drive(&d)?;
         }
@@ -136,12 +120,7 @@ impl SocketDesc {
     /// Checks the bodies too: live, and at least one dynamic.
     pub(crate) fn validate_with(&self, bodies: &BodyStore) -> Result<(), Error> {
         self.validate()?;
-        let ka = bodies.kind[bodies.index(self.body_a)?];
-        let kb = bodies.kind[bodies.index(self.body_b)?];
-        if ka != BodyKind::Dynamic && kb != BodyKind::Dynamic {
-            return Err(Error::NoDynamicBody);
-        }
-        Ok(())
+        crate::checks::joint_bodies(bodies, self.body_a, self.body_b)
     }
 }
 

@@ -204,11 +204,18 @@ fn constraint_error_converges_from_random_starts() {
     }
 }
 
-/// A 0.45 m rod from a static base to a 12 kg body, held horizontally
-/// and released under gravity; returns (max length error cm, max curve
-/// error rad, final tip drop m, energy samples).
-fn cantilever(bending: f32, frames: usize) -> (f32, f32, f32, Vec<f32>) {
-    let mut w = World::new(SolverConfig::default()).unwrap();
+/// A 0.45 m rod along +X from a static base at the origin to a 12 kg
+/// capsule, with `bending` stiffness, twisting 2 N m^2, and a bend limit.
+fn cantilever_world(
+    bending: RodStiffness,
+    iterations: u32,
+    bend_limit: Option<f32>,
+) -> (World, vertebra_world::BodyHandle, RodDesc) {
+    let mut w = World::new(SolverConfig {
+        iterations,
+        ..SolverConfig::default()
+    })
+    .unwrap();
     let base = w.add_body(BodyDesc::fixed()).unwrap();
     let tip = capsule(
         &mut w,
@@ -216,14 +223,23 @@ fn cantilever(bending: f32, frames: usize) -> (f32, f32, f32, Vec<f32>) {
         Vec3::new(0.51, 0.0, 0.0),
         12.0,
     );
-    let rod = RodDesc::from_pose(w.bodies(), base, tip, &[])
+    let mut rod = RodDesc::from_pose(w.bodies(), base, tip, &[])
         .unwrap()
-        .with_stiffness(
-            RodStiffness::Kirchhoff(bending),
-            RodStiffness::Kirchhoff(2.0),
-        )
-        .with_bend_limit(60f32.to_radians());
+        .with_stiffness(bending, RodStiffness::Kirchhoff(2.0));
+    rod.bend_limit = bend_limit;
     w.add_rod(rod).unwrap();
+    (w, tip, rod)
+}
+
+/// A 0.45 m rod from a static base to a 12 kg body, held horizontally
+/// and released under gravity; returns (max length error cm, max curve
+/// error rad, final tip drop m, energy samples).
+fn cantilever(bending: f32, frames: usize) -> (f32, f32, f32, Vec<f32>) {
+    let (mut w, tip, _) = cantilever_world(
+        RodStiffness::Kirchhoff(bending),
+        20,
+        Some(60f32.to_radians()),
+    );
     let (mut worst_len, mut worst_curve, mut energy) = (0.0f32, 0.0f32, Vec::new());
     for _ in 0..frames {
         w.step(DT).unwrap();
@@ -284,21 +300,9 @@ fn a_floppy_rod_stops_at_its_bend_limit_without_nan() {
     let (len, _, drop, _) = cantilever(0.0, 300);
     assert!(len < 0.1, "{len}");
     assert!(drop > 0.2, "it fell to the limit: {drop}");
-    let mut w = World::new(SolverConfig::default()).unwrap();
-    let base = w.add_body(BodyDesc::fixed()).unwrap();
-    let tip = capsule(
-        &mut w,
-        Vec3::new(0.39, 0.0, 0.0),
-        Vec3::new(0.51, 0.0, 0.0),
-        12.0,
-    );
     let limit = 60f32.to_radians();
-    let rod = RodDesc::from_pose(w.bodies(), base, tip, &[])
-        .unwrap()
-        .with_bend_limit(limit);
-    let frame_a = rod.frame_a;
-    let frame_b = rod.frame_b;
-    w.add_rod(rod).unwrap();
+    let (mut w, tip, rod) = cantilever_world(RodStiffness::Kirchhoff(0.0), 20, Some(limit));
+    let (frame_a, frame_b) = (rod.frame_a, rod.frame_b);
     for _ in 0..300 {
         w.step(DT).unwrap();
     }
@@ -362,22 +366,7 @@ fn arc_tangent_is_the_circle_tangent() {
 
 /// The sag of a cantilevered rod after 4 s at `iterations`.
 fn sag(bending: RodStiffness, iterations: u32) -> f32 {
-    let mut w = World::new(SolverConfig {
-        iterations,
-        ..SolverConfig::default()
-    })
-    .unwrap();
-    let base = w.add_body(BodyDesc::fixed()).unwrap();
-    let tip = capsule(
-        &mut w,
-        Vec3::new(0.39, 0.0, 0.0),
-        Vec3::new(0.51, 0.0, 0.0),
-        12.0,
-    );
-    let rod = RodDesc::from_pose(w.bodies(), base, tip, &[])
-        .unwrap()
-        .with_stiffness(bending, RodStiffness::Kirchhoff(2.0));
-    w.add_rod(rod).unwrap();
+    let (mut w, tip, _) = cantilever_world(bending, iterations, None);
     for _ in 0..240 {
         w.step(DT).unwrap();
     }

@@ -18,3 +18,39 @@ pub mod point;
 pub mod rod;
 pub mod swing;
 pub mod twist;
+
+use vertebra_math::{Lane, Quat, Vec3};
+
+use crate::body::BodyLanes;
+
+/// Both bodies' joint (or material) frames in the world and their +X
+/// axes: the twist axes of a socket, the tangents of a rod.
+#[derive(Clone, Copy, Debug)]
+pub struct Frames<L> {
+    /// `F(0) = q_a F_a`.
+    pub fa: Quat<L>,
+    /// `F(1) = q_b F_b`.
+    pub fb: Quat<L>,
+    /// `t_a = F(0) x`.
+    pub ta: Vec3<L>,
+    /// `t_b = F(1) x`.
+    pub tb: Vec3<L>,
+}
+
+/// Measures the frames at the bodies' current orientations.
+#[inline(always)]
+pub fn frames<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+) -> Frames<L> {
+    let x = Vec3::splat(crate::TWIST_AXIS);
+    let (fa, fb) = (a.q * frame_a, b.q * frame_b);
+    Frames {
+        fa,
+        fb,
+        ta: fa.rotate(x),
+        tb: fb.rotate(x),
+    }
+}

@@ -21,11 +21,9 @@ pub fn measure<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> (Vec3<L>, L) {
-    let x = Vec3::splat(crate::TWIST_AXIS);
-    let ta = (a.q * frame_a).rotate(x);
-    let tb = (b.q * frame_b).rotate(x);
-    let (n, sin) = ta.cross(tb).normalize_or_zero();
-    (n, poly::atan2(sin, ta.dot(tb)))
+    let f = super::frames(a, b, frame_a, frame_b);
+    let (n, sin) = f.ta.cross(f.tb).normalize_or_zero();
+    (n, poly::atan2(sin, f.ta.dot(f.tb)))
 }
 
 /// How far the swing exceeds `max_angle` (rad, >= 0).

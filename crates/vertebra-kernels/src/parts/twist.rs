@@ -21,10 +21,11 @@ pub fn measure<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> (Vec3<L>, L) {
-    let x = Vec3::splat(crate::TWIST_AXIS);
-    let fb = b.q * frame_b;
-    let relative = (a.q * frame_a).conjugate() * fb;
-    (fb.rotate(x), relative.twist_angle(x))
+    let f = super::frames(a, b, frame_a, frame_b);
+    (
+        f.tb,
+        (f.fa.conjugate() * f.fb).twist_angle(Vec3::splat(crate::TWIST_AXIS)),
+    )
 }
 
 /// `phi - clamp(phi, lo, hi)`: signed excess beyond the range (rad).

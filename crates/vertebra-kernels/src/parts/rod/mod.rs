@@ -14,40 +14,9 @@ pub mod curve;
 pub mod length;
 pub mod twist;
 
-use vertebra_math::{Lane, Quat, Vec3, poly};
+use vertebra_math::{Lane, Vec3, poly};
 
-use crate::body::BodyLanes;
-
-/// Both material frames and their tangents.
-#[derive(Clone, Copy, Debug)]
-pub struct Frames<L> {
-    /// `F(0) = q_a F_a`.
-    pub fa: Quat<L>,
-    /// `F(1) = q_b F_b`.
-    pub fb: Quat<L>,
-    /// `t_a = F(0) x`.
-    pub ta: Vec3<L>,
-    /// `t_b = F(1) x`.
-    pub tb: Vec3<L>,
-}
-
-/// Measures the material frames at the bodies' current orientations.
-#[inline(always)]
-pub fn frames<L: Lane>(
-    a: &BodyLanes<L>,
-    b: &BodyLanes<L>,
-    frame_a: Quat<L>,
-    frame_b: Quat<L>,
-) -> Frames<L> {
-    let x = Vec3::splat(crate::TWIST_AXIS);
-    let (fa, fb) = (a.q * frame_a, b.q * frame_b);
-    Frames {
-        fa,
-        fb,
-        ta: fa.rotate(x),
-        tb: fb.rotate(x),
-    }
-}
+pub use crate::parts::{Frames, frames};
 
 /// The bend axis (unit, or zero when straight or folded back) and the bend
 /// angle `psi` in [0, pi].

@@ -1,0 +1,38 @@
+//! Validation shared by every joint description.
+
+use core::f32::consts::PI;
+
+use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error};
+
+/// A largest angle (rad) in [0, pi], if set.
+pub(crate) fn max_angle(limit: Option<f32>, what: &'static str) -> Result<(), Error> {
+    match limit {
+        Some(m) if !m.is_finite() => Err(Error::NonFinite(what)),
+        Some(m) if !(0.0..=PI).contains(&m) => Err(Error::InvalidLimit(what)),
+        _ => Ok(()),
+    }
+}
+
+/// A twist range `[min, max]` (rad) within [-pi, pi], if set.
+pub(crate) fn twist_range(limit: Option<[f32; 2]>) -> Result<(), Error> {
+    match limit {
+        Some([lo, hi]) if !lo.is_finite() || !hi.is_finite() => {
+            Err(Error::NonFinite("twist limit"))
+        }
+        Some([lo, hi]) if !(-PI <= lo && lo <= hi && hi <= PI) => Err(Error::InvalidLimit("twist")),
+        _ => Ok(()),
+    }
+}
+
+/// Two different live bodies, at least one dynamic.
+pub(crate) fn joint_bodies(bodies: &BodyStore, a: BodyHandle, b: BodyHandle) -> Result<(), Error> {
+    if a == b {
+        return Err(Error::SameBody);
+    }
+    let ka = bodies.kind[bodies.index(a)?];
+    let kb = bodies.kind[bodies.index(b)?];
+    if ka != BodyKind::Dynamic && kb != BodyKind::Dynamic {
+        return Err(Error::NoDynamicBody);
+    }
+    Ok(())
+}
