@@ -9,6 +9,8 @@
 //!   twist range, angular drive. Each has its derivation in its header.
 //! - [`socket`]: the ball-and-socket joint: its lane block, its position
 //!   pass, its velocity (damping) pass, and its residual.
+//! - [`contact`]: contacts: non-penetration and static friction at the
+//!   position level, dynamic friction and restitution at the velocity level.
 //! - [`residual`]: one pass that measures any joint block's residual error.
 //! - [`rod`]: the paper's rod constraint: curve, length, bending, twisting
 //!   and limits in one kernel, its lane block and its residual.
@@ -17,6 +19,7 @@
 //! scatter in `vertebra-math` are the only places intrinsics live.
 
 pub mod body;
+pub mod contact;
 pub mod parts;
 pub mod residual;
 pub mod rod;

@@ -24,6 +24,7 @@
 
 mod checks;
 mod config;
+mod contact;
 mod layout;
 mod metrics;
 mod rod;
@@ -37,6 +38,7 @@ use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyKind, Slots};
 
 pub use config::SolverConfig;
+pub use contact::Contact;
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
@@ -59,6 +61,8 @@ pub struct World {
     colouring: Colouring,
     layout: layout::Layout,
     layout_dirty: bool,
+    contacts: Vec<Contact>,
+    contact_layout: contact::ContactLayout,
     rows: BodyRows,
     previous: Vec<(Vec3, Quat)>,
     residuals: Residuals,
@@ -95,6 +99,8 @@ impl World {
             colouring: Colouring::new(),
             layout: layout::Layout::default(),
             layout_dirty: false,
+            contacts: Vec::new(),
+            contact_layout: contact::ContactLayout::default(),
             rows: BodyRows::default(),
             previous: Vec::new(),
             residuals: Residuals::default(),
@@ -331,6 +337,20 @@ impl World {
         self.colouring.overflow().len()
     }
 
+    /// Sets the contacts for the next step (they apply to that step only:
+    /// feed them every step). The whole list is checked first; on error
+    /// the previous list stays.
+    pub fn set_contacts(&mut self, contacts: &[Contact]) -> Result<(), Error> {
+        contact::validate_all(contacts, &self.bodies)?;
+        self.contacts = contacts.to_vec();
+        Ok(())
+    }
+
+    /// The contacts set for the next step.
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
     /// Residual joint error of the current poses, without stepping (e.g.
     /// right after building a ragdoll).
     pub fn measure_residuals(&mut self) -> &Residuals {
@@ -362,12 +382,10 @@ impl World {
     /// Advances the world by `dt` seconds (finite, positive).
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
-        if self.layout_dirty {
-            self.layout =
-                layout::Layout::build(&self.colouring, &self.sockets, &self.rods, &self.bodies);
-            self.layout_dirty = false;
-        }
+        self.refresh_layout();
+        self.contact_layout = contact::ContactLayout::build(&self.contacts, &self.bodies);
         step::step(self, dt);
+        self.contacts.clear();
         self.residuals = metrics::residuals(self);
         Ok(())
     }

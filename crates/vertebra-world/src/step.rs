@@ -5,6 +5,7 @@
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::contact::{self, ContactBlock};
 use vertebra_kernels::rod::{self, RodBlock};
 use vertebra_kernels::socket::{PositionPass, SocketBlock, VelocityPass};
 use vertebra_math::Backend;
@@ -29,6 +30,11 @@ pub(crate) fn step(world: &mut World, dt: f32) {
             .blocks
             .iter_mut()
             .for_each(RodBlock::reset_lambdas);
+        world
+            .contact_layout
+            .blocks
+            .iter_mut()
+            .for_each(ContactBlock::reset_lambdas);
         for _ in 0..world.config.iterations {
             solve_positions(world, h);
         }
@@ -134,6 +140,8 @@ trait Pass: Sync {
     fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend);
     /// Rods.
     fn rods(&self, blocks: &mut [RodBlock], rows: &BodyRows, backend: Backend);
+    /// Contacts.
+    fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend);
 }
 
 /// Runs `pass` over every colour in order, then over the overflow set with
@@ -161,6 +169,16 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
         let blocks = &mut layout.rods.blocks[group.rods];
         chunked(parallel, min_blocks, blocks, |c| {
             pass.rods(c, rows, backend)
+        });
+    }
+    // Then this step's contacts, coloured on their own.
+    let contacts = &mut world.contact_layout;
+    let groups = contacts.colours.iter().map(|r| (r.clone(), world.backend));
+    let overflow = core::iter::once((contacts.overflow.clone(), Backend::Scalar));
+    for (range, backend) in groups.chain(overflow) {
+        let parallel = pool.as_ref().filter(|_| backend != Backend::Scalar);
+        chunked(parallel, min_blocks, &mut contacts.blocks[range], |c| {
+            pass.contacts(c, rows, backend)
         });
     }
     world.pool = pool;
@@ -211,11 +229,16 @@ impl Pass for Positions {
             inv_h2: self.inv_h2,
         });
     }
+    fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
+        backend.dispatch(contact::PositionPass { blocks, rows });
+    }
 }
 
-/// The velocity pass (drive damping; rods have none).
+/// The velocity pass (drive damping, contact friction and restitution;
+/// rods have none).
 struct Velocities {
     h: f32,
+    resting_speed: f32,
 }
 
 impl Pass for Velocities {
@@ -229,6 +252,15 @@ impl Pass for Velocities {
         }
     }
     fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
+    fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
+        let (h, resting_speed) = (self.h, self.resting_speed);
+        backend.dispatch(contact::VelocityPass {
+            blocks,
+            rows,
+            h,
+            resting_speed,
+        });
+    }
 }
 
 fn solve_positions(world: &mut World, h: f32) {
@@ -241,7 +273,8 @@ fn solve_positions(world: &mut World, h: f32) {
 }
 
 fn solve_velocities(world: &mut World, h: f32) {
-    for_each_colour(world, &Velocities { h });
+    let resting_speed = 2.0 * world.config.gravity.length() * h;
+    for_each_colour(world, &Velocities { h, resting_speed });
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {

@@ -1,0 +1,304 @@
+//! Contacts (Müller et al. 2020, sec. 3.5): non-penetration and static
+//! friction at the position level, dynamic friction and restitution at the
+//! velocity level, one lane-generic kernel each, bit for bit like the
+//! joints.
+//!
+//! A contact holds a point on each body (body frames) and a world normal
+//! `n` from a to b, fixed for the step. With `r_a = q_a c_a`, `r_b = q_b c_b`
+//! and the world points `p_a + r_a`, `p_b + r_b`:
+//!
+//! - **Non-penetration** (hard, one-sided): the separation along the normal
+//!   `s = ((p_b + r_b) - (p_a + r_a)) . n` must not be negative:
+//!   `C = min(s, 0)`, gradient `n` at `r_b` and `-n` at `r_a`, generalised
+//!   masses `1/m + (r x n)^T I^-1 (r x n)`. `lambda_n` accumulates over a
+//!   substep's iterations (the normal force is `lambda_n / h^2`).
+//! - **Static friction** (inside the cone): the points were one point when
+//!   the contact was made, so their tangential offset `d_t = d - (d . n) n`
+//!   (`d` their difference) is how far the bodies slid. It is removed along
+//!   `t = d_t / |d_t|`, with the accumulated tangential multiplier (a
+//!   vector in the tangent plane) clamped to `|lambda_t| <= mu lambda_n`. Müller et al. apply the whole
+//!   correction or none; solved point by point, a box corner's normal and
+//!   tangential generalised masses differ (`w_n > w_t`), so all-or-nothing
+//!   lets a box creep down a slope well below `atan(mu)`. Beyond the cone
+//!   the contact slides, and dynamic friction acts at the velocity level.
+//! - **Dynamic friction**: an impulse against the tangential relative
+//!   velocity `v_t` of `min((mu lambda_n - |lambda_t|) / h, |v_t| / w_t)`:
+//!   what is left of Coulomb's bound after the position level's friction
+//!   (`lambda / h` is an impulse), or what stops the sliding.
+//!   (Müller eq. 31 writes `min(h mu |f_n|, |v_t|)`, comparing an impulse
+//!   with a speed; the generalised mass `w_t` puts them in one unit.)
+//! - **Restitution**: the normal relative velocity is raised to
+//!   `max(-e v_approach, 0)` (never lowered: a contact pushes, it does not
+//!   pull), where `v_approach` is its value when the contact was made; below
+//!   `2 |g| h` of approach the target is 0, so resting contacts do not
+//!   jitter (Müller eq. 34).
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3 as GVec3;
+use vertebra_math::block::{BLOCK_LANES, Vec3Block};
+use vertebra_math::{Lane, LaneKernel, Vec3};
+
+use crate::body::{BodyLanes, BodyPairs, BodyRows, VelocityLanes, safe_ratio};
+
+/// Eight contacts, field by field.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C, align(32))]
+pub struct ContactBlock {
+    /// The two bodies of each lane.
+    pub bodies: BodyPairs,
+    /// Contact point on a (m, a's body frame).
+    pub point_a: Vec3Block,
+    /// Contact point on b (m, b's body frame).
+    pub point_b: Vec3Block,
+    /// Normal from a to b (world, unit).
+    pub normal: Vec3Block,
+    /// Friction coefficient (static and dynamic).
+    pub friction: [f32; BLOCK_LANES],
+    /// Coefficient of restitution in [0, 1].
+    pub restitution: [f32; BLOCK_LANES],
+    /// Normal relative velocity of b to a when the contact was made (m/s;
+    /// negative when approaching).
+    pub approach: [f32; BLOCK_LANES],
+    /// Accumulated normal multiplier, reset every substep.
+    pub lambda_n: [f32; BLOCK_LANES],
+    /// Accumulated tangential multiplier (a world vector in the tangent
+    /// plane), reset every substep.
+    pub lambda_t: Vec3Block,
+}
+
+/// One contact's solver data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactLane {
+    /// Row of body a.
+    pub body_a: u32,
+    /// Row of body b.
+    pub body_b: u32,
+    /// Whether body a is dynamic (written).
+    pub dynamic_a: bool,
+    /// Whether body b is dynamic (written).
+    pub dynamic_b: bool,
+    /// Contact point on a (a's body frame).
+    pub point_a: GVec3,
+    /// Contact point on b (b's body frame).
+    pub point_b: GVec3,
+    /// Normal from a to b (world, unit).
+    pub normal: GVec3,
+    /// Friction coefficient.
+    pub friction: f32,
+    /// Restitution.
+    pub restitution: f32,
+    /// Approach velocity along the normal (m/s).
+    pub approach: f32,
+}
+
+impl ContactBlock {
+    /// A block of padding lanes: null rows, zero normal, so nothing acts.
+    pub fn padding() -> Self {
+        Self::zeroed()
+    }
+
+    /// Writes one contact into `lane`.
+    pub fn set(&mut self, lane: usize, c: &ContactLane) {
+        self.bodies
+            .set(lane, c.body_a, c.body_b, c.dynamic_a, c.dynamic_b);
+        self.point_a.set(lane, c.point_a);
+        self.point_b.set(lane, c.point_b);
+        self.normal.set(lane, c.normal);
+        self.friction[lane] = c.friction;
+        self.restitution[lane] = c.restitution;
+        self.approach[lane] = c.approach;
+        self.lambda_n[lane] = 0.0;
+        self.lambda_t.set(lane, GVec3::ZERO);
+    }
+
+    /// Resets the multipliers (every substep).
+    pub fn reset_lambdas(&mut self) {
+        self.lambda_n = [0.0; BLOCK_LANES];
+        self.lambda_t = Vec3Block::default();
+    }
+}
+
+/// Lever arms and the world points' difference `(p_b + r_b) - (p_a + r_a)`.
+#[inline(always)]
+fn arms<L: Lane>(
+    block: &ContactBlock,
+    start: usize,
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+) -> (Vec3<L>, Vec3<L>, Vec3<L>) {
+    let ra = a.q.rotate(block.point_a.load(start));
+    let rb = b.q.rotate(block.point_b.load(start));
+    (ra, rb, (b.p + rb) - (a.p + ra))
+}
+
+/// Moves both bodies by the positional impulse `impulse` (b) and its
+/// opposite (a).
+#[inline(always)]
+fn push<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    ra: Vec3<L>,
+    rb: Vec3<L>,
+    impulse: Vec3<L>,
+) {
+    b.apply_impulse(rb, impulse);
+    a.apply_impulse(ra, -impulse);
+}
+
+/// One XPBD iteration over contact blocks: non-penetration, then static
+/// friction.
+pub struct PositionPass<'a> {
+    /// The blocks (one colour's, or the overflow set).
+    pub blocks: &'a mut [ContactBlock],
+    /// Body rows, read and written.
+    pub rows: &'a BodyRows,
+}
+
+impl LaneKernel for PositionPass<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        for block in self.blocks.iter_mut() {
+            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
+                solve_positions::<L>(block, start, self.rows);
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyRows) {
+    let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
+    let n = block.normal.load::<L>(start);
+    let zero = L::splat(0.0);
+
+    let (ra, rb, d) = arms(block, start, &a, &b);
+    let c = d.dot(n).min(zero);
+    let w = a.positional_weight(ra, n) + b.positional_weight(rb, n);
+    let dlambda_n = safe_ratio(-c, w);
+    push(&mut a, &mut b, ra, rb, n.scale(dlambda_n));
+    let lambda_n = L::load(&block.lambda_n[start..]) + dlambda_n;
+    lambda_n.store(&mut block.lambda_n[start..]);
+
+    let (ra, rb, d) = arms(block, start, &a, &b);
+    let (t, slide) = (d - n.scale(d.dot(n))).normalize_or_zero();
+    let w = a.positional_weight(ra, t) + b.positional_weight(rb, t);
+    // Coulomb: the accumulated tangential multiplier, a vector (the slide's
+    // direction changes between iterations), is clamped to the cone
+    // `|lambda_t| <= mu lambda_n`: a projection, as impulse solvers clamp.
+    let lambda_t = block.lambda_t.load::<L>(start);
+    let wanted = lambda_t + t.scale(safe_ratio(-slide, w));
+    let (direction, size) = wanted.normalize_or_zero();
+    let bound = L::load(&block.friction[start..]) * lambda_n;
+    let clamped = direction.scale(size.min(bound));
+    let impulse = clamped - lambda_t;
+    push(&mut a, &mut b, ra, rb, impulse);
+    block.lambda_t.store(start, clamped);
+
+    block.bodies.scatter(rows, start, &a, &b);
+}
+
+/// The velocity pass: dynamic friction and restitution.
+pub struct VelocityPass<'a> {
+    /// The blocks.
+    pub blocks: &'a [ContactBlock],
+    /// Body rows: poses and inertia read, velocities read and written.
+    pub rows: &'a BodyRows,
+    /// The substep `h` (s).
+    pub h: f32,
+    /// Approach speeds below this bounce not at all (m/s): `2 |g| h`.
+    pub resting_speed: f32,
+}
+
+impl LaneKernel for VelocityPass<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        for block in self.blocks {
+            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
+                solve_velocities::<L>(
+                    block,
+                    start,
+                    self.rows,
+                    L::splat(self.h),
+                    L::splat(self.resting_speed),
+                );
+            }
+        }
+    }
+}
+
+/// Adds the velocity impulse `impulse` at `rb` to b and its opposite at `ra`
+/// to a.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn kick<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    va: &mut VelocityLanes<L>,
+    vb: &mut VelocityLanes<L>,
+    ra: Vec3<L>,
+    rb: Vec3<L>,
+    impulse: Vec3<L>,
+) {
+    vb.v += impulse.scale(b.inv_mass);
+    vb.w += b.inv_inertia_mul(rb.cross(impulse));
+    va.v -= impulse.scale(a.inv_mass);
+    va.w -= a.inv_inertia_mul(ra.cross(impulse));
+}
+
+#[inline(always)]
+fn solve_velocities<L: Lane>(
+    block: &ContactBlock,
+    start: usize,
+    rows: &BodyRows,
+    h: L,
+    resting_speed: L,
+) {
+    let pairs = &block.bodies;
+    let (a, b) = pairs.gather::<L>(rows, start);
+    let mut va = VelocityLanes::<L>::gather(rows, &pairs.body_a[start..]);
+    let mut vb = VelocityLanes::<L>::gather(rows, &pairs.body_b[start..]);
+    let n = block.normal.load::<L>(start);
+    let zero = L::splat(0.0);
+    let (ra, rb, _) = arms(block, start, &a, &b);
+    let lambda_n = L::load(&block.lambda_n[start..]);
+    let touching = lambda_n.gt(zero);
+
+    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
+    let vn = relative.dot(n);
+    let (t, speed_t) = (relative - n.scale(vn)).normalize_or_zero();
+    // The impulse that stops the sliding, capped by what the position
+    // level left of Coulomb's budget: (mu lambda_n - |lambda_t|) / h.
+    let wt = a.positional_weight(ra, t) + b.positional_weight(rb, t);
+    let stop = safe_ratio(speed_t, wt);
+    let used = block.lambda_t.load::<L>(start).length();
+    let budget = ((L::load(&block.friction[start..]) * lambda_n - used) / h).max(zero);
+    let impulse = stop.min(budget);
+    let friction = t.scale(L::select(touching, -impulse, zero));
+    kick(&a, &b, &mut va, &mut vb, ra, rb, friction);
+
+    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
+    let approach = L::load(&block.approach[start..]);
+    let bounces = (-approach).gt(resting_speed);
+    let target = L::select(
+        bounces,
+        (-L::load(&block.restitution[start..]) * approach).max(zero),
+        zero,
+    );
+    let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
+    // One-sided: raise the normal velocity to the target, never pull.
+    let change = L::select(touching, (target - relative.dot(n)).max(zero), zero);
+    kick(
+        &a,
+        &b,
+        &mut va,
+        &mut vb,
+        ra,
+        rb,
+        n.scale(safe_ratio(change, wn)),
+    );
+
+    va.scatter(rows, &pairs.write_a[start..]);
+    vb.scatter(rows, &pairs.write_b[start..]);
+}

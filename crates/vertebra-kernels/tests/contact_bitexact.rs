@@ -1,0 +1,100 @@
+//! The contact kernel's passes give the scalar reference's bits on every
+//! backend, for random and adversarial contacts.
+
+mod common;
+
+use common::{
+    RawRows, assert_backends_agree, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat, vec,
+};
+use glam::Vec3;
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use vertebra_kernels::contact::{ContactBlock, ContactLane, PositionPass, VelocityPass};
+use vertebra_math::Backend;
+use vertebra_math::block::BLOCK_LANES;
+
+const STATICS: usize = 4;
+
+fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<ContactBlock>) {
+    let mut r = StdRng::seed_from_u64(seed);
+    let rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
+    let mut out = Vec::new();
+    for block_index in 0..blocks {
+        let mut block = ContactBlock::padding();
+        for lane in 0..BLOCK_LANES {
+            if r.random_bool(0.1) {
+                continue;
+            }
+            let (body_a, body_b) =
+                lane_bodies(&mut r, &rows, block_index * BLOCK_LANES + lane, STATICS);
+            let normal = unit_quat(&mut r) * Vec3::Y;
+            let (point_a, point_b) = if adversarial && r.random_bool(0.3) {
+                (Vec3::ZERO, Vec3::ZERO) // at the centres of mass: no lever
+            } else {
+                (vec(&mut r, 0.5), vec(&mut r, 0.5))
+            };
+            block.set(
+                lane,
+                &ContactLane {
+                    body_a,
+                    body_b,
+                    dynamic_a: dynamic(&rows, body_a),
+                    dynamic_b: dynamic(&rows, body_b),
+                    point_a,
+                    point_b,
+                    normal,
+                    friction: if adversarial && r.random_bool(0.2) {
+                        0.0
+                    } else {
+                        r.random_range(0.0..2.0)
+                    },
+                    restitution: r.random_range(0.0..=1.0),
+                    approach: r.random_range(-10.0..10.0),
+                },
+            );
+        }
+        out.push(block);
+    }
+    (rows, out)
+}
+
+fn run(backend: Backend, raw: &RawRows, blocks: &[ContactBlock]) -> Vec<f32> {
+    let rows = to_rows(raw);
+    let mut blocks = blocks.to_vec();
+    for _ in 0..4 {
+        backend.dispatch(PositionPass {
+            blocks: &mut blocks,
+            rows: &rows,
+        });
+    }
+    backend.dispatch(VelocityPass {
+        blocks: &blocks,
+        rows: &rows,
+        h: 1.0 / 60.0,
+        resting_speed: 0.33,
+    });
+    let mut out = flatten(&rows);
+    for b in &blocks {
+        out.extend(b.lambda_n);
+        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
+            &b.lambda_t,
+        )));
+    }
+    out
+}
+
+#[test]
+fn random_contacts_agree_on_every_backend() {
+    for seed in 0..40 {
+        let (rows, blocks) = scene(seed, 6, false);
+        assert_backends_agree(seed, |b| run(b, &rows, &blocks));
+    }
+}
+
+#[test]
+fn adversarial_contacts_agree_on_every_backend_and_stay_finite() {
+    for seed in 300..360 {
+        let (rows, blocks) = scene(seed, 6, true);
+        assert_backends_agree(seed, |b| run(b, &rows, &blocks));
+    }
+}

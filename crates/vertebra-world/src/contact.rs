@@ -1,0 +1,138 @@
+//! Contacts fed to the solver: by an engine's own collision detection, or
+//! by `vertebra-collide`. They are coloured on their own every step (they
+//! change every step) and solved after the joints in each iteration.
+
+use core::ops::Range;
+
+use glam::Vec3;
+use vertebra_kernels::contact::{ContactBlock, ContactLane};
+use vertebra_math::block::BLOCK_LANES;
+use vertebra_scheduler::{Colouring, MAX_COLOURS};
+use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_finite, check_unit_vec};
+
+/// A contact between two bodies for the next step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// The first body.
+    pub body_a: BodyHandle,
+    /// The second body.
+    pub body_b: BodyHandle,
+    /// The contact point, midway between the two surfaces (m, world).
+    pub point: Vec3,
+    /// The normal from a to b (unit, world).
+    pub normal: Vec3,
+    /// Penetration depth along the normal (m); negative for a gap.
+    pub depth: f32,
+    /// Friction coefficient (static and dynamic), >= 0.
+    pub friction: f32,
+    /// Coefficient of restitution, in [0, 1].
+    pub restitution: f32,
+}
+
+impl Contact {
+    /// Checks every field but the bodies' liveness.
+    pub fn validate(&self) -> Result<(), Error> {
+        if self.body_a == self.body_b {
+            return Err(Error::SameBody);
+        }
+        check_finite("contact point", self.point)?;
+        check_unit_vec("contact normal", self.normal)?;
+        if !self.depth.is_finite() {
+            return Err(Error::NonFinite("contact depth"));
+        }
+        if !self.friction.is_finite() {
+            return Err(Error::NonFinite("contact friction"));
+        }
+        if self.friction < 0.0 {
+            return Err(Error::NonPositive("contact friction"));
+        }
+        if !(0.0..=1.0).contains(&self.restitution) {
+            return Err(Error::InvalidLimit("restitution (must be in [0, 1])"));
+        }
+        Ok(())
+    }
+
+    /// Solver data at the bodies' current poses and velocities: the points
+    /// on each surface, `depth / 2` either side of `point` along the normal.
+    fn lane(&self, bodies: &BodyStore) -> ContactLane {
+        let (ia, ib) = (self.body_a.index(), self.body_b.index());
+        let n = self.normal.normalize();
+        let on_a = self.point + n * (0.5 * self.depth);
+        let on_b = self.point - n * (0.5 * self.depth);
+        let local = |i: usize, p: Vec3| bodies.orientation[i].inverse() * (p - bodies.position[i]);
+        let velocity = |i: usize, p: Vec3| {
+            bodies.linear_velocity[i] + bodies.angular_velocity[i].cross(p - bodies.position[i])
+        };
+        ContactLane {
+            body_a: ia as u32 + 1,
+            body_b: ib as u32 + 1,
+            dynamic_a: bodies.kind[ia] == BodyKind::Dynamic,
+            dynamic_b: bodies.kind[ib] == BodyKind::Dynamic,
+            point_a: local(ia, on_a),
+            point_b: local(ib, on_b),
+            normal: n,
+            friction: self.friction,
+            restitution: self.restitution,
+            approach: (velocity(ib, self.point) - velocity(ia, self.point)).dot(n),
+        }
+    }
+}
+
+/// This step's contacts, coloured and in blocks.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ContactLayout {
+    pub blocks: Vec<ContactBlock>,
+    /// Block ranges of the non-empty colours, in order.
+    pub colours: Vec<Range<usize>>,
+    /// Block range of the overflow set.
+    pub overflow: Range<usize>,
+}
+
+impl ContactLayout {
+    /// Colours `contacts` greedily (in the order given) and lays them out.
+    pub fn build(contacts: &[Contact], bodies: &BodyStore) -> Self {
+        let mut colouring = Colouring::new();
+        let dynamic = |h: BodyHandle| {
+            (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
+        };
+        for (k, c) in contacts.iter().enumerate() {
+            colouring.add(k as u64, [dynamic(c.body_a), dynamic(c.body_b)]);
+        }
+        let mut layout = Self::default();
+        for colour in 0..MAX_COLOURS {
+            let range = layout.append(colouring.colour(colour).iter(), contacts, bodies);
+            if !range.is_empty() {
+                layout.colours.push(range);
+            }
+        }
+        layout.overflow = layout.append(colouring.overflow().iter(), contacts, bodies);
+        layout
+    }
+
+    fn append<'k>(
+        &mut self,
+        keys: impl Iterator<Item = &'k u64>,
+        contacts: &[Contact],
+        bodies: &BodyStore,
+    ) -> Range<usize> {
+        let start = self.blocks.len();
+        for (k, &key) in keys.enumerate() {
+            if k % BLOCK_LANES == 0 {
+                self.blocks.push(ContactBlock::padding());
+            }
+            let block = self.blocks.len() - 1;
+            self.blocks[block].set(k % BLOCK_LANES, &contacts[key as usize].lane(bodies));
+        }
+        start..self.blocks.len()
+    }
+}
+
+/// Checks a whole contact list (bodies live, at least one dynamic) before
+/// any is used.
+pub(crate) fn validate_all(contacts: &[Contact], bodies: &BodyStore) -> Result<(), Error> {
+    for c in contacts {
+        c.validate()?;
+        crate::checks::joint_bodies(bodies, c.body_a, c.body_b)?;
+    }
+    Ok(())
+}

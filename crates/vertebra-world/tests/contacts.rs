@@ -1,0 +1,133 @@
+//! The contact solver with contacts fed by hand (as an engine with its own
+//! collision detection would): boxes on the plane y = 0.
+
+use glam::{Quat, Vec3};
+use vertebra_world::{BodyDesc, BodyHandle, Contact, Shape, SolverConfig, World};
+
+const DT: f32 = 1.0 / 60.0;
+
+/// Contacts of a box's corners that are below `margin` above the ground.
+fn corner_contacts(
+    w: &World,
+    ground: BodyHandle,
+    body: BodyHandle,
+    half: Vec3,
+    friction: f32,
+    up: Vec3,
+) -> Vec<Contact> {
+    let s = w.body(body).unwrap();
+    let mut out = Vec::new();
+    for k in 0..8 {
+        let corner = Vec3::new(
+            if k & 1 == 0 { -half.x } else { half.x },
+            if k & 2 == 0 { -half.y } else { half.y },
+            if k & 4 == 0 { -half.z } else { half.z },
+        );
+        let p = s.position + s.orientation * corner;
+        let height = p.dot(up);
+        if height < 0.01 {
+            out.push(Contact {
+                body_a: ground,
+                body_b: body,
+                point: p - up * (0.5 * height),
+                normal: up,
+                depth: -height,
+                friction,
+                restitution: 0.0,
+            });
+        }
+    }
+    out
+}
+
+fn box_world(substeps: u32) -> (World, BodyHandle, BodyHandle, Vec3) {
+    let mut w = World::new(SolverConfig {
+        substeps,
+        iterations: 10,
+        ..SolverConfig::default()
+    })
+    .unwrap();
+    let ground = w.add_body(BodyDesc::fixed()).unwrap();
+    let half = Vec3::new(0.3, 0.2, 0.25);
+    let props = Shape::Box { half_extents: half }
+        .mass_properties(500.0)
+        .unwrap();
+    let body = w
+        .add_body(BodyDesc::dynamic(props).with_position(Vec3::new(0.0, half.y + 0.05, 0.0)))
+        .unwrap();
+    (w, ground, body, half)
+}
+
+#[test]
+fn a_box_rests_on_the_ground_without_sinking_drifting_or_jittering() {
+    let (mut w, ground, body, half) = box_world(1);
+    let mut worst_depth = 0.0f32;
+    let mut positions = Vec::new();
+    for frame in 0..600 {
+        let contacts = corner_contacts(&w, ground, body, half, 0.6, Vec3::Y);
+        w.set_contacts(&contacts).unwrap();
+        w.step(DT).unwrap();
+        let s = w.body(body).unwrap();
+        let lowest = (0..8)
+            .map(|k| {
+                let c = Vec3::new(
+                    if k & 1 == 0 { -half.x } else { half.x },
+                    if k & 2 == 0 { -half.y } else { half.y },
+                    if k & 4 == 0 { -half.z } else { half.z },
+                );
+                (s.position + s.orientation * c).y
+            })
+            .fold(f32::MAX, f32::min);
+        if frame > 60 {
+            worst_depth = worst_depth.max(-lowest);
+            positions.push(s.position);
+        }
+    }
+    let first = positions[0];
+    let drift = positions
+        .iter()
+        .map(|p| (*p - first).length())
+        .fold(0.0f32, f32::max);
+    let speed = w.body(body).unwrap().linear_velocity.length();
+    eprintln!(
+        "box at rest: worst penetration {:.2} mm, drift {:.3} mm, final speed {speed:.2e} m/s",
+        worst_depth * 1e3,
+        drift * 1e3
+    );
+    assert!(worst_depth < 2e-3, "penetration {worst_depth}");
+    assert!(drift < 1e-3, "drift {drift}");
+    assert!(speed < 1e-2, "jitter {speed}");
+}
+
+#[test]
+fn static_friction_holds_below_atan_mu_and_slides_above() {
+    let mu = 0.5f32;
+    for (angle_deg, slides) in [(20.0f32, false), (35.0, true)] {
+        let (mut w, ground, body, half) = box_world(4);
+        let tilt = Quat::from_rotation_z(angle_deg.to_radians());
+        let up = tilt * Vec3::Y;
+        w.set_body_pose(body, up * (half.y + 0.001), tilt).unwrap();
+        for _ in 0..180 {
+            let contacts = corner_contacts(&w, ground, body, half, mu, up);
+            w.set_contacts(&contacts).unwrap();
+            w.step(DT).unwrap();
+        }
+        let moved = w.body(body).unwrap().position - up * (half.y);
+        let along = moved.length();
+        eprintln!(
+            "incline {angle_deg} deg (atan mu = {:.1}): moved {along:.4} m",
+            mu.atan().to_degrees()
+        );
+        if slides {
+            // Sliding from rest: s = 1/2 g (sin a - mu cos a) t^2, t = 3 s.
+            let a = angle_deg.to_radians();
+            let expected = 0.5 * 9.81 * (a.sin() - mu * a.cos()) * 9.0;
+            assert!(
+                (along - expected).abs() < 0.03 * expected,
+                "slides above atan(mu): {along} m vs {expected} m"
+            );
+        } else {
+            assert!(along < 1e-3, "holds below atan(mu): {along}");
+        }
+    }
+}
