@@ -35,7 +35,7 @@ use glam::{Quat, Vec3};
 use vertebra_kernels::body::BodyRows;
 use vertebra_math::Backend;
 use vertebra_scheduler::Colouring;
-use vertebra_store::{BodyKind, Slots};
+use vertebra_store::Slots;
 
 pub use config::SolverConfig;
 pub use contact::Contact;
@@ -44,7 +44,8 @@ pub use rod::{RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
-    BodyDesc, BodyHandle, BodyState, BodyStore, Error, MassProperties, Shape,
+    BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MassProperties, Shape,
+    check_positive, check_unit_vec,
 };
 
 /// Bodies, joints and the solver that steps them.

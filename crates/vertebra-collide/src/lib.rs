@@ -1,0 +1,284 @@
+//! Collision detection for vertebra, on `parry3d` (the field's library,
+//! glam-based like us): colliders on bodies, a sort-and-sweep broad phase,
+//! parry's contact manifolds as the narrow phase, and collision filtering;
+//! the result is the `Contact` list the core solver takes. An engine with
+//! its own collision detection skips this crate and calls
+//! `World::set_contacts` itself.
+//!
+//! Static geometry (ground, walls, boxes) is static bodies with colliders.
+//! Pairs of bodies that are never tested: the same body; two bodies that
+//! are both static or kinematic; pairs excluded by [`Collisions::exclude`]
+//! (a ragdoll's jointed pairs: `Ragdoll::non_colliding_pairs`); and pairs
+//! whose [`CollisionGroups`] do not match.
+
+use std::collections::HashSet;
+
+use glam::{Quat, Vec3};
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::math::Pose;
+use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
+use parry3d::shape::SharedShape;
+use vertebra_world::{BodyHandle, BodyKind, Contact, Error, Shape, World};
+
+/// Which colliders may touch: a pair is tested when each one's
+/// `membership` meets the other's `filter` (both bit sets).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CollisionGroups {
+    /// The groups this collider is in.
+    pub membership: u32,
+    /// The groups it collides with.
+    pub filter: u32,
+}
+
+impl Default for CollisionGroups {
+    fn default() -> Self {
+        Self {
+            membership: u32::MAX,
+            filter: u32::MAX,
+        }
+    }
+}
+
+/// A collider's geometry, in its body's frame (centred on the centre of
+/// mass, as the store's shapes are).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ColliderShape {
+    /// A body shape: sphere, box or capsule.
+    Solid(Shape),
+    /// The half space below the plane through the body's origin with the
+    /// given outward unit normal (body frame): the ground.
+    Plane(Vec3),
+}
+
+/// A collider on a body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Collider {
+    /// The body it moves with.
+    pub body: BodyHandle,
+    /// Its geometry.
+    pub shape: ColliderShape,
+    /// Friction coefficient (a pair uses the geometric mean).
+    pub friction: f32,
+    /// Restitution (a pair uses the larger).
+    pub restitution: f32,
+    /// Filtering.
+    pub groups: CollisionGroups,
+}
+
+impl Collider {
+    /// A collider of `shape` on `body`, friction 0.6, no restitution, in
+    /// every group.
+    pub fn new(body: BodyHandle, shape: ColliderShape) -> Self {
+        Self {
+            body,
+            shape,
+            friction: 0.6,
+            restitution: 0.0,
+            groups: CollisionGroups::default(),
+        }
+    }
+}
+
+/// All colliders and the rules for which pairs are tested.
+#[derive(Clone, Default)]
+pub struct Collisions {
+    colliders: Vec<(Collider, SharedShape)>,
+    excluded: HashSet<(BodyHandle, BodyHandle)>,
+    /// Contacts are made for gaps up to this size too (m), on top of how far
+    /// each body can move in the step (see [`Collisions::find_contacts`]).
+    pub prediction: f32,
+}
+
+fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {
+    if a.index() <= b.index() {
+        (a, b)
+    } else {
+        (b, a)
+    }
+}
+
+impl Collisions {
+    /// No colliders yet; a 1 cm prediction margin.
+    pub fn new() -> Self {
+        Self {
+            prediction: 0.01,
+            ..Self::default()
+        }
+    }
+
+    /// Adds a collider; `Err` for a degenerate shape, a non-unit plane
+    /// normal or bad friction and restitution.
+    pub fn add(&mut self, collider: Collider) -> Result<usize, Error> {
+        let shape = match collider.shape {
+            ColliderShape::Solid(s) => {
+                s.validate()?;
+                match s {
+                    Shape::Sphere { radius } => SharedShape::ball(radius),
+                    Shape::Box { half_extents: h } => SharedShape::cuboid(h.x, h.y, h.z),
+                    Shape::Capsule {
+                        half_segment,
+                        radius,
+                    } => SharedShape::capsule(-half_segment, half_segment, radius),
+                }
+            }
+            ColliderShape::Plane(n) => {
+                vertebra_world::check_unit_vec("plane normal", n)?;
+                SharedShape::halfspace(n.normalize())
+            }
+        };
+        if !(collider.friction.is_finite() && collider.friction >= 0.0) {
+            return Err(Error::NonPositive("collider friction"));
+        }
+        if !(0.0..=1.0).contains(&collider.restitution) {
+            return Err(Error::InvalidLimit("restitution (must be in [0, 1])"));
+        }
+        self.colliders.push((collider, shape));
+        Ok(self.colliders.len() - 1)
+    }
+
+    /// Never tests the pair `(a, b)` (e.g. a joint's two bodies).
+    pub fn exclude(&mut self, a: BodyHandle, b: BodyHandle) {
+        self.excluded.insert(ordered(a, b));
+    }
+
+    /// The colliders.
+    pub fn colliders(&self) -> impl Iterator<Item = &Collider> {
+        self.colliders.iter().map(|c| &c.0)
+    }
+
+    /// Forgets the colliders of `body` (before removing it from the world).
+    pub fn remove_body(&mut self, body: BodyHandle) {
+        self.colliders.retain(|c| c.0.body != body);
+        self.excluded.retain(|&(a, b)| a != body && b != body);
+    }
+
+    /// Every contact between the colliders at the bodies' current poses, in
+    /// a deterministic order; feed them to `World::set_contacts` before a
+    /// step of `dt` seconds. Contacts are speculative: a pair is caught up
+    /// to `prediction` plus how far its bodies can close in within `dt`
+    /// (linear speed plus angular speed times the collider's extent), so a
+    /// fast body meets the floor instead of passing into it; a gap does
+    /// nothing until it closes.
+    pub fn find_contacts(&self, world: &World, dt: f32) -> Result<Vec<Contact>, Error> {
+        vertebra_world::check_positive("time step", dt)?;
+        let mut poses = Vec::with_capacity(self.colliders.len());
+        let mut reach = Vec::with_capacity(self.colliders.len());
+        for (c, shape) in &self.colliders {
+            let s = world.body(c.body)?;
+            poses.push(Pose::from_parts(s.position, s.orientation));
+            let extent = shape.compute_local_bounding_sphere().radius;
+            let extent = if extent.is_finite() { extent } else { 0.0 };
+            reach.push((s.linear_velocity.length() + s.angular_velocity.length() * extent) * dt);
+        }
+        let mut contacts = Vec::new();
+        let mut manifolds = Vec::new();
+        for (i, j) in self.candidate_pairs(world, &poses, &reach) {
+            let ((ci, si), (cj, sj)) = (&self.colliders[i], &self.colliders[j]);
+            manifolds.clear();
+            let relative = poses[i].inv_mul(&poses[j]);
+            let prediction = self.prediction + reach[i] + reach[j];
+            if DefaultQueryDispatcher
+                .contact_manifolds(
+                    &relative,
+                    si.as_ref(),
+                    sj.as_ref(),
+                    prediction,
+                    &mut manifolds,
+                    &mut None,
+                )
+                .is_err()
+            {
+                continue; // a pair parry has no algorithm for (none of ours)
+            }
+            let friction = (ci.friction * cj.friction).sqrt();
+            let restitution = ci.restitution.max(cj.restitution);
+            for m in &manifolds {
+                push_manifold(
+                    &mut contacts,
+                    m,
+                    (ci.body, &poses[i]),
+                    (cj.body, &poses[j]),
+                    friction,
+                    restitution,
+                );
+            }
+        }
+        Ok(contacts)
+    }
+
+    /// Pairs of collider indices whose bounds overlap and that may collide:
+    /// sort-and-sweep along x for solids, every solid against every plane.
+    fn candidate_pairs(&self, world: &World, poses: &[Pose], reach: &[f32]) -> Vec<(usize, usize)> {
+        let aabbs: Vec<Aabb> = (0..self.colliders.len())
+            .map(|k| {
+                self.colliders[k]
+                    .1
+                    .compute_aabb(&poses[k])
+                    .loosened(self.prediction + reach[k])
+            })
+            .collect();
+        let is_plane = |k: usize| matches!(self.colliders[k].0.shape, ColliderShape::Plane(_));
+        let mut solids: Vec<usize> = (0..self.colliders.len())
+            .filter(|&k| !is_plane(k))
+            .collect();
+        solids.sort_by(|&a, &b| aabbs[a].mins.x.total_cmp(&aabbs[b].mins.x).then(a.cmp(&b)));
+        let mut pairs = Vec::new();
+        for (n, &a) in solids.iter().enumerate() {
+            for &b in &solids[n + 1..] {
+                if aabbs[b].mins.x > aabbs[a].maxs.x {
+                    break;
+                }
+                if aabbs[a].intersects(&aabbs[b]) {
+                    pairs.push((a.min(b), a.max(b)));
+                }
+            }
+        }
+        for plane in (0..self.colliders.len()).filter(|&k| is_plane(k)) {
+            pairs.extend(solids.iter().map(|&s| (plane.min(s), plane.max(s))));
+        }
+        pairs.retain(|&(a, b)| self.may_collide(world, a, b));
+        pairs.sort_unstable();
+        pairs
+    }
+
+    fn may_collide(&self, world: &World, a: usize, b: usize) -> bool {
+        let (ca, cb) = (&self.colliders[a].0, &self.colliders[b].0);
+        let dynamic = |h: BodyHandle| world.bodies().kind[h.index()] == BodyKind::Dynamic;
+        ca.body != cb.body
+            && (dynamic(ca.body) || dynamic(cb.body))
+            && !self.excluded.contains(&ordered(ca.body, cb.body))
+            && ca.groups.membership & cb.groups.filter != 0
+            && cb.groups.membership & ca.groups.filter != 0
+    }
+}
+
+/// A manifold's points as solver contacts: the normal from the first shape
+/// to the second, the point midway between the surfaces, depth = -distance.
+fn push_manifold(
+    out: &mut Vec<Contact>,
+    m: &ContactManifold<(), ()>,
+    (body_a, pose_a): (BodyHandle, &Pose),
+    (body_b, pose_b): (BodyHandle, &Pose),
+    friction: f32,
+    restitution: f32,
+) {
+    let normal = (pose_a.rotation * m.local_n1).normalize();
+    for point in &m.points {
+        let pa = pose_a.transform_point(point.local_p1);
+        let pb = pose_b.transform_point(point.local_p2);
+        out.push(Contact {
+            body_a,
+            body_b,
+            point: (pa + pb) * 0.5,
+            normal,
+            depth: -point.dist,
+            friction,
+            restitution,
+        });
+    }
+}
+
+/// The world pose of a body's collider frame (for callers drawing them).
+pub fn collider_pose(world: &World, body: BodyHandle) -> Result<(Vec3, Quat), Error> {
+    world.body(body).map(|s| (s.position, s.orientation))
+}
