@@ -9,7 +9,7 @@
 use std::hint::black_box;
 
 use iai_callgrind::{library_benchmark, library_benchmark_group, main};
-use vertebra_benches::{INSTRUCTION_BACKENDS, RodWorkload, SocketWorkload};
+use vertebra_benches::{ContactWorkload, INSTRUCTION_BACKENDS, RodWorkload, SocketWorkload};
 
 fn with_drive(backend: usize) -> SocketWorkload {
     SocketWorkload::new(INSTRUCTION_BACKENDS[backend], 256, true)
@@ -45,5 +45,16 @@ fn rod(mut work: RodWorkload) -> f32 {
     black_box(work.probe())
 }
 
-library_benchmark_group!(name = joints; benchmarks = socket_limits_drive, socket_limits, rod);
+fn contacts(backend: usize) -> ContactWorkload {
+    ContactWorkload::new(INSTRUCTION_BACKENDS[backend], 256)
+}
+
+#[library_benchmark]
+#[benches::backend(args = [0, 1, 2, 3], setup = contacts)]
+fn contact(mut work: ContactWorkload) -> f32 {
+    work.iterate();
+    black_box(work.probe())
+}
+
+library_benchmark_group!(name = joints; benchmarks = socket_limits_drive, socket_limits, rod, contact);
 main!(library_benchmark_groups = joints);

@@ -3,6 +3,7 @@
 
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
 use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
@@ -270,4 +271,142 @@ impl RodWorkload {
     pub fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]
     }
+}
+
+/// A batch of contacts laid out as the joint workloads: each lane on its
+/// own two dynamic bodies, penetrating and sliding, so both the normal and
+/// the friction corrections work.
+pub struct ContactWorkload {
+    backend: Backend,
+    rows: BodyRows,
+    blocks: Vec<ContactBlock>,
+}
+
+impl ContactWorkload {
+    /// `contacts` contacts (a multiple of 8) on `backend`.
+    pub fn new(backend: Backend, contacts: usize) -> Self {
+        let blocks = contacts.div_ceil(BLOCK_LANES);
+        let bodies = SocketWorkload::new(backend, blocks * BLOCK_LANES, false);
+        let mut out = vec![ContactBlock::padding(); blocks];
+        for k in 0..blocks * BLOCK_LANES {
+            let lane = ContactLane {
+                body_a: (2 * k + 1) as u32,
+                body_b: (2 * k + 2) as u32,
+                dynamic_a: true,
+                dynamic_b: true,
+                point_a: GVec3::new(0.05, 0.12, 0.0),
+                point_b: GVec3::new(-0.04, -0.13, 0.01),
+                normal: GVec3::new(0.1, 1.0, 0.05).normalize(),
+                friction: 0.6,
+                restitution: 0.2,
+                approach: -1.0,
+            };
+            out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
+        }
+        Self {
+            backend,
+            rows: bodies.rows,
+            blocks: out,
+        }
+    }
+
+    /// One position iteration over every contact.
+    pub fn iterate(&mut self) {
+        let (blocks, rows) = (&mut self.blocks, &self.rows);
+        self.backend
+            .dispatch(contact::PositionPass { blocks, rows });
+    }
+
+    /// The contacts in the batch.
+    pub fn contacts(&self) -> usize {
+        self.blocks.len() * BLOCK_LANES
+    }
+
+    /// A value that depends on the work (to keep it observable).
+    pub fn probe(&self) -> f32 {
+        self.rows.pose[1].get()[0]
+    }
+}
+
+/// The paper's ragdoll-drop world (issue 7's layout): a ground, a pit of
+/// four walls, three boxes, and 30 reference humanoids in 10 layers of 3,
+/// simplified (rod spine) or standard, each with capsule colliders.
+pub fn ragdoll_drop(
+    spine: vertebra_ragdoll::SpineMode,
+) -> (vertebra_world::World, vertebra_collide::Collisions) {
+    use glam::Quat;
+    use vertebra_collide::{Collider, ColliderShape, Collisions};
+    use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc};
+    use vertebra_world::{BodyDesc, Shape, SolverConfig, World};
+    let mut w = World::new(SolverConfig::default()).expect("default config");
+    let mut c = Collisions::new();
+    let fixed = |w: &mut World, c: &mut Collisions, at: GVec3, turn: Quat, shape: ColliderShape| {
+        let body = w
+            .add_body(BodyDesc::fixed().with_position(at).with_orientation(turn))
+            .expect("static body");
+        c.add(Collider::new(body, shape)).expect("collider");
+    };
+    fixed(
+        &mut w,
+        &mut c,
+        GVec3::ZERO,
+        Quat::IDENTITY,
+        ColliderShape::Plane(GVec3::Y),
+    );
+    for (at, half) in [
+        (GVec3::new(1.55, 0.5, 0.0), GVec3::new(0.05, 0.5, 1.6)),
+        (GVec3::new(-1.55, 0.5, 0.0), GVec3::new(0.05, 0.5, 1.6)),
+        (GVec3::new(0.0, 0.5, 1.55), GVec3::new(1.6, 0.5, 0.05)),
+        (GVec3::new(0.0, 0.5, -1.55), GVec3::new(1.6, 0.5, 0.05)),
+    ] {
+        fixed(
+            &mut w,
+            &mut c,
+            at,
+            Quat::IDENTITY,
+            ColliderShape::Solid(Shape::Box { half_extents: half }),
+        );
+    }
+    let crate_half = GVec3::new(0.3, 0.15, 0.3);
+    for (at, turn) in [
+        (GVec3::new(0.6, 0.15, 0.6), 0.0f32),
+        (GVec3::new(-0.7, 0.25, -0.2), 30f32.to_radians()),
+        (GVec3::new(0.2, 0.1, -0.8), 0.0),
+    ] {
+        fixed(
+            &mut w,
+            &mut c,
+            at,
+            Quat::from_rotation_y(turn),
+            ColliderShape::Solid(Shape::Box {
+                half_extents: crate_half,
+            }),
+        );
+    }
+    let desc = RagdollDesc::reference_humanoid();
+    let hips = desc.bodies[desc.root].centre();
+    for k in 0..30 {
+        let (layer, slot) = (k / 3, k % 3);
+        let yaw = (37.0 * layer as f32).to_radians();
+        let turn = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+        let u = GVec3::new(yaw.cos(), 0.0, -yaw.sin());
+        let at = GVec3::new(0.0, 1.0 + 0.5 * layer as f32, 0.0) + u * (0.6 * (slot as f32 - 1.0));
+        let pose = Pose::bind(&desc).moved(hips, turn, at - hips);
+        let ragdoll =
+            Ragdoll::build(&mut w, &desc, BuildOptions::new(spine), &pose, None).expect("ragdoll");
+        for (i, body) in ragdoll.bodies.iter().enumerate() {
+            if let Some(body) = body {
+                let def = &desc.bodies[i];
+                let centre = def.centre();
+                let shape =
+                    Shape::capsule(def.segment[0] - centre, def.segment[1] - centre, def.radius);
+                c.add(Collider::new(*body, ColliderShape::Solid(shape)))
+                    .expect("collider");
+            }
+        }
+        for (a, b) in ragdoll.non_colliding_pairs() {
+            c.exclude(a, b);
+        }
+    }
+    (w, c)
 }
