@@ -1,0 +1,170 @@
+//! `vertebra`: reproduce the paper's results on the reference humanoid
+//! (`vertebra reproduce`), or run one scene (`vertebra scene NAME ...`).
+
+mod output;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use vertebra_math::BackendChoice;
+use vertebra_ragdoll::{RagdollDesc, SpineMode};
+use vertebra_scenes::{Scene, SceneConfig, SceneRun};
+
+#[derive(Parser)]
+#[command(
+    name = "vertebra",
+    version,
+    about = "Rod constraints for simplified ragdolls: the paper's scenes"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Runs every scene both ways and writes tables, plots and pictures.
+    Reproduce {
+        /// Where to write the results.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
+    /// Runs one scene.
+    Scene {
+        /// passive-bending, ragdoll-drop or controllability.
+        name: String,
+        /// rod (simplified) or sockets (standard).
+        #[arg(long)]
+        spine: Spine,
+        /// Position iterations per substep.
+        #[arg(long, default_value_t = 20)]
+        iterations: u32,
+        /// Substeps per frame.
+        #[arg(long, default_value_t = 1)]
+        substeps: u32,
+        /// Frames to run (the scene's own count by default).
+        #[arg(long)]
+        frames: Option<usize>,
+        /// auto, scalar, portable, sse4, avx2x4 or avx2.
+        #[arg(long, default_value = "auto")]
+        backend: String,
+        /// Worker threads.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        /// A ragdoll description (TOML) instead of the reference humanoid.
+        #[arg(long)]
+        ragdoll: Option<PathBuf>,
+        /// One JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Spine {
+    Rod,
+    Sockets,
+}
+
+impl From<Spine> for SpineMode {
+    fn from(s: Spine) -> Self {
+        match s {
+            Spine::Rod => SpineMode::Rod,
+            Spine::Sockets => SpineMode::Sockets,
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version.
+            print!("{e}");
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            let text = e.to_string();
+            let line = text
+                .lines()
+                .next()
+                .unwrap_or("bad arguments")
+                .trim_start_matches("error: ");
+            eprintln!("vertebra: {line}");
+            return ExitCode::from(2);
+        }
+    };
+    match execute(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("vertebra: {message}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn execute(command: Command) -> Result<(), String> {
+    match command {
+        Command::Reproduce { out } => output::reproduce(&out),
+        Command::Scene {
+            name,
+            spine,
+            iterations,
+            substeps,
+            frames,
+            backend,
+            threads,
+            ragdoll,
+            json,
+        } => {
+            let scene: Scene = name.parse()?;
+            let backend: BackendChoice = backend.parse().map_err(|e| format!("{e}"))?;
+            backend.resolve().map_err(|e| format!("{e}"))?;
+            let ragdoll = match ragdoll {
+                Some(path) => {
+                    let text = std::fs::read_to_string(&path)
+                        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+                    Some(
+                        RagdollDesc::from_toml(&text)
+                            .map_err(|e| format!("{}: {e}", path.display()))?,
+                    )
+                }
+                None => None,
+            };
+            if frames == Some(0) {
+                return Err("--frames must be at least 1".to_owned());
+            }
+            let mut config = SceneConfig::new(scene, spine.into());
+            config.iterations = iterations;
+            config.substeps = substeps;
+            config.frames = frames;
+            config.backend = backend;
+            config.threads = threads;
+            config.ragdoll = ragdoll;
+            let run = vertebra_scenes::run(&config, |_, _| {}).map_err(|e| e.to_string())?;
+            if json {
+                println!("{}", output::run_json(&config, &run));
+            } else {
+                print_summary(&config, &run);
+            }
+            Ok(())
+        }
+    }
+}
+
+fn print_summary(config: &SceneConfig, run: &SceneRun) {
+    let s = output::Summary::of(run);
+    println!(
+        "{} ({}): mean eps_lin {:.4} cm, max {:.4} cm; mean eps_ang {:.5} rad, max {:.5} rad; {:.3} ms/step on {}; state {:016x}",
+        config.scene,
+        output::spine_name(config.spine),
+        s.mean_lin,
+        s.max_lin,
+        s.mean_ang,
+        s.max_ang,
+        run.ms_per_step,
+        run.backend,
+        run.state_hash
+    );
+}

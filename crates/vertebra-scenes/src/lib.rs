@@ -1,0 +1,12 @@
+//! The paper's scenes (figures 1, 2, 6, 7, 8), on the reference humanoid,
+//! at 60 Hz with gravity (0, -9.81, 0), 1 substep and 20 iterations unless
+//! told otherwise, each with a rod spine (simplified) or a socket spine
+//! (standard). Used by the `vertebra` command, the benches and the tests.
+
+mod kinematics;
+mod run;
+mod setup;
+
+pub use kinematics::{Locus, kinematics};
+pub use run::{Frame, SceneRun, run};
+pub use setup::{Scene, SceneConfig, ragdoll_drop};

@@ -1,0 +1,141 @@
+//! Running a scene and measuring it frame by frame.
+
+use std::collections::HashSet;
+use std::time::Instant;
+
+use vertebra_math::Backend;
+use vertebra_ragdoll::{Pose, RagdollError, SpineMapping};
+use vertebra_world::World;
+
+use crate::setup::{Built, Scene, SceneConfig, build};
+
+/// What one frame measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Frame {
+    /// Sum over the ragdolls' joints of the linear error (cm): anchor
+    /// separations, and the rod's `|C_len|`.
+    pub eps_lin_cm: f32,
+    /// Sum of the angular errors (rad): limit overshoot, and the rod's
+    /// curve error.
+    pub eps_ang_rad: f32,
+    /// Controllability: summed distance of the bodies from the target (cm).
+    pub deviation_cm: f32,
+    /// Controllability: summed angle of the bodies from the target (rad).
+    pub deviation_rad: f32,
+}
+
+/// A finished run.
+#[derive(Clone, Debug)]
+pub struct SceneRun {
+    /// What ran.
+    pub scene: Scene,
+    /// The backend it ran on.
+    pub backend: Backend,
+    /// Per frame.
+    pub frames: Vec<Frame>,
+    /// Mean wall time per step, collision detection included (ms).
+    pub ms_per_step: f64,
+    /// The final world state's hash.
+    pub state_hash: u64,
+    /// The first ragdoll's skeleton (arc mapping) at the first, middle and
+    /// last frame, for pictures.
+    pub snapshots: Vec<Pose>,
+    /// Every body's final position (m): (ragdoll index, position).
+    pub final_positions: Vec<(usize, glam::Vec3)>,
+}
+
+fn joint_sets(built: &Built) -> (HashSet<usize>, HashSet<usize>) {
+    let sockets = built
+        .ragdolls
+        .iter()
+        .flat_map(|r| r.sockets.iter().flatten().map(|s| s.index()))
+        .collect();
+    let rods = built
+        .ragdolls
+        .iter()
+        .filter_map(|r| r.rod.map(|h| h.index()))
+        .collect();
+    (sockets, rods)
+}
+
+fn measure(world: &World, built: &Built, sockets: &HashSet<usize>, rods: &HashSet<usize>) -> Frame {
+    let r = world.residuals();
+    let socket_errors = r
+        .sockets
+        .iter()
+        .filter(|j| sockets.contains(&j.joint.index()))
+        .map(|j| (j.linear_cm, j.angular_rad));
+    let rod_errors = r
+        .rods
+        .iter()
+        .filter(|j| rods.contains(&j.joint.index()))
+        .map(|j| (j.linear_cm, j.angular_rad));
+    let (eps_lin_cm, eps_ang_rad) = socket_errors
+        .chain(rod_errors)
+        .fold((0.0, 0.0), |(l, a), (dl, da)| (l + dl, a + da));
+    let (mut deviation_cm, mut deviation_rad) = (0.0, 0.0);
+    if let Some(target) = &built.target {
+        for ragdoll in &built.ragdolls {
+            for (i, body) in ragdoll.bodies.iter().enumerate() {
+                if let Some(state) = body.and_then(|b| world.body(b).ok()) {
+                    deviation_cm += (state.position - target.bones[i].0).length() * 100.0;
+                    deviation_rad += state.orientation.angle_between(target.bones[i].1);
+                }
+            }
+        }
+    }
+    Frame {
+        eps_lin_cm,
+        eps_ang_rad,
+        deviation_cm,
+        deviation_rad,
+    }
+}
+
+/// Runs `config`, calling `progress(frame, frames)` after each frame.
+pub fn run(
+    config: &SceneConfig,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<SceneRun, RagdollError> {
+    let mut built = build(config)?;
+    let (sockets, rods) = joint_sets(&built);
+    let frames = config.frames.unwrap_or(config.scene.default_frames());
+    let dt = 1.0 / 60.0;
+    let mut out = Vec::with_capacity(frames);
+    let mut snapshots = Vec::new();
+    let start = Instant::now();
+    for frame in 0..frames {
+        if let Some(collisions) = &built.collisions {
+            let contacts = collisions.find_contacts(&built.world, dt)?;
+            built.world.set_contacts(&contacts)?;
+        }
+        if let (Some((body, force)), Scene::Controllability) = (built.push, config.scene) {
+            if (30..90).contains(&frame) {
+                built.world.add_force(body, force)?;
+            }
+        }
+        built.world.step(dt)?;
+        out.push(measure(&built.world, &built, &sockets, &rods));
+        if frame == 0 || frame == frames / 2 || frame + 1 == frames {
+            snapshots.push(built.ragdolls[0].skeleton_pose(&built.world, SpineMapping::Arc)?);
+        }
+        progress(frame + 1, frames);
+    }
+    let ms_per_step = start.elapsed().as_secs_f64() * 1e3 / frames.max(1) as f64;
+    let final_positions = built
+        .ragdolls
+        .iter()
+        .enumerate()
+        .flat_map(|(k, r)| r.bodies.iter().flatten().map(move |b| (k, *b)))
+        .map(|(k, b)| built.world.body(b).map(|s| (k, s.position)))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(SceneRun {
+        scene: config.scene,
+        backend: built.world.backend(),
+        frames: out,
+        ms_per_step,
+        state_hash: built.world.state_hash(),
+        snapshots,
+        final_positions,
+    })
+}

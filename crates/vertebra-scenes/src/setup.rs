@@ -1,0 +1,312 @@
+//! Building each scene's world.
+
+use core::fmt;
+use core::str::FromStr;
+
+use glam::{Quat, Vec3};
+use vertebra_collide::{Collider, ColliderShape, Collisions};
+use vertebra_ragdoll::{
+    BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode, Strength,
+};
+use vertebra_world::{
+    AngularDrive, BackendChoice, BodyDesc, BodyHandle, Shape, SocketDesc, SolverConfig, World,
+};
+
+/// A scene of the paper.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Scene {
+    /// Figures 2 and 8 (left): the hips fixed, the upper body slumps.
+    PassiveBending,
+    /// Figures 1 and 8 (right): 30 ragdolls dropped into a pit.
+    RagdollDrop,
+    /// Figure 7: the hips fixed, every joint driven to the bind pose, the
+    /// chest pushed.
+    Controllability,
+}
+
+impl Scene {
+    /// Every simulated scene.
+    pub const ALL: [Scene; 3] = [
+        Scene::PassiveBending,
+        Scene::RagdollDrop,
+        Scene::Controllability,
+    ];
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scene::PassiveBending => "passive-bending",
+            Scene::RagdollDrop => "ragdoll-drop",
+            Scene::Controllability => "controllability",
+        }
+    }
+
+    /// Frames the paper's figure runs.
+    pub fn default_frames(self) -> usize {
+        match self {
+            Scene::PassiveBending => 300,
+            Scene::RagdollDrop => 600,
+            Scene::Controllability => 240,
+        }
+    }
+}
+
+impl fmt::Display for Scene {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Scene {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Scene::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| {
+            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability or kinematics)")
+        })
+    }
+}
+
+/// How to run a scene.
+#[derive(Clone, Debug)]
+pub struct SceneConfig {
+    /// Which scene.
+    pub scene: Scene,
+    /// Rod (simplified) or sockets (standard).
+    pub spine: SpineMode,
+    /// Position iterations per substep.
+    pub iterations: u32,
+    /// Substeps per frame.
+    pub substeps: u32,
+    /// Frames to run (the scene's default when `None`).
+    pub frames: Option<usize>,
+    /// Kernel backend.
+    pub backend: BackendChoice,
+    /// Worker threads.
+    pub threads: usize,
+    /// The ragdoll (the reference humanoid when `None`).
+    pub ragdoll: Option<RagdollDesc>,
+}
+
+impl SceneConfig {
+    /// The paper's settings for `scene` with `spine`.
+    pub fn new(scene: Scene, spine: SpineMode) -> Self {
+        Self {
+            scene,
+            spine,
+            iterations: 20,
+            substeps: 1,
+            frames: None,
+            backend: BackendChoice::Auto,
+            threads: 1,
+            ragdoll: None,
+        }
+    }
+
+    pub(crate) fn world(&self) -> Result<World, RagdollError> {
+        let config = SolverConfig {
+            iterations: self.iterations,
+            substeps: self.substeps,
+            backend: self.backend,
+            threads: self.threads,
+            ..SolverConfig::default()
+        };
+        Ok(World::new(config)?)
+    }
+
+    pub(crate) fn description(&self) -> RagdollDesc {
+        self.ragdoll
+            .clone()
+            .unwrap_or_else(RagdollDesc::reference_humanoid)
+    }
+}
+
+/// A built scene: its world, collisions, ragdolls, and what is measured.
+pub(crate) struct Built {
+    pub world: World,
+    pub collisions: Option<Collisions>,
+    pub ragdolls: Vec<Ragdoll>,
+    /// Target pose for the deviation metric (controllability).
+    pub target: Option<Pose>,
+    /// The body pushed, and the force (controllability).
+    pub push: Option<(BodyHandle, Vec3)>,
+}
+
+/// Holds `body` where it is: a static anchor and a socket with a stiff
+/// drive (its error is not counted in the ragdoll's residuals).
+fn fix(world: &mut World, body: BodyHandle) -> Result<(), RagdollError> {
+    let at = world.body(body)?.position;
+    let anchor = world.add_body(
+        BodyDesc::fixed()
+            .with_position(at)
+            .with_orientation(world.body(body)?.orientation),
+    )?;
+    let pin = SocketDesc::at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?.with_drive(
+        AngularDrive {
+            target: Quat::IDENTITY,
+            compliance: 0.0,
+            damping: 0.0,
+        },
+    );
+    world.add_socket(pin)?;
+    Ok(())
+}
+
+pub(crate) fn build(config: &SceneConfig) -> Result<Built, RagdollError> {
+    let desc = config.description();
+    let mut world = config.world()?;
+    match config.scene {
+        Scene::PassiveBending => {
+            // Bind pose leaned 30 degrees about +X through the hips centre
+            // (0, 1, 0): the upper body toward +Z.
+            let pose = Pose::bind(&desc).moved(
+                Vec3::new(0.0, 1.0, 0.0),
+                Quat::from_rotation_x(30f32.to_radians()),
+                Vec3::ZERO,
+            );
+            let ragdoll = Ragdoll::build(
+                &mut world,
+                &desc,
+                BuildOptions::new(config.spine),
+                &pose,
+                None,
+            )?;
+            fix(
+                &mut world,
+                ragdoll.bodies[desc.root].expect("the root body exists"),
+            )?;
+            Ok(Built {
+                world,
+                collisions: None,
+                ragdolls: vec![ragdoll],
+                target: None,
+                push: None,
+            })
+        }
+        Scene::Controllability => {
+            let pose = Pose::bind(&desc);
+            let ragdoll = Ragdoll::build(
+                &mut world,
+                &desc,
+                BuildOptions::new(config.spine),
+                &pose,
+                None,
+            )?;
+            fix(
+                &mut world,
+                ragdoll.bodies[desc.root].expect("the root body exists"),
+            )?;
+            ragdoll.drive_to(
+                &mut world,
+                &pose,
+                &DriveSettings::uniform(Strength::Infinite),
+            )?;
+            // 200 N along +Z on the top of the spine (the chest).
+            let push = ragdoll.bodies[spine_top(&desc)].map(|c| (c, Vec3::new(0.0, 0.0, 200.0)));
+            Ok(Built {
+                world,
+                collisions: None,
+                ragdolls: vec![ragdoll],
+                target: Some(pose),
+                push,
+            })
+        }
+        Scene::RagdollDrop => {
+            let (world, collisions, ragdolls) = ragdoll_drop(world, &desc, config.spine)?;
+            Ok(Built {
+                world,
+                collisions: Some(collisions),
+                ragdolls,
+                target: None,
+                push: None,
+            })
+        }
+    }
+}
+
+/// The top of the spine chain (the chest), or the root when there is none.
+fn spine_top(desc: &RagdollDesc) -> usize {
+    desc.spine
+        .as_ref()
+        .and_then(|s| s.bodies.last().copied())
+        .unwrap_or(desc.root)
+}
+
+/// The paper's ragdoll-drop world: ground with its top at y = 0; a pit of
+/// four static walls (inner faces at x, z = +-1.5, 1 m tall, 0.1 m thick);
+/// three static boxes of half-extents (0.3, 0.15, 0.3); 30 ragdolls in 10
+/// layers of 3, lying face down, layer `j` turned by 37 j degrees about +Y,
+/// hips at (0, 1 + 0.5 j, 0) + (i - 1) 0.6 u_j. A ragdoll's jointed pairs
+/// never collide.
+pub fn ragdoll_drop(
+    mut world: World,
+    desc: &RagdollDesc,
+    spine: SpineMode,
+) -> Result<(World, Collisions, Vec<Ragdoll>), RagdollError> {
+    let mut collisions = Collisions::new();
+    let mut fixed = |world: &mut World,
+                     at: Vec3,
+                     turn: Quat,
+                     shape: ColliderShape|
+     -> Result<(), RagdollError> {
+        let body = world.add_body(BodyDesc::fixed().with_position(at).with_orientation(turn))?;
+        collisions.add(Collider::new(body, shape))?;
+        Ok(())
+    };
+    fixed(
+        &mut world,
+        Vec3::ZERO,
+        Quat::IDENTITY,
+        ColliderShape::Plane(Vec3::Y),
+    )?;
+    for (at, half) in [
+        (Vec3::new(1.55, 0.5, 0.0), Vec3::new(0.05, 0.5, 1.6)),
+        (Vec3::new(-1.55, 0.5, 0.0), Vec3::new(0.05, 0.5, 1.6)),
+        (Vec3::new(0.0, 0.5, 1.55), Vec3::new(1.6, 0.5, 0.05)),
+        (Vec3::new(0.0, 0.5, -1.55), Vec3::new(1.6, 0.5, 0.05)),
+    ] {
+        fixed(
+            &mut world,
+            at,
+            Quat::IDENTITY,
+            ColliderShape::Solid(Shape::Box { half_extents: half }),
+        )?;
+    }
+    let half = Vec3::new(0.3, 0.15, 0.3);
+    for (at, turn) in [
+        (Vec3::new(0.6, 0.15, 0.6), 0.0f32),
+        (Vec3::new(-0.7, 0.25, -0.2), 30f32.to_radians()),
+        (Vec3::new(0.2, 0.1, -0.8), 0.0),
+    ] {
+        fixed(
+            &mut world,
+            at,
+            Quat::from_rotation_y(turn),
+            ColliderShape::Solid(Shape::Box { half_extents: half }),
+        )?;
+    }
+    let hips = desc.bodies[desc.root].centre();
+    let mut ragdolls = Vec::new();
+    for k in 0..30 {
+        let (layer, slot) = (k / 3, k % 3);
+        let yaw = (37.0 * layer as f32).to_radians();
+        let turn = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+        let u = Vec3::new(yaw.cos(), 0.0, -yaw.sin());
+        let at = Vec3::new(0.0, 1.0 + 0.5 * layer as f32, 0.0) + u * (0.6 * (slot as f32 - 1.0));
+        let pose = Pose::bind(desc).moved(hips, turn, at - hips);
+        let ragdoll = Ragdoll::build(&mut world, desc, BuildOptions::new(spine), &pose, None)?;
+        for (i, body) in ragdoll.bodies.iter().enumerate() {
+            if let Some(body) = body {
+                let def = &desc.bodies[i];
+                let centre = def.centre();
+                let shape =
+                    Shape::capsule(def.segment[0] - centre, def.segment[1] - centre, def.radius);
+                collisions.add(Collider::new(*body, ColliderShape::Solid(shape)))?;
+            }
+        }
+        for (a, b) in ragdoll.non_colliding_pairs() {
+            collisions.exclude(a, b);
+        }
+        ragdolls.push(ragdoll);
+    }
+    Ok((world, collisions, ragdolls))
+}
