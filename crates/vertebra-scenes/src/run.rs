@@ -109,10 +109,11 @@ pub fn run(
             let contacts = collisions.find_contacts(&built.world, dt)?;
             built.world.set_contacts(&contacts)?;
         }
-        if let (Some((body, force)), Scene::Controllability) = (built.push, config.scene) {
-            if (30..90).contains(&frame) {
-                built.world.add_force(body, force)?;
-            }
+        // The push of figure 7: frames 30 to 90.
+        if let (Some((body, force)), Scene::Controllability, true) =
+            (built.push, config.scene, (30..90).contains(&frame))
+        {
+            built.world.add_force(body, force)?;
         }
         built.world.step(dt)?;
         out.push(measure(&built.world, &built, &sockets, &rods));
