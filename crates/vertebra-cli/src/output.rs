@@ -174,7 +174,7 @@ fn ratio(sockets: f32, rod: f32) -> f32 {
 }
 
 fn progress(label: &str, frame: usize, frames: usize) {
-    if frame % 10 == 0 || frame == frames {
+    if frame.is_multiple_of(10) || frame == frames {
         let width = 30;
         let done = width * frame / frames.max(1);
         eprint!(
@@ -199,6 +199,9 @@ fn write_csv(path: &Path, run: &SceneRun) -> Result<(), String> {
     std::fs::write(path, csv).map_err(io)
 }
 
+/// One quantity of a frame.
+type Measure = fn(&vertebra_scenes::Frame) -> f32;
+
 /// Figure 8's layout: linear error on top, angular below; sockets blue,
 /// rod red. Controllability plots its deviation from the target instead.
 fn plot(path: &Path, scene: Scene, runs: &[(SpineMode, SceneRun)]) -> Result<(), String> {
@@ -206,7 +209,7 @@ fn plot(path: &Path, scene: Scene, runs: &[(SpineMode, SceneRun)]) -> Result<(),
     root.fill(&WHITE).map_err(io)?;
     let panels = root.split_evenly((2, 1));
     let deviation = scene == Scene::Controllability;
-    let series: [(&str, fn(&vertebra_scenes::Frame) -> f32); 2] = if deviation {
+    let series: [(&str, Measure); 2] = if deviation {
         [
             ("deviation (cm)", |f| f.deviation_cm),
             ("deviation (rad)", |f| f.deviation_rad),
