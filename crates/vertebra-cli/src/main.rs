@@ -85,13 +85,12 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
         Err(e) => {
+            // One line: clap's message without its usage block and tips.
             let text = e.to_string();
-            let line = text
-                .lines()
-                .next()
-                .unwrap_or("bad arguments")
-                .trim_start_matches("error: ");
-            eprintln!("vertebra: {line}");
+            let message = text.split("\n\nUsage:").next().unwrap_or("bad arguments");
+            let message = message.split("\n\n  tip:").next().unwrap_or(message);
+            let line = message.split_whitespace().collect::<Vec<_>>().join(" ");
+            eprintln!("vertebra: {}", line.trim_start_matches("error: "));
             return ExitCode::from(2);
         }
     };

@@ -163,8 +163,7 @@ impl RagdollDesc {
 
     /// Parses and validates a description.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
-        let raw: RawFile = toml::from_str(text)
-            .map_err(|e| RagdollError::Syntax(e.to_string().trim().to_owned()))?;
+        let raw: RawFile = toml::from_str(text).map_err(|e| syntax(text, &e))?;
         let bodies = raw.body.iter().map(body).collect::<Result<Vec<_>, _>>()?;
         let index = names(
             &raw.body.iter().map(|b| b.name.as_str()).collect::<Vec<_>>(),
@@ -216,6 +215,18 @@ impl RagdollDesc {
     /// Total mass (kg).
     pub fn total_mass(&self) -> f32 {
         self.bodies.iter().map(|b| b.mass).sum()
+    }
+}
+
+/// A parse error on one line: where, and what (without the source excerpt).
+fn syntax(text: &str, e: &toml::de::Error) -> RagdollError {
+    let message = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+    match e.span() {
+        Some(span) => RagdollError::Syntax(format!(
+            "line {}: {message}",
+            text[..span.start.min(text.len())].lines().count().max(1)
+        )),
+        None => RagdollError::Syntax(message),
     }
 }
 

@@ -1,0 +1,193 @@
+//! The `vertebra` command as a user runs it.
+
+use std::process::Command;
+
+fn vertebra(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_vertebra"))
+        .args(args)
+        .output()
+        .expect("the binary runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn scene_json_has_every_field() {
+    let (code, stdout, stderr) = vertebra(&[
+        "scene",
+        "passive-bending",
+        "--spine",
+        "rod",
+        "--frames",
+        "12",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    for field in [
+        "scene",
+        "spine",
+        "iterations",
+        "substeps",
+        "backend",
+        "threads",
+        "frames",
+        "summary",
+        "state_hash",
+    ] {
+        assert!(v.get(field).is_some(), "missing `{field}` in {v}");
+    }
+    assert_eq!(v["scene"], "passive-bending");
+    assert_eq!(v["spine"], "rod");
+    assert_eq!(v["iterations"], 20);
+    let frames = v["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 12);
+    assert!(
+        frames
+            .iter()
+            .all(|f| f["eps_lin_cm"].is_number() && f["eps_ang_rad"].is_number())
+    );
+    for field in [
+        "mean_eps_lin_cm",
+        "max_eps_lin_cm",
+        "mean_eps_ang_rad",
+        "max_eps_ang_rad",
+        "ms_per_step",
+    ] {
+        assert!(v["summary"][field].is_number(), "summary.{field}");
+    }
+    assert_eq!(v["state_hash"].as_str().unwrap().len(), 16);
+    // The same run gives the same hash.
+    let (_, again, _) = vertebra(&[
+        "scene",
+        "passive-bending",
+        "--spine",
+        "rod",
+        "--frames",
+        "12",
+        "--json",
+        "--backend",
+        "scalar",
+    ]);
+    let again: serde_json::Value = serde_json::from_str(again.trim()).unwrap();
+    assert_eq!(
+        again["state_hash"], v["state_hash"],
+        "every backend gives the same bits"
+    );
+}
+
+/// A failing run: non-zero status, one line on stderr naming the problem,
+/// no panic or backtrace.
+fn fails_with(args: &[&str], expected: &str) {
+    let (code, _, stderr) = vertebra(args);
+    assert_ne!(code, 0, "{args:?} should fail");
+    assert_eq!(stderr.trim().lines().count(), 1, "one line: {stderr}");
+    assert!(
+        stderr.contains(expected),
+        "{args:?}: expected `{expected}` in `{stderr}`"
+    );
+    assert!(!stderr.contains("panicked") && !stderr.contains("backtrace"));
+}
+
+#[test]
+fn bad_arguments_end_with_one_clear_line() {
+    fails_with(
+        &["scene", "somersault", "--spine", "rod"],
+        "unknown scene `somersault`",
+    );
+    fails_with(&["scene", "passive-bending", "--spine", "noodle"], "noodle");
+    fails_with(&["scene", "passive-bending"], "--spine");
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--backend",
+            "avx512",
+        ],
+        "unknown backend `avx512`",
+    );
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--frames",
+            "0",
+        ],
+        "--frames must be at least 1",
+    );
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--iterations",
+            "0",
+        ],
+        "iterations must be at least 1",
+    );
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--threads",
+            "zero",
+        ],
+        "zero",
+    );
+    fails_with(&["dance"], "dance");
+}
+
+#[test]
+fn malformed_ragdoll_files_end_with_one_clear_line() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let missing = dir.join("missing.toml");
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--ragdoll",
+            missing.to_str().unwrap(),
+        ],
+        "cannot read",
+    );
+    let bad = dir.join("bad.toml");
+    let text = vertebra_ragdoll::REFERENCE_HUMANOID.replacen("mass = 11.0", "mass = -11.0", 1);
+    std::fs::write(&bad, text).unwrap();
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--ragdoll",
+            bad.to_str().unwrap(),
+        ],
+        "body `hips`: mass must be positive",
+    );
+    let garbage = dir.join("garbage.toml");
+    std::fs::write(&garbage, "[[body]\nname = ").unwrap();
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--ragdoll",
+            garbage.to_str().unwrap(),
+        ],
+        "malformed ragdoll file",
+    );
+}
