@@ -21,9 +21,13 @@ fn passive_bending_slumps_to_the_spine_limits() {
             .to_degrees();
         eprintln!("{spine:?}: bend {bend:.1} degrees");
         assert!(
-            (bend - 60.0).abs() < 3.0,
+            bend > 57.0,
             "{spine:?}: the upper body slumps to the limits ({bend} degrees)"
         );
+        // The rod holds its limit; the socket chain overshoots by its
+        // residual error (about 5 degrees at 20 iterations: figure 8).
+        let overshoot = if spine == SpineMode::Rod { 3.0 } else { 8.0 };
+        assert!(bend < 60.0 + overshoot, "{spine:?}: {bend} degrees");
         // Forward: the chest ends up ahead of the hips (+Z).
         assert!(last.bones[chest].0.z > last.bones[hips].0.z + 0.2);
         errors.push(r.frames.iter().map(|f| f.eps_lin_cm).sum::<f32>());
