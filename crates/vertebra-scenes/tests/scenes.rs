@@ -113,3 +113,22 @@ fn runs_are_deterministic_and_backend_independent() {
         );
     }
 }
+
+#[test]
+fn the_rod_ragdolls_drop_with_less_joint_error() {
+    // Figure 8, right: smaller than passive bending, but consistent.
+    let mean = |spine| {
+        let r = run(&SceneConfig::new(Scene::RagdollDrop, spine), |_, _| {}).unwrap();
+        let n = r.frames.len() as f32;
+        (
+            r.frames.iter().map(|f| f.eps_lin_cm).sum::<f32>() / n,
+            r.frames.iter().map(|f| f.eps_ang_rad).sum::<f32>() / n,
+        )
+    };
+    let (sockets, rod) = (mean(SpineMode::Sockets), mean(SpineMode::Rod));
+    eprintln!("drop: sockets {sockets:?}, rod {rod:?}");
+    assert!(
+        rod.0 < sockets.0 && rod.1 < sockets.1,
+        "sockets {sockets:?}, rod {rod:?}"
+    );
+}
