@@ -76,9 +76,35 @@ fn io(e: impl std::fmt::Display) -> String {
     format!("cannot write the results: {e}")
 }
 
+/// Renders the SVG at `svg` to a PNG beside it (same name, `.png`), with
+/// the system's fonts (DejaVu on the project's machines; without fonts the
+/// text is left out and the rest is drawn).
+fn to_png(svg: &Path, options: &resvg::usvg::Options) -> Result<(), String> {
+    let data = std::fs::read(svg).map_err(io)?;
+    let tree = resvg::usvg::Tree::from_data(&data, options).map_err(io)?;
+    let size = tree.size().to_int_size();
+    let mut pixmap =
+        resvg::tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("empty picture")?;
+    resvg::render(
+        &tree,
+        resvg::tiny_skia::Transform::default(),
+        &mut pixmap.as_mut(),
+    );
+    pixmap.save_png(svg.with_extension("png")).map_err(io)
+}
+
+fn font_options() -> resvg::usvg::Options<'static> {
+    let mut options = resvg::usvg::Options::default();
+    let fonts = options.fontdb_mut();
+    fonts.load_system_fonts();
+    fonts.set_sans_serif_family("DejaVu Sans");
+    options
+}
+
 /// Runs every scene both ways and writes everything under `out`.
 pub fn reproduce(out: &Path) -> Result<(), String> {
     std::fs::create_dir_all(out).map_err(io)?;
+    let fonts = font_options();
     let mut summary = Vec::new();
     let mut table = String::new();
     writeln!(
@@ -138,11 +164,18 @@ pub fn reproduce(out: &Path) -> Result<(), String> {
             ratio(sockets.mean_ang, rod.mean_ang)
         )
         .ok();
-        plot(&out.join(format!("{scene}.svg")), scene, &runs)?;
-        picture(&out.join(format!("{scene}-poses.svg")), scene, &runs)?;
+        let (chart, poses) = (
+            out.join(format!("{scene}.svg")),
+            out.join(format!("{scene}-poses.svg")),
+        );
+        plot(&chart, scene, &runs)?;
+        picture(&poses, scene, &runs)?;
+        to_png(&chart, &fonts)?;
+        to_png(&poses, &fonts)?;
     }
     let locus = kinematics(0.45, 60f32.to_radians(), 61);
     plot_locus(&out.join("kinematics.svg"), &locus)?;
+    to_png(&out.join("kinematics.svg"), &fonts)?;
     let mut csv = String::from("chain,largest_gap_m\n");
     for (name, _, gap) in &locus.chains {
         writeln!(csv, "{name},{gap}").ok();
@@ -296,10 +329,13 @@ fn plot_locus(path: &Path, locus: &vertebra_scenes::Locus) -> Result<(), String>
 }
 
 /// Side views (z forward, y up) of the first ragdoll at the first, middle
-/// and last frame, both ways: figures 2 and 7.
+/// (mid-push for controllability) and last frame, both ways: figures 2
+/// and 7.
 fn picture(path: &Path, scene: Scene, runs: &[(SpineMode, SceneRun)]) -> Result<(), String> {
     let desc = RagdollDesc::reference_humanoid();
-    let (width, height, scale) = (300.0 * 3.0, 300.0 * 2.0, 120.0f32);
+    // Three columns of 300 px, one 400 px row per spine; hips at 160 px
+    // from the row's top (bodies reach about 1 m = 120 px either way).
+    let (width, height, scale) = (300.0 * 3.0, 400.0 * 2.0, 120.0f32);
     let mut svg = format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\"><rect width=\"100%\" height=\"100%\" fill=\"white\"/>"
     );
@@ -310,10 +346,10 @@ fn picture(path: &Path, scene: Scene, runs: &[(SpineMode, SceneRun)]) -> Result<
             "blue"
         };
         for (col, pose) in run.snapshots.iter().enumerate() {
-            let (ox, oy) = (150.0 + 300.0 * col as f32, 270.0 + 300.0 * row as f32);
+            let (ox, oy) = (150.0 + 300.0 * col as f32, 200.0 + 400.0 * row as f32);
             draw_pose(&mut svg, &desc, pose, ox, oy, scale, colour);
         }
-        writeln!(svg, "<text x=\"10\" y=\"{}\" font-family=\"sans-serif\" font-size=\"16\">{scene} ({}): first, middle, last frame</text>", 20 + 300 * row, spine_name(*spine)).ok();
+        writeln!(svg, "<text x=\"10\" y=\"{}\" font-family=\"sans-serif\" font-size=\"16\">{scene} ({}): first, middle, last frame</text>", 24 + 400 * row, spine_name(*spine)).ok();
     }
     svg.push_str("</svg>");
     std::fs::write(path, svg).map_err(io)

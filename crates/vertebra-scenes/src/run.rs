@@ -37,8 +37,8 @@ pub struct SceneRun {
     pub ms_per_step: f64,
     /// The final world state's hash.
     pub state_hash: u64,
-    /// The first ragdoll's skeleton (arc mapping) at the first, middle and
-    /// last frame, for pictures.
+    /// The first ragdoll's skeleton (arc mapping) at the first, middle
+    /// (controllability: frame 60, mid-push) and last frame, for pictures.
     pub snapshots: Vec<Pose>,
     /// Every body's final position (m): (ragdoll index, position).
     pub final_positions: Vec<(usize, glam::Vec3)>,
@@ -117,7 +117,13 @@ pub fn run(
         }
         built.world.step(dt)?;
         out.push(measure(&built.world, &built, &sockets, &rods));
-        if frame == 0 || frame == frames / 2 || frame + 1 == frames {
+        // First, middle (mid-push for controllability: figure 7), last.
+        let middle = if config.scene == Scene::Controllability {
+            60.min(frames / 2)
+        } else {
+            frames / 2
+        };
+        if frame == 0 || frame == middle || frame + 1 == frames {
             snapshots.push(built.ragdolls[0].skeleton_pose(&built.world, SpineMapping::Arc)?);
         }
         progress(frame + 1, frames);
