@@ -5,8 +5,8 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use vertebra_benches::ragdoll_drop;
-use vertebra_ragdoll::SpineMode;
+use vertebra_ragdoll::{RagdollDesc, SpineMode};
+use vertebra_world::{SolverConfig, World};
 
 fn collisions(c: &mut Criterion) {
     let mut group = c.benchmark_group("ragdoll_drop_30");
@@ -14,7 +14,10 @@ fn collisions(c: &mut Criterion) {
         ("find_contacts_rod", SpineMode::Rod),
         ("find_contacts_sockets", SpineMode::Sockets),
     ] {
-        let (mut world, colliders) = ragdoll_drop(spine);
+        let world = World::new(SolverConfig::default()).expect("default config");
+        let (mut world, colliders, _) =
+            vertebra_scenes::ragdoll_drop(world, &RagdollDesc::reference_humanoid(), spine)
+                .expect("the drop world");
         for _ in 0..60 {
             let contacts = colliders
                 .find_contacts(&world, 1.0 / 60.0)

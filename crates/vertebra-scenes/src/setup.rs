@@ -61,7 +61,7 @@ impl FromStr for Scene {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         Scene::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| {
-            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability or kinematics)")
+            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop or controllability)")
         })
     }
 }
