@@ -131,6 +131,21 @@ pub(crate) struct Built {
     pub push: Option<(BodyHandle, Vec3)>,
 }
 
+/// A ragdoll at `pose` whose root body (the hips) is held where it is.
+fn ragdoll_with_fixed_hips(
+    world: &mut World,
+    desc: &RagdollDesc,
+    spine: SpineMode,
+    pose: &Pose,
+) -> Result<Ragdoll, RagdollError> {
+    let ragdoll = Ragdoll::build(world, desc, BuildOptions::new(spine), pose, None)?;
+    fix(
+        world,
+        ragdoll.bodies[desc.root].expect("the root body exists"),
+    )?;
+    Ok(ragdoll)
+}
+
 /// Holds `body` where it is: a static anchor and a socket with a stiff
 /// drive (its error is not counted in the ragdoll's residuals).
 fn fix(world: &mut World, body: BodyHandle) -> Result<(), RagdollError> {
@@ -163,17 +178,7 @@ pub(crate) fn build(config: &SceneConfig) -> Result<Built, RagdollError> {
                 Quat::from_rotation_x(30f32.to_radians()),
                 Vec3::ZERO,
             );
-            let ragdoll = Ragdoll::build(
-                &mut world,
-                &desc,
-                BuildOptions::new(config.spine),
-                &pose,
-                None,
-            )?;
-            fix(
-                &mut world,
-                ragdoll.bodies[desc.root].expect("the root body exists"),
-            )?;
+            let ragdoll = ragdoll_with_fixed_hips(&mut world, &desc, config.spine, &pose)?;
             Ok(Built {
                 world,
                 collisions: None,
@@ -184,17 +189,7 @@ pub(crate) fn build(config: &SceneConfig) -> Result<Built, RagdollError> {
         }
         Scene::Controllability => {
             let pose = Pose::bind(&desc);
-            let ragdoll = Ragdoll::build(
-                &mut world,
-                &desc,
-                BuildOptions::new(config.spine),
-                &pose,
-                None,
-            )?;
-            fix(
-                &mut world,
-                ragdoll.bodies[desc.root].expect("the root body exists"),
-            )?;
+            let ragdoll = ragdoll_with_fixed_hips(&mut world, &desc, config.spine, &pose)?;
             ragdoll.drive_to(
                 &mut world,
                 &pose,
