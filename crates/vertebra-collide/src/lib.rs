@@ -136,6 +136,23 @@ impl Collisions {
         Ok(self.colliders.len() - 1)
     }
 
+    /// Adds a solid collider per `(body, shape)` (default friction and
+    /// groups) and never tests the `excluded` pairs: how a ragdoll joins,
+    /// with `Ragdoll::collision_shapes` and `Ragdoll::non_colliding_pairs`.
+    pub fn add_jointed(
+        &mut self,
+        shapes: &[(BodyHandle, Shape)],
+        excluded: &[(BodyHandle, BodyHandle)],
+    ) -> Result<(), Error> {
+        for &(body, shape) in shapes {
+            self.add(Collider::new(body, ColliderShape::Solid(shape)))?;
+        }
+        for &(a, b) in excluded {
+            self.exclude(a, b);
+        }
+        Ok(())
+    }
+
     /// Never tests the pair `(a, b)` (e.g. a joint's two bodies).
     pub fn exclude(&mut self, a: BodyHandle, b: BodyHandle) {
         self.excluded.insert(ordered(a, b));

@@ -141,19 +141,8 @@ fn drop_world(backend: Backend, threads: usize) -> (World, Collisions, Vec<Ragdo
             Vec3::new(0.0, 0.3 + 0.4 * k as f32 - 1.0, 0.0) + Vec3::Y,
         );
         let r = Ragdoll::build(&mut w, &desc, BuildOptions::new(spine), &pose, None).unwrap();
-        for (i, b) in r.bodies.iter().enumerate() {
-            if let Some(b) = b {
-                let def = &desc.bodies[i];
-                let centre = def.centre();
-                let shape =
-                    Shape::capsule(def.segment[0] - centre, def.segment[1] - centre, def.radius);
-                c.add(Collider::new(*b, ColliderShape::Solid(shape)))
-                    .unwrap();
-            }
-        }
-        for (a, b) in r.non_colliding_pairs() {
-            c.exclude(a, b);
-        }
+        c.add_jointed(&r.collision_shapes(), &r.non_colliding_pairs())
+            .unwrap();
         ragdolls.push(r);
     }
     (w, c, ragdolls)

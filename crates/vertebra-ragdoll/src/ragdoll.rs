@@ -269,6 +269,29 @@ impl Ragdoll {
         self.options
     }
 
+    /// Each body's capsule (its body frame, centred on its centre of mass),
+    /// for a collision layer.
+    pub fn collision_shapes(&self) -> Vec<(BodyHandle, Shape)> {
+        self.desc
+            .bodies
+            .iter()
+            .zip(&self.bodies)
+            .filter_map(|(def, body)| {
+                let centre = def.centre();
+                body.map(|b| {
+                    (
+                        b,
+                        Shape::capsule(
+                            def.segment[0] - centre,
+                            def.segment[1] - centre,
+                            def.radius,
+                        ),
+                    )
+                })
+            })
+            .collect()
+    }
+
     /// Pairs of bodies that must never collide: every joint's (and the
     /// rod's) two bodies.
     pub fn non_colliding_pairs(&self) -> Vec<(BodyHandle, BodyHandle)> {

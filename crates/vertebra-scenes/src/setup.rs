@@ -289,18 +289,7 @@ pub fn ragdoll_drop(
         let at = Vec3::new(0.0, 1.0 + 0.5 * layer as f32, 0.0) + u * (0.6 * (slot as f32 - 1.0));
         let pose = Pose::bind(desc).moved(hips, turn, at - hips);
         let ragdoll = Ragdoll::build(&mut world, desc, BuildOptions::new(spine), &pose, None)?;
-        for (i, body) in ragdoll.bodies.iter().enumerate() {
-            if let Some(body) = body {
-                let def = &desc.bodies[i];
-                let centre = def.centre();
-                let shape =
-                    Shape::capsule(def.segment[0] - centre, def.segment[1] - centre, def.radius);
-                collisions.add(Collider::new(*body, ColliderShape::Solid(shape)))?;
-            }
-        }
-        for (a, b) in ragdoll.non_colliding_pairs() {
-            collisions.exclude(a, b);
-        }
+        collisions.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())?;
         ragdolls.push(ragdoll);
     }
     Ok((world, collisions, ragdolls))
