@@ -169,22 +169,19 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
             pass.contacts(c, rows, backend)
         });
     }
+    // The groups are read in place (no copy per iteration): they and the
+    // blocks are disjoint fields of the layout.
     let layout = &mut world.layout;
-    let groups: Vec<_> = layout
-        .colours
-        .iter()
-        .map(|g| (g.clone(), world.backend))
-        .collect();
-    let overflow = (layout.overflow.clone(), Backend::Scalar);
-    for (group, backend) in groups.into_iter().chain(core::iter::once(overflow)) {
+    let groups = layout.colours.iter().map(|g| (g, world.backend));
+    for (group, backend) in groups.chain(core::iter::once((&layout.overflow, Backend::Scalar))) {
         let parallel = pool.as_ref().filter(|_| backend != Backend::Scalar);
-        for (range, driven) in [(group.driven, true), (group.plain, false)] {
-            let blocks = &mut layout.sockets.blocks[range];
+        for (range, driven) in [(&group.driven, true), (&group.plain, false)] {
+            let blocks = &mut layout.sockets.blocks[range.clone()];
             chunked(parallel, min_blocks, blocks, |c| {
                 pass.sockets(c, driven, rows, backend)
             });
         }
-        let blocks = &mut layout.rods.blocks[group.rods];
+        let blocks = &mut layout.rods.blocks[group.rods.clone()];
         chunked(parallel, min_blocks, blocks, |c| {
             pass.rods(c, rows, backend)
         });
