@@ -4,9 +4,7 @@
 
 mod common;
 
-use common::{
-    RawRows, assert_backends_agree, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat,
-};
+use common::{RawRows, agree_over_seeds, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat};
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -135,16 +133,10 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[RodBlock]) -> Vec<f32> {
 
 #[test]
 fn random_rods_agree_on_every_backend() {
-    for seed in 0..40 {
-        let (rows, blocks) = scene(seed, 6, false);
-        assert_backends_agree(seed, |b| run(b, &rows, &blocks));
-    }
+    agree_over_seeds(0..40, false, scene, run);
 }
 
 #[test]
 fn adversarial_rods_agree_on_every_backend_and_stay_finite() {
-    for seed in 200..280 {
-        let (rows, blocks) = scene(seed, 6, true);
-        assert_backends_agree(seed, |b| run(b, &rows, &blocks));
-    }
+    agree_over_seeds(200..280, true, scene, run);
 }

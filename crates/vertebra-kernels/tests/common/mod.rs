@@ -131,3 +131,17 @@ pub fn assert_backends_agree(seed: u64, run: impl Fn(Backend) -> Vec<f32>) {
         }
     }
 }
+
+/// Builds a scene per seed (random, or adversarial) and checks that every
+/// backend runs it to the scalar reference's bits.
+pub fn agree_over_seeds<B>(
+    seeds: core::ops::Range<u64>,
+    adversarial: bool,
+    scene: fn(u64, usize, bool) -> (RawRows, Vec<B>),
+    run: fn(Backend, &RawRows, &[B]) -> Vec<f32>,
+) {
+    for seed in seeds {
+        let (rows, blocks) = scene(seed, 6, adversarial);
+        assert_backends_agree(seed, |b| run(b, &rows, &blocks));
+    }
+}
