@@ -1,58 +1,64 @@
-//! Nanoseconds per joint per backend, sockets and rods: one position
-//! iteration over a
-//! batch of 1024 joints (2048 bodies, in cache): point, swing cone and
-//! twist range, with and without the angular drive.
-//! `cargo bench -p vertebra-benches --bench socket`
+//! Nanoseconds per joint per backend: one position iteration over a batch
+//! of sockets (point, swing cone and twist range, with and without the
+//! angular drive), rods and contacts, each lane on its own two bodies (as in
+//! one colour). In cache: 1024 joints on 2048 bodies in order. Out of
+//! cache: 2^18 joints on 2^19 bodies scattered through memory (about
+//! 90 MB).
+//! `cargo bench -p vertebra-benches --bench joints`
 
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use vertebra_benches::{ContactWorkload, RodWorkload, SocketWorkload};
+use vertebra_benches::{
+    ConstraintWorkload, ContactWorkload, OUT_OF_CACHE_JOINTS, Placement, RodWorkload,
+    SocketWorkload,
+};
 use vertebra_math::Backend;
 
-fn joints(c: &mut Criterion) {
-    for (name, drive) in [("socket_limits_drive", true), ("socket_limits", false)] {
-        bench_sockets(c, name, drive);
-    }
-    let mut group = c.benchmark_group("contact");
-    for backend in Backend::available() {
-        let mut work = ContactWorkload::new(backend, 1024);
-        group.throughput(Throughput::Elements(work.contacts() as u64));
-        group.bench_function(backend.name(), |b| {
-            b.iter(|| {
-                work.iterate();
-                black_box(work.probe())
-            })
-        });
-    }
-    group.finish();
-    let mut group = c.benchmark_group("rod");
-    for backend in Backend::available() {
-        let mut work = RodWorkload::new(backend, 1024);
-        group.throughput(Throughput::Elements(work.rods() as u64));
-        group.bench_function(backend.name(), |b| {
-            b.iter(|| {
-                work.iterate();
-                black_box(work.probe())
-            })
-        });
-    }
-    group.finish();
-}
+const PLACEMENTS: [(&str, Placement, usize); 2] = [
+    ("", Placement::InCache, 1024),
+    ("_out_of_cache", Placement::OutOfCache, OUT_OF_CACHE_JOINTS),
+];
 
-fn bench_sockets(c: &mut Criterion, name: &str, drive: bool) {
-    let mut group = c.benchmark_group(name);
-    for backend in Backend::available() {
-        let mut work = SocketWorkload::new(backend, 1024, drive);
-        group.throughput(Throughput::Elements(work.sockets() as u64));
-        group.bench_function(backend.name(), |b| {
-            b.iter(|| {
-                work.iterate();
-                black_box(work.probe())
-            })
-        });
+/// A constraint kind: its group name and how to build its workload.
+type Kind = (
+    &'static str,
+    fn(Backend, usize, Placement) -> Box<dyn ConstraintWorkload>,
+);
+
+const KINDS: [Kind; 4] = [
+    ("socket_limits_drive", |b, n, p| {
+        Box::new(SocketWorkload::new(b, n, true, p))
+    }),
+    ("socket_limits", |b, n, p| {
+        Box::new(SocketWorkload::new(b, n, false, p))
+    }),
+    ("rod", |b, n, p| Box::new(RodWorkload::new(b, n, p))),
+    ("contact", |b, n, p| Box::new(ContactWorkload::new(b, n, p))),
+];
+
+fn joints(c: &mut Criterion) {
+    for (suffix, placement, joints) in PLACEMENTS {
+        for (name, make) in KINDS {
+            let mut group = c.benchmark_group(format!("{name}{suffix}"));
+            group.sample_size(if placement == Placement::InCache {
+                100
+            } else {
+                10
+            });
+            group.throughput(Throughput::Elements(joints as u64));
+            for backend in Backend::available() {
+                let mut work = make(backend, joints, placement);
+                group.bench_function(backend.name(), |b| {
+                    b.iter(|| {
+                        work.iterate();
+                        black_box(work.probe())
+                    })
+                });
+            }
+            group.finish();
+        }
     }
-    group.finish();
 }
 
 criterion_group!(benches, joints);

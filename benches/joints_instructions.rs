@@ -9,14 +9,22 @@
 use std::hint::black_box;
 
 use iai_callgrind::{library_benchmark, library_benchmark_group, main};
-use vertebra_benches::{ContactWorkload, INSTRUCTION_BACKENDS, RodWorkload, SocketWorkload};
+use vertebra_benches::{
+    ConstraintWorkload, ContactWorkload, INSTRUCTION_BACKENDS, Placement, RodWorkload,
+    SocketWorkload,
+};
 
 fn with_drive(backend: usize) -> SocketWorkload {
-    SocketWorkload::new(INSTRUCTION_BACKENDS[backend], 256, true)
+    SocketWorkload::new(INSTRUCTION_BACKENDS[backend], 256, true, Placement::InCache)
 }
 
 fn without_drive(backend: usize) -> SocketWorkload {
-    SocketWorkload::new(INSTRUCTION_BACKENDS[backend], 256, false)
+    SocketWorkload::new(
+        INSTRUCTION_BACKENDS[backend],
+        256,
+        false,
+        Placement::InCache,
+    )
 }
 
 // Argument k is INSTRUCTION_BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
@@ -35,7 +43,7 @@ fn socket_limits(mut work: SocketWorkload) -> f32 {
 }
 
 fn rods(backend: usize) -> RodWorkload {
-    RodWorkload::new(INSTRUCTION_BACKENDS[backend], 256)
+    RodWorkload::new(INSTRUCTION_BACKENDS[backend], 256, Placement::InCache)
 }
 
 #[library_benchmark]
@@ -46,7 +54,7 @@ fn rod(mut work: RodWorkload) -> f32 {
 }
 
 fn contacts(backend: usize) -> ContactWorkload {
-    ContactWorkload::new(INSTRUCTION_BACKENDS[backend], 256)
+    ContactWorkload::new(INSTRUCTION_BACKENDS[backend], 256, Placement::InCache)
 }
 
 #[library_benchmark]

@@ -8,7 +8,9 @@ use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::map::{LaneMap, map_arrays};
-use vertebra_math::{Backend, Lane, Quat, Vec3, poly};
+use vertebra_math::{Backend, BackendChoice, Lane, Quat, Vec3, poly};
+use vertebra_ragdoll::SpineMode;
+use vertebra_scenes::{Scene, SceneConfig, SceneWorld, build};
 
 /// The backends the instruction-count benches measure, by argument index:
 /// 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
@@ -122,6 +124,42 @@ impl LaneMap for QuatRotate {
     }
 }
 
+/// A batch of constraints the joint benchmarks time.
+pub trait ConstraintWorkload {
+    /// One position iteration over every constraint.
+    fn iterate(&mut self);
+    /// A value that depends on the work (to keep it observable).
+    fn probe(&self) -> f32;
+}
+
+/// Where a joint workload's bodies lie in memory.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// Joint `k` on bodies `2k + 1` and `2k + 2`: gathers walk the rows in
+    /// order (with 1024 joints everything fits in L2).
+    InCache,
+    /// Joint `k` on two bodies scattered by a fixed permutation of all the
+    /// bodies: with [`OUT_OF_CACHE_JOINTS`] joints the rows and blocks
+    /// (about 90 MB) outgrow the last-level cache, and every gather misses.
+    OutOfCache,
+}
+
+/// Joints in an out-of-cache workload: 2^18 joints on 2^19 bodies.
+pub const OUT_OF_CACHE_JOINTS: usize = 1 << 18;
+
+impl Placement {
+    /// The body rows (1-based: row 0 is the null body) of joint `k` among
+    /// `bodies` (a power of two).
+    fn bodies(self, k: usize, bodies: usize) -> (u32, u32) {
+        let scatter = |i: usize| match self {
+            Placement::InCache => i,
+            // An odd multiplier is a bijection modulo a power of two.
+            Placement::OutOfCache => i.wrapping_mul(0x9E37_79B1) & (bodies - 1),
+        };
+        ((scatter(2 * k) + 1) as u32, (scatter(2 * k + 1) + 1) as u32)
+    }
+}
+
 /// A batch of socket joints, each lane on its own two dynamic bodies (as
 /// one colour is), the joints violated so every correction does work: point,
 /// swing cone and twist range always, the angular drive when `drive`.
@@ -133,8 +171,8 @@ pub struct SocketWorkload {
 }
 
 impl SocketWorkload {
-    /// `sockets` joints (a multiple of 8) on `backend`.
-    pub fn new(backend: Backend, sockets: usize, drive: bool) -> Self {
+    /// `sockets` joints (a power of two, at least 8) on `backend`.
+    pub fn new(backend: Backend, sockets: usize, drive: bool, placement: Placement) -> Self {
         if !backend.is_available() {
             eprintln!("warning: {backend} is not available here; it runs as scalar");
         }
@@ -159,9 +197,10 @@ impl SocketWorkload {
         }
         let mut out = vec![SocketBlock::padding(); blocks];
         for k in 0..blocks * BLOCK_LANES {
+            let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = SocketLane {
-                body_a: (2 * k + 1) as u32,
-                body_b: (2 * k + 2) as u32,
+                body_a,
+                body_b,
                 dynamic_a: true,
                 dynamic_b: true,
                 anchor_a: GVec3::new(0.05, 0.1, 0.0),
@@ -182,8 +221,14 @@ impl SocketWorkload {
         }
     }
 
-    /// One position iteration over every joint.
-    pub fn iterate(&mut self) {
+    /// The joints in the batch.
+    pub fn sockets(&self) -> usize {
+        self.blocks.len() * BLOCK_LANES
+    }
+}
+
+impl ConstraintWorkload for SocketWorkload {
+    fn iterate(&mut self) {
         let (blocks, rows) = (&mut self.blocks, &self.rows);
         if self.drive {
             self.backend.dispatch(PositionPass::<true> {
@@ -199,14 +244,7 @@ impl SocketWorkload {
             });
         }
     }
-
-    /// The joints in the batch.
-    pub fn sockets(&self) -> usize {
-        self.blocks.len() * BLOCK_LANES
-    }
-
-    /// A value that depends on the work (to keep it observable).
-    pub fn probe(&self) -> f32 {
+    fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]
     }
 }
@@ -221,16 +259,17 @@ pub struct RodWorkload {
 }
 
 impl RodWorkload {
-    /// `rods` rods (a multiple of 8) on `backend`.
-    pub fn new(backend: Backend, rods: usize) -> Self {
+    /// `rods` rods (a power of two, at least 8) on `backend`.
+    pub fn new(backend: Backend, rods: usize, placement: Placement) -> Self {
         let blocks = rods.div_ceil(BLOCK_LANES);
         // The same bodies as the socket workload, so the costs compare.
-        let sockets = SocketWorkload::new(backend, blocks * BLOCK_LANES, false);
+        let sockets = SocketWorkload::new(backend, blocks * BLOCK_LANES, false, placement);
         let mut out = vec![RodBlock::padding(); blocks];
         for k in 0..blocks * BLOCK_LANES {
+            let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = RodLane {
-                body_a: (2 * k + 1) as u32,
-                body_b: (2 * k + 2) as u32,
+                body_a,
+                body_b,
                 dynamic_a: true,
                 dynamic_b: true,
                 frame_a: GQuat::from_rotation_z(0.1),
@@ -252,8 +291,14 @@ impl RodWorkload {
         }
     }
 
-    /// One position iteration over every rod.
-    pub fn iterate(&mut self) {
+    /// The rods in the batch.
+    pub fn rods(&self) -> usize {
+        self.blocks.len() * BLOCK_LANES
+    }
+}
+
+impl ConstraintWorkload for RodWorkload {
+    fn iterate(&mut self) {
         let (blocks, rows) = (&mut self.blocks, &self.rows);
         self.backend.dispatch(rod::PositionPass {
             blocks,
@@ -261,14 +306,7 @@ impl RodWorkload {
             inv_h2: 3600.0,
         });
     }
-
-    /// The rods in the batch.
-    pub fn rods(&self) -> usize {
-        self.blocks.len() * BLOCK_LANES
-    }
-
-    /// A value that depends on the work (to keep it observable).
-    pub fn probe(&self) -> f32 {
+    fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]
     }
 }
@@ -283,15 +321,16 @@ pub struct ContactWorkload {
 }
 
 impl ContactWorkload {
-    /// `contacts` contacts (a multiple of 8) on `backend`.
-    pub fn new(backend: Backend, contacts: usize) -> Self {
+    /// `contacts` contacts (a power of two, at least 8) on `backend`.
+    pub fn new(backend: Backend, contacts: usize, placement: Placement) -> Self {
         let blocks = contacts.div_ceil(BLOCK_LANES);
-        let bodies = SocketWorkload::new(backend, blocks * BLOCK_LANES, false);
+        let bodies = SocketWorkload::new(backend, blocks * BLOCK_LANES, false, placement);
         let mut out = vec![ContactBlock::padding(); blocks];
         for k in 0..blocks * BLOCK_LANES {
+            let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = ContactLane {
-                body_a: (2 * k + 1) as u32,
-                body_b: (2 * k + 2) as u32,
+                body_a,
+                body_b,
                 dynamic_a: true,
                 dynamic_b: true,
                 point_a: GVec3::new(0.05, 0.12, 0.0),
@@ -310,20 +349,48 @@ impl ContactWorkload {
         }
     }
 
-    /// One position iteration over every contact.
-    pub fn iterate(&mut self) {
-        let (blocks, rows) = (&mut self.blocks, &self.rows);
-        self.backend
-            .dispatch(contact::PositionPass { blocks, rows });
-    }
-
     /// The contacts in the batch.
     pub fn contacts(&self) -> usize {
         self.blocks.len() * BLOCK_LANES
     }
+}
 
-    /// A value that depends on the work (to keep it observable).
-    pub fn probe(&self) -> f32 {
+impl ConstraintWorkload for ContactWorkload {
+    fn iterate(&mut self) {
+        let (blocks, rows) = (&mut self.blocks, &self.rows);
+        self.backend
+            .dispatch(contact::PositionPass { blocks, rows });
+    }
+    fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]
     }
+}
+
+/// The scenes' frame time step (s).
+pub const DT: f32 = 1.0 / 60.0;
+
+/// The ragdoll drop with `count` ragdolls (30 per pit) at 20 iterations on
+/// `threads` threads, one second (60 frames) in: piled up, many contacts.
+pub fn drop_scene(spine: SpineMode, count: usize, threads: usize) -> SceneWorld {
+    drop_scene_with(spine, count, threads, BackendChoice::Auto)
+}
+
+/// [`drop_scene`] on one thread with a forced backend.
+pub fn drop_scene_on(spine: SpineMode, count: usize, backend: Backend) -> SceneWorld {
+    drop_scene_with(spine, count, 1, BackendChoice::Forced(backend))
+}
+
+fn drop_scene_with(
+    spine: SpineMode,
+    count: usize,
+    threads: usize,
+    backend: BackendChoice,
+) -> SceneWorld {
+    let mut config = SceneConfig::new(Scene::RagdollDrop, spine);
+    (config.ragdolls, config.threads, config.backend) = (count, threads, backend);
+    let mut scene = build(&config).expect("the drop scene");
+    for frame in 0..60 {
+        scene.advance(config.scene, frame, DT).expect("a frame");
+    }
+    scene
 }

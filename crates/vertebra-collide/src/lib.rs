@@ -163,6 +163,17 @@ impl Collisions {
         self.colliders.iter().map(|c| &c.0)
     }
 
+    /// The colliders with their parry geometry (body frame), for handing
+    /// the same shapes to another engine.
+    pub fn shapes(&self) -> impl Iterator<Item = (&Collider, &SharedShape)> {
+        self.colliders.iter().map(|(c, s)| (c, s))
+    }
+
+    /// Whether the pair `(a, b)` is never tested (either order).
+    pub fn is_excluded(&self, a: BodyHandle, b: BodyHandle) -> bool {
+        self.excluded.contains(&ordered(a, b))
+    }
+
     /// Forgets the colliders of `body` (before removing it from the world).
     pub fn remove_body(&mut self, body: BodyHandle) {
         self.colliders.retain(|c| c.0.body != body);

@@ -50,6 +50,27 @@ impl BodyRows {
         rows
     }
 
+    /// Tables from plain rows (pose, inverse inertia, velocity per body;
+    /// entry 0 is the null row), as tests and fuzzing build them.
+    pub fn from_raw(raw: &[[[f32; ROW_LEN]; 3]]) -> Self {
+        let rows = Self::with_bodies(raw.len().saturating_sub(1));
+        for (i, [pose, inertia, velocity]) in raw.iter().enumerate() {
+            rows.pose[i].set(*pose);
+            rows.inertia[i].set(*inertia);
+            rows.velocity[i].set(*velocity);
+        }
+        rows
+    }
+
+    /// The null body's plain rows: at the origin, unrotated, no mass.
+    pub fn null_raw() -> [[f32; ROW_LEN]; 3] {
+        [
+            Self::pose_row(glam::Vec3::ZERO, 0.0, glam::Quat::IDENTITY),
+            [0.0; ROW_LEN],
+            [0.0; ROW_LEN],
+        ]
+    }
+
     /// Packs a pose row.
     pub fn pose_row(
         position: glam::Vec3,

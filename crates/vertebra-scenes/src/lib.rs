@@ -9,4 +9,4 @@ mod setup;
 
 pub use kinematics::{Locus, kinematics};
 pub use run::{Frame, SceneRun, run};
-pub use setup::{Scene, SceneConfig, ragdoll_drop};
+pub use setup::{Scene, SceneConfig, SceneWorld, build, ragdoll_drop};

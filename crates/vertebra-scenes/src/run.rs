@@ -1,13 +1,11 @@
 //! Running a scene and measuring it frame by frame.
 
-use std::collections::HashSet;
 use std::time::Instant;
 
 use vertebra_math::Backend;
 use vertebra_ragdoll::{Pose, RagdollError, SpineMapping};
-use vertebra_world::World;
 
-use crate::setup::{Built, Scene, SceneConfig, build};
+use crate::setup::{Scene, SceneConfig, build};
 
 /// What one frame measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -44,79 +42,20 @@ pub struct SceneRun {
     pub final_positions: Vec<(usize, glam::Vec3)>,
 }
 
-fn joint_sets(built: &Built) -> (HashSet<usize>, HashSet<usize>) {
-    let sockets = built
-        .ragdolls
-        .iter()
-        .flat_map(|r| r.sockets.iter().flatten().map(|s| s.index()))
-        .collect();
-    let rods = built
-        .ragdolls
-        .iter()
-        .filter_map(|r| r.rod.map(|h| h.index()))
-        .collect();
-    (sockets, rods)
-}
-
-fn measure(world: &World, built: &Built, sockets: &HashSet<usize>, rods: &HashSet<usize>) -> Frame {
-    let r = world.residuals();
-    let socket_errors = r
-        .sockets
-        .iter()
-        .filter(|j| sockets.contains(&j.joint.index()))
-        .map(|j| (j.linear_cm, j.angular_rad));
-    let rod_errors = r
-        .rods
-        .iter()
-        .filter(|j| rods.contains(&j.joint.index()))
-        .map(|j| (j.linear_cm, j.angular_rad));
-    let (eps_lin_cm, eps_ang_rad) = socket_errors
-        .chain(rod_errors)
-        .fold((0.0, 0.0), |(l, a), (dl, da)| (l + dl, a + da));
-    let (mut deviation_cm, mut deviation_rad) = (0.0, 0.0);
-    if let Some(target) = &built.target {
-        for ragdoll in &built.ragdolls {
-            for (i, body) in ragdoll.bodies.iter().enumerate() {
-                if let Some(state) = body.and_then(|b| world.body(b).ok()) {
-                    deviation_cm += (state.position - target.bones[i].0).length() * 100.0;
-                    deviation_rad += state.orientation.angle_between(target.bones[i].1);
-                }
-            }
-        }
-    }
-    Frame {
-        eps_lin_cm,
-        eps_ang_rad,
-        deviation_cm,
-        deviation_rad,
-    }
-}
-
 /// Runs `config`, calling `progress(frame, frames)` after each frame.
 pub fn run(
     config: &SceneConfig,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<SceneRun, RagdollError> {
     let mut built = build(config)?;
-    let (sockets, rods) = joint_sets(&built);
     let frames = config.frames.unwrap_or(config.scene.default_frames());
     let dt = 1.0 / 60.0;
     let mut out = Vec::with_capacity(frames);
     let mut snapshots = Vec::new();
     let start = Instant::now();
     for frame in 0..frames {
-        if let Some(collisions) = &built.collisions {
-            let contacts = collisions.find_contacts(&built.world, dt)?;
-            built.world.set_contacts(&contacts)?;
-        }
-        // The push of figure 7: frames 30 to 90.
-        if let (Some((body, force)), Scene::Controllability, true) =
-            (built.push, config.scene, (30..90).contains(&frame))
-        {
-            built.world.add_force(body, force)?;
-        }
-        built.world.step(dt)?;
-        out.push(measure(&built.world, &built, &sockets, &rods));
+        built.advance(config.scene, frame, dt)?;
+        out.push(built.measure(&built.world));
         // First, middle (mid-push for controllability: figure 7), last.
         let middle = if config.scene == Scene::Controllability {
             60.min(frames / 2)

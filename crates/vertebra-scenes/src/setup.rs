@@ -2,6 +2,7 @@
 
 use core::fmt;
 use core::str::FromStr;
+use std::collections::HashSet;
 
 use glam::{Quat, Vec3};
 use vertebra_collide::{Collider, ColliderShape, Collisions};
@@ -9,8 +10,11 @@ use vertebra_ragdoll::{
     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode, Strength,
 };
 use vertebra_world::{
-    AngularDrive, BackendChoice, BodyDesc, BodyHandle, Shape, SocketDesc, SolverConfig, World,
+    AngularDrive, BackendChoice, BodyDesc, BodyHandle, RodHandle, Shape, SocketDesc, SocketHandle,
+    SolverConfig, World,
 };
+
+use crate::Frame;
 
 /// A scene of the paper.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -85,6 +89,9 @@ pub struct SceneConfig {
     pub threads: usize,
     /// The ragdoll (the reference humanoid when `None`).
     pub ragdoll: Option<RagdollDesc>,
+    /// Ragdolls dropped in the ragdoll-drop scene (the paper's 30; see
+    /// [`ragdoll_drop`] for more).
+    pub ragdolls: usize,
 }
 
 impl SceneConfig {
@@ -99,6 +106,7 @@ impl SceneConfig {
             backend: BackendChoice::Auto,
             threads: 1,
             ragdoll: None,
+            ragdolls: 30,
         }
     }
 
@@ -120,15 +128,103 @@ impl SceneConfig {
     }
 }
 
-/// A built scene: its world, collisions, ragdolls, and what is measured.
-pub(crate) struct Built {
+/// A built scene: its world, collisions and ragdolls, and what is
+/// measured. [`SceneWorld::advance`] runs one frame as [`run`](crate::run)
+/// does; [`SceneWorld::measure`] measures any world holding the same joints
+/// (the peer comparison measures a mirror of another engine's bodies).
+pub struct SceneWorld {
+    /// The world.
     pub world: World,
+    /// The colliders (the ragdoll drop), or `None`.
     pub collisions: Option<Collisions>,
+    /// The ragdolls.
     pub ragdolls: Vec<Ragdoll>,
     /// Target pose for the deviation metric (controllability).
     pub target: Option<Pose>,
-    /// The body pushed, and the force (controllability).
+    /// The body pushed, and the force (N) (controllability).
     pub push: Option<(BodyHandle, Vec3)>,
+    /// The ragdolls' joints: the residual error counts these (not the pins
+    /// holding hips in place).
+    sockets: HashSet<SocketHandle>,
+    rods: HashSet<RodHandle>,
+}
+
+impl SceneWorld {
+    fn new(
+        world: World,
+        collisions: Option<Collisions>,
+        ragdolls: Vec<Ragdoll>,
+        target: Option<Pose>,
+        push: Option<(BodyHandle, Vec3)>,
+    ) -> Self {
+        let sockets = ragdolls
+            .iter()
+            .flat_map(|r| r.sockets.iter().flatten().copied())
+            .collect();
+        let rods = ragdolls.iter().filter_map(|r| r.rod).collect();
+        Self {
+            world,
+            collisions,
+            ragdolls,
+            target,
+            push,
+            sockets,
+            rods,
+        }
+    }
+
+    /// Frame `frame` of the scene, `dt` seconds: collision detection, the
+    /// push of figure 7 (controllability, frames 30 to 90), the step.
+    pub fn advance(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
+        if let Some(collisions) = &self.collisions {
+            let contacts = collisions.find_contacts(&self.world, dt)?;
+            self.world.set_contacts(&contacts)?;
+        }
+        if let (Some((body, force)), Scene::Controllability, true) =
+            (self.push, scene, (30..90).contains(&frame))
+        {
+            self.world.add_force(body, force)?;
+        }
+        Ok(self.world.step(dt)?)
+    }
+
+    /// The ragdolls' residual error (as of `world`'s last step or
+    /// [`World::measure_residuals`]) and deviation from the target, in
+    /// `world`: this scene's own world, or one holding the same bodies and
+    /// joints under the same handles (the peer comparison's mirror).
+    pub fn measure(&self, world: &World) -> Frame {
+        let r = world.residuals();
+        let socket_errors = r
+            .sockets
+            .iter()
+            .filter(|j| self.sockets.contains(&j.joint))
+            .map(|j| (j.linear_cm, j.angular_rad));
+        let rod_errors = r
+            .rods
+            .iter()
+            .filter(|j| self.rods.contains(&j.joint))
+            .map(|j| (j.linear_cm, j.angular_rad));
+        let (eps_lin_cm, eps_ang_rad) = socket_errors
+            .chain(rod_errors)
+            .fold((0.0, 0.0), |(l, a), (dl, da)| (l + dl, a + da));
+        let (mut deviation_cm, mut deviation_rad) = (0.0, 0.0);
+        if let Some(target) = &self.target {
+            for ragdoll in &self.ragdolls {
+                for (i, body) in ragdoll.bodies.iter().enumerate() {
+                    if let Some(state) = body.and_then(|b| world.body(b).ok()) {
+                        deviation_cm += (state.position - target.bones[i].0).length() * 100.0;
+                        deviation_rad += state.orientation.angle_between(target.bones[i].1);
+                    }
+                }
+            }
+        }
+        Frame {
+            eps_lin_cm,
+            eps_ang_rad,
+            deviation_cm,
+            deviation_rad,
+        }
+    }
 }
 
 /// A ragdoll at `pose` whose root body (the hips) is held where it is.
@@ -166,7 +262,8 @@ fn fix(world: &mut World, body: BodyHandle) -> Result<(), RagdollError> {
     Ok(())
 }
 
-pub(crate) fn build(config: &SceneConfig) -> Result<Built, RagdollError> {
+/// Builds `config`'s scene at its first frame.
+pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
     let desc = config.description();
     let mut world = config.world()?;
     match config.scene {
@@ -179,13 +276,7 @@ pub(crate) fn build(config: &SceneConfig) -> Result<Built, RagdollError> {
                 Vec3::ZERO,
             );
             let ragdoll = ragdoll_with_fixed_hips(&mut world, &desc, config.spine, &pose)?;
-            Ok(Built {
-                world,
-                collisions: None,
-                ragdolls: vec![ragdoll],
-                target: None,
-                push: None,
-            })
+            Ok(SceneWorld::new(world, None, vec![ragdoll], None, None))
         }
         Scene::Controllability => {
             let pose = Pose::bind(&desc);
@@ -197,23 +288,24 @@ pub(crate) fn build(config: &SceneConfig) -> Result<Built, RagdollError> {
             )?;
             // 200 N along +Z on the top of the spine (the chest).
             let push = ragdoll.bodies[spine_top(&desc)].map(|c| (c, Vec3::new(0.0, 0.0, 200.0)));
-            Ok(Built {
+            Ok(SceneWorld::new(
                 world,
-                collisions: None,
-                ragdolls: vec![ragdoll],
-                target: Some(pose),
+                None,
+                vec![ragdoll],
+                Some(pose),
                 push,
-            })
+            ))
         }
         Scene::RagdollDrop => {
-            let (world, collisions, ragdolls) = ragdoll_drop(world, &desc, config.spine)?;
-            Ok(Built {
+            let (world, collisions, ragdolls) =
+                ragdoll_drop(world, &desc, config.spine, config.ragdolls)?;
+            Ok(SceneWorld::new(
                 world,
-                collisions: Some(collisions),
+                Some(collisions),
                 ragdolls,
-                target: None,
-                push: None,
-            })
+                None,
+                None,
+            ))
         }
     }
 }
@@ -226,16 +318,25 @@ fn spine_top(desc: &RagdollDesc) -> usize {
         .unwrap_or(desc.root)
 }
 
-/// The paper's ragdoll-drop world: ground with its top at y = 0; a pit of
-/// four static walls (inner faces at x, z = +-1.5, 1 m tall, 0.1 m thick);
-/// three static boxes of half-extents (0.3, 0.15, 0.3); 30 ragdolls in 10
-/// layers of 3, lying face down, layer `j` turned by 37 j degrees about +Y,
-/// hips at (0, 1 + 0.5 j, 0) + (i - 1) 0.6 u_j. A ragdoll's jointed pairs
-/// never collide.
+/// Ragdolls per pit in [`ragdoll_drop`]: the paper's figure.
+pub const RAGDOLLS_PER_PIT: usize = 30;
+
+/// Distance (m) between the centres of neighbouring pits along +X.
+const PIT_SPACING: f32 = 4.0;
+
+/// The paper's ragdoll-drop world for `count` ragdolls: ground with its top
+/// at y = 0 and, per 30 ragdolls, a pit (the first centred on the origin,
+/// the next 4 m further along +X each): four static walls (inner faces at
+/// x, z = +-1.5 about the pit's centre, 1 m tall, 0.1 m thick) and three
+/// static boxes of half-extents (0.3, 0.15, 0.3). A pit's ragdolls lie face
+/// down in 10 layers of 3, layer `j` turned by 37 j degrees about +Y, hips
+/// at (0, 1 + 0.5 j, 0) + (i - 1) 0.6 u_j from its centre. A ragdoll's
+/// jointed pairs never collide. With 30 this is exactly the paper's scene.
 pub fn ragdoll_drop(
     mut world: World,
     desc: &RagdollDesc,
     spine: SpineMode,
+    count: usize,
 ) -> Result<(World, Collisions, Vec<Ragdoll>), RagdollError> {
     let mut collisions = Collisions::new();
     let mut fixed = |world: &mut World,
@@ -253,40 +354,41 @@ pub fn ragdoll_drop(
         Quat::IDENTITY,
         ColliderShape::Plane(Vec3::Y),
     )?;
-    for (at, half) in [
-        (Vec3::new(1.55, 0.5, 0.0), Vec3::new(0.05, 0.5, 1.6)),
-        (Vec3::new(-1.55, 0.5, 0.0), Vec3::new(0.05, 0.5, 1.6)),
-        (Vec3::new(0.0, 0.5, 1.55), Vec3::new(1.6, 0.5, 0.05)),
-        (Vec3::new(0.0, 0.5, -1.55), Vec3::new(1.6, 0.5, 0.05)),
-    ] {
-        fixed(
-            &mut world,
-            at,
-            Quat::IDENTITY,
-            ColliderShape::Solid(Shape::Box { half_extents: half }),
-        )?;
-    }
-    let half = Vec3::new(0.3, 0.15, 0.3);
-    for (at, turn) in [
-        (Vec3::new(0.6, 0.15, 0.6), 0.0f32),
-        (Vec3::new(-0.7, 0.25, -0.2), 30f32.to_radians()),
-        (Vec3::new(0.2, 0.1, -0.8), 0.0),
-    ] {
-        fixed(
-            &mut world,
-            at,
-            Quat::from_rotation_y(turn),
-            ColliderShape::Solid(Shape::Box { half_extents: half }),
-        )?;
+    let pits = count.div_ceil(RAGDOLLS_PER_PIT);
+    let centre = |pit: usize| Vec3::X * (PIT_SPACING * pit as f32);
+    for pit in 0..pits {
+        let half_box = Vec3::new(0.3, 0.15, 0.3);
+        let walls = [
+            (Vec3::new(1.55, 0.5, 0.0), Vec3::new(0.05, 0.5, 1.6), 0.0),
+            (Vec3::new(-1.55, 0.5, 0.0), Vec3::new(0.05, 0.5, 1.6), 0.0),
+            (Vec3::new(0.0, 0.5, 1.55), Vec3::new(1.6, 0.5, 0.05), 0.0),
+            (Vec3::new(0.0, 0.5, -1.55), Vec3::new(1.6, 0.5, 0.05), 0.0),
+        ];
+        let boxes = [
+            (Vec3::new(0.6, 0.15, 0.6), half_box, 0.0f32),
+            (Vec3::new(-0.7, 0.25, -0.2), half_box, 30f32.to_radians()),
+            (Vec3::new(0.2, 0.1, -0.8), half_box, 0.0),
+        ];
+        for (at, half, turn) in walls.into_iter().chain(boxes) {
+            fixed(
+                &mut world,
+                centre(pit) + at,
+                Quat::from_rotation_y(turn),
+                ColliderShape::Solid(Shape::Box { half_extents: half }),
+            )?;
+        }
     }
     let hips = desc.bodies[desc.root].centre();
     let mut ragdolls = Vec::new();
-    for k in 0..30 {
+    for k in 0..count {
+        let (pit, k) = (k / RAGDOLLS_PER_PIT, k % RAGDOLLS_PER_PIT);
         let (layer, slot) = (k / 3, k % 3);
         let yaw = (37.0 * layer as f32).to_radians();
         let turn = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
         let u = Vec3::new(yaw.cos(), 0.0, -yaw.sin());
-        let at = Vec3::new(0.0, 1.0 + 0.5 * layer as f32, 0.0) + u * (0.6 * (slot as f32 - 1.0));
+        let at = centre(pit)
+            + Vec3::new(0.0, 1.0 + 0.5 * layer as f32, 0.0)
+            + u * (0.6 * (slot as f32 - 1.0));
         let pose = Pose::bind(desc).moved(hips, turn, at - hips);
         let ragdoll = Ragdoll::build(&mut world, desc, BuildOptions::new(spine), &pose, None)?;
         collisions.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())?;

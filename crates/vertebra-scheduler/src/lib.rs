@@ -20,7 +20,9 @@ use std::collections::{BTreeMap, BTreeSet};
 pub const MAX_COLOURS: usize = 24;
 
 /// Where a constraint is solved.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 pub enum Slot {
     /// In this colour (`< MAX_COLOURS`).
     Colour(u8),
@@ -30,7 +32,7 @@ pub enum Slot {
 
 /// The colouring of a set of constraints, each named by a `u64` key and
 /// touching up to two dynamic bodies (by index).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Colouring {
     body_colours: Vec<u32>,
     members: Vec<BTreeSet<u64>>,

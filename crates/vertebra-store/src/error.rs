@@ -30,6 +30,10 @@ pub enum Error {
     InvalidLimit(&'static str),
     /// A solver setting out of its range.
     InvalidConfig(&'static str),
+    /// A snapshot taken of a different world.
+    ForeignSnapshot,
+    /// A snapshot whose bytes are damaged or not a snapshot at all.
+    CorruptSnapshot(&'static str),
 }
 
 impl fmt::Display for Error {
@@ -49,6 +53,8 @@ impl fmt::Display for Error {
             Error::NoDynamicBody => write!(f, "a joint needs at least one dynamic body"),
             Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
             Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
+            Error::ForeignSnapshot => write!(f, "the snapshot was taken of another world"),
+            Error::CorruptSnapshot(why) => write!(f, "corrupt snapshot: {why}"),
         }
     }
 }

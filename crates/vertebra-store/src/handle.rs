@@ -5,6 +5,8 @@
 use core::marker::PhantomData;
 
 /// A stable reference to an item of kind `T` in a [`Slots`] table.
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
 pub struct Handle<T> {
     index: u32,
     generation: u32,
@@ -43,7 +45,7 @@ impl<T> core::fmt::Debug for Handle<T> {
 
 /// Slot bookkeeping: which indices are live, their generations, and a free
 /// list that reuses the lowest freed index first (deterministic).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Slots {
     generation: Vec<u32>,
     live: Vec<bool>,
@@ -91,6 +93,16 @@ impl Slots {
     /// The number of slots ever allocated (live or free).
     pub fn capacity(&self) -> usize {
         self.live.len()
+    }
+
+    /// Whether the generation and liveness tables agree in length and the
+    /// free list names only dead slots.
+    pub fn is_consistent(&self) -> bool {
+        self.generation.len() == self.live.len()
+            && self
+                .free
+                .iter()
+                .all(|&i| self.live.get(i as usize) == Some(&false))
     }
 
     /// Whether slot `index` is live.

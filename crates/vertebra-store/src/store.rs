@@ -15,7 +15,7 @@ pub enum BodyTag {}
 pub type BodyHandle = Handle<BodyTag>;
 
 /// How a body moves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum BodyKind {
     /// Moved by gravity, forces and constraints.
     Dynamic,
@@ -145,7 +145,7 @@ pub struct BodyState {
 
 /// Bodies as structure of arrays. Index `i` of every array belongs to the
 /// body whose handle has slot `i`; freed slots keep stale data until reused.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct BodyStore {
     slots: Slots,
     /// How each body moves.
@@ -177,6 +177,30 @@ pub struct BodyStore {
 }
 
 impl BodyStore {
+    /// Whether every array has one entry per slot (a decoded snapshot is
+    /// checked with this before it is used).
+    pub fn is_consistent(&self) -> bool {
+        let n = self.slots.capacity();
+        [
+            self.kind.len(),
+            self.position.len(),
+            self.orientation.len(),
+            self.linear_velocity.len(),
+            self.angular_velocity.len(),
+            self.mass.len(),
+            self.inverse_mass.len(),
+            self.inertia.len(),
+            self.inverse_inertia.len(),
+            self.force.len(),
+            self.torque.len(),
+            self.linear_damping.len(),
+            self.angular_damping.len(),
+        ]
+        .iter()
+        .all(|&len| len == n)
+            && self.slots.is_consistent()
+    }
+
     /// Adds a body after validating `desc`; nothing changes on error.
     pub fn insert(&mut self, desc: &BodyDesc) -> Result<BodyHandle, Error> {
         desc.validate()?;
@@ -325,7 +349,9 @@ impl BodyStore {
     pub fn add_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), Error> {
         let i = self.index(handle)?;
         check_finite("force", force)?;
-        self.force[i] += force;
+        let total = self.force[i] + force;
+        check_finite("accumulated force", total)?;
+        self.force[i] = total;
         Ok(())
     }
 
@@ -339,8 +365,12 @@ impl BodyStore {
         let i = self.index(handle)?;
         check_finite("force", force)?;
         check_finite("point", point)?;
-        self.force[i] += force;
-        self.torque[i] += (point - self.position[i]).cross(force);
+        let total = self.force[i] + force;
+        let torque = self.torque[i] + (point - self.position[i]).cross(force);
+        check_finite("accumulated force", total)?;
+        check_finite("accumulated torque", torque)?;
+        self.force[i] = total;
+        self.torque[i] = torque;
         Ok(())
     }
 
@@ -348,7 +378,9 @@ impl BodyStore {
     pub fn add_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), Error> {
         let i = self.index(handle)?;
         check_finite("torque", torque)?;
-        self.torque[i] += torque;
+        let total = self.torque[i] + torque;
+        check_finite("accumulated torque", total)?;
+        self.torque[i] = total;
         Ok(())
     }
 

@@ -21,6 +21,20 @@ pub struct SolverConfig {
     /// A colour is split over threads when it has at least this many
     /// blocks of eight constraints (smaller ones run on one thread).
     pub parallel_min_blocks: usize,
+    /// The fastest (m/s) overlapping bodies are pushed apart: a step removes
+    /// at most `max_push_out_speed * dt` of a contact's overlap (Box2D's
+    /// `contactPushMaxVelocity`, PhysX's `maxDepenetrationVelocity`). A body
+    /// teleported into another comes out over a few steps; it is not fired
+    /// out at `depth / dt`. Off (infinity) by default, as in PhysX: in a
+    /// pile of ragdolls, slower push-out leaves more of the contacts'
+    /// conflict to the joints (the drop's joint error rose 7%-38% at
+    /// 3 m/s). A game that teleports bodies sets it (Box2D uses 3 m/s).
+    pub max_push_out_speed: f32,
+    /// Bodies never move faster than this (m/s): velocities are clamped
+    /// before each substep moves them (Jolt clamps at 500 m/s too).
+    pub max_linear_speed: f32,
+    /// Bodies never spin faster than this (rad/s): 50 turns a second.
+    pub max_angular_speed: f32,
 }
 
 impl Default for SolverConfig {
@@ -32,6 +46,9 @@ impl Default for SolverConfig {
             threads: 1,
             gravity: Vec3::new(0.0, -9.81, 0.0),
             parallel_min_blocks: 4,
+            max_push_out_speed: f32::INFINITY,
+            max_linear_speed: 500.0,
+            max_angular_speed: 100.0 * core::f32::consts::PI,
         }
     }
 }
@@ -52,6 +69,25 @@ impl SolverConfig {
             return Err(Error::InvalidConfig(
                 "parallel_min_blocks must be at least 1",
             ));
+        }
+        if self.max_push_out_speed.is_nan() || self.max_push_out_speed < 0.0 {
+            return Err(Error::InvalidConfig(
+                "max_push_out_speed must be zero or positive",
+            ));
+        }
+        for (speed, what) in [
+            (
+                self.max_linear_speed,
+                "max_linear_speed must be positive and finite",
+            ),
+            (
+                self.max_angular_speed,
+                "max_angular_speed must be positive and finite",
+            ),
+        ] {
+            if !(speed.is_finite() && speed > 0.0) {
+                return Err(Error::InvalidConfig(what));
+            }
         }
         check_finite("gravity", self.gravity)
     }

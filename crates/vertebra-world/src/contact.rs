@@ -11,7 +11,7 @@ use vertebra_scheduler::{Colouring, MAX_COLOURS};
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_finite, check_unit_vec};
 
 /// A contact between two bodies for the next step.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Contact {
     /// The first body.
     pub body_a: BodyHandle,
@@ -53,12 +53,18 @@ impl Contact {
     }
 
     /// Solver data at the bodies' current poses and velocities: the points
-    /// on each surface, `depth / 2` either side of `point` along the normal.
-    fn lane(&self, bodies: &BodyStore) -> ContactLane {
+    /// on each surface, `depth / 2` either side of `point` along the normal,
+    /// with the depth capped at `max_depth`. The cap is the push-out limit:
+    /// the solver removes at most `max_depth` of an overlap this step (the
+    /// rest is still there at the next detection), so a body teleported
+    /// deep into another comes out at the configured speed instead of
+    /// being fired out at `depth / dt`, tearing its joints on the way.
+    fn lane(&self, bodies: &BodyStore, max_depth: f32) -> ContactLane {
         let (ia, ib) = (self.body_a.index(), self.body_b.index());
         let n = self.normal.normalize();
-        let on_a = self.point + n * (0.5 * self.depth);
-        let on_b = self.point - n * (0.5 * self.depth);
+        let depth = self.depth.min(max_depth);
+        let on_a = self.point + n * (0.5 * depth);
+        let on_b = self.point - n * (0.5 * depth);
         let local = |i: usize, p: Vec3| bodies.orientation[i].inverse() * (p - bodies.position[i]);
         let velocity = |i: usize, p: Vec3| {
             bodies.linear_velocity[i] + bodies.angular_velocity[i].cross(p - bodies.position[i])
@@ -89,8 +95,9 @@ pub(crate) struct ContactLayout {
 }
 
 impl ContactLayout {
-    /// Colours `contacts` greedily (in the order given) and lays them out.
-    pub fn build(contacts: &[Contact], bodies: &BodyStore) -> Self {
+    /// Colours `contacts` greedily (in the order given) and lays them out,
+    /// each overlap capped at `max_depth` (m) for this step.
+    pub fn build(contacts: &[Contact], bodies: &BodyStore, max_depth: f32) -> Self {
         let mut colouring = Colouring::new();
         let dynamic = |h: BodyHandle| {
             (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
@@ -100,12 +107,12 @@ impl ContactLayout {
         }
         let mut layout = Self::default();
         for colour in 0..MAX_COLOURS {
-            let range = layout.append(colouring.colour(colour).iter(), contacts, bodies);
+            let range = layout.append(colouring.colour(colour).iter(), contacts, bodies, max_depth);
             if !range.is_empty() {
                 layout.colours.push(range);
             }
         }
-        layout.overflow = layout.append(colouring.overflow().iter(), contacts, bodies);
+        layout.overflow = layout.append(colouring.overflow().iter(), contacts, bodies, max_depth);
         layout
     }
 
@@ -114,6 +121,7 @@ impl ContactLayout {
         keys: impl Iterator<Item = &'k u64>,
         contacts: &[Contact],
         bodies: &BodyStore,
+        max_depth: f32,
     ) -> Range<usize> {
         let start = self.blocks.len();
         for (k, &key) in keys.enumerate() {
@@ -121,7 +129,10 @@ impl ContactLayout {
                 self.blocks.push(ContactBlock::padding());
             }
             let block = self.blocks.len() - 1;
-            self.blocks[block].set(k % BLOCK_LANES, &contacts[key as usize].lane(bodies));
+            self.blocks[block].set(
+                k % BLOCK_LANES,
+                &contacts[key as usize].lane(bodies, max_depth),
+            );
         }
         start..self.blocks.len()
     }

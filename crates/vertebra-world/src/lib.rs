@@ -28,6 +28,7 @@ mod contact;
 mod layout;
 mod metrics;
 mod rod;
+mod snapshot;
 mod socket;
 mod step;
 
@@ -41,6 +42,7 @@ pub use config::SolverConfig;
 pub use contact::Contact;
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{RodDesc, RodHandle, RodStiffness, arc_tangent};
+pub use snapshot::Snapshot;
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
@@ -50,6 +52,8 @@ pub use vertebra_store::{
 
 /// Bodies, joints and the solver that steps them.
 pub struct World {
+    /// Names this world in its snapshots.
+    id: u64,
     config: SolverConfig,
     backend: Backend,
     pool: Option<rayon::ThreadPool>,
@@ -88,6 +92,7 @@ impl World {
             None
         };
         Ok(Self {
+            id: snapshot::new_world_id(),
             config,
             backend,
             pool,
@@ -291,6 +296,22 @@ impl World {
         self.layout_dirty = true;
     }
 
+    /// Every live socket with its description, in slot order.
+    pub fn sockets(&self) -> impl Iterator<Item = (SocketHandle, SocketDesc)> + '_ {
+        self.sockets.iter().enumerate().filter_map(|(i, desc)| {
+            let handle = self.socket_slots.handle_at(i)?;
+            desc.map(|d| (handle, d))
+        })
+    }
+
+    /// Every live rod with its description, in slot order.
+    pub fn rods(&self) -> impl Iterator<Item = (RodHandle, RodDesc)> + '_ {
+        self.rods.iter().enumerate().filter_map(|(i, desc)| {
+            let handle = self.rod_slots.handle_at(i)?;
+            desc.map(|d| (handle, d))
+        })
+    }
+
     /// A socket's description.
     pub fn socket(&self, handle: SocketHandle) -> Result<SocketDesc, Error> {
         if !self.socket_slots.contains(handle) {
@@ -384,8 +405,18 @@ impl World {
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         self.refresh_layout();
-        self.contact_layout = contact::ContactLayout::build(&self.contacts, &self.bodies);
-        step::step(self, dt);
+        let max_depth = self.config.max_push_out_speed * dt;
+        self.contact_layout =
+            contact::ContactLayout::build(&self.contacts, &self.bodies, max_depth);
+        // One entry into the pool per step: the colours' fork-joins then run
+        // among its workers (see step::for_each_colour).
+        match self.pool.take() {
+            Some(pool) => {
+                pool.install(|| step::step(self, dt));
+                self.pool = Some(pool);
+            }
+            None => step::step(self, dt),
+        }
         self.contacts.clear();
         self.residuals = metrics::residuals(self);
         Ok(())

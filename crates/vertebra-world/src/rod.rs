@@ -17,7 +17,7 @@ pub enum RodTag {}
 pub type RodHandle = Handle<RodTag>;
 
 /// How stiff a rod is in bending or twisting.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum RodStiffness {
     /// Kirchhoff stiffness `k` (N m^2): the energy is `1/2 k kappa^2 l0`
     /// with `kappa` the curvature (or twist rate). Solved as XPBD with
@@ -35,7 +35,7 @@ pub enum RodStiffness {
 /// The material frames `F_a`, `F_b` are given in the bodies' frames; their
 /// +X axes are the tangents. [`RodDesc::from_pose`] sets everything so that
 /// the rod holds exactly at the bodies' current poses.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RodDesc {
     /// The first body (the paper's `x_a`; the hips of a spine).
     pub body_a: BodyHandle,

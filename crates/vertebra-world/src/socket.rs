@@ -13,7 +13,7 @@ pub enum SocketTag {}
 pub type SocketHandle = Handle<SocketTag>;
 
 /// Drives a socket's body b toward an orientation relative to body a.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AngularDrive {
     /// b's joint frame relative to a's joint frame (unit quaternion).
     pub target: Quat,
@@ -30,7 +30,7 @@ pub struct AngularDrive {
 /// body frame); the anchors are held together, and the frames' +X axes are
 /// the twist axes: the swing cone limits the angle between them, the twist
 /// range the rotation about them.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SocketDesc {
     /// The parent body.
     pub body_a: BodyHandle,

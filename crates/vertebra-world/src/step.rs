@@ -72,17 +72,30 @@ pub(crate) fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
 /// deriving velocities afterwards.
 fn predict(world: &mut World, h: f32) {
     let g = world.config.gravity;
+    let (max_linear, max_angular) = (
+        world.config.max_linear_speed,
+        world.config.max_angular_speed,
+    );
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if !b.is_live(i) || b.kind[i] == BodyKind::Static {
             continue;
         }
+        // The speed limits, before and after the forces: huge but finite
+        // velocities or forces would overflow `|w|^2` in the exponential map
+        // (or `w x I w`) and poison the world.
+        let w = limit(b.angular_velocity[i], max_angular);
         if b.kind[i] == BodyKind::Dynamic {
-            b.linear_velocity[i] += (g + b.force[i] * b.inverse_mass[i]) * h;
+            let v = b.linear_velocity[i] + (g + b.force[i] * b.inverse_mass[i]) * h;
+            b.linear_velocity[i] = limit(v, max_linear);
             let q = b.orientation[i];
-            let w_body = gyroscopic(q.inverse() * b.angular_velocity[i], b.inertia[i], h);
+            let w_body = gyroscopic(q.inverse() * w, b.inertia[i], h);
             let torque_body = q.inverse() * b.torque[i];
-            b.angular_velocity[i] = q * (w_body + b.inverse_inertia[i] * torque_body * h);
+            let w_body = limit(w_body + b.inverse_inertia[i] * torque_body * h, max_angular);
+            b.angular_velocity[i] = q * w_body;
+        } else {
+            b.linear_velocity[i] = limit(b.linear_velocity[i], max_linear);
+            b.angular_velocity[i] = w;
         }
         world.previous[i] = (b.position[i], b.orientation[i]);
         b.position[i] += b.linear_velocity[i] * h;
@@ -93,6 +106,17 @@ fn predict(world: &mut World, h: f32) {
             b.orientation[i],
         ));
     }
+}
+
+/// `v` shortened to at most `max` (`v` itself when it is no longer), and
+/// finite even when a component overflowed to infinity.
+fn limit(v: Vec3, max: f32) -> Vec3 {
+    if v.length_squared() <= max * max {
+        return v;
+    }
+    let v = v.clamp(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
+    let scaled = v / v.abs().max_element();
+    scaled.normalize() * max
 }
 
 /// The gyroscopic term, implicitly: `I (w' - w) + h w' x I w' = 0` in the
@@ -109,8 +133,11 @@ fn gyroscopic(w: Vec3, inertia: glam::Mat3, h: f32) -> Vec3 {
     };
     let residual = w.cross(inertia * w) * h;
     let jacobian = inertia + (skew(w) * inertia - skew(inertia * w)) * h;
-    if jacobian.determinant().abs() > f32::MIN_POSITIVE {
-        w - jacobian.inverse() * residual
+    let turned = w - jacobian.inverse() * residual;
+    // A singular Jacobian, or an inertia so large the product overflowed:
+    // no gyroscopic correction this substep.
+    if jacobian.determinant().abs() > f32::MIN_POSITIVE && turned.is_finite() {
+        turned
     } else {
         w
     }
@@ -156,7 +183,9 @@ trait Pass: Sync {
 /// while ragdolls met the floor less deeply (10 mm against 25 mm at
 /// impact, 1.4 mm against 0.5 mm at rest); see docs/contacts.md.
 fn for_each_colour(world: &mut World, pass: &impl Pass) {
-    let pool = world.pool.take();
+    // The whole step runs inside the pool (World::step), so a split colour
+    // is a fork-join among its workers, not a wake-up from outside.
+    let threads = world.config.threads;
     let min_blocks = world.config.parallel_min_blocks;
     let rows = &world.rows;
     // This step's contacts first, coloured on their own; the joints after.
@@ -164,7 +193,11 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
     let groups = contacts.colours.iter().map(|r| (r.clone(), world.backend));
     let overflow = core::iter::once((contacts.overflow.clone(), Backend::Scalar));
     for (range, backend) in groups.chain(overflow) {
-        let parallel = pool.as_ref().filter(|_| backend != Backend::Scalar);
+        let parallel = if backend == Backend::Scalar {
+            1
+        } else {
+            threads
+        };
         chunked(parallel, min_blocks, &mut contacts.blocks[range], |c| {
             pass.contacts(c, rows, backend)
         });
@@ -174,7 +207,11 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
     let layout = &mut world.layout;
     let groups = layout.colours.iter().map(|g| (g, world.backend));
     for (group, backend) in groups.chain(core::iter::once((&layout.overflow, Backend::Scalar))) {
-        let parallel = pool.as_ref().filter(|_| backend != Backend::Scalar);
+        let parallel = if backend == Backend::Scalar {
+            1
+        } else {
+            threads
+        };
         for (range, driven) in [(&group.driven, true), (&group.plain, false)] {
             let blocks = &mut layout.sockets.blocks[range.clone()];
             chunked(parallel, min_blocks, blocks, |c| {
@@ -186,22 +223,21 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
             pass.rods(c, rows, backend)
         });
     }
-    world.pool = pool;
 }
 
-/// Runs `run` on all `blocks`, split over `pool` when there are enough.
+/// Runs `run` on all `blocks`, split over `threads` (of the current rayon
+/// pool: the step runs inside the world's) when there are enough.
 fn chunked<B: Send>(
-    pool: Option<&rayon::ThreadPool>,
+    threads: usize,
     min_blocks: usize,
     blocks: &mut [B],
     run: impl Fn(&mut [B]) + Sync,
 ) {
-    match pool {
-        Some(pool) if blocks.len() >= min_blocks => {
-            let chunk = blocks.len().div_ceil(pool.current_num_threads() * 2);
-            pool.install(|| blocks.par_chunks_mut(chunk).for_each(&run));
-        }
-        _ => run(blocks),
+    if threads > 1 && blocks.len() >= min_blocks {
+        let chunk = blocks.len().div_ceil(threads * 2);
+        blocks.par_chunks_mut(chunk).for_each(&run);
+    } else {
+        run(blocks);
     }
 }
 

@@ -285,6 +285,30 @@ fn bad_configs_are_refused() {
         }),
         Some(Error::NonFinite("gravity"))
     );
+    for speed in [-1.0, f32::NAN] {
+        assert!(matches!(
+            bad(SolverConfig {
+                max_push_out_speed: speed,
+                ..SolverConfig::default()
+            }),
+            Some(Error::InvalidConfig(_))
+        ));
+    }
+    for speed in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        let limits = [
+            SolverConfig {
+                max_linear_speed: speed,
+                ..SolverConfig::default()
+            },
+            SolverConfig {
+                max_angular_speed: speed,
+                ..SolverConfig::default()
+            },
+        ];
+        for config in limits {
+            assert!(matches!(bad(config), Some(Error::InvalidConfig(_))));
+        }
+    }
     for backend in vertebra_math::Backend::ALL {
         let result = World::new(SolverConfig {
             backend: BackendChoice::Forced(backend),
@@ -366,4 +390,43 @@ fn a_body_with_a_rod_cannot_be_removed_until_the_rod_is() {
     assert_eq!(w.rod(rod), Err(Error::StaleHandle("rod")));
     w.remove_body(c).unwrap();
     w.step(1.0 / 60.0).unwrap();
+}
+
+/// Huge but finite velocities and forces are accepted, and the solver's
+/// speed limits keep the world finite (the fuzzer found `|w| = 3.6e28`
+/// overflowing `|w|^2` in the exponential map, and `|w| = 1e34` overflowing
+/// the gyroscopic term); a force that would overflow the accumulator is
+/// refused.
+#[test]
+fn huge_finite_velocities_are_clamped_to_the_speed_limits() {
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let config = *world.config();
+    let shape = Shape::Sphere { radius: 0.1 };
+    let body = world
+        .add_body(BodyDesc::dynamic(shape.mass_properties(1000.0).unwrap()))
+        .unwrap();
+    let spinner = world.add_body(BodyDesc::kinematic()).unwrap();
+    world
+        .set_body_velocity(
+            body,
+            Vec3::new(3e30, 0.0, 0.0),
+            Vec3::new(0.0, -3.6e28, 0.0),
+        )
+        .unwrap();
+    world
+        .set_body_velocity(spinner, Vec3::ZERO, Vec3::new(-3.6e28, 5.0, 6.0))
+        .unwrap();
+    world.add_force(body, Vec3::new(0.0, 3e38, 0.0)).unwrap();
+    assert_eq!(
+        world.add_force(body, Vec3::new(0.0, 3e38, 0.0)),
+        Err(Error::NonFinite("accumulated force"))
+    );
+    world.add_torque(body, Vec3::new(3e38, 0.0, 0.0)).unwrap();
+    world.step(1.0 / 60.0).unwrap();
+    for handle in [body, spinner] {
+        let state = world.body(handle).unwrap();
+        assert!(state.position.is_finite() && state.orientation.is_finite());
+        assert!(state.linear_velocity.length() <= config.max_linear_speed * 1.0001);
+        assert!(state.angular_velocity.length() <= config.max_angular_speed * 1.0001);
+    }
 }

@@ -45,12 +45,7 @@ pub fn inverse_inertia(r: &mut StdRng) -> Mat3 {
 /// masses and identity orientations.
 pub fn rows(r: &mut StdRng, lanes: usize, statics: usize, adversarial: bool) -> RawRows {
     let bodies = lanes * 2 + statics;
-    let mut rows = vec![[[0.0f32; 8]; 3]; bodies + 1];
-    rows[0] = [
-        BodyRows::pose_row(Vec3::ZERO, 0.0, Quat::IDENTITY),
-        [0.0; 8],
-        [0.0; 8],
-    ];
+    let mut rows = vec![BodyRows::null_raw(); bodies + 1];
     for (i, row) in rows.iter_mut().enumerate().skip(1) {
         let fixed = i > bodies - statics || (adversarial && r.random_bool(0.1));
         let inv_mass = if fixed {
@@ -95,13 +90,7 @@ pub fn dynamic(rows: &RawRows, row: u32) -> bool {
 }
 
 pub fn to_rows(raw: &RawRows) -> BodyRows {
-    let rows = BodyRows::with_bodies(raw.len() - 1);
-    for (i, r) in raw.iter().enumerate() {
-        rows.pose[i].set(r[0]);
-        rows.inertia[i].set(r[1]);
-        rows.velocity[i].set(r[2]);
-    }
-    rows
+    BodyRows::from_raw(raw)
 }
 
 /// Every row's pose and velocity, flattened.

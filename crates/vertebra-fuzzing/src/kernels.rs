@@ -1,0 +1,204 @@
+//! Arbitrary lanes through the socket, rod and contact kernels.
+
+use core::f32::consts::PI;
+
+use glam::{Mat3, Vec3};
+use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
+use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
+use vertebra_kernels::socket::{self, SocketBlock, SocketLane};
+use vertebra_math::Backend;
+use vertebra_math::block::BLOCK_LANES;
+use vertebra_math::check::same_bits;
+
+use crate::input::Input;
+
+/// Rows per lane pair plus two static rows at the end (row 0 is null).
+const BODIES: usize = 2 * BLOCK_LANES + 2;
+
+type RawRows = Vec<[[f32; 8]; 3]>;
+
+fn raw_rows(input: &mut Input) -> RawRows {
+    let mut rows = vec![BodyRows::null_raw(); BODIES + 1];
+    for (i, row) in rows.iter_mut().enumerate().skip(1) {
+        let fixed = i > 2 * BLOCK_LANES || input.pick(10) == 0;
+        let inverse_mass = if fixed { 0.0 } else { input.positive(10.0) };
+        let axes = Mat3::from_quat(input.quat());
+        let diagonal = Vec3::new(
+            input.positive(50.0),
+            input.positive(50.0),
+            input.positive(50.0),
+        );
+        let inverse_inertia = if fixed {
+            Mat3::ZERO
+        } else {
+            axes * Mat3::from_diagonal(diagonal) * axes.transpose()
+        };
+        *row = [
+            BodyRows::pose_row(input.vec3(5.0), inverse_mass, input.quat()),
+            BodyRows::inertia_row(inverse_inertia),
+            BodyRows::velocity_row(input.vec3(10.0), input.vec3(10.0)),
+        ];
+    }
+    rows
+}
+
+/// Lane `k`'s two rows: its own pair, or a static row on one side (a
+/// written row belongs to one lane only, as the colouring ensures).
+fn lane_bodies(input: &mut Input, rows: &RawRows, k: usize) -> (u32, u32, bool, bool) {
+    let own = |j: usize| (1 + 2 * k + j) as u32;
+    let fixed = (2 * BLOCK_LANES + 1 + input.pick(2)) as u32;
+    let (a, b) = match input.pick(4) {
+        0 => (fixed, own(1)),
+        1 => (own(0), fixed),
+        _ => (own(0), own(1)),
+    };
+    let dynamic = |row: u32| rows[row as usize][0][3] > 0.0;
+    (a, b, dynamic(a), dynamic(b))
+}
+
+fn sorted_range(input: &mut Input) -> [f32; 2] {
+    let (x, y) = (input.float(PI), input.float(PI));
+    if x <= y { [x, y] } else { [y, x] }
+}
+
+fn softness(input: &mut Input) -> RodSoftness {
+    if input.flag() {
+        RodSoftness::Compliance(input.float(1.0).abs())
+    } else {
+        RodSoftness::Relaxation(input.float(1.0).abs().min(1.0))
+    }
+}
+
+fn socket_block(input: &mut Input, rows: &RawRows) -> SocketBlock {
+    let mut block = SocketBlock::padding();
+    for k in 0..BLOCK_LANES {
+        let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
+        let lane = SocketLane {
+            body_a,
+            body_b,
+            dynamic_a,
+            dynamic_b,
+            anchor_a: input.vec3(1.0),
+            anchor_b: input.vec3(1.0),
+            frame_a: input.quat(),
+            frame_b: input.quat(),
+            swing_max: input.float(PI).abs().min(PI),
+            twist: sorted_range(input),
+            drive: input.flag().then(|| {
+                (
+                    input.quat(),
+                    input.float(1.0).abs(),
+                    input.float(10.0).abs(),
+                )
+            }),
+        };
+        block.set(k, &lane);
+    }
+    block
+}
+
+fn rod_block(input: &mut Input, rows: &RawRows) -> RodBlock {
+    let mut block = RodBlock::padding();
+    for k in 0..BLOCK_LANES {
+        let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
+        let lane = RodLane {
+            body_a,
+            body_b,
+            dynamic_a,
+            dynamic_b,
+            frame_a: input.quat(),
+            frame_b: input.quat(),
+            rest_length: input.float(2.0).abs().max(1e-3),
+            bend_rest: input.vec3(1.0).try_normalize().unwrap_or(Vec3::X),
+            twist_rest: input.float(PI),
+            bend: softness(input),
+            twist: softness(input),
+            bend_max: input.float(PI).abs().min(PI),
+            twist_range: sorted_range(input),
+        };
+        block.set(k, &lane);
+    }
+    block
+}
+
+fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
+    let mut block = ContactBlock::padding();
+    for k in 0..BLOCK_LANES {
+        let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
+        let lane = ContactLane {
+            body_a,
+            body_b,
+            dynamic_a,
+            dynamic_b,
+            point_a: input.vec3(1.0),
+            point_b: input.vec3(1.0),
+            normal: input.vec3(1.0).try_normalize().unwrap_or(Vec3::Y),
+            friction: input.float(2.0).abs(),
+            restitution: input.float(1.0).abs().min(1.0),
+            approach: input.float(10.0),
+        };
+        block.set(k, &lane);
+    }
+    block
+}
+
+/// One position pass of each kernel over the same rows, on `backend`:
+/// every row's pose afterwards.
+fn run(
+    backend: Backend,
+    raw: &RawRows,
+    blocks: &(SocketBlock, RodBlock, ContactBlock),
+    inv_h2: f32,
+) -> Vec<f32> {
+    let rows = BodyRows::from_raw(raw);
+    let (mut sockets, mut rods, mut contacts) = ([blocks.0], [blocks.1], [blocks.2]);
+    backend.dispatch(socket::PositionPass::<true> {
+        blocks: &mut sockets,
+        rows: &rows,
+        inv_h2,
+    });
+    backend.dispatch(rod::PositionPass {
+        blocks: &mut rods,
+        rows: &rows,
+        inv_h2,
+    });
+    backend.dispatch(contact::PositionPass {
+        blocks: &mut contacts,
+        rows: &rows,
+    });
+    (0..rows.pose.len())
+        .flat_map(|i| rows.pose[i].get())
+        .collect()
+}
+
+/// Arbitrary bodies and lanes (unit or arbitrary quaternions, any floats one
+/// time in eight) through the socket (with drive), rod and contact position
+/// passes: every backend gives the scalar reference's bits, and input with
+/// no wild value gives finite poses.
+pub fn kernels(data: &[u8]) {
+    let mut input = Input::new(data);
+    let raw = raw_rows(&mut input);
+    let blocks = (
+        socket_block(&mut input, &raw),
+        rod_block(&mut input, &raw),
+        contact_block(&mut input, &raw),
+    );
+    let inv_h2 = 1.0 / (input.positive(0.05) * input.positive(0.05));
+    let expected = run(Backend::Scalar, &raw, &blocks, inv_h2);
+    for backend in Backend::available() {
+        let actual = run(backend, &raw, &blocks, inv_h2);
+        if let Some(k) = (0..expected.len()).find(|&k| !same_bits(expected[k], actual[k])) {
+            panic!(
+                "{backend} differs at float {k}: {:e} vs scalar {:e}",
+                actual[k], expected[k]
+            );
+        }
+    }
+    if !input.wild {
+        assert!(
+            expected.iter().all(|x| x.is_finite()),
+            "finite, valid lanes gave a non-finite pose"
+        );
+    }
+}

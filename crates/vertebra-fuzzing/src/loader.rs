@@ -1,0 +1,41 @@
+//! Arbitrary bytes as a ragdoll file.
+
+use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
+use vertebra_world::{SolverConfig, World};
+
+/// Arbitrary bytes (as UTF-8, lossily) through the TOML loader: an error,
+/// or a description that builds both ways and steps to a finite state.
+pub fn ragdoll_loader(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let Ok(desc) = RagdollDesc::from_toml(&text) else {
+        return;
+    };
+    for spine in [SpineMode::Sockets, SpineMode::Rod] {
+        let mut world = World::new(SolverConfig::default()).expect("the default config is valid");
+        let built = Ragdoll::build(
+            &mut world,
+            &desc,
+            BuildOptions::new(spine),
+            &Pose::bind(&desc),
+            None,
+        );
+        if built.is_err() {
+            assert_eq!(
+                world.bodies().len(),
+                0,
+                "a refused ragdoll left bodies behind"
+            );
+            continue;
+        }
+        for _ in 0..4 {
+            world.step(1.0 / 60.0).expect("a valid step");
+        }
+        let store = world.bodies();
+        for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
+            assert!(
+                store.position[i].is_finite() && store.orientation[i].is_finite(),
+                "a loaded ragdoll went non-finite"
+            );
+        }
+    }
+}

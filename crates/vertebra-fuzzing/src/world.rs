@@ -1,0 +1,191 @@
+//! Arbitrary call sequences on a world.
+
+use glam::Vec3;
+use vertebra_world::{
+    AngularDrive, BodyDesc, BodyHandle, Contact, Error, RodDesc, RodHandle, RodStiffness, Shape,
+    SocketDesc, SocketHandle, SolverConfig, World,
+};
+
+use crate::input::Input;
+
+/// What the world held before a call, to check a rejected one changed
+/// nothing.
+fn fingerprint(world: &World) -> (u64, usize, usize, usize) {
+    (
+        world.state_hash(),
+        world.bodies().len(),
+        world.sockets().count(),
+        world.rods().count(),
+    )
+}
+
+/// Handles seen so far (live or removed: stale ones must be refused).
+#[derive(Default)]
+struct Seen {
+    bodies: Vec<BodyHandle>,
+    sockets: Vec<SocketHandle>,
+    rods: Vec<RodHandle>,
+}
+
+impl Seen {
+    fn body(&self, input: &mut Input) -> Option<BodyHandle> {
+        (!self.bodies.is_empty()).then(|| self.bodies[input.pick(self.bodies.len())])
+    }
+}
+
+fn add_body(world: &mut World, input: &mut Input) -> Result<BodyHandle, Error> {
+    let desc = match input.pick(3) {
+        0 => BodyDesc::fixed(),
+        1 => BodyDesc::kinematic(),
+        _ => {
+            let shape = match input.pick(3) {
+                0 => Shape::Sphere {
+                    radius: input.float(0.5),
+                },
+                1 => Shape::Box {
+                    half_extents: input.vec3(0.5),
+                },
+                _ => Shape::capsule(input.vec3(0.5), input.vec3(0.5), input.float(0.2)),
+            };
+            BodyDesc::dynamic(shape.mass_properties_with_mass(input.float(100.0))?)
+        }
+    };
+    world.add_body(
+        desc.with_position(input.vec3(5.0))
+            .with_orientation(input.quat())
+            .with_velocity(input.vec3(20.0), input.vec3(20.0))
+            .with_damping(input.float(1.0), input.float(1.0)),
+    )
+}
+
+fn add_socket(world: &mut World, seen: &Seen, input: &mut Input) -> Result<SocketHandle, Error> {
+    let (Some(a), Some(b)) = (seen.body(input), seen.body(input)) else {
+        return Err(Error::SameBody);
+    };
+    let mut socket =
+        SocketDesc::at_world_anchor(world.bodies(), a, b, input.vec3(5.0), input.vec3(1.0))?;
+    if input.flag() {
+        socket = socket.with_swing_limit(input.float(4.0));
+    }
+    if input.flag() {
+        socket = socket.with_twist_limit(input.float(4.0), input.float(4.0));
+    }
+    if input.flag() {
+        socket = socket.with_drive(AngularDrive {
+            target: input.quat(),
+            compliance: input.float(1.0),
+            damping: input.float(10.0),
+        });
+    }
+    world.add_socket(socket)
+}
+
+fn add_rod(world: &mut World, seen: &Seen, input: &mut Input) -> Result<RodHandle, Error> {
+    let (Some(a), Some(b)) = (seen.body(input), seen.body(input)) else {
+        return Err(Error::SameBody);
+    };
+    let through: Vec<Vec3> = (0..input.pick(3)).map(|_| input.vec3(5.0)).collect();
+    let mut rod = RodDesc::from_pose(world.bodies(), a, b, &through)?.with_stiffness(
+        RodStiffness::Kirchhoff(input.float(100.0)),
+        RodStiffness::Kirchhoff(input.float(100.0)),
+    );
+    if input.flag() {
+        rod = rod.with_bend_limit(input.float(4.0));
+    }
+    if input.flag() {
+        rod = rod.with_twist_limit(input.float(4.0), input.float(4.0));
+    }
+    world.add_rod(rod)
+}
+
+fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) -> Result<(), Error> {
+    let mut contacts = Vec::new();
+    for _ in 0..input.pick(5) {
+        let (Some(body_a), Some(body_b)) = (seen.body(input), seen.body(input)) else {
+            break;
+        };
+        contacts.push(Contact {
+            body_a,
+            body_b,
+            point: input.vec3(5.0),
+            normal: input.vec3(1.0).try_normalize().unwrap_or(Vec3::Y),
+            depth: input.float(0.2),
+            friction: input.float(1.0),
+            restitution: input.float(1.0),
+        });
+    }
+    world.set_contacts(&contacts)
+}
+
+/// One call chosen by the input; `Err` is a refusal.
+fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Error> {
+    match input.pick(11) {
+        0 => add_body(world, input).map(|h| seen.bodies.push(h)),
+        1 => match seen.body(input) {
+            Some(h) => world.remove_body(h),
+            None => Ok(()),
+        },
+        2 => add_socket(world, seen, input).map(|h| seen.sockets.push(h)),
+        3 if !seen.sockets.is_empty() => {
+            world.remove_socket(seen.sockets[input.pick(seen.sockets.len())])
+        }
+        4 => add_rod(world, seen, input).map(|h| seen.rods.push(h)),
+        5 if !seen.rods.is_empty() => world.remove_rod(seen.rods[input.pick(seen.rods.len())]),
+        6 => match seen.body(input) {
+            Some(h) => world.set_body_pose(h, input.vec3(5.0), input.quat()),
+            None => Ok(()),
+        },
+        7 => match seen.body(input) {
+            Some(h) => world.set_body_velocity(h, input.vec3(50.0), input.vec3(50.0)),
+            None => Ok(()),
+        },
+        8 => set_contacts(world, seen, input),
+        9 => match seen.body(input) {
+            Some(h) => world.add_force(h, input.vec3(1000.0)),
+            None => Ok(()),
+        },
+        _ => world.step(if input.flag() {
+            1.0 / 60.0
+        } else {
+            input.float(0.1)
+        }),
+    }
+}
+
+/// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
+/// removed, poses, velocities and forces set, steps) with arbitrary floats
+/// one time in eight: no panic; every refused call leaves the world as it
+/// was; every body stays finite.
+pub fn world_api(data: &[u8]) {
+    let mut input = Input::new(data);
+    let config = SolverConfig {
+        iterations: 1 + input.pick(8) as u32,
+        substeps: 1 + input.pick(3) as u32,
+        ..SolverConfig::default()
+    };
+    let mut world = World::new(config).expect("a valid config");
+    let mut seen = Seen::default();
+    for _ in 0..64 {
+        if input.is_empty() {
+            break;
+        }
+        let before = fingerprint(&world);
+        let result = call(&mut world, &mut seen, &mut input);
+        if let Err(error) = result {
+            assert!(!error.to_string().is_empty());
+            assert_eq!(
+                fingerprint(&world),
+                before,
+                "refused ({error}) but changed the world"
+            );
+        }
+        let store = world.bodies();
+        for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
+            let finite = store.position[i].is_finite()
+                && store.orientation[i].is_finite()
+                && store.linear_velocity[i].is_finite()
+                && store.angular_velocity[i].is_finite();
+            assert!(finite, "body {i} went non-finite");
+        }
+    }
+}
