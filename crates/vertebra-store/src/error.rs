@@ -30,6 +30,9 @@ pub enum Error {
     InvalidLimit(&'static str),
     /// A solver setting out of its range.
     InvalidConfig(&'static str),
+    /// A finite value beyond what the solver can work with: a coordinate
+    /// beyond [`MAX_COORDINATE`], a time step above [`MAX_TIME_STEP`].
+    OutOfRange(&'static str),
     /// A snapshot taken of a different world.
     ForeignSnapshot,
     /// A snapshot whose bytes are damaged or not a snapshot at all.
@@ -53,6 +56,7 @@ impl fmt::Display for Error {
             Error::NoDynamicBody => write!(f, "a joint needs at least one dynamic body"),
             Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
             Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
+            Error::OutOfRange(what) => write!(f, "{what} is out of range"),
             Error::ForeignSnapshot => write!(f, "the snapshot was taken of another world"),
             Error::CorruptSnapshot(why) => write!(f, "corrupt snapshot: {why}"),
         }
@@ -82,6 +86,24 @@ pub fn check_unit_quat(what: &'static str, q: glam::Quat) -> Result<(), Error> {
 /// Checks a finite vector.
 pub fn check_finite(what: &'static str, v: glam::Vec3) -> Result<(), Error> {
     finite(what, &v.to_array())
+}
+
+/// The largest coordinate (m) a position or anchor may have: at 1e6 m an
+/// `f32` resolves 6 cm, already too coarse for joints, and far beyond it
+/// differences of positions overflow.
+pub const MAX_COORDINATE: f32 = 1.0e6;
+
+/// The longest time step (s) a world takes in one call.
+pub const MAX_TIME_STEP: f32 = 1.0;
+
+/// Checks a finite point within [`MAX_COORDINATE`] of the origin on every
+/// axis.
+pub fn check_coordinate(what: &'static str, v: glam::Vec3) -> Result<(), Error> {
+    check_finite(what, v)?;
+    if v.abs().max_element() > MAX_COORDINATE {
+        return Err(Error::OutOfRange(what));
+    }
+    Ok(())
 }
 
 /// Checks a finite direction of unit length (within 1e-3).

@@ -11,7 +11,10 @@ mod handle;
 mod shape;
 mod store;
 
-pub use error::{Error, check_finite, check_positive, check_unit_quat, check_unit_vec};
+pub use error::{
+    Error, MAX_COORDINATE, MAX_TIME_STEP, check_coordinate, check_finite, check_positive,
+    check_unit_quat, check_unit_vec,
+};
 pub use handle::{Handle, Slots};
 pub use shape::{MassProperties, Shape};
 pub use store::{BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore};

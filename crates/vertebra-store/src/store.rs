@@ -3,7 +3,7 @@
 
 use glam::{Mat3, Quat, Vec3};
 
-use crate::error::{Error, check_finite, check_unit_quat};
+use crate::error::{Error, check_coordinate, check_finite, check_unit_quat};
 use crate::handle::{Handle, Slots};
 use crate::shape::MassProperties;
 
@@ -107,7 +107,7 @@ impl BodyDesc {
 
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), Error> {
-        check_finite("position", self.position)?;
+        check_coordinate("position", self.position)?;
         check_unit_quat("orientation", self.orientation)?;
         check_finite("linear velocity", self.linear_velocity)?;
         check_finite("angular velocity", self.angular_velocity)?;
@@ -321,7 +321,7 @@ impl BodyStore {
         orientation: Quat,
     ) -> Result<(), Error> {
         let i = self.index(handle)?;
-        check_finite("position", position)?;
+        check_coordinate("position", position)?;
         check_unit_quat("orientation", orientation)?;
         self.position[i] = position;
         self.orientation[i] = orientation.normalize();
@@ -364,7 +364,7 @@ impl BodyStore {
     ) -> Result<(), Error> {
         let i = self.index(handle)?;
         check_finite("force", force)?;
-        check_finite("point", point)?;
+        check_coordinate("point", point)?;
         let total = self.force[i] + force;
         let torque = self.torque[i] + (point - self.position[i]).cross(force);
         check_finite("accumulated force", total)?;

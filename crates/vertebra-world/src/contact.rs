@@ -8,7 +8,7 @@ use glam::Vec3;
 use vertebra_kernels::contact::{ContactBlock, ContactLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::{Colouring, MAX_COLOURS};
-use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_finite, check_unit_vec};
+use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_coordinate, check_unit_vec};
 
 /// A contact between two bodies for the next step.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -35,7 +35,7 @@ impl Contact {
         if self.body_a == self.body_b {
             return Err(Error::SameBody);
         }
-        check_finite("contact point", self.point)?;
+        check_coordinate("contact point", self.point)?;
         check_unit_vec("contact normal", self.normal)?;
         if !self.depth.is_finite() {
             return Err(Error::NonFinite("contact depth"));

@@ -46,8 +46,8 @@ pub use snapshot::Snapshot;
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
-    BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MassProperties, Shape,
-    check_positive, check_unit_vec,
+    BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MAX_COORDINATE, MAX_TIME_STEP,
+    MassProperties, Shape, check_positive, check_unit_vec,
 };
 
 /// Bodies, joints and the solver that steps them.
@@ -404,6 +404,9 @@ impl World {
     /// Advances the world by `dt` seconds (finite, positive).
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
+        if dt > vertebra_store::MAX_TIME_STEP {
+            return Err(Error::OutOfRange("time step (at most 1 s)"));
+        }
         self.refresh_layout();
         let max_depth = self.config.max_push_out_speed * dt;
         self.contact_layout =

@@ -6,7 +6,7 @@ use core::f32::consts::PI;
 use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
 use vertebra_store::{
-    BodyHandle, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
+    BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
 };
 
 /// Marker for rod handles.
@@ -91,7 +91,7 @@ impl RodDesc {
         let a = bodies.state(body_a)?;
         let b = bodies.state(body_b)?;
         for p in through {
-            check_finite("bone position", *p)?;
+            check_coordinate("bone position", *p)?;
         }
         let chord = b.position - a.position;
         if chord.length() < 1e-4 {

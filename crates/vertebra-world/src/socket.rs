@@ -2,7 +2,7 @@
 
 use glam::{Quat, Vec3};
 use vertebra_store::{
-    BodyHandle, BodyStore, Error, Handle, check_finite, check_unit_quat, check_unit_vec,
+    BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
 };
 
 /// Marker for socket handles.
@@ -64,7 +64,7 @@ impl SocketDesc {
         anchor: Vec3,
         twist_axis: Vec3,
     ) -> Result<Self, Error> {
-        check_finite("anchor", anchor)?;
+        check_coordinate("anchor", anchor)?;
         check_unit_vec("twist axis", twist_axis)?;
         let a = bodies.state(body_a)?;
         let b = bodies.state(body_b)?;
@@ -105,8 +105,8 @@ impl SocketDesc {
         if self.body_a == self.body_b {
             return Err(Error::SameBody);
         }
-        check_finite("anchor a", self.anchor_a)?;
-        check_finite("anchor b", self.anchor_b)?;
+        check_coordinate("anchor a", self.anchor_a)?;
+        check_coordinate("anchor b", self.anchor_b)?;
         check_unit_quat("frame a", self.frame_a)?;
         check_unit_quat("frame b", self.frame_b)?;
         crate::checks::max_angle(self.swing_limit, "swing")?;

@@ -430,3 +430,32 @@ fn huge_finite_velocities_are_clamped_to_the_speed_limits() {
         assert!(state.angular_velocity.length() <= config.max_angular_speed * 1.0001);
     }
 }
+
+/// Coordinates beyond `MAX_COORDINATE` and steps beyond `MAX_TIME_STEP`
+/// are refused with the world unchanged (the fuzzer stepped a world by
+/// 1e30 s into infinities).
+#[test]
+fn coordinates_and_time_steps_out_of_range_are_refused() {
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let far = Vec3::new(0.0, 2.0 * vertebra_world::MAX_COORDINATE, 0.0);
+    assert_eq!(
+        world.add_body(BodyDesc::fixed().with_position(far)),
+        Err(Error::OutOfRange("position"))
+    );
+    let shape = Shape::Sphere { radius: 0.1 };
+    let body = world
+        .add_body(BodyDesc::dynamic(shape.mass_properties(1000.0).unwrap()))
+        .unwrap();
+    let before = world.state_hash();
+    assert_eq!(
+        world.set_body_pose(body, far, glam::Quat::IDENTITY),
+        Err(Error::OutOfRange("position"))
+    );
+    assert_eq!(
+        world.step(2.0 * vertebra_world::MAX_TIME_STEP),
+        Err(Error::OutOfRange("time step (at most 1 s)"))
+    );
+    assert_eq!(world.state_hash(), before);
+    world.step(vertebra_world::MAX_TIME_STEP).unwrap();
+    assert!(world.body(body).unwrap().position.is_finite());
+}
