@@ -10,8 +10,10 @@ use vertebra_world::{BodyDesc, BodyHandle, Shape, SocketDesc, SolverConfig, Worl
 
 const DT: f32 = 1.0 / 60.0;
 
-/// The fastest body (m/s) and whether every body is finite.
+/// The fastest body (m/s); every body must be finite, and the step's NaN
+/// guard must never have fired.
 fn fastest(world: &World) -> f32 {
+    assert_eq!(world.repaired_bodies(), 0, "the NaN guard fired");
     let store = world.bodies();
     (0..store.capacity())
         .filter(|&i| store.is_live(i))

@@ -155,6 +155,9 @@ fn positive_size(what: &'static str, x: f32) -> Result<(), Error> {
     }
 }
 
+/// The masses a body may have (kg): a milligram to a mountain.
+pub const MASS_RANGE: core::ops::RangeInclusive<f32> = 1.0e-6..=1.0e12;
+
 impl MassProperties {
     /// Given directly: `mass` (kg) and the body-frame `inertia` (kg m^2).
     pub fn new(mass: f32, inertia: Mat3) -> Result<Self, Error> {
@@ -163,10 +166,15 @@ impl MassProperties {
         Ok(props)
     }
 
-    /// Checks a finite positive mass and a symmetric positive definite
-    /// inertia tensor (Sylvester's criterion on the leading minors).
+    /// Checks a positive mass within [`MASS_RANGE`] and a symmetric positive
+    /// definite inertia tensor (Sylvester's criterion on the leading minors)
+    /// whose inverse is finite in `f32` (the solver works with inverses: a
+    /// 1e24 kg m^2 tensor's determinant overflows, and its inverse is NaN).
     pub fn validate(&self) -> Result<(), Error> {
         check_positive("mass", self.mass)?;
+        if !MASS_RANGE.contains(&self.mass) {
+            return Err(Error::OutOfRange("mass (1e-6 to 1e12 kg)"));
+        }
         let m = self.inertia;
         if !m.to_cols_array().iter().all(|x| x.is_finite()) {
             return Err(Error::NonFinite("inertia"));
@@ -179,6 +187,9 @@ impl MassProperties {
         let minor2 = m.x_axis.x * m.y_axis.y - m.x_axis.y * m.y_axis.x;
         if asymmetric || m.x_axis.x <= 0.0 || minor2 <= 0.0 || m.determinant() <= 0.0 {
             return Err(Error::InvalidInertia);
+        }
+        if !(m.determinant().is_finite() && m.inverse().is_finite()) {
+            return Err(Error::OutOfRange("inertia (its inverse overflows)"));
         }
         Ok(())
     }

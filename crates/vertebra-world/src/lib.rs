@@ -46,8 +46,8 @@ pub use snapshot::Snapshot;
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
-    BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MAX_COORDINATE, MAX_TIME_STEP,
-    MassProperties, Shape, check_positive, check_unit_vec,
+    BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
+    MAX_TIME_STEP, MassProperties, Shape, check_positive, check_unit_vec,
 };
 
 /// Bodies, joints and the solver that steps them.
@@ -71,6 +71,8 @@ pub struct World {
     rows: BodyRows,
     previous: Vec<(Vec3, Quat)>,
     residuals: Residuals,
+    /// Bodies put back by the step's last-line NaN guard, ever.
+    repaired: u64,
 }
 
 impl World {
@@ -110,6 +112,7 @@ impl World {
             rows: BodyRows::default(),
             previous: Vec::new(),
             residuals: Residuals::default(),
+            repaired: 0,
         })
     }
 
@@ -393,6 +396,13 @@ impl World {
     /// Residual joint error after the last step.
     pub fn residuals(&self) -> &Residuals {
         &self.residuals
+    }
+
+    /// How many times a step found a body's state no longer finite and put
+    /// it back to its pose before the substep, at rest (since the world was
+    /// made). Zero in every test scene; see docs/robustness.md.
+    pub fn repaired_bodies(&self) -> u64 {
+        self.repaired
     }
 
     /// A 64-bit hash of every live body's state, bit for bit: two worlds
