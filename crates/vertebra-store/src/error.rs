@@ -96,6 +96,10 @@ pub const MAX_COORDINATE: f32 = 1.0e6;
 /// The longest time step (s) a world takes in one call.
 pub const MAX_TIME_STEP: f32 = 1.0;
 
+/// The shortest time step (s) a world takes: velocities are derived by
+/// dividing motion by the substep, and a subnormal step overflows them.
+pub const MIN_TIME_STEP: f32 = 1.0e-6;
+
 /// Checks a finite point within [`MAX_COORDINATE`] of the origin on every
 /// axis.
 pub fn check_coordinate(what: &'static str, v: glam::Vec3) -> Result<(), Error> {

@@ -47,7 +47,7 @@ pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
-    MAX_TIME_STEP, MassProperties, Shape, check_positive, check_unit_vec,
+    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, Shape, check_positive, check_unit_vec,
 };
 
 /// Bodies, joints and the solver that steps them.
@@ -416,6 +416,11 @@ impl World {
         vertebra_store::check_positive("time step", dt)?;
         if dt > vertebra_store::MAX_TIME_STEP {
             return Err(Error::OutOfRange("time step (at most 1 s)"));
+        }
+        if dt / (self.config.substeps as f32) < vertebra_store::MIN_TIME_STEP {
+            return Err(Error::OutOfRange(
+                "time step (each substep at least 1e-6 s)",
+            ));
         }
         self.refresh_layout();
         let max_depth = self.config.max_push_out_speed * dt;

@@ -352,10 +352,10 @@ fn derive_velocities(world: &mut World, h: f32) {
 /// Linear and angular damping: `v /= 1 + h c`.
 /// The last line of defence: a body whose state is no longer finite goes
 /// back to its pose before the substep, at rest, and is counted. Validated
-/// input keeps every body finite in every test and scene; the fuzzer found
-/// extreme but valid inputs (a body thrown 8 m in one substep against a
-/// driven socket) whose corrections are not, and this keeps NaN out of the
-/// world while those are open (docs/robustness.md).
+/// input keeps every body finite: it never fired in any test, scene or in
+/// 390,000 fuzzed call sequences run with it made to panic
+/// (docs/robustness.md). It stays so that a case nobody found yet costs a
+/// body a substep, not the world.
 fn repair(b: &mut BodyStore, previous: &[(Vec3, Quat)]) -> u64 {
     let mut repaired = 0;
     for (i, &(position, orientation)) in previous.iter().enumerate().take(b.capacity()) {

@@ -431,9 +431,10 @@ fn huge_finite_velocities_are_clamped_to_the_speed_limits() {
     }
 }
 
-/// Coordinates beyond `MAX_COORDINATE` and steps beyond `MAX_TIME_STEP`
-/// are refused with the world unchanged (the fuzzer stepped a world by
-/// 1e30 s into infinities).
+/// Coordinates beyond `MAX_COORDINATE` and steps outside `MIN_TIME_STEP`
+/// to `MAX_TIME_STEP` are refused with the world unchanged (the fuzzer
+/// stepped a world by 1e30 s into infinities, and by subnormal steps into
+/// infinite derived velocities).
 #[test]
 fn coordinates_and_time_steps_out_of_range_are_refused() {
     let mut world = World::new(SolverConfig::default()).unwrap();
@@ -454,6 +455,13 @@ fn coordinates_and_time_steps_out_of_range_are_refused() {
     assert_eq!(
         world.step(2.0 * vertebra_world::MAX_TIME_STEP),
         Err(Error::OutOfRange("time step (at most 1 s)"))
+    );
+    // A subnormal step: velocities derived as motion / h would overflow.
+    assert_eq!(
+        world.step(1e-40),
+        Err(Error::OutOfRange(
+            "time step (each substep at least 1e-6 s)"
+        ))
     );
     assert_eq!(world.state_hash(), before);
     world.step(vertebra_world::MAX_TIME_STEP).unwrap();
