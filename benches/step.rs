@@ -16,17 +16,14 @@ const SPINES: [(&str, SpineMode); 2] = [
     ("standard", SpineMode::Sockets),
 ];
 
-/// Times `iters` frames of `scene`, only the part `timed` picks.
+/// Times `iters` frames of `scene`: the step alone (`time_step`), or the
+/// collision detection (with handing the contacts to the world) alone.
 fn frames(scene: &mut vertebra_scenes::SceneWorld, iters: u64, time_step: bool) -> Duration {
     let mut total = Duration::ZERO;
     for _ in 0..iters {
-        let collisions = scene.collisions.as_ref().expect("the drop has colliders");
         let start = Instant::now();
-        let contacts = collisions
-            .find_contacts(&scene.world, DT)
-            .expect("contacts");
+        scene.detect(DT).expect("contacts");
         let detected = start.elapsed();
-        scene.world.set_contacts(&contacts).expect("valid contacts");
         let start = Instant::now();
         scene.world.step(DT).expect("a step");
         total += if time_step { start.elapsed() } else { detected };

@@ -173,13 +173,21 @@ impl SceneWorld {
         }
     }
 
-    /// Frame `frame` of the scene, `dt` seconds: collision detection, the
-    /// push of figure 7 (controllability, frames 30 to 90), the step.
-    pub fn advance(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
+    /// Collision detection for a step of `dt` seconds: this scene's
+    /// contacts, handed to the world for its next step (nothing without
+    /// colliders).
+    pub fn detect(&mut self, dt: f32) -> Result<(), RagdollError> {
         if let Some(collisions) = &self.collisions {
             let contacts = collisions.find_contacts(&self.world, dt)?;
             self.world.set_contacts(&contacts)?;
         }
+        Ok(())
+    }
+
+    /// Frame `frame` of the scene, `dt` seconds: collision detection, the
+    /// push of figure 7 (controllability, frames 30 to 90), the step.
+    pub fn advance(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
+        self.detect(dt)?;
         if let (Some((body, force)), Scene::Controllability, true) =
             (self.push, scene, (30..90).contains(&frame))
         {

@@ -177,6 +177,15 @@ pub struct BodyStore {
 }
 
 impl BodyStore {
+    /// Whether slot `i`'s position, orientation and velocities are all
+    /// finite (stale slots included: they hold the last values written).
+    pub fn is_finite(&self, i: usize) -> bool {
+        self.position[i].is_finite()
+            && self.orientation[i].is_finite()
+            && self.linear_velocity[i].is_finite()
+            && self.angular_velocity[i].is_finite()
+    }
+
     /// Whether every array has one entry per slot (a decoded snapshot is
     /// checked with this before it is used).
     pub fn is_consistent(&self) -> bool {

@@ -359,11 +359,7 @@ fn derive_velocities(world: &mut World, h: f32) {
 fn repair(b: &mut BodyStore, previous: &[(Vec3, Quat)]) -> u64 {
     let mut repaired = 0;
     for (i, &(position, orientation)) in previous.iter().enumerate().take(b.capacity()) {
-        let finite = b.position[i].is_finite()
-            && b.orientation[i].is_finite()
-            && b.linear_velocity[i].is_finite()
-            && b.angular_velocity[i].is_finite();
-        if b.is_live(i) && b.kind[i] != BodyKind::Static && !finite {
+        if b.is_live(i) && b.kind[i] != BodyKind::Static && !b.is_finite(i) {
             (b.position[i], b.orientation[i]) = (position, orientation);
             b.linear_velocity[i] = Vec3::ZERO;
             b.angular_velocity[i] = Vec3::ZERO;
