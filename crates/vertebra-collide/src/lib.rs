@@ -171,9 +171,7 @@ fn check_prediction(prediction: f32) -> Result<(), Error> {
 pub struct Collisions {
     colliders: Vec<(Collider, SharedShape)>,
     excluded: HashSet<(BodyHandle, BodyHandle)>,
-    /// Contacts are made for gaps up to this size too (m), on top of how far
-    /// each body can move in the step (see [`Collisions::find_contacts`]).
-    pub prediction: f32,
+    prediction: f32,
 }
 
 fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {
@@ -191,6 +189,21 @@ impl Collisions {
             prediction: 0.01,
             ..Self::default()
         }
+    }
+
+    /// The prediction margin (m): contacts are made for gaps up to this
+    /// size too, on top of how far each body can move in the step (see
+    /// [`Collisions::find_contacts`]).
+    pub fn prediction(&self) -> f32 {
+        self.prediction
+    }
+
+    /// Sets the prediction margin (m, finite, not negative); `Err` (and no
+    /// change) otherwise.
+    pub fn set_prediction(&mut self, margin: f32) -> Result<(), Error> {
+        check_prediction(margin)?;
+        self.prediction = margin;
+        Ok(())
     }
 
     /// Adds a collider; returns its index in [`Collisions::colliders`]
@@ -331,7 +344,6 @@ impl Collisions {
     /// colliders with [`Collisions::remove_body`]).
     pub fn find_contacts(&self, world: &World, dt: f32) -> Result<Vec<Contact>, Error> {
         vertebra_world::check_positive("time step", dt)?;
-        check_prediction(self.prediction)?;
         let mut poses = Vec::with_capacity(self.colliders.len());
         let mut reach = Vec::with_capacity(self.colliders.len());
         for (index, (c, shape)) in self.colliders.iter().enumerate() {

@@ -72,7 +72,8 @@ impl Collisions {
     /// snapshot of this version, damaged or undecodable; `Err(Collider)`
     /// naming the collider and its body for a collider [`Collisions::add`]
     /// would refuse or whose body is not in `world`; `NonFinite` or
-    /// `NonPositive` for a bad prediction margin. The set is unchanged on
+    /// `NonPositive` for a margin [`Collisions::set_prediction`] would
+    /// refuse. A set's own snapshot always restores into its world. The set is unchanged on
     /// error.
     pub fn restore(&mut self, snapshot: &CollisionSnapshot, world: &World) -> Result<(), Error> {
         let state = decode(&snapshot.bytes)?;

@@ -131,6 +131,19 @@ fn colliders_beyond_the_size_limit_are_refused() {
 }
 
 #[test]
+fn a_bad_prediction_margin_is_refused() {
+    let (_, mut c, _) = boxes();
+    for (margin, refused) in [
+        (f32::NAN, Error::NonFinite("collision prediction")),
+        (f32::INFINITY, Error::NonFinite("collision prediction")),
+        (-0.01, Error::NonPositive("collision prediction")),
+    ] {
+        assert_eq!(c.set_prediction(margin), Err(refused));
+    }
+    assert_eq!(c.prediction(), 0.01);
+}
+
+#[test]
 fn a_collider_whose_body_is_gone_is_named() {
     // Failed before the fix: `find_contacts` said only "stale or unknown
     // body handle".
@@ -275,7 +288,7 @@ fn restoring_the_world_and_the_set_replays_bit_for_bit() {
     c.add(Collider::new(ball, ColliderShape::Solid(shape)))
         .unwrap();
     c.exclude(ball, ragdolls[0].bodies[0].unwrap());
-    c.prediction = 0.05;
+    c.set_prediction(0.05).unwrap();
     for _ in 0..10 {
         step(&mut w, &c);
     }
@@ -401,7 +414,7 @@ fn crafted_collision_snapshots_never_panic_nor_admit_a_bad_value() {
         match set.restore(&resealed(bytes), &w) {
             Ok(()) => {
                 accepted += 1;
-                assert!(set.prediction.is_finite() && set.prediction >= 0.0);
+                assert!(set.prediction().is_finite() && set.prediction() >= 0.0);
                 // Its contacts pass the world's own checks.
                 let contacts = set.find_contacts(&w, DT).unwrap();
                 w.set_contacts(&contacts).unwrap();
