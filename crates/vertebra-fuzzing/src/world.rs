@@ -185,7 +185,10 @@ pub fn world_api(data: &[u8]) {
         }
         let live = |b: BodyHandle| store.contains(b);
         assert!(
-            world.contacts().iter().all(|c| live(c.body_a) && live(c.body_b)),
+            world
+                .contacts()
+                .iter()
+                .all(|c| live(c.body_a) && live(c.body_b)),
             "a pending contact names a removed body"
         );
     }
