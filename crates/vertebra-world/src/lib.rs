@@ -387,6 +387,7 @@ impl World {
     pub fn measure_residuals(&mut self) -> &Residuals {
         self.refresh_layout();
         step::upload(&self.bodies, &mut self.rows);
+        self.layout.start_step(&self.bodies);
         self.residuals = metrics::residuals(self);
         &self.residuals
     }
