@@ -55,16 +55,17 @@ impl Shape {
     /// segment may also be zero).
     pub fn validate(&self) -> Result<(), Error> {
         match *self {
-            Shape::Sphere { radius } => size("sphere radius (1e-3 to 1e3 m)", radius),
+            Shape::Sphere { radius } => {
+                size(["sphere radius", "sphere radius (1e-3 to 1e3 m)"], radius)
+            }
             Shape::Box { half_extents } => {
                 check_finite("box half extents", half_extents)?;
                 if half_extents.min_element() <= 0.0 {
                     return Err(Error::DegenerateShape("box half extents must be positive"));
                 }
-                half_extents
-                    .to_array()
-                    .into_iter()
-                    .try_for_each(|h| size("box half extents (1e-3 to 1e3 m)", h))
+                half_extents.to_array().into_iter().try_for_each(|h| {
+                    size(["box half extents", "box half extents (1e-3 to 1e3 m)"], h)
+                })
             }
             Shape::Capsule {
                 half_segment,
@@ -74,7 +75,7 @@ impl Shape {
                 if half_segment.length() > *SIZE_RANGE.end() {
                     return Err(Error::OutOfRange("capsule half segment (at most 1e3 m)"));
                 }
-                size("capsule radius (1e-3 to 1e3 m)", radius)
+                size(["capsule radius", "capsule radius (1e-3 to 1e3 m)"], radius)
             }
         }
     }
@@ -162,16 +163,17 @@ impl Shape {
     }
 }
 
-/// A finite dimension within [`SIZE_RANGE`]; `what` names it and the range.
-fn size(what: &'static str, x: f32) -> Result<(), Error> {
+/// A finite dimension within [`SIZE_RANGE`]; `name` is the dimension's
+/// name and the same with the range.
+fn size([name, with_range]: [&'static str; 2], x: f32) -> Result<(), Error> {
     if !x.is_finite() {
-        return Err(Error::NonFinite(what));
+        return Err(Error::NonFinite(name));
     }
     if x <= 0.0 {
-        return Err(Error::DegenerateShape(what));
+        return Err(Error::DegenerateShape(name));
     }
     if !SIZE_RANGE.contains(&x) {
-        return Err(Error::OutOfRange(what));
+        return Err(Error::OutOfRange(with_range));
     }
     Ok(())
 }
