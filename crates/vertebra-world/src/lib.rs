@@ -49,8 +49,8 @@ pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
-    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, SIZE_RANGE, Shape, check_positive,
-    check_unit_vec,
+    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, SIZE_RANGE, Shape, check_coordinate,
+    check_positive, check_unit_quat, check_unit_vec,
 };
 
 /// Bodies, joints and the solver that steps them.
