@@ -184,12 +184,12 @@ pub fn world_settings(data: &[u8]) {
 /// Solver settings from the input (one thread: thread counts do not change
 /// the bits, and pools are slow to start).
 fn settings(input: &mut Input) -> SolverConfig {
-    let mut count = |input: &mut Input| match input.pick(16) {
+    let count = |input: &mut Input| match input.pick(16) {
         0 => u32::MAX - input.pick(4) as u32,
         _ => 1 + input.pick(8) as u32,
     };
     let (substeps, iterations) = (count(input), count(input));
-    let mut speed = |input: &mut Input, ceiling: f32| match input.pick(4) {
+    let speed = |input: &mut Input, ceiling: f32| match input.pick(4) {
         0 => ceiling,
         _ => input.float(ceiling).abs(),
     };
