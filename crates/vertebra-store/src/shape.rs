@@ -50,33 +50,51 @@ impl Shape {
         }
     }
 
-    /// Checks that every dimension (radius, half extent, half segment
-    /// length) is finite and within [`SIZE_RANGE`] (a capsule's half
-    /// segment may also be zero).
+    /// Checks that the shape has finite, positive size (what a collider
+    /// needs; mass properties need [`SIZE_RANGE`] too).
     pub fn validate(&self) -> Result<(), Error> {
         match *self {
-            Shape::Sphere { radius } => {
-                size(["sphere radius", "sphere radius (1e-3 to 1e3 m)"], radius)
-            }
+            Shape::Sphere { radius } => positive_size("sphere radius", radius),
             Shape::Box { half_extents } => {
                 check_finite("box half extents", half_extents)?;
-                if half_extents.min_element() <= 0.0 {
-                    return Err(Error::DegenerateShape("box half extents must be positive"));
+                if half_extents.min_element() > 0.0 {
+                    Ok(())
+                } else {
+                    Err(Error::DegenerateShape("box half extents must be positive"))
                 }
-                half_extents.to_array().into_iter().try_for_each(|h| {
-                    size(["box half extents", "box half extents (1e-3 to 1e3 m)"], h)
-                })
             }
             Shape::Capsule {
                 half_segment,
                 radius,
             } => {
                 check_finite("capsule segment", half_segment)?;
+                positive_size("capsule radius", radius)
+            }
+        }
+    }
+
+    /// Checks a valid shape's dimensions (radius, half extents) lie in
+    /// [`SIZE_RANGE`], and a capsule's half segment is at most its end.
+    fn check_size_range(&self) -> Result<(), Error> {
+        let (dimensions, what) = match *self {
+            Shape::Sphere { radius } => ([radius; 3], "sphere radius (1e-3 to 1e3 m)"),
+            Shape::Box { half_extents } => {
+                (half_extents.to_array(), "box half extents (1e-3 to 1e3 m)")
+            }
+            Shape::Capsule {
+                half_segment,
+                radius,
+            } => {
                 if half_segment.length() > *SIZE_RANGE.end() {
                     return Err(Error::OutOfRange("capsule half segment (at most 1e3 m)"));
                 }
-                size(["capsule radius", "capsule radius (1e-3 to 1e3 m)"], radius)
+                ([radius; 3], "capsule radius (1e-3 to 1e3 m)")
             }
+        };
+        if dimensions.iter().all(|d| SIZE_RANGE.contains(d)) {
+            Ok(())
+        } else {
+            Err(Error::OutOfRange(what))
         }
     }
 
@@ -95,11 +113,13 @@ impl Shape {
         }
     }
 
-    /// Mass properties at uniform `density` (kg/m^3), checked as
+    /// Mass properties at uniform `density` (kg/m^3): dimensions within
+    /// [`SIZE_RANGE`], the result checked as
     /// [`MassProperties::validate`] checks them: the mass (density times
     /// volume) within [`MASS_RANGE`], the inertia invertible.
     pub fn mass_properties(&self, density: f32) -> Result<MassProperties, Error> {
         self.validate()?;
+        self.check_size_range()?;
         check_positive("density", density)?;
         let unit = self.unit_density_properties();
         // In f64: density times volume may overflow f32.
@@ -112,10 +132,12 @@ impl Shape {
         unit.scaled(density).checked()
     }
 
-    /// Mass properties of a uniform solid of total `mass` (kg), checked as
+    /// Mass properties of a uniform solid of total `mass` (kg): dimensions
+    /// within [`SIZE_RANGE`], the result checked as
     /// [`MassProperties::validate`] checks them.
     pub fn mass_properties_with_mass(&self, mass: f32) -> Result<MassProperties, Error> {
         self.validate()?;
+        self.check_size_range()?;
         check_mass(mass)?;
         let unit = self.unit_density_properties();
         unit.scaled(mass / unit.mass).checked()
@@ -163,19 +185,15 @@ impl Shape {
     }
 }
 
-/// A finite dimension within [`SIZE_RANGE`]; `name` is the dimension's
-/// name and the same with the range.
-fn size([name, with_range]: [&'static str; 2], x: f32) -> Result<(), Error> {
+fn positive_size(what: &'static str, x: f32) -> Result<(), Error> {
     if !x.is_finite() {
-        return Err(Error::NonFinite(name));
+        return Err(Error::NonFinite(what));
     }
-    if x <= 0.0 {
-        return Err(Error::DegenerateShape(name));
+    if x > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::DegenerateShape(what))
     }
-    if !SIZE_RANGE.contains(&x) {
-        return Err(Error::OutOfRange(with_range));
-    }
-    Ok(())
 }
 
 /// The dimensions a shape may have (m): radii, half extents and half
