@@ -211,8 +211,9 @@ impl RagdollDesc {
     /// Parses and validates a description. Errors about a body, joint or
     /// the spine start with the line where it is defined.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
-        let raw: RawFile = toml::from_str(text).map_err(|e| syntax(text, &e))?;
-        let at = |span: core::ops::Range<usize>| line(text, span.start);
+        let lines = Lines::new(text);
+        let raw: RawFile = toml::from_str(text).map_err(|e| syntax(&lines, &e))?;
+        let at = |span: core::ops::Range<usize>| lines.at(span.start);
         let bodies = raw
             .body
             .iter()
@@ -274,20 +275,25 @@ impl RagdollDesc {
     }
 }
 
-/// The line (from 1) of byte `offset` of `text`.
-fn line(text: &str, offset: usize) -> usize {
-    text.as_bytes()[..offset.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+/// Where a text's lines end, to name the line of a byte offset.
+struct Lines(Vec<usize>);
+
+impl Lines {
+    fn new(text: &str) -> Self {
+        Self(text.match_indices('\n').map(|(at, _)| at).collect())
+    }
+
+    /// The line (from 1) of byte `offset`.
+    fn at(&self, offset: usize) -> usize {
+        self.0.partition_point(|&end| end < offset) + 1
+    }
 }
 
 /// A parse error on one line: where, and what (without the source excerpt).
-fn syntax(text: &str, e: &toml::de::Error) -> RagdollError {
+fn syntax(lines: &Lines, e: &toml::de::Error) -> RagdollError {
     let message = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
     match e.span() {
-        Some(span) => RagdollError::Syntax(format!("line {}: {message}", line(text, span.start))),
+        Some(span) => RagdollError::Syntax(format!("line {}: {message}", lines.at(span.start))),
         None => RagdollError::Syntax(message),
     }
 }
