@@ -252,6 +252,14 @@ fn extreme_counts_end_with_one_clear_line() {
 }
 
 #[test]
+fn an_output_directory_that_cannot_be_made_is_named() {
+    fails_with(
+        &["reproduce", "--out", "/proc/vertebra-none/out"],
+        "cannot write the results: /proc/vertebra-none/out: ",
+    );
+}
+
+#[test]
 fn ragdoll_files_are_read_bounded_and_named_in_every_error() {
     let dir = std::env::temp_dir().join(format!("vertebra-cli-bounded-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
