@@ -10,14 +10,7 @@ use clap::error::ErrorKind;
 use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
-use vertebra_scenes::{Scene, SceneConfig, SceneRun};
-
-/// The most frames `scene --frames` runs: 4.6 hours at 60 Hz. The run
-/// keeps a record per frame (16 bytes, and about 60 bytes of JSON), sized
-/// from this count up front, so the bound keeps them under 100 MB; without
-/// it `--frames` near `u64::MAX` overflowed the allocation and `1e12`
-/// frames aborted allocating 17 TB.
-const MAX_FRAMES: usize = 1_000_000;
+use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, SceneRun};
 
 #[derive(Parser)]
 #[command(
