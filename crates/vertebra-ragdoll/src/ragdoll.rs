@@ -3,8 +3,8 @@
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, BodyHandle, MassProperties, RodDesc, RodHandle, RodStiffness, Shape, SocketDesc,
-    SocketHandle, World,
+    BodyDesc, BodyHandle, MIN_TIME_STEP, MassProperties, RodDesc, RodHandle, RodStiffness, Shape,
+    SocketDesc, SocketHandle, World,
 };
 
 use crate::description::RagdollDesc;
@@ -138,10 +138,12 @@ impl Ragdoll {
         pose.validate(desc)?;
         if let Some((p, dt)) = previous {
             p.validate(desc)?;
-            if !(dt.is_finite() && dt > 0.0) {
-                return Err(RagdollError::BadPose(
-                    "the time between the two poses must be positive".to_owned(),
-                ));
+            // Velocities are motion divided by dt, as in the step: below
+            // the world's shortest time step they overflow.
+            if !(dt.is_finite() && dt >= MIN_TIME_STEP) {
+                return Err(RagdollError::BadPose(format!(
+                    "the time between the two poses is {dt} s; it must be at least {MIN_TIME_STEP} s"
+                )));
             }
         }
         let mut ragdoll = Self {

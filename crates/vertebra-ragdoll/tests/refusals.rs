@@ -197,3 +197,25 @@ fn build_errors_name_the_body_or_the_rod() {
     );
     assert_eq!(world.bodies().len(), 0);
 }
+
+/// Velocities from two poses are motion over the time between them: a
+/// subnormal time made them infinite (the world then refused a body's
+/// velocity, naming nothing about the time), or 1e38 m/s.
+#[test]
+fn the_time_between_two_poses_is_at_least_the_shortest_step() {
+    let desc = RagdollDesc::reference_humanoid();
+    let previous = Pose::bind(&desc);
+    let current = previous.moved(Vec3::ZERO, Quat::IDENTITY, Vec3::new(0.0, 0.0, 0.01));
+    for dt in [1e-40, 1e-7, 0.0, -1.0, f32::NAN] {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let options = BuildOptions::new(SpineMode::Rod);
+        let built = Ragdoll::build(&mut world, &desc, options, &current, Some((&previous, dt)));
+        let message = built.expect_err("refused").to_string();
+        assert!(
+            message.starts_with("bad pose: the time between the two poses is")
+                && message.ends_with("it must be at least 0.000001 s"),
+            "{dt}: {message}"
+        );
+        assert_eq!(world.bodies().len(), 0);
+    }
+}
