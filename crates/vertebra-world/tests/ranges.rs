@@ -7,8 +7,9 @@ mod common;
 use common::capsule;
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyHandle, Contact, Error, MAX_ANGULAR_SPEED_LIMIT, MAX_COORDINATE, MAX_LINEAR_SPEED_LIMIT,
-    MAX_ROD_LENGTH, MAX_SOLVER_SWEEPS, MAX_THREADS, RodDesc, RodStiffness, SolverConfig, World,
+    AngularDrive, BodyHandle, Contact, Error, MAX_ANGULAR_SPEED_LIMIT, MAX_COORDINATE,
+    MAX_LINEAR_SPEED_LIMIT, MAX_ROD_LENGTH, MAX_SOLVER_SWEEPS, MAX_THREADS, RodDesc, RodStiffness,
+    SolverConfig, World,
 };
 
 /// Steps `world` a second at 60 Hz; every body stays finite and within
@@ -107,8 +108,9 @@ fn solver_settings_beyond_their_ranges_are_refused() {
 }
 
 /// Every setting at the edge of its range: speed limits at their ceilings,
-/// gravity at `f32::MAX`, bodies thrown at 1e30 m/s and rad/s, a joint:
-/// the step stays finite and within one step's motion per step.
+/// gravity at `f32::MAX`, bodies thrown at 1e30 m/s and rad/s, a socket
+/// driven with compliance and damping of `f32::MAX`: the step stays finite
+/// and within one step's motion per step.
 #[test]
 fn settings_at_their_limits_step_finite_and_bounded() {
     for gravity in [0.0, f32::MAX] {
@@ -131,7 +133,12 @@ fn settings_at_their_limits_step_finite_and_bounded() {
             -Vec3::Y,
         )
         .unwrap();
-        world.add_socket(socket).unwrap();
+        let drive = AngularDrive {
+            target: Quat::from_rotation_z(1.0),
+            compliance: f32::MAX,
+            damping: f32::MAX,
+        };
+        world.add_socket(socket.with_drive(drive)).unwrap();
         // 60 steps of at most MAX_LINEAR_SPEED_LIMIT / 60 m each.
         steps_clean(&mut world, MAX_LINEAR_SPEED_LIMIT * 1.01);
     }
@@ -191,9 +198,9 @@ fn rod_rest_lengths_beyond_any_body_pair_are_refused() {
     );
 }
 
-/// The longest and shortest rest lengths, stiff and soft, limited, with the
-/// bodies spinning: finite, and the NaN guard (which fired every substep
-/// at 1e30 m) silent.
+/// The longest and shortest rest lengths, stiff and soft, limited, a rest
+/// twist of 1e30 rad, with the bodies spinning: finite, and the NaN guard
+/// (which fired every substep at a rest length of 1e30 m) silent.
 #[test]
 fn rods_at_the_ends_of_their_ranges_step_finite() {
     for length in [MAX_ROD_LENGTH, 1e-30] {
@@ -201,6 +208,7 @@ fn rods_at_the_ends_of_their_ranges_step_finite() {
             let (mut world, result) = rod_world(|r| {
                 RodDesc {
                     rest_length: length,
+                    twist_rest: 1e30,
                     ..r
                 }
                 .with_stiffness(RodStiffness::Kirchhoff(k), RodStiffness::Kirchhoff(k))
