@@ -6,16 +6,18 @@ mod output;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
 use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
-use vertebra_scenes::{Scene, SceneConfig, SceneRun};
+use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, SceneRun};
 
 #[derive(Parser)]
 #[command(
     name = "vertebra",
     version,
-    about = "Rod constraints for simplified ragdolls: the paper's scenes"
+    about = "Rod constraints for simplified ragdolls: the paper's scenes",
+    arg_required_else_help = true
 )]
 struct Cli {
     #[command(subcommand)]
@@ -37,22 +39,24 @@ enum Command {
         /// rod (simplified) or sockets (standard).
         #[arg(long)]
         spine: Spine,
-        /// Position iterations per substep.
+        /// Position iterations per substep (substeps x iterations at most
+        /// 10000).
         #[arg(long, default_value_t = 20)]
         iterations: u32,
         /// Substeps per frame.
         #[arg(long, default_value_t = 1)]
         substeps: u32,
-        /// Frames to run (the scene's own count by default).
+        /// Frames to run, 1 to 1000000 (the scene's own count by default).
         #[arg(long)]
         frames: Option<usize>,
         /// auto, scalar, portable, sse4, avx2x4 or avx2.
         #[arg(long, default_value = "auto")]
         backend: String,
-        /// Worker threads.
+        /// Worker threads, 1 to 256.
         #[arg(long, default_value_t = 1)]
         threads: usize,
-        /// A ragdoll description (TOML) instead of the reference humanoid.
+        /// A ragdoll description (TOML, at most 1 MiB) instead of the
+        /// reference humanoid.
         #[arg(long)]
         ragdoll: Option<PathBuf>,
         /// One JSON object on stdout.
@@ -79,6 +83,11 @@ impl From<Spine> for SpineMode {
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
+        Err(e) if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            // No arguments at all: the usage, as a usage error.
+            eprint!("{e}");
+            return ExitCode::from(2);
+        }
         Err(e) if !e.use_stderr() => {
             // --help and --version.
             print!("{e}");
@@ -120,20 +129,17 @@ fn execute(command: Command) -> Result<(), String> {
             let scene: Scene = name.parse()?;
             let backend: BackendChoice = backend.parse().map_err(|e| format!("{e}"))?;
             backend.resolve().map_err(|e| format!("{e}"))?;
-            let ragdoll = match ragdoll {
-                Some(path) => {
-                    let text = std::fs::read_to_string(&path)
-                        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-                    Some(
-                        RagdollDesc::from_toml(&text)
-                            .map_err(|e| format!("{}: {e}", path.display()))?,
-                    )
+            match frames {
+                Some(0) => return Err("--frames must be at least 1".to_owned()),
+                Some(n) if n > MAX_FRAMES => {
+                    return Err(format!("--frames must be at most {MAX_FRAMES}"));
                 }
-                None => None,
-            };
-            if frames == Some(0) {
-                return Err("--frames must be at least 1".to_owned());
+                _ => {}
             }
+            let ragdoll = ragdoll
+                .map(|path| RagdollDesc::from_file(&path))
+                .transpose()
+                .map_err(|e| e.to_string())?;
             let mut config = SceneConfig::new(scene, spine.into());
             config.iterations = iterations;
             config.substeps = substeps;

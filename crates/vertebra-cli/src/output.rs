@@ -103,7 +103,7 @@ fn font_options() -> resvg::usvg::Options<'static> {
 
 /// Runs every scene both ways and writes everything under `out`.
 pub fn reproduce(out: &Path) -> Result<(), String> {
-    std::fs::create_dir_all(out).map_err(io)?;
+    std::fs::create_dir_all(out).map_err(|e| io(format!("{}: {e}", out.display())))?;
     let fonts = font_options();
     let mut summary = Vec::new();
     let mut table = String::new();

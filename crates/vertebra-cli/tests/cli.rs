@@ -191,3 +191,112 @@ fn malformed_ragdoll_files_end_with_one_clear_line() {
         "malformed ragdoll file",
     );
 }
+
+#[test]
+fn no_arguments_print_the_usage() {
+    let (code, stdout, stderr) = vertebra(&[]);
+    assert_eq!(code, 2, "a usage error, as clap gives");
+    assert!(stdout.is_empty());
+    for expected in ["Usage: vertebra", "reproduce", "scene"] {
+        assert!(stderr.contains(expected), "`{expected}` in {stderr}");
+    }
+}
+
+/// `scene passive-bending --spine rod` with `extra` arguments.
+fn scene_with(extra: &[&str]) -> Vec<String> {
+    ["scene", "passive-bending", "--spine", "rod"]
+        .iter()
+        .chain(extra)
+        .map(|s| s.to_string())
+        .collect()
+}
+
+#[test]
+fn extreme_counts_end_with_one_clear_line() {
+    let cases: [(&[&str], &str); 11] = [
+        (
+            &["--frames", "18446744073709551615"],
+            "--frames must be at most 1000000",
+        ),
+        (
+            &["--frames", "1000000000000"],
+            "--frames must be at most 1000000",
+        ),
+        (&["--frames", "1e12"], "invalid value '1e12' for '--frames"),
+        (&["--frames", "-5"], "-5"),
+        (&["--frames", "NaN"], "invalid value 'NaN' for '--frames"),
+        (
+            &["--frames", "18446744073709551616"],
+            "invalid value '18446744073709551616'",
+        ),
+        (
+            &["--threads", "18446744073709551615"],
+            "threads must be at most 256",
+        ),
+        (&["--threads", "257"], "threads must be at most 256"),
+        (
+            &["--iterations", "4294967295"],
+            "substeps x iterations must be at most 10000",
+        ),
+        (
+            &["--substeps", "4294967295"],
+            "substeps x iterations must be at most 10000",
+        ),
+        (&["--iterations", "-1"], "-1"),
+    ];
+    for (extra, expected) in cases {
+        let args = scene_with(extra);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        fails_with(&args, expected);
+    }
+}
+
+#[test]
+fn an_output_directory_that_cannot_be_made_is_named() {
+    fails_with(
+        &["reproduce", "--out", "/proc/vertebra-none/out"],
+        "cannot write the results: /proc/vertebra-none/out: ",
+    );
+}
+
+#[test]
+fn ragdoll_files_are_read_bounded_and_named_in_every_error() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-bounded-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let with_ragdoll = |path: &str| scene_with(&["--ragdoll", path]);
+    let run = |path: &str, expected: &str| {
+        let args = with_ragdoll(path);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        fails_with(&args, expected);
+    };
+    run(
+        "/dev/zero",
+        "/dev/zero: cannot read the ragdoll file: larger than 1048576 bytes",
+    );
+    let dir_name = dir.to_str().unwrap();
+    run(
+        dir_name,
+        &format!("{dir_name}: cannot read the ragdoll file"),
+    );
+    let binary = dir.join("binary.toml");
+    std::fs::write(&binary, [b'n', b'a', 0xff, 0xfe]).unwrap();
+    let binary = binary.to_str().unwrap();
+    run(
+        binary,
+        &format!("{binary}: cannot read the ragdoll file: not UTF-8 text (at byte 2)"),
+    );
+    let tiny = dir.join("tiny.toml");
+    let text = vertebra_ragdoll::REFERENCE_HUMANOID.replacen("radius = 0.10", "radius = 1e-30", 1);
+    std::fs::write(&tiny, &text).unwrap();
+    let line = text[..text.find("[[body]]\nname = \"hips\"").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
+    let tiny = tiny.to_str().unwrap();
+    run(
+        tiny,
+        &format!(
+            "{tiny}: line {line}: body `hips`: capsule radius (1e-3 to 1e3 m) is out of range"
+        ),
+    );
+}

@@ -11,7 +11,10 @@
 //!   rows: every backend gives the scalar reference's bits; finite, valid
 //!   input gives finite output.
 //! - [`world_api`]: arbitrary sequences of calls on a world with arbitrary
-//!   floats: no panic, a rejected call changes nothing, no non-finite state.
+//!   floats: no panic, a rejected call changes nothing, no non-finite state,
+//!   the step's NaN guard never needed.
+//! - [`world_settings`]: the same on a world with arbitrary solver
+//!   settings (speed limits up to their ceilings, gravity, push-out).
 //! - [`ragdoll_loader`]: arbitrary bytes as a ragdoll file: an error or a
 //!   ragdoll that builds, never a panic.
 //! - [`collisions`]: bodies, colliders and ragdolls added and removed, the
@@ -30,16 +33,17 @@ pub use collisions::collisions;
 pub use kernels::kernels;
 pub use loader::ragdoll_loader;
 pub use math::math_backends;
-pub use world::world_api;
+pub use world::{world_api, world_settings};
 
 /// A fuzz target's body: panics on a broken promise.
 pub type Target = fn(&[u8]);
 
 /// Every target, by its cargo-fuzz name.
-pub const TARGETS: [(&str, Target); 5] = [
+pub const TARGETS: [(&str, Target); 6] = [
     ("math_backends", math_backends),
     ("kernels", kernels),
     ("world_api", world_api),
+    ("world_settings", world_settings),
     ("ragdoll_loader", ragdoll_loader),
     ("collisions", collisions),
 ];

@@ -4,7 +4,8 @@ use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
 use vertebra_world::{SolverConfig, World};
 
 /// Arbitrary bytes (as UTF-8, lossily) through the TOML loader: an error,
-/// or a description that builds both ways and steps to a finite state.
+/// or a description that builds both ways and steps to a finite state
+/// without the step's NaN guard.
 pub fn ragdoll_loader(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let Ok(desc) = RagdollDesc::from_toml(&text) else {
@@ -34,5 +35,10 @@ pub fn ragdoll_loader(data: &[u8]) {
         for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
             assert!(store.is_finite(i), "a loaded ragdoll went non-finite");
         }
+        assert_eq!(
+            world.repaired_bodies(),
+            0,
+            "a loaded ragdoll tripped the NaN guard"
+        );
     }
 }

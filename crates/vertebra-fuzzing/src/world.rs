@@ -2,8 +2,9 @@
 
 use glam::Vec3;
 use vertebra_world::{
-    AngularDrive, BodyDesc, BodyHandle, Contact, Error, RodDesc, RodHandle, RodStiffness, Shape,
-    SocketDesc, SocketHandle, SolverConfig, World,
+    AngularDrive, BodyDesc, BodyHandle, Contact, Error, MAX_ANGULAR_SPEED_LIMIT,
+    MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle, RodStiffness, Shape, SocketDesc, SocketHandle,
+    SolverConfig, World,
 };
 
 use crate::input::Input;
@@ -155,7 +156,9 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
 /// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
 /// removed, poses, velocities and forces set, steps) with arbitrary floats
 /// one time in eight: no panic; every refused call leaves the world as it
-/// was; every body stays finite; no pending contact names a removed body.
+/// was; every body stays finite; no pending contact names a removed body;
+/// and the step's last-line NaN guard never fires (accepted input must
+/// never need it).
 pub fn world_api(data: &[u8]) {
     let mut input = Input::new(data);
     let config = SolverConfig {
@@ -163,14 +166,58 @@ pub fn world_api(data: &[u8]) {
         substeps: 1 + input.pick(3) as u32,
         ..SolverConfig::default()
     };
-    let mut world = World::new(config).expect("a valid config");
+    calls(World::new(config).expect("a valid config"), &mut input);
+}
+
+/// As [`world_api`], on a world with arbitrary settings: speed limits up
+/// to their ceilings (or wild), gravity and push-out speed arbitrary, now
+/// and then a count far out of range. A refused setting is an error, and
+/// every accepted one steps as [`world_api`] promises.
+pub fn world_settings(data: &[u8]) {
+    let mut input = Input::new(data);
+    let config = settings(&mut input);
+    match World::new(config) {
+        Ok(world) => calls(world, &mut input),
+        Err(error) => assert!(!error.to_string().is_empty()),
+    }
+}
+
+/// Solver settings from the input (one thread: thread counts do not change
+/// the bits, and pools are slow to start).
+fn settings(input: &mut Input) -> SolverConfig {
+    let count = |input: &mut Input| match input.pick(16) {
+        0 => u32::MAX - input.pick(4) as u32,
+        _ => 1 + input.pick(8) as u32,
+    };
+    let (substeps, iterations) = (count(input), count(input));
+    let speed = |input: &mut Input, ceiling: f32| match input.pick(4) {
+        0 => ceiling,
+        _ => input.float(ceiling).abs(),
+    };
+    SolverConfig {
+        substeps,
+        iterations,
+        max_linear_speed: speed(input, MAX_LINEAR_SPEED_LIMIT),
+        max_angular_speed: speed(input, MAX_ANGULAR_SPEED_LIMIT),
+        max_push_out_speed: match input.pick(4) {
+            0 => f32::INFINITY,
+            _ => input.float(10.0).abs(),
+        },
+        gravity: input.vec3(100.0),
+        parallel_min_blocks: 1 + input.pick(8),
+        ..SolverConfig::default()
+    }
+}
+
+/// Up to 64 calls on `world`, checking the promises after each.
+fn calls(mut world: World, input: &mut Input) {
     let mut seen = Seen::default();
     for _ in 0..64 {
         if input.is_empty() {
             break;
         }
         let before = fingerprint(&world);
-        let result = call(&mut world, &mut seen, &mut input);
+        let result = call(&mut world, &mut seen, input);
         if let Err(error) = result {
             assert!(!error.to_string().is_empty());
             assert_eq!(
@@ -190,6 +237,11 @@ pub fn world_api(data: &[u8]) {
                 .iter()
                 .all(|c| live(c.body_a) && live(c.body_b)),
             "a pending contact names a removed body"
+        );
+        assert_eq!(
+            world.repaired_bodies(),
+            0,
+            "accepted input tripped the step's NaN guard"
         );
     }
 }

@@ -5,9 +5,13 @@
 //! radians.
 
 use std::collections::HashMap;
+use std::io::Read;
+use std::path::Path;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use serde::Deserialize;
+use toml::Spanned;
+use vertebra_world::{Shape, check_coordinate};
 
 use crate::error::RagdollError;
 
@@ -15,15 +19,21 @@ use crate::error::RagdollError;
 /// a 4-body spine.
 pub const REFERENCE_HUMANOID: &str = include_str!("../models/humanoid.toml");
 
+/// The largest ragdoll file [`RagdollDesc::from_file`] reads (bytes): the
+/// reference humanoid is 5 KB and a body or joint about 150 bytes, so
+/// 1 MiB holds thousands; a larger file (or `/dev/zero`) is refused before
+/// it is read whole.
+pub const MAX_FILE_BYTES: u64 = 1 << 20;
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawFile {
     name: String,
     total_mass: Option<f32>,
-    body: Vec<RawBody>,
+    body: Vec<Spanned<RawBody>>,
     #[serde(default)]
-    joint: Vec<RawJoint>,
-    spine: Option<RawSpine>,
+    joint: Vec<Spanned<RawJoint>>,
+    spine: Option<Spanned<RawSpine>>,
 }
 
 #[derive(Deserialize)]
@@ -75,6 +85,16 @@ impl BodyDef {
     /// The centre of mass at bind pose (m, world).
     pub fn centre(&self) -> Vec3 {
         (self.segment[0] + self.segment[1]) * 0.5
+    }
+
+    /// The capsule in its body frame (centred on the centre of mass).
+    pub fn shape(&self) -> Shape {
+        let centre = self.centre();
+        Shape::capsule(
+            self.segment[0] - centre,
+            self.segment[1] - centre,
+            self.radius,
+        )
     }
 }
 
@@ -161,31 +181,68 @@ impl RagdollDesc {
         Self::from_toml(REFERENCE_HUMANOID).expect("the shipped reference humanoid is valid")
     }
 
-    /// Parses and validates a description.
+    /// Reads, parses and validates a description file of at most
+    /// [`MAX_FILE_BYTES`]; every error names the file (and the line, where
+    /// there is one).
+    pub fn from_file(path: &Path) -> Result<Self, RagdollError> {
+        let in_file = |error| RagdollError::File {
+            path: path.display().to_string(),
+            error: Box::new(error),
+        };
+        let unreadable = |reason: String| in_file(RagdollError::Unreadable(reason));
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|file| file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(|e| unreadable(e.to_string()))?;
+        if bytes.len() as u64 > MAX_FILE_BYTES {
+            return Err(unreadable(format!(
+                "larger than {MAX_FILE_BYTES} bytes; a ragdoll file is a few KB"
+            )));
+        }
+        let text = String::from_utf8(bytes).map_err(|e| {
+            unreadable(format!(
+                "not UTF-8 text (at byte {})",
+                e.utf8_error().valid_up_to()
+            ))
+        })?;
+        Self::from_toml(&text).map_err(in_file)
+    }
+
+    /// Parses and validates a description. Errors about a body, joint or
+    /// the spine start with the line where it is defined.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
-        let raw: RawFile = toml::from_str(text).map_err(|e| syntax(text, &e))?;
-        let bodies = raw.body.iter().map(body).collect::<Result<Vec<_>, _>>()?;
+        let lines = Lines::new(text);
+        let raw: RawFile = toml::from_str(text).map_err(|e| syntax(&lines, &e))?;
+        let at = |span: core::ops::Range<usize>| lines.at(span.start);
+        let bodies = raw
+            .body
+            .iter()
+            .map(|b| body(b.get_ref(), at(b.span())))
+            .collect::<Result<Vec<_>, _>>()?;
         let index = names(
-            &raw.body.iter().map(|b| b.name.as_str()).collect::<Vec<_>>(),
+            &raw.body
+                .iter()
+                .map(|b| (b.get_ref().name.as_str(), at(b.span())))
+                .collect::<Vec<_>>(),
             "body",
         )?;
         names(
             &raw.joint
                 .iter()
-                .map(|j| j.name.as_str())
+                .map(|j| (j.get_ref().name.as_str(), at(j.span())))
                 .collect::<Vec<_>>(),
             "joint",
         )?;
         let joints = raw
             .joint
             .iter()
-            .map(|j| joint(j, &index))
+            .map(|j| joint(j.get_ref(), at(j.span()), &index))
             .collect::<Result<Vec<_>, _>>()?;
         let (root, parent_joint) = tree(&bodies, &joints)?;
         let spine = raw
             .spine
             .as_ref()
-            .map(|s| spine(s, &index, &joints, &parent_joint))
+            .map(|s| spine(s.get_ref(), at(s.span()), &index, &joints, &parent_joint))
             .transpose()?;
         if let Some(total) = raw.total_mass {
             finite("ragdoll", "total_mass", &[total])?;
@@ -218,23 +275,40 @@ impl RagdollDesc {
     }
 }
 
+/// Where a text's lines end, to name the line of a byte offset.
+struct Lines(Vec<usize>);
+
+impl Lines {
+    fn new(text: &str) -> Self {
+        Self(text.match_indices('\n').map(|(at, _)| at).collect())
+    }
+
+    /// The line (from 1) of byte `offset`.
+    fn at(&self, offset: usize) -> usize {
+        self.0.partition_point(|&end| end < offset) + 1
+    }
+}
+
 /// A parse error on one line: where, and what (without the source excerpt).
-fn syntax(text: &str, e: &toml::de::Error) -> RagdollError {
+fn syntax(lines: &Lines, e: &toml::de::Error) -> RagdollError {
     let message = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
     match e.span() {
-        Some(span) => RagdollError::Syntax(format!(
-            "line {}: {message}",
-            text[..span.start.min(text.len())].lines().count().max(1)
-        )),
+        Some(span) => RagdollError::Syntax(format!("line {}: {message}", lines.at(span.start))),
         None => RagdollError::Syntax(message),
     }
 }
 
-fn names(names: &[&str], kind: &'static str) -> Result<HashMap<String, usize>, RagdollError> {
+/// Indexes `(name, line)` pairs by name; a name used twice is refused at
+/// its second line.
+fn names(
+    names: &[(&str, usize)],
+    kind: &'static str,
+) -> Result<HashMap<String, usize>, RagdollError> {
     let mut index = HashMap::new();
-    for (i, &n) in names.iter().enumerate() {
+    for (i, &(n, line)) in names.iter().enumerate() {
         if index.insert(n.to_owned(), i).is_some() {
             return Err(RagdollError::DuplicateName {
+                line,
                 kind,
                 name: n.to_owned(),
             });
@@ -243,23 +317,37 @@ fn names(names: &[&str], kind: &'static str) -> Result<HashMap<String, usize>, R
     Ok(index)
 }
 
-fn body(b: &RawBody) -> Result<BodyDef, RagdollError> {
-    let context = format!("body `{}`", b.name);
+/// A body's segment within the world's coordinate range, and a capsule the
+/// world accepts at its mass (size within `SIZE_RANGE`, mass within
+/// `MASS_RANGE`, invertible inertia), so building it cannot fail on them.
+fn body(b: &RawBody, line: usize) -> Result<BodyDef, RagdollError> {
+    let context = format!("line {line}: body `{}`", b.name);
     finite(&context, "segment", b.segment.as_flattened())?;
     finite(&context, "radius", &[b.radius])?;
     finite(&context, "mass", &[b.mass])?;
     range(&context, "mass", b.mass > 0.0, "must be positive")?;
     range(&context, "radius", b.radius > 0.0, "must be positive")?;
-    Ok(BodyDef {
+    let def = BodyDef {
         name: b.name.clone(),
         segment: b.segment.map(Vec3::from),
         radius: b.radius,
         mass: b.mass,
-    })
+    };
+    for end in def.segment {
+        check_coordinate("segment end", end).map_err(|e| RagdollError::world(&context, e))?;
+    }
+    def.shape()
+        .mass_properties_with_mass(def.mass)
+        .map_err(|e| RagdollError::world(&context, e))?;
+    Ok(def)
 }
 
-fn joint(j: &RawJoint, index: &HashMap<String, usize>) -> Result<JointDef, RagdollError> {
-    let context = format!("joint `{}`", j.name);
+fn joint(
+    j: &RawJoint,
+    line: usize,
+    index: &HashMap<String, usize>,
+) -> Result<JointDef, RagdollError> {
+    let context = format!("line {line}: joint `{}`", j.name);
     let lookup = |field: &'static str, name: &str| {
         index
             .get(name)
@@ -275,7 +363,11 @@ fn joint(j: &RawJoint, index: &HashMap<String, usize>) -> Result<JointDef, Ragdo
     finite(&context, "axis", &j.axis)?;
     finite(&context, "swing", &[j.swing])?;
     finite(&context, "twist", &j.twist)?;
-    let axis = Vec3::from(j.axis);
+    check_coordinate("anchor", Vec3::from(j.anchor))
+        .map_err(|e| RagdollError::world(&context, e))?;
+    // In f64: the length of [1e38, 1e38, 0] overflows f32, and the axis
+    // normalised in f32 became zero.
+    let axis = DVec3::from(j.axis.map(f64::from));
     if axis.length() <= 1e-6 {
         return Err(RagdollError::ZeroAxis {
             joint: j.name.clone(),
@@ -299,7 +391,7 @@ fn joint(j: &RawJoint, index: &HashMap<String, usize>) -> Result<JointDef, Ragdo
         parent,
         child,
         anchor: Vec3::from(j.anchor),
-        axis: axis.normalize(),
+        axis: axis.normalize().as_vec3(),
         swing: j.swing.to_radians(),
         twist: [lo.to_radians(), hi.to_radians()],
     })
@@ -359,11 +451,12 @@ fn tree(
 
 fn spine(
     s: &RawSpine,
+    line: usize,
     index: &HashMap<String, usize>,
     joints: &[JointDef],
     parent_joint: &[Option<usize>],
 ) -> Result<SpineDef, RagdollError> {
-    let context = "[spine]";
+    let context = &format!("line {line}: [spine]");
     let bodies = s
         .bodies
         .iter()

@@ -10,7 +10,7 @@ use vertebra_world::{AngularDrive, RodStiffness, World};
 
 use crate::error::RagdollError;
 use crate::pose::Pose;
-use crate::ragdoll::Ragdoll;
+use crate::ragdoll::{Ragdoll, rod_name};
 
 /// How hard a joint is driven.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,7 +104,9 @@ impl Ragdoll {
                 compliance,
                 damping: settings.damping,
             };
-            world.set_socket_drive(*socket, Some(drive))?;
+            world
+                .set_socket_drive(*socket, Some(drive))
+                .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
         }
         if let (Some(rod), Some(rest), Some(spine)) = (self.rod, self.rod_rest, &self.desc.spine) {
             let (base, top) = (
@@ -120,7 +122,9 @@ impl Ragdoll {
             let mut driven = rest.with_stiffness(stiffness, stiffness);
             driven.bend_rest = (f0.inverse() * tb).normalize();
             driven.twist_rest = crate::mapping::rod_twist(f0, f1);
-            world.set_rod(rod, driven)?;
+            world
+                .set_rod(rod, driven)
+                .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
         }
         Ok(())
     }
@@ -128,11 +132,17 @@ impl Ragdoll {
     /// Turns every drive off: sockets without drives, the rod back to its
     /// rest shape and passive stiffness.
     pub fn release_drives(&self, world: &mut World) -> Result<(), RagdollError> {
-        for socket in self.sockets.iter().flatten() {
-            world.set_socket_drive(*socket, None)?;
+        for (socket, j) in self.sockets.iter().zip(&self.desc.joints) {
+            if let Some(socket) = socket {
+                world
+                    .set_socket_drive(*socket, None)
+                    .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
+            }
         }
         if let (Some(rod), Some(rest)) = (self.rod, self.rod_rest) {
-            world.set_rod(rod, rest)?;
+            world
+                .set_rod(rod, rest)
+                .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
         }
         Ok(())
     }

@@ -9,8 +9,20 @@ pub enum RagdollError {
     /// Not TOML, a missing or mistyped field, or an unknown one (the
     /// parser's message names the line and the field).
     Syntax(String),
+    /// A ragdoll file that could not be read: missing, unreadable, larger
+    /// than `MAX_FILE_BYTES`, or not UTF-8 (the reason).
+    Unreadable(String),
+    /// An error in the ragdoll file at `path`.
+    File {
+        /// The file, as given.
+        path: String,
+        /// What is wrong with it.
+        error: Box<RagdollError>,
+    },
     /// A body or joint name used twice.
     DuplicateName {
+        /// The line of its second use.
+        line: usize,
         /// `body` or `joint`.
         kind: &'static str,
         /// The name.
@@ -55,8 +67,15 @@ pub enum RagdollError {
     /// A pose that does not fit the description (wrong bone count,
     /// non-finite or non-normalised transforms).
     BadPose(String),
-    /// The world refused a body or joint.
-    World(vertebra_world::Error),
+    /// The world refused a body or joint: which one (and which field,
+    /// where the world's error does not name it), and the world's reason.
+    World {
+        /// The item, e.g. `body `hips``; empty for a call that was not
+        /// about one item of a ragdoll.
+        context: String,
+        /// The world's error, which names the field.
+        error: vertebra_world::Error,
+    },
     /// A ragdoll that cannot be removed as it is (nothing was removed).
     NotRemovable {
         /// The item, e.g. `body `hips`` or `joint `knee_l``.
@@ -66,12 +85,24 @@ pub enum RagdollError {
     },
 }
 
+impl RagdollError {
+    /// The world's `error`, raised for the item `context`.
+    pub(crate) fn world(context: &str, error: vertebra_world::Error) -> Self {
+        RagdollError::World {
+            context: context.to_owned(),
+            error,
+        }
+    }
+}
+
 impl fmt::Display for RagdollError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             RagdollError::Syntax(m) => write!(f, "malformed ragdoll file: {m}"),
-            RagdollError::DuplicateName { kind, name } => {
-                write!(f, "{kind} name `{name}` is used twice")
+            RagdollError::Unreadable(why) => write!(f, "cannot read the ragdoll file: {why}"),
+            RagdollError::File { path, error } => write!(f, "{path}: {error}"),
+            RagdollError::DuplicateName { line, kind, name } => {
+                write!(f, "line {line}: {kind} name `{name}` is used twice")
             }
             RagdollError::UnknownBody {
                 context,
@@ -92,7 +123,8 @@ impl fmt::Display for RagdollError {
             RagdollError::NotATree(m) => write!(f, "the joints do not form a tree: {m}"),
             RagdollError::SpineNotChain(m) => write!(f, "[spine]: {m}"),
             RagdollError::BadPose(m) => write!(f, "bad pose: {m}"),
-            RagdollError::World(e) => write!(f, "{e}"),
+            RagdollError::World { context, error } if context.is_empty() => write!(f, "{error}"),
+            RagdollError::World { context, error } => write!(f, "{context}: {error}"),
             RagdollError::NotRemovable { item, reason } => {
                 write!(f, "the ragdoll cannot be removed: {item} {reason}")
             }
@@ -102,8 +134,10 @@ impl fmt::Display for RagdollError {
 
 impl std::error::Error for RagdollError {}
 
+/// A world error from a call about no one item of a ragdoll (creating a
+/// world, stepping it): the world's error alone.
 impl From<vertebra_world::Error> for RagdollError {
-    fn from(e: vertebra_world::Error) -> Self {
-        RagdollError::World(e)
+    fn from(error: vertebra_world::Error) -> Self {
+        RagdollError::world("", error)
     }
 }

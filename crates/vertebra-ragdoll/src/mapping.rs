@@ -16,7 +16,7 @@ use vertebra_world::World;
 
 use crate::error::RagdollError;
 use crate::pose::Pose;
-use crate::ragdoll::{Ragdoll, SpineMode};
+use crate::ragdoll::{Ragdoll, SpineMode, rod_name};
 
 /// How a simplified ragdoll's interior spine bones are placed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -40,9 +40,11 @@ impl Ragdoll {
         mapping: SpineMapping,
     ) -> Result<Pose, RagdollError> {
         let mut bones = vec![(Vec3::ZERO, Quat::IDENTITY); self.desc.bodies.len()];
-        for (bone, body) in bones.iter_mut().zip(&self.bodies) {
+        for ((bone, body), def) in bones.iter_mut().zip(&self.bodies).zip(&self.desc.bodies) {
             if let Some(h) = body {
-                let s = world.body(*h)?;
+                let s = world
+                    .body(*h)
+                    .map_err(|e| RagdollError::world(&format!("body `{}`", def.name), e))?;
                 *bone = (s.position, s.orientation);
             }
         }
@@ -62,7 +64,9 @@ impl Ragdoll {
                     mapping == SpineMapping::PositionOrientation,
                 ),
                 SpineMapping::Arc => {
-                    let rod = world.rod(self.rod.expect("a simplified ragdoll has its rod"))?;
+                    let rod = world
+                        .rod(self.rod.expect("a simplified ragdoll has its rod"))
+                        .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
                     on_arc(
                         &fractions,
                         bones[chain[0]],

@@ -4,6 +4,7 @@
 //! bind, where body axes are world axes).
 
 use glam::{Quat, Vec3};
+use vertebra_world::check_unit_quat;
 
 use crate::description::RagdollDesc;
 use crate::error::RagdollError;
@@ -41,7 +42,8 @@ impl Pose {
     /// Forward kinematics: the root bone at `root`, and each joint turning
     /// its child by `rotations[joint]` about the joint's anchor, relative to
     /// the parent (world frame at bind pose). Identity rotations give the
-    /// bind pose moved to `root`.
+    /// bind pose moved to `root`. The root's position must be finite and
+    /// every orientation and rotation a unit quaternion (within 1e-3).
     pub fn from_joint_rotations(
         desc: &RagdollDesc,
         root: (Vec3, Quat),
@@ -53,6 +55,11 @@ impl Pose {
                 rotations.len(),
                 desc.joints.len()
             )));
+        }
+        bone(&desc.bodies[desc.root].name, root)?;
+        for (j, &r) in desc.joints.iter().zip(rotations) {
+            check_unit_quat("rotation", r)
+                .map_err(|e| RagdollError::BadPose(format!("joint `{}`: {e}", j.name)))?;
         }
         let mut bones: Vec<Option<(Vec3, Quat)>> = vec![None; desc.bodies.len()];
         bones[desc.root] = Some(root);
@@ -83,20 +90,18 @@ impl Pose {
                 desc.bodies.len()
             )));
         }
-        for ((p, q), body) in self.bones.iter().zip(&desc.bodies) {
-            if !p.is_finite() || !q.is_finite() {
-                return Err(RagdollError::BadPose(format!(
-                    "bone `{}` is not finite",
-                    body.name
-                )));
-            }
-            if (q.length() - 1.0).abs() > 1e-3 {
-                return Err(RagdollError::BadPose(format!(
-                    "bone `{}`: orientation is not normalised",
-                    body.name
-                )));
-            }
+        for (&transform, body) in self.bones.iter().zip(&desc.bodies) {
+            bone(&body.name, transform)?;
         }
         Ok(())
     }
+}
+
+/// A bone's transform: a finite position and a unit orientation.
+fn bone(name: &str, (p, q): (Vec3, Quat)) -> Result<(), RagdollError> {
+    let bad = |e| RagdollError::BadPose(format!("bone `{name}`: {e}"));
+    if !p.is_finite() {
+        return Err(bad(vertebra_world::Error::NonFinite("position")));
+    }
+    check_unit_quat("orientation", q).map_err(bad)
 }

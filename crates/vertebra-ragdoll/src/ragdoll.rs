@@ -5,7 +5,8 @@ use std::collections::{HashMap, HashSet};
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, BodyHandle, RodDesc, RodHandle, RodStiffness, Shape, SocketDesc, SocketHandle, World,
+    BodyDesc, BodyHandle, MIN_TIME_STEP, MassProperties, RodDesc, RodHandle, RodStiffness, Shape,
+    SocketDesc, SocketHandle, World,
 };
 
 use crate::description::RagdollDesc;
@@ -29,8 +30,9 @@ pub struct BuildOptions {
     pub spine: SpineMode,
     /// Opt-in stabilisation (after Jolt's `Ragdoll::Stabilize`, which
     /// follows Strunk): the largest allowed mass ratio across a joint, and
-    /// between a body's largest and smallest principal inertia. `None`
-    /// keeps the file's masses.
+    /// between a body's largest and smallest principal inertia: finite and
+    /// at least 1 (a ratio below 1 is no ratio of heavier to lighter).
+    /// `None` keeps the file's masses.
     pub stabilise: Option<f32>,
 }
 
@@ -40,6 +42,18 @@ impl BuildOptions {
         Self {
             spine,
             stabilise: None,
+        }
+    }
+
+    /// Checks the stabilisation ratio.
+    pub fn validate(&self) -> Result<(), RagdollError> {
+        match self.stabilise {
+            Some(ratio) if !(ratio.is_finite() && ratio >= 1.0) => Err(RagdollError::OutOfRange {
+                context: "build options".to_owned(),
+                field: "stabilise",
+                reason: format!("is {ratio}; a largest mass ratio must be finite and at least 1"),
+            }),
+            _ => Ok(()),
         }
     }
 }
@@ -122,13 +136,16 @@ impl Ragdoll {
         pose: &Pose,
         previous: Option<(&Pose, f32)>,
     ) -> Result<Self, RagdollError> {
+        options.validate()?;
         pose.validate(desc)?;
         if let Some((p, dt)) = previous {
             p.validate(desc)?;
-            if !(dt.is_finite() && dt > 0.0) {
-                return Err(RagdollError::BadPose(
-                    "the time between the two poses must be positive".to_owned(),
-                ));
+            // Velocities are motion divided by dt, as in the step: below
+            // the world's shortest time step they overflow.
+            if !(dt.is_finite() && dt >= MIN_TIME_STEP) {
+                return Err(RagdollError::BadPose(format!(
+                    "the time between the two poses is {dt} s; it must be at least {MIN_TIME_STEP} s"
+                )));
             }
         }
         let mut ragdoll = Self {
@@ -164,24 +181,24 @@ impl Ragdoll {
             if masses[i] <= 0.0 {
                 continue; // an interior spine body of the simplified ragdoll
             }
-            let centre = b.centre();
-            let shape = Shape::capsule(b.segment[0] - centre, b.segment[1] - centre, b.radius);
-            let mut props = shape.mass_properties_with_mass(masses[i])?;
+            let in_body = |e| RagdollError::world(&format!("body `{}`", b.name), e);
+            let mut props = b
+                .shape()
+                .mass_properties_with_mass(masses[i])
+                .map_err(in_body)?;
             if let Some(ratio) = self.options.stabilise {
-                props.inertia = clamp_inertia(props.inertia, ratio);
+                props = MassProperties::new(props.mass, clamp_inertia(props.inertia, ratio))
+                    .map_err(in_body)?;
             }
             let (p, q) = pose.bones[i];
             let (v, w) = previous.map_or((Vec3::ZERO, Vec3::ZERO), |(prev, dt)| {
                 velocities(prev.bones[i], (p, q), dt)
             });
-            self.bodies[i] = Some(
-                world.add_body(
-                    BodyDesc::dynamic(props)
-                        .with_position(p)
-                        .with_orientation(q)
-                        .with_velocity(v, w),
-                )?,
-            );
+            let body = BodyDesc::dynamic(props)
+                .with_position(p)
+                .with_orientation(q)
+                .with_velocity(v, w);
+            self.bodies[i] = Some(world.add_body(body).map_err(in_body)?);
         }
         for (k, j) in desc.joints.iter().enumerate() {
             if removed_joint(k) {
@@ -205,10 +222,15 @@ impl Ragdoll {
                 twist_limit: Some(j.twist),
                 drive: None,
             };
-            self.sockets[k] = Some(world.add_socket(socket)?);
+            self.sockets[k] = Some(
+                world
+                    .add_socket(socket)
+                    .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?,
+            );
         }
         if let (SpineMode::Rod, Some(spine)) = (self.options.spine, &desc.spine) {
             let (first, last) = (spine.bodies[0], *spine.bodies.last().expect("a chain"));
+            let in_rod = |e| RagdollError::world(&rod_name(desc), e);
             let bones: Vec<Vec3> = spine.bodies[1..spine.bodies.len() - 1]
                 .iter()
                 .map(|&b| pose.bones[b].0)
@@ -218,14 +240,15 @@ impl Ragdoll {
                 self.bodies[first].expect("built"),
                 self.bodies[last].expect("built"),
                 &bones,
-            )?
+            )
+            .map_err(in_rod)?
             .with_stiffness(
                 RodStiffness::Kirchhoff(spine.bend_stiffness),
                 RodStiffness::Kirchhoff(spine.twist_stiffness),
             )
             .with_bend_limit(spine.bend_limit)
             .with_twist_limit(spine.twist_limit[0], spine.twist_limit[1]);
-            self.rod = Some(world.add_rod(rod)?);
+            self.rod = Some(world.add_rod(rod).map_err(in_rod)?);
             self.rod_rest = Some(rod);
         }
         Ok(())
@@ -243,13 +266,23 @@ impl Ragdoll {
     pub fn remove(&mut self, world: &mut World) -> Result<(), RagdollError> {
         self.check_removable(world)?;
         if let Some(rod) = self.rod.take() {
-            world.remove_rod(rod)?;
+            world
+                .remove_rod(rod)
+                .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
         }
-        for socket in self.sockets.iter_mut().filter_map(Option::take) {
-            world.remove_socket(socket)?;
+        for (socket, j) in self.sockets.iter_mut().zip(&self.desc.joints) {
+            if let Some(socket) = socket.take() {
+                world
+                    .remove_socket(socket)
+                    .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
+            }
         }
-        for body in self.bodies.iter_mut().filter_map(Option::take) {
-            world.remove_body(body)?;
+        for (body, b) in self.bodies.iter_mut().zip(&self.desc.bodies) {
+            if let Some(body) = body.take() {
+                world
+                    .remove_body(body)
+                    .map_err(|e| RagdollError::world(&format!("body `{}`", b.name), e))?;
+            }
         }
         Ok(())
     }
@@ -337,19 +370,7 @@ impl Ragdoll {
             .bodies
             .iter()
             .zip(&self.bodies)
-            .filter_map(|(def, body)| {
-                let centre = def.centre();
-                body.map(|b| {
-                    (
-                        b,
-                        Shape::capsule(
-                            def.segment[0] - centre,
-                            def.segment[1] - centre,
-                            def.radius,
-                        ),
-                    )
-                })
-            })
+            .filter_map(|(def, body)| body.map(|b| (b, def.shape())))
             .collect()
     }
 
@@ -373,6 +394,18 @@ impl Ragdoll {
             pairs.push((rest.body_a, rest.body_b));
         }
         pairs
+    }
+}
+
+/// How errors name a simplified ragdoll's spine rod: by its end bodies.
+pub(crate) fn rod_name(desc: &RagdollDesc) -> String {
+    match &desc.spine {
+        Some(spine) => format!(
+            "spine rod `{}`-`{}`",
+            desc.bodies[spine.bodies[0]].name,
+            desc.bodies[*spine.bodies.last().expect("a chain")].name
+        ),
+        None => "spine rod".to_owned(),
     }
 }
 

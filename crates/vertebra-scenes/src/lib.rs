@@ -8,5 +8,5 @@ mod run;
 mod setup;
 
 pub use kinematics::{Locus, kinematics};
-pub use run::{Frame, SceneRun, run};
+pub use run::{Frame, MAX_FRAMES, SceneRun, run};
 pub use setup::{Scene, SceneConfig, SceneWorld, build, ragdoll_drop};

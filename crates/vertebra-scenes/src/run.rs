@@ -7,6 +7,13 @@ use vertebra_ragdoll::{Pose, RagdollError, SpineMapping};
 
 use crate::setup::{Scene, SceneConfig, build};
 
+/// The most frames a run takes: 4.6 hours at 60 Hz. A run keeps a record
+/// per frame (16 bytes), reserved up front from the count, so the bound
+/// keeps it (and the CLI's JSON, about 60 bytes a frame) under 100 MB;
+/// without it a count near `usize::MAX` overflowed the reservation and
+/// 1e12 frames aborted allocating 16 TB.
+pub const MAX_FRAMES: usize = 1_000_000;
+
 /// What one frame measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Frame {
@@ -42,13 +49,21 @@ pub struct SceneRun {
     pub final_positions: Vec<(usize, glam::Vec3)>,
 }
 
-/// Runs `config`, calling `progress(frame, frames)` after each frame.
+/// Runs `config` (1 to [`MAX_FRAMES`] frames), calling
+/// `progress(frame, frames)` after each frame.
 pub fn run(
     config: &SceneConfig,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<SceneRun, RagdollError> {
-    let mut built = build(config)?;
     let frames = config.frames.unwrap_or(config.scene.default_frames());
+    if !(1..=MAX_FRAMES).contains(&frames) {
+        return Err(RagdollError::OutOfRange {
+            context: "scene".to_owned(),
+            field: "frames",
+            reason: format!("is {frames}; must be 1 to {MAX_FRAMES}"),
+        });
+    }
+    let mut built = build(config)?;
     let dt = 1.0 / 60.0;
     let mut out = Vec::with_capacity(frames);
     let mut snapshots = Vec::new();

@@ -16,5 +16,5 @@ pub use error::{
     check_point, check_positive, check_unit_quat, check_unit_vec,
 };
 pub use handle::{Handle, Slots};
-pub use shape::{MASS_RANGE, MassProperties, Shape};
+pub use shape::{MASS_RANGE, MassProperties, SIZE_RANGE, Shape};
 pub use store::{BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore};

@@ -50,7 +50,8 @@ impl Shape {
         }
     }
 
-    /// Checks that the shape has finite, positive size.
+    /// Checks that the shape has finite, positive size (what a collider
+    /// needs; mass properties need [`SIZE_RANGE`] too).
     pub fn validate(&self) -> Result<(), Error> {
         match *self {
             Shape::Sphere { radius } => positive_size("sphere radius", radius),
@@ -72,6 +73,31 @@ impl Shape {
         }
     }
 
+    /// Checks a valid shape's dimensions (radius, half extents) lie in
+    /// [`SIZE_RANGE`], and a capsule's half segment is at most its end.
+    fn check_size_range(&self) -> Result<(), Error> {
+        let (dimensions, what) = match *self {
+            Shape::Sphere { radius } => ([radius; 3], "sphere radius (1e-3 to 1e3 m)"),
+            Shape::Box { half_extents } => {
+                (half_extents.to_array(), "box half extents (1e-3 to 1e3 m)")
+            }
+            Shape::Capsule {
+                half_segment,
+                radius,
+            } => {
+                if half_segment.length() > *SIZE_RANGE.end() {
+                    return Err(Error::OutOfRange("capsule half segment (at most 1e3 m)"));
+                }
+                ([radius; 3], "capsule radius (1e-3 to 1e3 m)")
+            }
+        };
+        if dimensions.iter().all(|d| SIZE_RANGE.contains(d)) {
+            Ok(())
+        } else {
+            Err(Error::OutOfRange(what))
+        }
+    }
+
     /// Volume (m^3).
     pub fn volume(&self) -> f32 {
         match *self {
@@ -87,19 +113,34 @@ impl Shape {
         }
     }
 
-    /// Mass properties at uniform `density` (kg/m^3).
+    /// Mass properties at uniform `density` (kg/m^3): dimensions within
+    /// [`SIZE_RANGE`], the result checked as
+    /// [`MassProperties::validate`] checks them: the mass (density times
+    /// volume) within [`MASS_RANGE`], the inertia invertible.
     pub fn mass_properties(&self, density: f32) -> Result<MassProperties, Error> {
         self.validate()?;
+        self.check_size_range()?;
         check_positive("density", density)?;
-        Ok(self.unit_density_properties().scaled(density))
+        let unit = self.unit_density_properties();
+        // In f64: density times volume may overflow f32.
+        let mass = f64::from(density) * f64::from(unit.mass);
+        if !(f64::from(*MASS_RANGE.start())..=f64::from(*MASS_RANGE.end())).contains(&mass) {
+            return Err(Error::OutOfRange(
+                "mass (density x volume, 1e-6 to 1e12 kg)",
+            ));
+        }
+        unit.scaled(density).checked()
     }
 
-    /// Mass properties of a uniform solid of total `mass` (kg).
+    /// Mass properties of a uniform solid of total `mass` (kg): dimensions
+    /// within [`SIZE_RANGE`], the result checked as
+    /// [`MassProperties::validate`] checks them.
     pub fn mass_properties_with_mass(&self, mass: f32) -> Result<MassProperties, Error> {
         self.validate()?;
-        check_positive("mass", mass)?;
+        self.check_size_range()?;
+        check_mass(mass)?;
         let unit = self.unit_density_properties();
-        Ok(unit.scaled(mass / unit.mass))
+        unit.scaled(mass / unit.mass).checked()
     }
 
     fn unit_density_properties(&self) -> MassProperties {
@@ -155,6 +196,24 @@ fn positive_size(what: &'static str, x: f32) -> Result<(), Error> {
     }
 }
 
+/// The dimensions a shape may have (m): radii, half extents and half
+/// segment lengths, a millimetre to a kilometre. Over this range a unit
+/// density's volume (about `s^3`) and inertia (about `s^5`) stay normal
+/// `f32` numbers (1e-15 to 1e16), so the scale from them to any mass in
+/// [`MASS_RANGE`] is finite and non-zero. A capsule radius of 1e-30 m had
+/// a volume of zero and a mass of NaN; at 1e6 m coordinates an `f32`
+/// resolves 6 cm, so nothing below a millimetre could be placed anyway.
+pub const SIZE_RANGE: core::ops::RangeInclusive<f32> = 1.0e-3..=1.0e3;
+
+/// A finite mass within [`MASS_RANGE`].
+fn check_mass(mass: f32) -> Result<(), Error> {
+    check_positive("mass", mass)?;
+    if !MASS_RANGE.contains(&mass) {
+        return Err(Error::OutOfRange("mass (1e-6 to 1e12 kg)"));
+    }
+    Ok(())
+}
+
 /// The masses a body may have (kg): a milligram to a mountain.
 pub const MASS_RANGE: core::ops::RangeInclusive<f32> = 1.0e-6..=1.0e12;
 
@@ -171,10 +230,7 @@ impl MassProperties {
     /// whose inverse is finite in `f32` (the solver works with inverses: a
     /// 1e24 kg m^2 tensor's determinant overflows, and its inverse is NaN).
     pub fn validate(&self) -> Result<(), Error> {
-        check_positive("mass", self.mass)?;
-        if !MASS_RANGE.contains(&self.mass) {
-            return Err(Error::OutOfRange("mass (1e-6 to 1e12 kg)"));
-        }
+        check_mass(self.mass)?;
         let m = self.inertia;
         if !m.to_cols_array().iter().all(|x| x.is_finite()) {
             return Err(Error::NonFinite("inertia"));
@@ -192,6 +248,12 @@ impl MassProperties {
             return Err(Error::OutOfRange("inertia (its inverse overflows)"));
         }
         Ok(())
+    }
+
+    /// `Ok(self)` if it passes [`MassProperties::validate`].
+    fn checked(self) -> Result<Self, Error> {
+        self.validate()?;
+        Ok(self)
     }
 
     fn scaled(self, factor: f32) -> Self {

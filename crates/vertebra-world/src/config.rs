@@ -2,19 +2,50 @@
 
 use glam::Vec3;
 use vertebra_math::BackendChoice;
-use vertebra_store::{Error, check_finite};
+use vertebra_store::{Error, MAX_COORDINATE, MAX_TIME_STEP, check_finite};
+
+/// The most position sweeps (`substeps * iterations`) one step may take.
+/// A sweep of the 30-ragdoll drop takes about 66 us on one core, so a step
+/// at the bound takes under a second there (and about 6 s for 300
+/// ragdolls): bounded, where `u32::MAX` iterations never returned. It is
+/// 500 times the paper's 20 and leaves room for both styles: many
+/// iterations (100 x 100) or many substeps of one iteration each
+/// (Macklin et al.'s "small steps": 10,000 x 1).
+pub const MAX_SOLVER_SWEEPS: u32 = 10_000;
+
+/// The most worker threads a world starts: rayon starts every worker up
+/// front, and more workers than cores only contend; 256 is above the core
+/// count of any machine a game runs on.
+pub const MAX_THREADS: usize = 256;
+
+/// The highest `max_linear_speed` (m/s) a world accepts: in one step of at
+/// most [`MAX_TIME_STEP`] a body then moves at most [`MAX_COORDINATE`], so
+/// a body in range ends a step within twice the range, and positions stay
+/// 32 orders of magnitude below `f32` overflow for any game's lifetime
+/// (`f32::MAX` was accepted, and bodies reached 3e38 m).
+pub const MAX_LINEAR_SPEED_LIMIT: f32 = MAX_COORDINATE / MAX_TIME_STEP;
+
+/// The highest `max_angular_speed` (rad/s) a world accepts: `|w|^2` (1e12)
+/// is far from overflow, and so is the gyroscopic term `w x (I w)` for any
+/// inertia whose inverse exists in `f32` (below about 7e12 kg m^2 per
+/// axis). A substep of the shortest length (1e-6 s) turns a body by at
+/// most 1 rad.
+pub const MAX_ANGULAR_SPEED_LIMIT: f32 = 1.0e6;
 
 /// How the world steps. Games use a fixed iteration count; so does the
 /// paper (20 iterations, 1 substep).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverConfig {
-    /// Substeps per step (>= 1): each integrates `dt / substeps`.
+    /// Substeps per step (>= 1): each integrates `dt / substeps`. With
+    /// `iterations`, at most [`MAX_SOLVER_SWEEPS`] sweeps a step.
     pub substeps: u32,
-    /// Position iterations per substep (>= 1).
+    /// Position iterations per substep (>= 1). With `substeps`, at most
+    /// [`MAX_SOLVER_SWEEPS`] sweeps a step.
     pub iterations: u32,
     /// Instruction set for the kernels.
     pub backend: BackendChoice,
-    /// Worker threads (>= 1); 1 solves on the calling thread.
+    /// Worker threads (1 to [`MAX_THREADS`]); 1 solves on the calling
+    /// thread.
     pub threads: usize,
     /// Gravity (m/s^2, world).
     pub gravity: Vec3,
@@ -31,9 +62,11 @@ pub struct SolverConfig {
     /// 3 m/s). A game that teleports bodies sets it (Box2D uses 3 m/s).
     pub max_push_out_speed: f32,
     /// Bodies never move faster than this (m/s): velocities are clamped
-    /// before each substep moves them (Jolt clamps at 500 m/s too).
+    /// before each substep moves them (Jolt clamps at 500 m/s too). At most
+    /// [`MAX_LINEAR_SPEED_LIMIT`].
     pub max_linear_speed: f32,
-    /// Bodies never spin faster than this (rad/s): 50 turns a second.
+    /// Bodies never spin faster than this (rad/s): 50 turns a second by
+    /// default, at most [`MAX_ANGULAR_SPEED_LIMIT`].
     pub max_angular_speed: f32,
 }
 
@@ -62,8 +95,16 @@ impl SolverConfig {
         if self.iterations == 0 {
             return Err(Error::InvalidConfig("iterations must be at least 1"));
         }
+        if u64::from(self.substeps) * u64::from(self.iterations) > u64::from(MAX_SOLVER_SWEEPS) {
+            return Err(Error::InvalidConfig(
+                "substeps x iterations must be at most 10000",
+            ));
+        }
         if self.threads == 0 {
             return Err(Error::InvalidConfig("threads must be at least 1"));
+        }
+        if self.threads > MAX_THREADS {
+            return Err(Error::InvalidConfig("threads must be at most 256"));
         }
         if self.parallel_min_blocks == 0 {
             return Err(Error::InvalidConfig(
@@ -75,17 +116,19 @@ impl SolverConfig {
                 "max_push_out_speed must be zero or positive",
             ));
         }
-        for (speed, what) in [
+        for (speed, ceiling, what) in [
             (
                 self.max_linear_speed,
-                "max_linear_speed must be positive and finite",
+                MAX_LINEAR_SPEED_LIMIT,
+                "max_linear_speed must be positive and at most 1e6 m/s",
             ),
             (
                 self.max_angular_speed,
-                "max_angular_speed must be positive and finite",
+                MAX_ANGULAR_SPEED_LIMIT,
+                "max_angular_speed must be positive and at most 1e6 rad/s",
             ),
         ] {
-            if !(speed.is_finite() && speed > 0.0) {
+            if !(speed > 0.0 && speed <= ceiling) {
                 return Err(Error::InvalidConfig(what));
             }
         }

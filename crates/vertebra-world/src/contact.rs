@@ -22,7 +22,10 @@ pub struct Contact {
     pub point: Vec3,
     /// The normal from a to b (unit, world).
     pub normal: Vec3,
-    /// Penetration depth along the normal (m); negative for a gap.
+    /// Penetration depth along the normal (m); negative for a gap. At most
+    /// [`MAX_COORDINATE`](vertebra_store::MAX_COORDINATE) either way: no
+    /// overlap of bodies in range is deeper, and a depth of 1e30 m threw a
+    /// body out to 3.7e30 m.
     pub depth: f32,
     /// Friction coefficient (static and dynamic), >= 0.
     pub friction: f32,
@@ -40,6 +43,9 @@ impl Contact {
         check_unit_vec("contact normal", self.normal)?;
         if !self.depth.is_finite() {
             return Err(Error::NonFinite("contact depth"));
+        }
+        if self.depth.abs() > vertebra_store::MAX_COORDINATE {
+            return Err(Error::OutOfRange("contact depth (at most 1e6 m)"));
         }
         if !self.friction.is_finite() {
             return Err(Error::NonFinite("contact friction"));

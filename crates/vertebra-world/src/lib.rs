@@ -38,16 +38,19 @@ use vertebra_math::Backend;
 use vertebra_scheduler::Colouring;
 use vertebra_store::Slots;
 
-pub use config::SolverConfig;
+pub use config::{
+    MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
+};
 pub use contact::Contact;
 pub use metrics::{JointResidual, Residuals};
-pub use rod::{RodDesc, RodHandle, RodStiffness, arc_tangent};
+pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use snapshot::Snapshot;
 pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
-    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, Shape, check_positive, check_unit_vec,
+    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, SIZE_RANGE, Shape, check_coordinate,
+    check_positive, check_unit_quat, check_unit_vec,
 };
 
 /// Bodies, joints and the solver that steps them.

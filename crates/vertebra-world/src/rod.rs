@@ -6,8 +6,17 @@ use core::f32::consts::PI;
 use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
 use vertebra_store::{
-    BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
+    BodyHandle, BodyStore, Error, Handle, MAX_COORDINATE, check_coordinate, check_unit_quat,
+    check_unit_vec,
 };
+
+/// The longest rest length (m) a rod may have: two bodies within
+/// [`MAX_COORDINATE`] of the origin on every axis are at most
+/// `2 sqrt(3) MAX_COORDINATE` apart, and an arc over that chord bent by
+/// nearly pi is pi/2 longer (5.44e6 m). A longer rest length is no rod any
+/// body pair can hold: its length constraint throws the bodies apart (at
+/// 1e30 m the last-line NaN guard fired every substep).
+pub const MAX_ROD_LENGTH: f32 = 6.0 * MAX_COORDINATE;
 
 /// Marker for rod handles.
 #[derive(Debug)]
@@ -45,7 +54,7 @@ pub struct RodDesc {
     pub frame_a: Quat,
     /// Material frame at b, in b's body frame.
     pub frame_b: Quat,
-    /// Rest length `l0` of the arc (m).
+    /// Rest length `l0` of the arc (m, positive, at most [`MAX_ROD_LENGTH`]).
     pub rest_length: f32,
     /// Rest direction of `t_b` in a's material frame (unit; `+X` is
     /// straight). Its angle from `+X` is the rest bend, its direction the
@@ -156,6 +165,9 @@ impl RodDesc {
         check_unit_quat("rod frame b", self.frame_b)?;
         check_unit_vec("rod rest bend", self.bend_rest)?;
         vertebra_store::check_positive("rod rest length", self.rest_length)?;
+        if self.rest_length > MAX_ROD_LENGTH {
+            return Err(Error::OutOfRange("rod rest length (at most 6e6 m)"));
+        }
         if !self.twist_rest.is_finite() {
             return Err(Error::NonFinite("rod rest twist"));
         }

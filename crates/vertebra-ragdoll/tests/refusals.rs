@@ -1,0 +1,221 @@
+//! Values a ragdoll accepts give a finite ragdoll; values it cannot use are
+//! refused with the item (line, body, joint, option) and field named
+//! (issue 13, classes 5 and 6).
+
+use glam::{Quat, Vec3};
+use vertebra_ragdoll::{
+    BuildOptions, Pose, REFERENCE_HUMANOID, Ragdoll, RagdollDesc, RagdollError, SpineMode,
+};
+use vertebra_world::{SolverConfig, World};
+
+/// The reference file with `from` replaced by `to` (which must occur).
+fn edited(from: &str, to: &str) -> String {
+    assert!(REFERENCE_HUMANOID.contains(from), "the file has `{from}`");
+    REFERENCE_HUMANOID.replacen(from, to, 1)
+}
+
+/// The line (from 1) of the first `needle` in the reference file.
+fn line_of(needle: &str) -> usize {
+    let at = REFERENCE_HUMANOID.find(needle).expect("in the file");
+    REFERENCE_HUMANOID[..at].matches('\n').count() + 1
+}
+
+fn build(
+    desc: &RagdollDesc,
+    options: BuildOptions,
+    pose: &Pose,
+) -> (World, Result<Ragdoll, RagdollError>) {
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let built = Ragdoll::build(&mut world, desc, options, pose, None);
+    (world, built)
+}
+
+#[test]
+fn stabilisation_ratios_that_are_no_ratio_are_refused() {
+    let desc = RagdollDesc::reference_humanoid();
+    for ratio in [1e-8, 0.0, f32::NAN, -1.0, 0.5, f32::INFINITY] {
+        for spine in [SpineMode::Rod, SpineMode::Sockets] {
+            let options = BuildOptions {
+                spine,
+                stabilise: Some(ratio),
+            };
+            let (world, built) = build(&desc, options, &Pose::bind(&desc));
+            let message = built.expect_err("refused").to_string();
+            assert!(
+                message.starts_with("build options: stabilise is"),
+                "{ratio}: {message}"
+            );
+            assert_eq!(world.bodies().len(), 0);
+        }
+    }
+    // The tightest ratio builds and steps finite.
+    let options = BuildOptions {
+        spine: SpineMode::Rod,
+        stabilise: Some(1.0),
+    };
+    let (mut world, built) = build(&desc, options, &Pose::bind(&desc));
+    built.unwrap();
+    for _ in 0..60 {
+        world.step(1.0 / 60.0).unwrap();
+    }
+    assert_eq!(world.repaired_bodies(), 0);
+}
+
+#[test]
+fn an_axis_whose_length_overflows_keeps_its_direction() {
+    let text = edited(
+        "anchor = [0.10, 0.525, 0.0]\naxis = [0.0, -1.0, 0.0]",
+        "anchor = [0.10, 0.525, 0.0]\naxis = [1e38, 1e38, 0.0]",
+    );
+    let desc = RagdollDesc::from_toml(&text).unwrap();
+    let knee = desc.joints.iter().find(|j| j.name == "knee_l").unwrap();
+    let expected = Vec3::new(1.0, 1.0, 0.0).normalize();
+    assert!((knee.axis - expected).length() < 1e-6, "{}", knee.axis);
+}
+
+#[test]
+fn zero_or_non_finite_joint_rotations_are_refused() {
+    let desc = RagdollDesc::reference_humanoid();
+    let root = (Vec3::new(0.0, 1.0, 0.0), Quat::IDENTITY);
+    let mut rotations = vec![Quat::IDENTITY; desc.joints.len()];
+    let knee = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
+    for bad in [
+        Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+        Quat::from_xyzw(0.0, 0.0, 0.0, f32::NAN),
+        Quat::from_xyzw(0.0, 0.0, 0.0, 3.0),
+    ] {
+        rotations[knee] = bad;
+        let error = Pose::from_joint_rotations(&desc, root, &rotations).expect_err("refused");
+        assert!(
+            error
+                .to_string()
+                .contains("joint `knee_l`: rotation is not"),
+            "{error}"
+        );
+    }
+    rotations[knee] = Quat::IDENTITY;
+    let error = Pose::from_joint_rotations(&desc, (Vec3::NAN, Quat::IDENTITY), &rotations)
+        .expect_err("refused");
+    assert_eq!(
+        error.to_string(),
+        "bad pose: bone `hips`: position is not finite"
+    );
+    let error = Pose::from_joint_rotations(
+        &desc,
+        (Vec3::ZERO, Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)),
+        &rotations,
+    )
+    .expect_err("refused");
+    assert_eq!(
+        error.to_string(),
+        "bad pose: bone `hips`: orientation is not normalised"
+    );
+}
+
+#[test]
+fn loader_errors_name_the_line_the_item_and_the_field() {
+    let hips = line_of("[[body]]\nname = \"hips\"");
+    let knee = line_of("[[joint]]\nname = \"knee_l\"");
+    let cases = [
+        (
+            edited("radius = 0.10\nmass = 11.0", "radius = 1e-30\nmass = 11.0"),
+            format!("line {hips}: body `hips`: capsule radius (1e-3 to 1e3 m) is out of range"),
+        ),
+        (
+            edited("mass = 11.0", "mass = 1e30"),
+            format!("line {hips}: body `hips`: mass (1e-6 to 1e12 kg) is out of range"),
+        ),
+        (
+            edited(
+                "segment = [[-0.06, 1.00, 0.0]",
+                "segment = [[-1e30, 1.00, 0.0]",
+            ),
+            format!("line {hips}: body `hips`: segment end is out of range"),
+        ),
+        (
+            edited("mass = 11.0", "mass = nan"),
+            format!("line {hips}: body `hips`: mass is not finite"),
+        ),
+        (
+            edited("anchor = [0.10, 0.525, 0.0]", "anchor = [0.10, 1e30, 0.0]"),
+            format!("line {knee}: joint `knee_l`: anchor is out of range"),
+        ),
+        (
+            edited(
+                "swing = 70.0\ntwist = [-5.0, 5.0]",
+                "swing = 270.0\ntwist = [-5.0, 5.0]",
+            ),
+            format!("line {knee}: joint `knee_l`: swing must be in [0, 180] degrees"),
+        ),
+        (
+            edited("name = \"knee_r\"", "name = \"knee_l\""),
+            format!(
+                "line {}: joint name `knee_l` is used twice",
+                line_of("[[joint]]\nname = \"knee_r\"")
+            ),
+        ),
+        (
+            edited("bend_limit = 60.0", "bend_limit = -1.0"),
+            format!(
+                "line {}: [spine]: bend_limit must be in [0, 180] degrees",
+                line_of("\n[spine]") + 1
+            ),
+        ),
+    ];
+    for (text, expected) in cases {
+        let error = RagdollDesc::from_toml(&text).expect_err("refused");
+        assert_eq!(error.to_string(), expected);
+    }
+}
+
+#[test]
+fn build_errors_name_the_body_or_the_rod() {
+    let desc = RagdollDesc::reference_humanoid();
+    let far = Pose::bind(&desc).moved(Vec3::ZERO, Quat::IDENTITY, Vec3::new(2e6, 0.0, 0.0));
+    let (world, built) = build(&desc, BuildOptions::new(SpineMode::Sockets), &far);
+    assert_eq!(
+        built.expect_err("refused").to_string(),
+        "body `hips`: position is out of range"
+    );
+    assert_eq!(world.bodies().len(), 0);
+    // Spine bones folded back below the hips bend the rod's arc by more
+    // than pi.
+    let mut folded = Pose::bind(&desc);
+    let spine = desc.spine.as_ref().unwrap();
+    let (hips, chest) = (
+        folded.bones[spine.bodies[0]].0,
+        folded.bones[*spine.bodies.last().unwrap()].0,
+    );
+    for &b in &spine.bodies[1..spine.bodies.len() - 1] {
+        folded.bones[b].0 = hips + (hips - chest) + Vec3::new(0.05, 0.0, 0.0);
+    }
+    let (world, built) = build(&desc, BuildOptions::new(SpineMode::Rod), &folded);
+    let message = built.expect_err("refused").to_string();
+    assert!(
+        message.starts_with("spine rod `hips`-`chest`: "),
+        "{message}"
+    );
+    assert_eq!(world.bodies().len(), 0);
+}
+
+/// Velocities from two poses are motion over the time between them: a
+/// subnormal time made them infinite (the world then refused a body's
+/// velocity, naming nothing about the time), or 1e38 m/s.
+#[test]
+fn the_time_between_two_poses_is_at_least_the_shortest_step() {
+    let desc = RagdollDesc::reference_humanoid();
+    let previous = Pose::bind(&desc);
+    let current = previous.moved(Vec3::ZERO, Quat::IDENTITY, Vec3::new(0.0, 0.0, 0.01));
+    for dt in [1e-40, 1e-7, 0.0, -1.0, f32::NAN] {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let options = BuildOptions::new(SpineMode::Rod);
+        let built = Ragdoll::build(&mut world, &desc, options, &current, Some((&previous, dt)));
+        let message = built.expect_err("refused").to_string();
+        assert!(
+            message.starts_with("bad pose: the time between the two poses is")
+                && message.ends_with("it must be at least 0.000001 s"),
+            "{dt}: {message}"
+        );
+        assert_eq!(world.bodies().len(), 0);
+    }
+}
