@@ -433,6 +433,9 @@ impl World {
             ));
         }
         self.refresh_layout();
+        let (max_linear, max_angular) =
+            (self.config.max_linear_speed, self.config.max_angular_speed);
+        step::hold_speeds(&mut self.bodies, max_linear, max_angular);
         let max_depth = self.config.max_push_out_speed * dt;
         self.contact_layout =
             contact::ContactLayout::build(&self.contacts, &self.bodies, max_depth);

@@ -133,6 +133,19 @@ fn predict(world: &mut World, h: f32) {
     }
 }
 
+/// Holds every moving body's velocities to the speed limits, as the step
+/// begins: the contacts measure their approach speed from them before any
+/// substep has held them (an accepted spin of 1e38 rad/s overflowed
+/// `w x r` there and turned both bodies NaN).
+pub(crate) fn hold_speeds(b: &mut BodyStore, max_linear: f32, max_angular: f32) {
+    for i in 0..b.capacity() {
+        if b.is_live(i) && b.kind[i] != BodyKind::Static {
+            b.linear_velocity[i] = limit(b.linear_velocity[i], max_linear);
+            b.angular_velocity[i] = limit(b.angular_velocity[i], max_angular);
+        }
+    }
+}
+
 /// `v` shortened to at most `max` (`v` itself when it is no longer), and
 /// finite even when a component overflowed to infinity.
 fn limit(v: Vec3, max: f32) -> Vec3 {
@@ -341,12 +354,16 @@ fn solve_positions(world: &mut World, h: f32) {
 fn solve_velocities(world: &mut World, h: f32) {
     let resting_speed = 2.0 * world.config.gravity.length() * h;
     for_each_colour(world, &Velocities { h, resting_speed });
+    let (max_linear, max_angular) = (
+        world.config.max_linear_speed,
+        world.config.max_angular_speed,
+    );
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
             let [vx, vy, vz, _, wx, wy, wz, _] = world.rows.velocity[i + 1].get();
-            b.linear_velocity[i] = Vec3::new(vx, vy, vz);
-            b.angular_velocity[i] = Vec3::new(wx, wy, wz);
+            b.linear_velocity[i] = limit(Vec3::new(vx, vy, vz), max_linear);
+            b.angular_velocity[i] = limit(Vec3::new(wx, wy, wz), max_angular);
         }
     }
 }

@@ -12,12 +12,13 @@ use vertebra_world::{
     SolverConfig, World,
 };
 
-/// Steps `world` a second at 60 Hz; every body stays finite and within
-/// `bound` m of the origin, and the NaN guard never fires. (Velocities
-/// against the speed limits after corrections are class 1's, in step.rs.)
+/// Steps `world` a second at 60 Hz; every body stays finite, within
+/// `bound` m of the origin and within the speed limits after every step,
+/// and the NaN guard never fires.
 fn steps_clean(world: &mut World, bound: f32) {
     for _ in 0..60 {
         world.step(1.0 / 60.0).expect("a valid step");
+        within_speed_limits(world);
     }
     let store = world.bodies();
     for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
@@ -29,6 +30,72 @@ fn steps_clean(world: &mut World, bound: f32) {
             s.position
         );
     }
+    assert_eq!(world.repaired_bodies(), 0, "the NaN guard fired");
+}
+
+/// Every body's speed and spin within the configured limits (to rounding).
+fn within_speed_limits(world: &World) {
+    let (config, store) = (world.config(), world.bodies());
+    for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
+        let v = store.linear_velocity[i].length();
+        let w = store.angular_velocity[i].length();
+        assert!(
+            v <= config.max_linear_speed * (1.0 + 1e-6),
+            "body {i}: {v} m/s"
+        );
+        assert!(
+            w <= config.max_angular_speed * (1.0 + 1e-6),
+            "body {i}: {w} rad/s"
+        );
+    }
+}
+
+/// A hard correction that moves a body 100 m in one step (a socket whose
+/// anchors start 100 m apart) reports at most the speed limit, not the
+/// 2,000 m/s its motion implies.
+#[test]
+fn hard_corrections_report_within_the_speed_limits() {
+    let mut world = World::new(SolverConfig::default()).expect("default config");
+    let (a, b) = two_bodies(&mut world);
+    let socket = vertebra_world::SocketDesc::at_world_anchor(
+        world.bodies(),
+        a,
+        b,
+        Vec3::new(0.0, -0.45, 0.0),
+        -Vec3::Y,
+    )
+    .expect("socket");
+    world.add_socket(socket).expect("socket");
+    world
+        .set_body_pose(b, Vec3::new(100.0, 0.0, 0.0), Quat::IDENTITY)
+        .expect("pose");
+    world.step(1.0 / 60.0).expect("step");
+    within_speed_limits(&world);
+}
+
+/// An accepted spin of 1.8e38 rad/s on a body in contact steps finite and
+/// within the limits (the world now holds it to the limit before the
+/// contact measures its approach speed, where `w x r` can overflow).
+#[test]
+fn accepted_spins_are_held_before_contacts_measure_them() {
+    // A slow spin limit, so that the body barely turns and its contact
+    // stays closed through the step.
+    let config = SolverConfig {
+        max_angular_speed: 1.0,
+        ..SolverConfig::default()
+    };
+    let mut world = World::new(config).expect("valid config");
+    let (a, b) = two_bodies(&mut world);
+    world
+        .set_body_velocity(a, Vec3::ZERO, Vec3::new(1.8e38, 0.0, 0.0))
+        .expect("finite, so accepted");
+    let far_point = Contact {
+        point: Vec3::new(0.0, -0.45, 5.0),
+        ..contact(a, b, 0.01)
+    };
+    world.set_contacts(&[far_point]).expect("contact");
+    world.step(1.0 / 60.0).expect("step");
+    within_speed_limits(&world);
     assert_eq!(world.repaired_bodies(), 0, "the NaN guard fired");
 }
 
