@@ -1,30 +1,67 @@
-//! Saving a world's full state and restoring it bit for bit (rollback).
+//! Saving a world's full state and restoring it bit for bit: rollback,
+//! save games, a server's state sent to its clients.
 //!
 //! A snapshot holds everything a step reads that outlives a step: the body
 //! store (poses, velocities, masses, pending forces, slots), the joints and
 //! their slots, the colouring (its history decides the solve order, so it
 //! is saved, not rebuilt), and the contacts set for the next step. The
 //! block layout is rebuilt from those on the next step, exactly as it was
-//! built before. The solver settings are not part of it: they belong to the
-//! world, and stepping is bit-identical across backends and thread counts.
+//! built before.
 //!
-//! Bytes: `"VTBSNAP1"`, the world's id (u64 LE), the xxh3 hash of the
-//! payload (u64 LE), then the payload (postcard).
+//! **Portable.** A snapshot restores into any world of the same build: the
+//! world that took it, or a fresh one in another process or on another
+//! machine. Nothing of the [`SolverConfig`](crate::SolverConfig) has to
+//! match for the snapshot to be accepted (the settings are the world's,
+//! not the snapshot's). To step on bit for bit as the original would have,
+//! the settings that change results must match: `substeps`, `iterations`,
+//! `gravity`, `max_push_out_speed`, `max_linear_speed`,
+//! `max_angular_speed`; `backend`, `threads` and `parallel_min_blocks` may
+//! differ (stepping is bit-identical across them). "The same build" is the
+//! same vertebra version and snapshot format; identity across compilers and
+//! targets is not promised (see `docs/robustness.md`).
+//!
+//! **Handles.** The snapshot carries its world's lineage (see
+//! [`Slots`]): a world that restores it takes on that lineage, so the
+//! handles of the world that took it are valid here (a client acting on
+//! its server's handles, a save game's handles after loading) and handles
+//! of any other world are refused as foreign. Generations only ever rise:
+//! restoring never lowers the world's counter, so a handle issued after the
+//! snapshot was taken stays stale after it is restored, and the world never
+//! issues it again.
+//!
+//! **Untrusted.** The checksum only catches accidents: anyone can write a
+//! payload that passes it. Restoring decodes and validates the whole state
+//! before anything is assigned, with the checks the API applies to the same
+//! values (bodies as [`BodyStore::validate`], joints and contacts by their
+//! `validate`, with their bodies live and the right lineage) and structural
+//! ones (slot tables, array lengths, each body's joint count, the colouring
+//! as [`Colouring::validate`]). A refused snapshot gets
+//! `Err(CorruptSnapshot)` naming the item and the reason (or
+//! `Err(IncompatibleSnapshot)` for another build) and the world is
+//! unchanged.
+//!
+//! Bytes: `"VTBSNAP2"` (the format), the build id (u64 LE: a hash of the
+//! crate version and the format), the xxh3 hash of the payload (u64 LE),
+//! then the payload (postcard).
 
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use serde::{Deserialize, Serialize};
 use vertebra_scheduler::Colouring;
-use vertebra_store::{BodyStore, Error, Slots};
+use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 
-use crate::{Contact, RodDesc, SocketDesc, World};
+use crate::{Contact, RodDesc, SocketDesc, World, checks, layout::ROD_KEY};
 
-const MAGIC: &[u8; 8] = b"VTBSNAP1";
+/// Bump with every change to [`State`] or anything in it.
+const FORMAT: u8 = b'2';
+const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
 /// A world's full state at one instant: [`World::snapshot`] takes it,
-/// [`World::restore`] puts it back. Stepping on from a restored world gives
-/// the same bits as stepping on from the original did.
+/// [`World::restore`] puts it back, into this world or any other of the
+/// same build (see the module documentation). Stepping on from a restored
+/// world gives the same bits as stepping on from the original did.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Snapshot {
     bytes: Vec<u8>,
@@ -36,19 +73,25 @@ impl Snapshot {
         &self.bytes
     }
 
-    /// A snapshot from bytes [`Snapshot::as_bytes`] gave; checked when it is
-    /// restored.
+    /// A snapshot from bytes [`Snapshot::as_bytes`] gave (in any process);
+    /// checked in full when it is restored.
     pub fn from_bytes(bytes: Vec<u8>) -> Self {
         Self { bytes }
     }
 }
 
-/// A process-unique id, different across processes too (hashed with the
-/// process's random hasher keys).
-pub(crate) fn new_world_id() -> u64 {
+/// A new world's lineage: different for every world, across processes too
+/// (hashed with the process's random hasher keys).
+pub(crate) fn new_lineage() -> u32 {
     use std::hash::{BuildHasher, RandomState};
     static NEXT: AtomicU64 = AtomicU64::new(0);
-    RandomState::new().hash_one(NEXT.fetch_add(1, Ordering::Relaxed))
+    RandomState::new().hash_one(NEXT.fetch_add(1, Ordering::Relaxed)) as u32
+}
+
+/// The build a snapshot must come from: this crate's version and the format.
+fn build_id() -> u64 {
+    let name = concat!("vertebra-world ", env!("CARGO_PKG_VERSION"), " snapshot ");
+    xxhash_rust::xxh3::xxh3_64(&[name.as_bytes(), MAGIC].concat())
 }
 
 #[derive(Serialize, Deserialize)]
@@ -63,21 +106,134 @@ struct State {
     contacts: Vec<Contact>,
 }
 
+fn corrupt(why: String) -> Error {
+    Error::CorruptSnapshot(why)
+}
+
 impl State {
-    fn is_consistent(&self) -> bool {
-        let b = &self.bodies;
-        let sound = |i: usize| {
-            b.is_finite(i)
-                && vertebra_store::check_unit_quat("orientation", b.orientation[i]).is_ok()
-        };
-        self.bodies.is_consistent()
-            && self.joints_at.len() == self.bodies.capacity()
-            && self.socket_slots.is_consistent()
-            && self.rod_slots.is_consistent()
-            && self.sockets.len() == self.socket_slots.capacity()
-            && self.rods.len() == self.rod_slots.capacity()
-            && (0..b.capacity()).all(sound)
+    /// The header checked, the payload decoded (nothing validated yet).
+    fn decode(bytes: &[u8]) -> Result<Self, Error> {
+        if bytes.len() < HEADER || &bytes[..7] != b"VTBSNAP" {
+            return Err(corrupt("not a vertebra snapshot".into()));
+        }
+        if bytes[7] != FORMAT {
+            return Err(Error::IncompatibleSnapshot("another snapshot format"));
+        }
+        let word = |k: usize| u64::from_le_bytes(bytes[k..k + 8].try_into().expect("8 bytes"));
+        if word(8) != build_id() {
+            return Err(Error::IncompatibleSnapshot(
+                "written by another vertebra version",
+            ));
+        }
+        let payload = &bytes[HEADER..];
+        if xxhash_rust::xxh3::xxh3_64(payload) != word(16) {
+            return Err(corrupt("checksum mismatch".into()));
+        }
+        match postcard::take_from_bytes(payload) {
+            Ok((state, [])) => Ok(state),
+            Ok(_) => Err(corrupt("bytes after the state".into())),
+            Err(e) => Err(corrupt(format!("undecodable state ({e})"))),
+        }
     }
+
+    /// The state's bytes with their header.
+    fn encode(&self) -> Vec<u8> {
+        let payload = postcard::to_allocvec(self).expect("the state always encodes");
+        let mut bytes = Vec::with_capacity(HEADER + payload.len());
+        bytes.extend_from_slice(MAGIC);
+        bytes.extend_from_slice(&build_id().to_le_bytes());
+        bytes.extend_from_slice(&xxhash_rust::xxh3::xxh3_64(&payload).to_le_bytes());
+        bytes.extend_from_slice(&payload);
+        bytes
+    }
+
+    /// Everything a world built through the API would satisfy (see the
+    /// module documentation); the error names the item.
+    fn validate(&self) -> Result<(), Error> {
+        let bodies = &self.bodies;
+        bodies.validate()?;
+        if self.joints_at.len() != bodies.capacity() {
+            return Err(corrupt(format!(
+                "{} joint counts for {} body slots",
+                self.joints_at.len(),
+                bodies.capacity()
+            )));
+        }
+        let mut edges = BTreeMap::new();
+        let mut joints_at = vec![0u32; bodies.capacity()];
+        let mut joint = |key: u64, a: BodyHandle, b: BodyHandle| {
+            edges.insert(key, checks::dynamic_bodies(bodies, a, b));
+            for h in [a, b] {
+                joints_at[h.index()] += 1;
+            }
+        };
+        let sockets = joints("socket", &self.socket_slots, &self.sockets, |d| {
+            d.validate_with(bodies)
+        })?;
+        for (slot, d) in sockets {
+            joint(slot as u64, d.body_a, d.body_b);
+        }
+        let rods = joints("rod", &self.rod_slots, &self.rods, |d| {
+            d.validate_with(bodies)
+        })?;
+        for (slot, d) in rods {
+            joint(slot as u64 + ROD_KEY, d.body_a, d.body_b);
+        }
+        if let Some(i) = (0..joints_at.len()).find(|&i| joints_at[i] != self.joints_at[i]) {
+            return Err(corrupt(format!(
+                "body {i}: counted in {} joints, used by {}",
+                self.joints_at[i], joints_at[i]
+            )));
+        }
+        self.colouring
+            .validate(&edges, bodies.capacity())
+            .map_err(|why| corrupt(format!("colouring: {why}")))?;
+        for (k, c) in self.contacts.iter().enumerate() {
+            c.validate_with(bodies)
+                .map_err(|e| corrupt(format!("contact {k}: {e}")))?;
+        }
+        Ok(())
+    }
+}
+
+/// The live joints of one kind, each checked by `validate` (the API's own
+/// check), with their slots; a description must be present exactly where
+/// its slot is live.
+fn joints<'s, D>(
+    kind: &str,
+    slots: &Slots,
+    descs: &'s [Option<D>],
+    validate: impl Fn(&D) -> Result<(), Error>,
+) -> Result<Vec<(usize, &'s D)>, Error> {
+    slots.validate(kind)?;
+    if descs.len() != slots.capacity() {
+        return Err(corrupt(format!(
+            "{} {kind} descriptions for {} slots",
+            descs.len(),
+            slots.capacity()
+        )));
+    }
+    let mut live = Vec::new();
+    for (slot, desc) in descs.iter().enumerate() {
+        match (slots.is_live(slot), desc) {
+            (true, Some(d)) => {
+                validate(d).map_err(|e| corrupt(format!("{kind} {slot}: {e}")))?;
+                live.push((slot, d));
+            }
+            (false, None) => {}
+            (true, None) => {
+                return Err(corrupt(format!(
+                    "{kind} {slot}: live without a description"
+                )));
+            }
+            (false, Some(_)) => {
+                return Err(corrupt(format!(
+                    "{kind} {slot}: a description in a free slot"
+                )));
+            }
+        }
+    }
+    Ok(live)
 }
 
 impl World {
@@ -93,38 +249,24 @@ impl World {
             colouring: self.colouring.clone(),
             contacts: self.contacts.clone(),
         };
-        let payload = postcard::to_allocvec(&state).expect("the state always encodes");
-        let mut bytes = Vec::with_capacity(HEADER + payload.len());
-        bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&self.id.to_le_bytes());
-        bytes.extend_from_slice(&xxhash_rust::xxh3::xxh3_64(&payload).to_le_bytes());
-        bytes.extend_from_slice(&payload);
-        Snapshot { bytes }
+        Snapshot {
+            bytes: state.encode(),
+        }
     }
 
-    /// Puts the world back to `snapshot`: bodies, joints and contacts added
-    /// since are gone, removed ones are back, and the handles of the time
-    /// are valid again. `Err(ForeignSnapshot)` for another world's snapshot,
-    /// `Err(CorruptSnapshot)` for damaged bytes; the world is unchanged on
-    /// error.
+    /// Puts the world in `snapshot`'s state: bodies, joints and contacts
+    /// added since are gone, removed ones are back, and the handles of the
+    /// snapshot's world are valid (see the module documentation for what
+    /// another world's snapshot needs). Handles issued after the snapshot
+    /// was taken stay stale. `Err(IncompatibleSnapshot)` for another
+    /// build's snapshot, `Err(CorruptSnapshot)` naming the item for damaged
+    /// or crafted bytes; the world is unchanged on error.
     pub fn restore(&mut self, snapshot: &Snapshot) -> Result<(), Error> {
-        let bytes = &snapshot.bytes;
-        if bytes.len() < HEADER || &bytes[..8] != MAGIC {
-            return Err(Error::CorruptSnapshot("not a vertebra snapshot"));
-        }
-        let word = |k: usize| u64::from_le_bytes(bytes[k..k + 8].try_into().expect("8 bytes"));
-        if word(8) != self.id {
-            return Err(Error::ForeignSnapshot);
-        }
-        let payload = &bytes[HEADER..];
-        if xxhash_rust::xxh3::xxh3_64(payload) != word(16) {
-            return Err(Error::CorruptSnapshot("checksum mismatch"));
-        }
-        let state: State = postcard::from_bytes(payload)
-            .map_err(|_| Error::CorruptSnapshot("undecodable state"))?;
-        if !state.is_consistent() {
-            return Err(Error::CorruptSnapshot("inconsistent state"));
-        }
+        let mut state = State::decode(&snapshot.bytes)?;
+        state.validate()?;
+        state.bodies.issue_after(&self.bodies);
+        state.socket_slots.issue_after(&self.socket_slots);
+        state.rod_slots.issue_after(&self.rod_slots);
         self.bodies = state.bodies;
         self.joints_at = state.joints_at;
         self.socket_slots = state.socket_slots;
@@ -144,7 +286,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn world_ids_differ() {
-        assert_ne!(new_world_id(), new_world_id());
+    fn lineages_differ() {
+        assert_ne!(new_lineage(), new_lineage());
     }
 }
