@@ -283,10 +283,273 @@ impl World {
 
 #[cfg(test)]
 mod tests {
+    use glam::{Quat, Vec3};
+
     use super::*;
+    use crate::{AngularDrive, BodyDesc, RodStiffness, Shape, SolverConfig};
 
     #[test]
     fn lineages_differ() {
         assert_ne!(new_lineage(), new_lineage());
+    }
+
+    /// Ground, three capsules hanging from it by a socket, a rod and a
+    /// driven socket, a contact pending, a removed body's slot: every part
+    /// of the state in use.
+    fn world() -> World {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let ground = world.add_body(BodyDesc::fixed()).unwrap();
+        let mass = Shape::capsule(-0.2 * Vec3::Y, 0.2 * Vec3::Y, 0.05)
+            .mass_properties_with_mass(2.0)
+            .unwrap();
+        let links: Vec<_> = (1..=3)
+            .map(|k| {
+                let at = Vec3::new(0.0, -0.5 * k as f32, 0.0);
+                world
+                    .add_body(BodyDesc::dynamic(mass).with_position(at))
+                    .unwrap()
+            })
+            .collect();
+        let gone = world.add_body(BodyDesc::fixed()).unwrap();
+        world.remove_body(gone).unwrap();
+        let bodies = world.bodies();
+        let socket =
+            SocketDesc::at_world_anchor(bodies, ground, links[0], -0.25 * Vec3::Y, -Vec3::Y)
+                .unwrap()
+                .with_swing_limit(1.0);
+        let rod = RodDesc::from_pose(bodies, links[0], links[1], &[])
+            .unwrap()
+            .with_stiffness(RodStiffness::Kirchhoff(5.0), RodStiffness::Relaxation(0.5));
+        let drive = AngularDrive {
+            target: Quat::IDENTITY,
+            compliance: 0.01,
+            damping: 1.0,
+        };
+        let driven =
+            SocketDesc::at_world_anchor(bodies, links[1], links[2], -1.25 * Vec3::Y, -Vec3::Y)
+                .unwrap()
+                .with_drive(drive);
+        world.add_socket(socket).unwrap();
+        world.add_rod(rod).unwrap();
+        world.add_socket(driven).unwrap();
+        world.set_body_velocity(links[2], Vec3::X, Vec3::Z).unwrap();
+        for _ in 0..5 {
+            world.step(1.0 / 60.0).unwrap();
+        }
+        let contact = Contact {
+            body_a: ground,
+            body_b: links[2],
+            point: -1.6 * Vec3::Y,
+            normal: -Vec3::Y,
+            depth: 0.01,
+            friction: 0.5,
+            restitution: 0.0,
+        };
+        world.set_contacts(&[contact]).unwrap();
+        world
+    }
+
+    /// `world`'s snapshot decoded, changed by `change` and encoded again
+    /// with a correct checksum: what an attacker can send.
+    fn crafted(world: &World, change: impl FnOnce(&mut State)) -> Snapshot {
+        let mut state = State::decode(world.snapshot().as_bytes()).unwrap();
+        change(&mut state);
+        Snapshot::from_bytes(state.encode())
+    }
+
+    /// The error restoring `snapshot` gives, after checking that the world
+    /// is exactly as it was.
+    fn refusal(world: &mut World, snapshot: &Snapshot) -> String {
+        let before = world.snapshot();
+        let error = world.restore(snapshot).unwrap_err();
+        assert_eq!(world.snapshot(), before, "{error} changed the world");
+        error.to_string()
+    }
+
+    #[test]
+    fn an_unchanged_state_round_trips() {
+        let mut world = world();
+        let snapshot = crafted(&world, |_| {});
+        assert_eq!(snapshot, world.snapshot());
+        world.restore(&snapshot).unwrap();
+    }
+
+    /// Payloads that were accepted and put NaN into the world, or panicked
+    /// in `restore` or the next step, before restore validated the state.
+    #[test]
+    fn crafted_states_are_refused_by_name_and_change_nothing() {
+        let mut world = world();
+        let nan = f32::NAN;
+        let cases: Vec<(Box<dyn FnOnce(&mut State)>, &str)> = vec![
+            (
+                Box::new(|s| s.sockets[0].as_mut().unwrap().anchor_a.x = nan),
+                "socket 0: anchor a is not finite",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().rest_length = -0.4),
+                "rod 0: rod rest length must be positive",
+            ),
+            (
+                Box::new(|s| s.bodies.inverse_mass[1] = nan),
+                "body 1: inverse mass is not 1/mass",
+            ),
+            (
+                Box::new(|s| s.bodies.inverse_mass[2] *= 2.0),
+                "body 2: inverse mass is not 1/mass",
+            ),
+            (
+                Box::new(|s| s.bodies.inverse_inertia[3].x_axis.x = 1e30),
+                "body 3: inverse inertia is not the inertia's inverse",
+            ),
+            (
+                Box::new(|s| s.bodies.mass[0] = 1.0),
+                "body 0: mass of an infinite-mass body is not zero",
+            ),
+            (
+                Box::new(|s| s.bodies.position[3].y = 2e6),
+                "body 3: position is out of range",
+            ),
+            (
+                Box::new(|s| s.bodies.orientation[1] = Quat::from_xyzw(0.0, 0.0, 0.0, 2.0)),
+                "body 1: orientation is not normalised",
+            ),
+            (
+                Box::new(|s| s.bodies.linear_velocity[0] = Vec3::X),
+                "body 0: a static body moves",
+            ),
+            (
+                // The removed body's slot: the step uploads every slot.
+                Box::new(|s| s.bodies.angular_velocity[4].z = f32::INFINITY),
+                "body 4: angular velocity is not finite",
+            ),
+            (
+                Box::new(|s| s.bodies.force[2].y = nan),
+                "body 2: accumulated force is not finite",
+            ),
+            (
+                Box::new(|s| s.bodies.linear_damping[1] = -1.0),
+                "body 1: linear damping must be positive",
+            ),
+            (
+                Box::new(|s| {
+                    s.bodies.mass.pop();
+                }),
+                "bodies: 4 mass entries for 5 slots",
+            ),
+            (
+                Box::new(|s| s.joints_at[1] -= 1),
+                "body 1: counted in 1 joints, used by 2",
+            ),
+            (
+                Box::new(|s| s.joints_at.push(0)),
+                "6 joint counts for 5 body slots",
+            ),
+            (
+                Box::new(|s| s.sockets[1] = None),
+                "socket 1: live without a description",
+            ),
+            (
+                Box::new(|s| s.rods.push(None)),
+                "2 rod descriptions for 1 slots",
+            ),
+            (
+                Box::new(|s| {
+                    let rod = s.rods[0].as_mut().unwrap();
+                    rod.body_b = rod.body_a;
+                }),
+                "rod 0: a joint needs two different bodies",
+            ),
+            (
+                Box::new(|s| {
+                    let socket = s.sockets[1].as_mut().unwrap();
+                    socket.drive.as_mut().unwrap().compliance = -1.0;
+                }),
+                "socket 1: drive compliance must be positive",
+            ),
+            (
+                Box::new(|s| s.colouring = Colouring::new()),
+                "colouring: constraint 0 is not coloured",
+            ),
+            (
+                Box::new(|s| {
+                    s.colouring.remove(0);
+                    s.colouring.add(0, [Some(3), None]);
+                }),
+                "colouring: constraint 0 is coloured over other bodies",
+            ),
+            (
+                Box::new(|s| s.contacts[0].normal = Vec3::ZERO),
+                "contact 0: contact normal is not normalised",
+            ),
+            (
+                Box::new(|s| s.contacts[0].body_b = s.contacts[0].body_a),
+                "contact 0: a joint needs two different bodies",
+            ),
+        ];
+        for (change, expected) in cases {
+            let snapshot = crafted(&world, change);
+            assert_eq!(
+                refusal(&mut world, &snapshot),
+                format!("corrupt snapshot: {expected}")
+            );
+        }
+        world.step(1.0 / 60.0).unwrap();
+    }
+
+    #[test]
+    fn a_removed_or_foreign_body_in_a_joint_is_refused() {
+        let mut world = world();
+        let mut other = World::new(SolverConfig::default()).unwrap();
+        let foreign = other.add_body(BodyDesc::fixed()).unwrap();
+        let removed = {
+            let mut w = World::new(SolverConfig::default()).unwrap();
+            w.restore(&world.snapshot()).unwrap();
+            let h = w.add_body(BodyDesc::fixed()).unwrap();
+            w.remove_body(h).unwrap();
+            h
+        };
+        let cases = [
+            (foreign, "socket 0: body handle of another world"),
+            (removed, "socket 0: stale or unknown body handle"),
+        ];
+        for (body, expected) in cases {
+            let snapshot = crafted(&world, |s| s.sockets[0].as_mut().unwrap().body_a = body);
+            assert_eq!(
+                refusal(&mut world, &snapshot),
+                format!("corrupt snapshot: {expected}")
+            );
+        }
+    }
+
+    #[test]
+    fn other_formats_builds_and_damage_are_refused() {
+        let mut world = world();
+        let good = world.snapshot().as_bytes().to_vec();
+        let mut other_format = good.clone();
+        other_format[7] = b'1';
+        let mut other_build = good.clone();
+        other_build[8] ^= 1;
+        let mut trailing = State::decode(&good).unwrap().encode();
+        trailing.push(0);
+        let sum = xxhash_rust::xxh3::xxh3_64(&trailing[HEADER..]);
+        trailing[16..24].copy_from_slice(&sum.to_le_bytes());
+        let cases = [
+            (
+                other_format,
+                "incompatible snapshot: another snapshot format",
+            ),
+            (
+                other_build,
+                "incompatible snapshot: written by another vertebra version",
+            ),
+            (trailing, "corrupt snapshot: bytes after the state"),
+            (
+                good[..HEADER - 1].to_vec(),
+                "corrupt snapshot: not a vertebra snapshot",
+            ),
+        ];
+        for (bytes, expected) in cases {
+            assert_eq!(refusal(&mut world, &Snapshot::from_bytes(bytes)), expected);
+        }
     }
 }
