@@ -374,13 +374,16 @@ mod tests {
         world.restore(&snapshot).unwrap();
     }
 
+    /// One change to a decoded state.
+    type Change = Box<dyn FnOnce(&mut State)>;
+
     /// Payloads that were accepted and put NaN into the world, or panicked
     /// in `restore` or the next step, before restore validated the state.
     #[test]
     fn crafted_states_are_refused_by_name_and_change_nothing() {
         let mut world = world();
         let nan = f32::NAN;
-        let cases: Vec<(Box<dyn FnOnce(&mut State)>, &str)> = vec![
+        let cases: Vec<(Change, &str)> = vec![
             (
                 Box::new(|s| s.sockets[0].as_mut().unwrap().anchor_a.x = nan),
                 "socket 0: anchor a is not finite",
