@@ -382,10 +382,10 @@ mod tests {
     #[test]
     fn crafted_states_are_refused_by_name_and_change_nothing() {
         let mut world = world();
-        let nan = f32::NAN;
+        const NAN: f32 = f32::NAN;
         let cases: Vec<(Change, &str)> = vec![
             (
-                Box::new(|s| s.sockets[0].as_mut().unwrap().anchor_a.x = nan),
+                Box::new(|s| s.sockets[0].as_mut().unwrap().anchor_a.x = NAN),
                 "socket 0: anchor a is not finite",
             ),
             (
@@ -393,7 +393,7 @@ mod tests {
                 "rod 0: rod rest length must be positive",
             ),
             (
-                Box::new(|s| s.bodies.inverse_mass[1] = nan),
+                Box::new(|s| s.bodies.inverse_mass[1] = NAN),
                 "body 1: inverse mass is not 1/mass",
             ),
             (
@@ -426,7 +426,7 @@ mod tests {
                 "body 4: angular velocity is not finite",
             ),
             (
-                Box::new(|s| s.bodies.force[2].y = nan),
+                Box::new(|s| s.bodies.force[2].y = NAN),
                 "body 2: accumulated force is not finite",
             ),
             (
