@@ -14,25 +14,31 @@
 //!   floats: no panic, a rejected call changes nothing, no non-finite state.
 //! - [`ragdoll_loader`]: arbitrary bytes as a ragdoll file: an error or a
 //!   ragdoll that builds, never a panic.
+//! - [`snapshot`]: a valid world's snapshot with its decoded state changed
+//!   (or its payload's bytes) and a correct checksum: refused by name with
+//!   the world unchanged, or accepted and stepped with every body finite.
 
 mod input;
 mod kernels;
 mod loader;
 mod math;
+mod snapshot;
 mod world;
 
 pub use kernels::kernels;
 pub use loader::ragdoll_loader;
 pub use math::math_backends;
+pub use snapshot::snapshot;
 pub use world::world_api;
 
 /// A fuzz target's body: panics on a broken promise.
 pub type Target = fn(&[u8]);
 
 /// Every target, by its cargo-fuzz name.
-pub const TARGETS: [(&str, Target); 4] = [
+pub const TARGETS: [(&str, Target); 5] = [
     ("math_backends", math_backends),
     ("kernels", kernels),
     ("world_api", world_api),
     ("ragdoll_loader", ragdoll_loader),
+    ("snapshot", snapshot),
 ];
