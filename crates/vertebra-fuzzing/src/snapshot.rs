@@ -368,9 +368,9 @@ pub fn snapshot(data: &[u8]) {
         let mut bytes = encoded;
         for _ in 0..1 + input.pick(4) {
             let k = input.pick(bytes.len());
-            match input.pick(3) {
-                0 => bytes[k] ^= 1 << input.pick(8),
-                1 => bytes[k] = input.pick(256) as u8,
+            match (input.pick(3), bytes.get_mut(k)) {
+                (0, Some(byte)) => *byte ^= 1 << input.pick(8),
+                (1, Some(byte)) => *byte = input.pick(256) as u8,
                 _ => bytes.truncate(k),
             }
         }
