@@ -144,7 +144,8 @@ fn slots(input: &mut Input, s: &mut Slots) {
 }
 
 fn body(input: &mut Input, b: &mut Bodies) {
-    let n = b.kind.len();
+    // Earlier changes may have shortened `position` (and only it).
+    let n = b.kind.len().min(b.position.len());
     if n == 0 {
         return slots(input, &mut b.slots);
     }
