@@ -134,7 +134,7 @@ fn slots(input: &mut Input, s: &mut Slots) {
         2 => {
             s.free.insert(index(input, n) as u32);
         }
-        3 => s.next_generation = input.pick(8) as u64,
+        3 => s.next_generation = [0, 1, 7, 1 << 48, (1 << 48) + 1, u64::MAX][input.pick(6)],
         4 => s.lineage ^= 1 + input.pick(255) as u32,
         _ => {
             s.generation.push(0);

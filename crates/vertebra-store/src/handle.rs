@@ -18,6 +18,11 @@ use core::marker::PhantomData;
 
 use crate::error::Error;
 
+/// The most generations a table issues: 2^48 insertions, a million a
+/// second for nine years. A decoded table whose counter is beyond it is
+/// refused, so the counter can never overflow.
+pub const MAX_GENERATION: u64 = 1 << 48;
+
 /// A stable reference to an item of kind `T` in a [`Slots`] table.
 #[derive(serde::Serialize, serde::Deserialize)]
 #[serde(bound = "")]
@@ -154,7 +159,8 @@ impl Slots {
 
     /// Checks the table's own consistency (a decoded snapshot's tables are
     /// untrusted): one generation per slot, every generation below the
-    /// counter, and the free list naming exactly the dead slots. The error
+    /// counter, the counter at most [`MAX_GENERATION`], and the free list
+    /// naming exactly the dead slots. The error
     /// names the table (`what`) and the slot.
     pub fn validate(&self, what: &str) -> Result<(), Error> {
         let corrupt = |why: String| Err(Error::CorruptSnapshot(format!("{what} slots: {why}")));
@@ -164,6 +170,9 @@ impl Slots {
                 self.generation.len(),
                 self.live.len()
             ));
+        }
+        if self.next_generation > MAX_GENERATION {
+            return corrupt(format!("{} generations issued", self.next_generation));
         }
         if let Some(i) = (0..self.live.len()).find(|&i| self.generation[i] >= self.next_generation)
         {
@@ -222,6 +231,20 @@ mod tests {
         assert_eq!(first.index(), second.index());
         assert_eq!(slots.check(first, "x"), Err(Error::StaleHandle("x")));
         assert_eq!(slots.check(second, "x"), Ok(0));
+    }
+
+    #[test]
+    fn a_counter_that_could_overflow_is_refused() {
+        let mut slots = Slots::new(1);
+        let _: Handle<()> = slots.insert();
+        assert_eq!(slots.validate("body"), Ok(()));
+        slots.next_generation = u64::MAX;
+        assert!(slots.validate("body").is_err());
+        slots.next_generation = 0;
+        assert!(
+            slots.validate("body").is_err(),
+            "slot 0's generation was never issued"
+        );
     }
 
     #[test]
