@@ -106,22 +106,26 @@ fn encode<T: Serialize>(value: &T) -> Vec<u8> {
 /// The state in `bytes`, if they are an intact snapshot of this version.
 fn decode(bytes: &[u8]) -> Result<State, Error> {
     if bytes.len() < HEADER || &bytes[..8] != MAGIC {
-        return Err(Error::CorruptSnapshot("not a collision-set snapshot"));
+        return Err(Error::CorruptSnapshot(
+            "not a collision-set snapshot".into(),
+        ));
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
     if version != VERSION {
-        return Err(Error::CorruptSnapshot(
+        return Err(Error::IncompatibleSnapshot(
             "a collision-set snapshot of another format version",
         ));
     }
     let checksum = u64::from_le_bytes(bytes[12..HEADER].try_into().expect("8 bytes"));
     let payload = &bytes[HEADER..];
     if xxhash_rust::xxh3::xxh3_64(payload) != checksum {
-        return Err(Error::CorruptSnapshot("checksum mismatch"));
+        return Err(Error::CorruptSnapshot("checksum mismatch".into()));
     }
     match postcard::take_from_bytes::<State>(payload) {
         Ok((state, [])) => Ok(state),
-        Ok(_) => Err(Error::CorruptSnapshot("bytes after the collision set")),
-        Err(_) => Err(Error::CorruptSnapshot("undecodable collision set")),
+        Ok(_) => Err(Error::CorruptSnapshot(
+            "bytes after the collision set".into(),
+        )),
+        Err(_) => Err(Error::CorruptSnapshot("undecodable collision set".into())),
     }
 }

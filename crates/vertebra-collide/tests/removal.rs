@@ -335,7 +335,7 @@ fn assert_refused(bad: &CollisionSnapshot, expected: Option<Error>) {
 fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
     let (_, c, [_, _, b]) = boxes();
     let good = c.snapshot().as_bytes().to_vec();
-    let corrupt = |why| Some(Error::CorruptSnapshot(why));
+    let corrupt = |why: &str| Some(Error::CorruptSnapshot(why.into()));
     assert_refused(
         &CollisionSnapshot::from_bytes(b"VTBSNAP1 and more bytes".to_vec()),
         corrupt("not a collision-set snapshot"),
@@ -348,7 +348,9 @@ fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
     newer[8] = 2;
     assert_refused(
         &CollisionSnapshot::from_bytes(newer),
-        corrupt("a collision-set snapshot of another format version"),
+        Some(Error::IncompatibleSnapshot(
+            "a collision-set snapshot of another format version",
+        )),
     );
     let mut flipped = good.clone();
     *flipped.last_mut().unwrap() ^= 0x10;

@@ -21,29 +21,35 @@
 //!   world and the collision set saved and restored (also from crafted
 //!   bytes), steps with detection: a refused call changes nothing, no
 //!   collider or contact outlives its body.
+//! - [`snapshot`]: a valid world's snapshot with its decoded state changed
+//!   (or its payload's bytes) and a correct checksum: refused by name with
+//!   the world unchanged, or accepted and stepped with every body finite.
 
 mod collisions;
 mod input;
 mod kernels;
 mod loader;
 mod math;
+mod snapshot;
 mod world;
 
 pub use collisions::collisions;
 pub use kernels::kernels;
 pub use loader::ragdoll_loader;
 pub use math::math_backends;
+pub use snapshot::snapshot;
 pub use world::{world_api, world_settings};
 
 /// A fuzz target's body: panics on a broken promise.
 pub type Target = fn(&[u8]);
 
 /// Every target, by its cargo-fuzz name.
-pub const TARGETS: [(&str, Target); 6] = [
+pub const TARGETS: [(&str, Target); 7] = [
     ("math_backends", math_backends),
     ("kernels", kernels),
     ("world_api", world_api),
     ("world_settings", world_settings),
     ("ragdoll_loader", ragdoll_loader),
     ("collisions", collisions),
+    ("snapshot", snapshot),
 ];

@@ -22,10 +22,10 @@ fn fingerprint(world: &World) -> (u64, usize, usize, usize) {
 
 /// Handles seen so far (live or removed: stale ones must be refused).
 #[derive(Default)]
-struct Seen {
-    bodies: Vec<BodyHandle>,
-    sockets: Vec<SocketHandle>,
-    rods: Vec<RodHandle>,
+pub(crate) struct Seen {
+    pub bodies: Vec<BodyHandle>,
+    pub sockets: Vec<SocketHandle>,
+    pub rods: Vec<RodHandle>,
 }
 
 impl Seen {
@@ -34,7 +34,7 @@ impl Seen {
     }
 }
 
-fn add_body(world: &mut World, input: &mut Input) -> Result<BodyHandle, Error> {
+pub(crate) fn add_body(world: &mut World, input: &mut Input) -> Result<BodyHandle, Error> {
     let desc = match input.pick(3) {
         0 => BodyDesc::fixed(),
         1 => BodyDesc::kinematic(),
@@ -59,7 +59,11 @@ fn add_body(world: &mut World, input: &mut Input) -> Result<BodyHandle, Error> {
     )
 }
 
-fn add_socket(world: &mut World, seen: &Seen, input: &mut Input) -> Result<SocketHandle, Error> {
+pub(crate) fn add_socket(
+    world: &mut World,
+    seen: &Seen,
+    input: &mut Input,
+) -> Result<SocketHandle, Error> {
     let (Some(a), Some(b)) = (seen.body(input), seen.body(input)) else {
         return Err(Error::SameBody);
     };
@@ -81,7 +85,11 @@ fn add_socket(world: &mut World, seen: &Seen, input: &mut Input) -> Result<Socke
     world.add_socket(socket)
 }
 
-fn add_rod(world: &mut World, seen: &Seen, input: &mut Input) -> Result<RodHandle, Error> {
+pub(crate) fn add_rod(
+    world: &mut World,
+    seen: &Seen,
+    input: &mut Input,
+) -> Result<RodHandle, Error> {
     let (Some(a), Some(b)) = (seen.body(input), seen.body(input)) else {
         return Err(Error::SameBody);
     };
@@ -99,7 +107,7 @@ fn add_rod(world: &mut World, seen: &Seen, input: &mut Input) -> Result<RodHandl
     world.add_rod(rod)
 }
 
-fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) -> Result<(), Error> {
+pub(crate) fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) -> Result<(), Error> {
     let mut contacts = Vec::new();
     for _ in 0..input.pick(5) {
         let (Some(body_a), Some(body_b)) = (seen.body(input), seen.body(input)) else {

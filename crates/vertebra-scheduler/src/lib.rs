@@ -119,6 +119,83 @@ impl Colouring {
         self.body_colours.get(body as usize).copied().unwrap_or(0)
     }
 
+    /// Checks a colouring that did not come from [`Colouring::add`] (a
+    /// decoded snapshot) against the constraints it should colour, `key ->
+    /// dynamic bodies` (as passed to `add`), over `bodies` body slots:
+    /// every constraint placed exactly once, in a colour below
+    /// [`MAX_COLOURS`] or the overflow set, over the same bodies; no two
+    /// constraints of one colour share a dynamic body; each body's bitset
+    /// names exactly its constraints' colours. Nothing is rebuilt: the
+    /// colours a valid history gave decide the solve order, and keeping
+    /// them keeps it. The error names the constraint or body.
+    pub fn validate(
+        &self,
+        constraints: &BTreeMap<u64, [Option<u32>; 2]>,
+        bodies: usize,
+    ) -> Result<(), String> {
+        if self.members.len() != MAX_COLOURS {
+            return Err(format!("{} colours, not {MAX_COLOURS}", self.members.len()));
+        }
+        if self.body_colours.len() > bodies {
+            return Err(format!(
+                "bitsets for {} bodies, but {bodies} body slots",
+                self.body_colours.len()
+            ));
+        }
+        for (&key, &edge) in constraints {
+            let Some(&(slot, placed)) = self.placed.get(&key) else {
+                return Err(format!("constraint {key} is not coloured"));
+            };
+            if placed != edge {
+                return Err(format!("constraint {key} is coloured over other bodies"));
+            }
+            let member = match slot {
+                Slot::Colour(c) => self
+                    .members
+                    .get(c as usize)
+                    .is_some_and(|m| m.contains(&key)),
+                Slot::Overflow => self.overflow.contains(&key),
+            };
+            if !member {
+                return Err(format!("constraint {key} is missing from its {slot:?}"));
+            }
+        }
+        let members = self.members.iter().map(BTreeSet::len).sum::<usize>() + self.overflow.len();
+        if self.placed.len() != constraints.len() || members != constraints.len() {
+            return Err(format!(
+                "{} constraints placed and {members} in colours for {} constraints",
+                self.placed.len(),
+                constraints.len()
+            ));
+        }
+        let mut expected = vec![0u32; self.body_colours.len()];
+        for (colour, keys) in self.members.iter().enumerate() {
+            let mut seen = BTreeSet::new();
+            for &b in keys.iter().flat_map(|k| constraints[k].iter().flatten()) {
+                let bits = expected
+                    .get_mut(b as usize)
+                    .ok_or_else(|| format!("body {b} has no colour bitset"))?;
+                if !seen.insert(b) {
+                    return Err(format!("body {b} is in colour {colour} twice"));
+                }
+                *bits |= 1 << colour;
+            }
+        }
+        if let Some(b) = (0..expected.len()).find(|&b| expected[b] != self.body_colours[b]) {
+            return Err(format!(
+                "body {b}'s colour bitset disagrees with its constraints"
+            ));
+        }
+        if let Some(b) = constraints
+            .values()
+            .flat_map(|e| e.iter().flatten())
+            .find(|&&b| b as usize >= self.body_colours.len())
+        {
+            return Err(format!("body {b} has no colour bitset"));
+        }
+        Ok(())
+    }
+
     /// Makes room for body indices below `bodies`.
     pub fn reserve_bodies(&mut self, bodies: usize) {
         if self.body_colours.len() < bodies {
@@ -177,6 +254,42 @@ mod tests {
             }
         }
         check(&c, &edges);
+    }
+
+    #[test]
+    fn validate_accepts_what_add_made_and_names_what_was_tampered_with() {
+        let mut c = Colouring::new();
+        let mut edges = BTreeMap::new();
+        for k in 0..10u64 {
+            let bodies = [Some(k as u32), Some(k as u32 + 1)];
+            c.add(k, bodies);
+            edges.insert(k, bodies);
+        }
+        assert_eq!(c.validate(&edges, 11), Ok(()));
+        assert!(c.validate(&edges, 5).is_err(), "bitsets beyond the bodies");
+        let mut missing = edges.clone();
+        missing.insert(99, [Some(0), None]);
+        assert_eq!(
+            c.validate(&missing, 11),
+            Err("constraint 99 is not coloured".into())
+        );
+        // Joint 1 moved into joint 0's colour: they share body 1.
+        let mut clash = c.clone();
+        clash.members[1].remove(&1);
+        clash.members[0].insert(1);
+        clash.placed.insert(1, (Slot::Colour(0), edges[&1]));
+        assert_eq!(
+            clash.validate(&edges, 11),
+            Err("body 1 is in colour 0 twice".into())
+        );
+        let mut bits = c.clone();
+        bits.body_colours[3] = 0;
+        assert!(bits.validate(&edges, 11).is_err());
+        let mut out_of_range = c.clone();
+        out_of_range
+            .placed
+            .insert(2, (Slot::Colour(200), edges[&2]));
+        assert!(out_of_range.validate(&edges, 11).is_err());
     }
 
     #[test]

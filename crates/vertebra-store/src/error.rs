@@ -23,6 +23,12 @@ pub enum Error {
     SameBody,
     /// A handle whose body or constraint was removed, or that never existed.
     StaleHandle(&'static str),
+    /// A handle issued by another world (another lineage): refused rather
+    /// than applied to whatever this world holds in the same slot. A world
+    /// that restores a snapshot takes on the snapshot's lineage, so the
+    /// handles of the world that took it work, and its own earlier ones
+    /// become foreign.
+    ForeignHandle(&'static str),
     /// A body that other constraints still reference.
     BodyInUse,
     /// A joint between two bodies neither of which is dynamic.
@@ -35,10 +41,13 @@ pub enum Error {
     /// A finite value beyond what the solver can work with: a coordinate
     /// beyond [`MAX_COORDINATE`], a time step above [`MAX_TIME_STEP`].
     OutOfRange(&'static str),
-    /// A snapshot taken of a different world.
-    ForeignSnapshot,
-    /// A snapshot whose bytes are damaged or not a snapshot at all.
-    CorruptSnapshot(&'static str),
+    /// A snapshot written by an incompatible build: another snapshot
+    /// format or another vertebra version.
+    IncompatibleSnapshot(&'static str),
+    /// A snapshot whose bytes are damaged, not a snapshot at all, or that
+    /// decode to a state the API could never have produced; the message
+    /// names the item (body, joint, contact, slot table) and the reason.
+    CorruptSnapshot(String),
     /// A collider (of a collision layer such as `vertebra-collide`) that was
     /// refused, or whose body is no longer in the world.
     Collider {
@@ -62,6 +71,7 @@ impl fmt::Display for Error {
             Error::DegenerateShape(why) => write!(f, "degenerate shape: {why}"),
             Error::SameBody => write!(f, "a joint needs two different bodies"),
             Error::StaleHandle(what) => write!(f, "stale or unknown {what} handle"),
+            Error::ForeignHandle(what) => write!(f, "{what} handle of another world"),
             Error::BodyInUse => write!(
                 f,
                 "the body is still used by a joint; remove the joint first"
@@ -70,7 +80,7 @@ impl fmt::Display for Error {
             Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
             Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
             Error::OutOfRange(what) => write!(f, "{what} is out of range"),
-            Error::ForeignSnapshot => write!(f, "the snapshot was taken of another world"),
+            Error::IncompatibleSnapshot(why) => write!(f, "incompatible snapshot: {why}"),
             Error::CorruptSnapshot(why) => write!(f, "corrupt snapshot: {why}"),
             Error::Collider {
                 index,

@@ -1,15 +1,35 @@
-//! Generational handles: a slot index and the slot's generation, so a
-//! handle to a removed item is recognised as stale even after its slot is
-//! reused.
+//! Generational handles: a slot index, the generation the slot had when
+//! the item was made, and the lineage of the tables that issued it.
+//!
+//! - **Generations are never reissued.** A table keeps one counter, raised
+//!   by every insertion and never lowered (a restored snapshot's counter
+//!   only raises it, see [`Slots::issue_after`]), so a handle to a removed
+//!   item is recognised as stale even after its slot is reused, and a
+//!   handle issued after a snapshot stays stale after that snapshot is
+//!   restored.
+//! - **Lineages tell worlds apart.** Every world draws a random lineage;
+//!   its handles carry it, and a handle of another lineage is refused as
+//!   foreign instead of acting on whatever body has the same slot here. A
+//!   restored snapshot brings its lineage with it: a world that restores
+//!   another world's snapshot (a save game, a server's state) takes on that
+//!   world's handles, and its own earlier handles become foreign.
 
 use core::marker::PhantomData;
+
+use crate::error::Error;
+
+/// The most generations a table issues: 2^48 insertions, a million a
+/// second for nine years. A decoded table whose counter is beyond it is
+/// refused, so the counter can never overflow.
+pub const MAX_GENERATION: u64 = 1 << 48;
 
 /// A stable reference to an item of kind `T` in a [`Slots`] table.
 #[derive(serde::Serialize, serde::Deserialize)]
 #[serde(bound = "")]
 pub struct Handle<T> {
     index: u32,
-    generation: u32,
+    lineage: u32,
+    generation: u64,
     _kind: PhantomData<fn() -> T>,
 }
 
@@ -17,6 +37,10 @@ impl<T> Handle<T> {
     /// The slot index (stable while the item lives).
     pub fn index(self) -> usize {
         self.index as usize
+    }
+
+    fn key(self) -> (u32, u32, u64) {
+        (self.index, self.lineage, self.generation)
     }
 }
 
@@ -28,31 +52,47 @@ impl<T> Clone for Handle<T> {
 impl<T> Copy for Handle<T> {}
 impl<T> PartialEq for Handle<T> {
     fn eq(&self, o: &Self) -> bool {
-        (self.index, self.generation) == (o.index, o.generation)
+        self.key() == o.key()
     }
 }
 impl<T> Eq for Handle<T> {}
 impl<T> core::hash::Hash for Handle<T> {
     fn hash<H: core::hash::Hasher>(&self, h: &mut H) {
-        (self.index, self.generation).hash(h);
+        self.key().hash(h);
     }
 }
 impl<T> core::fmt::Debug for Handle<T> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "Handle({}v{})", self.index, self.generation)
+        write!(
+            f,
+            "Handle({}v{}@{:08x})",
+            self.index, self.generation, self.lineage
+        )
     }
 }
 
-/// Slot bookkeeping: which indices are live, their generations, and a free
-/// list that reuses the lowest freed index first (deterministic).
+/// Slot bookkeeping: which indices are live, the generation each live one
+/// was issued with, and a free list that reuses the lowest freed index
+/// first (deterministic).
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Slots {
-    generation: Vec<u32>,
+    lineage: u32,
+    /// The generation the next insertion gets; above every one issued.
+    next_generation: u64,
+    generation: Vec<u64>,
     live: Vec<bool>,
     free: std::collections::BTreeSet<u32>,
 }
 
 impl Slots {
+    /// An empty table whose handles carry `lineage`.
+    pub fn new(lineage: u32) -> Self {
+        Self {
+            lineage,
+            ..Self::default()
+        }
+    }
+
     /// Takes a slot; returns its handle. The caller stores the item's data
     /// at `handle.index()`, growing its arrays when the index is new.
     pub fn insert<T>(&mut self) -> Handle<T> {
@@ -64,30 +104,52 @@ impl Slots {
                 (self.live.len() - 1) as u32
             }
         };
+        let generation = self.next_generation;
+        self.next_generation += 1;
         self.live[index as usize] = true;
+        self.generation[index as usize] = generation;
         Handle {
             index,
-            generation: self.generation[index as usize],
+            lineage: self.lineage,
+            generation,
             _kind: PhantomData,
+        }
+    }
+
+    /// `Ok(slot index)` for a live handle; `ForeignHandle(what)` for a
+    /// handle of another lineage, `StaleHandle(what)` for a removed item.
+    pub fn check<T>(&self, handle: Handle<T>, what: &'static str) -> Result<usize, Error> {
+        let i = handle.index as usize;
+        if handle.lineage != self.lineage {
+            Err(Error::ForeignHandle(what))
+        } else if self.is_live(i) && self.generation[i] == handle.generation {
+            Ok(i)
+        } else {
+            Err(Error::StaleHandle(what))
         }
     }
 
     /// Whether `handle` names a live item.
     pub fn contains<T>(&self, handle: Handle<T>) -> bool {
-        let i = handle.index as usize;
-        i < self.live.len() && self.live[i] && self.generation[i] == handle.generation
+        self.check(handle, "").is_ok()
     }
 
-    /// Frees the slot of a live handle; `false` if it was stale.
+    /// Frees the slot of a live handle; `false` if it was stale or foreign.
     pub fn remove<T>(&mut self, handle: Handle<T>) -> bool {
         if !self.contains(handle) {
             return false;
         }
-        let i = handle.index as usize;
-        self.live[i] = false;
-        self.generation[i] = self.generation[i].wrapping_add(1);
+        self.live[handle.index as usize] = false;
         self.free.insert(handle.index);
         true
+    }
+
+    /// Makes the handles this table issues from now on newer than every
+    /// handle `other` ever issued: a world restoring a snapshot keeps its
+    /// own counter when it is ahead, so nothing it handed out before the
+    /// restore is handed out again.
+    pub fn issue_after(&mut self, other: &Slots) {
+        self.next_generation = self.next_generation.max(other.next_generation);
     }
 
     /// The number of slots ever allocated (live or free).
@@ -95,14 +157,39 @@ impl Slots {
         self.live.len()
     }
 
-    /// Whether the generation and liveness tables agree in length and the
-    /// free list names only dead slots.
-    pub fn is_consistent(&self) -> bool {
-        self.generation.len() == self.live.len()
-            && self
-                .free
-                .iter()
-                .all(|&i| self.live.get(i as usize) == Some(&false))
+    /// Checks the table's own consistency (a decoded snapshot's tables are
+    /// untrusted): one generation per slot, every generation below the
+    /// counter, the counter at most [`MAX_GENERATION`], and the free list
+    /// naming exactly the dead slots. The error
+    /// names the table (`what`) and the slot.
+    pub fn validate(&self, what: &str) -> Result<(), Error> {
+        let corrupt = |why: String| Err(Error::CorruptSnapshot(format!("{what} slots: {why}")));
+        if self.generation.len() != self.live.len() {
+            return corrupt(format!(
+                "{} generations for {} slots",
+                self.generation.len(),
+                self.live.len()
+            ));
+        }
+        if self.next_generation > MAX_GENERATION {
+            return corrupt(format!("{} generations issued", self.next_generation));
+        }
+        if let Some(i) = (0..self.live.len()).find(|&i| self.generation[i] >= self.next_generation)
+        {
+            return corrupt(format!("slot {i}'s generation was never issued"));
+        }
+        if let Some(&i) = self.free.iter().find(|&&i| self.is_live(i as usize)) {
+            return corrupt(format!("slot {i} is both live and free"));
+        }
+        let dead = self.live.iter().filter(|&&l| !l).count();
+        if self.free.len() != dead {
+            return corrupt(format!(
+                "{} dead slots but {} on the free list",
+                dead,
+                self.free.len()
+            ));
+        }
+        Ok(())
     }
 
     /// Whether slot `index` is live.
@@ -114,6 +201,7 @@ impl Slots {
     pub fn handle_at<T>(&self, index: usize) -> Option<Handle<T>> {
         self.is_live(index).then(|| Handle {
             index: index as u32,
+            lineage: self.lineage,
             generation: self.generation[index],
             _kind: PhantomData,
         })
@@ -127,5 +215,56 @@ impl Slots {
     /// No live items.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reused_slot_gets_a_new_generation() {
+        let mut slots = Slots::new(1);
+        let first: Handle<()> = slots.insert();
+        assert!(slots.remove(first));
+        let second: Handle<()> = slots.insert();
+        assert_eq!(first.index(), second.index());
+        assert_eq!(slots.check(first, "x"), Err(Error::StaleHandle("x")));
+        assert_eq!(slots.check(second, "x"), Ok(0));
+    }
+
+    #[test]
+    fn a_counter_that_could_overflow_is_refused() {
+        let mut slots = Slots::new(1);
+        let _: Handle<()> = slots.insert();
+        assert_eq!(slots.validate("body"), Ok(()));
+        slots.next_generation = u64::MAX;
+        assert!(slots.validate("body").is_err());
+        slots.next_generation = 0;
+        assert!(
+            slots.validate("body").is_err(),
+            "slot 0's generation was never issued"
+        );
+    }
+
+    #[test]
+    fn another_lineage_is_foreign() {
+        let mut ours = Slots::new(1);
+        let mut theirs = Slots::new(2);
+        let _: Handle<()> = ours.insert();
+        let foreign: Handle<()> = theirs.insert();
+        assert_eq!(ours.check(foreign, "x"), Err(Error::ForeignHandle("x")));
+    }
+
+    #[test]
+    fn issuing_after_an_earlier_table_never_repeats_a_handle() {
+        let mut slots = Slots::new(1);
+        let earlier = slots.clone();
+        let later: Handle<()> = slots.insert();
+        let mut restored = earlier.clone();
+        restored.issue_after(&slots);
+        let again: Handle<()> = restored.insert();
+        assert_ne!(again, later);
+        assert_eq!(restored.check(later, "x"), Err(Error::StaleHandle("x")));
     }
 }

@@ -195,29 +195,131 @@ impl BodyStore {
             && self.angular_velocity[i].is_finite()
     }
 
-    /// Whether every array has one entry per slot (a decoded snapshot is
-    /// checked with this before it is used).
-    pub fn is_consistent(&self) -> bool {
+    /// An empty store whose handles carry `lineage` (see [`Slots`]).
+    pub fn with_lineage(lineage: u32) -> Self {
+        Self {
+            slots: Slots::new(lineage),
+            ..Self::default()
+        }
+    }
+
+    /// Checks a store that did not come from [`BodyStore::insert`] (a
+    /// decoded snapshot): the slot table, one entry per slot in every
+    /// array, and every slot (live or freed: the step uploads them all)
+    /// holding what `insert` makes of a valid [`BodyDesc`] and the step
+    /// keeps: the description's checks, masses and inertia with their
+    /// inverses computed as `insert` computes them (zero for kinematic and
+    /// static bodies), a static body at rest, finite pending forces.
+    /// The error (`CorruptSnapshot`) names the body's slot and the reason.
+    pub fn validate(&self) -> Result<(), Error> {
+        self.slots.validate("body")?;
         let n = self.slots.capacity();
-        [
-            self.kind.len(),
-            self.position.len(),
-            self.position_low.len(),
-            self.orientation.len(),
-            self.linear_velocity.len(),
-            self.angular_velocity.len(),
-            self.mass.len(),
-            self.inverse_mass.len(),
-            self.inertia.len(),
-            self.inverse_inertia.len(),
-            self.force.len(),
-            self.torque.len(),
-            self.linear_damping.len(),
-            self.angular_damping.len(),
-        ]
-        .iter()
-        .all(|&len| len == n)
-            && self.slots.is_consistent()
+        let lengths = [
+            ("kind", self.kind.len()),
+            ("position", self.position.len()),
+            ("position low part", self.position_low.len()),
+            ("orientation", self.orientation.len()),
+            ("linear velocity", self.linear_velocity.len()),
+            ("angular velocity", self.angular_velocity.len()),
+            ("mass", self.mass.len()),
+            ("inverse mass", self.inverse_mass.len()),
+            ("inertia", self.inertia.len()),
+            ("inverse inertia", self.inverse_inertia.len()),
+            ("force", self.force.len()),
+            ("torque", self.torque.len()),
+            ("linear damping", self.linear_damping.len()),
+            ("angular damping", self.angular_damping.len()),
+        ];
+        if let Some((what, len)) = lengths.iter().find(|&&(_, len)| len != n) {
+            return Err(Error::CorruptSnapshot(format!(
+                "bodies: {len} {what} entries for {n} slots"
+            )));
+        }
+        (0..n).try_for_each(|i| {
+            self.validate_slot(i)
+                .map_err(|why| Error::CorruptSnapshot(format!("body {i}: {why}")))
+        })
+    }
+
+    /// Slot `i` against what `insert` would have stored; the reason on error.
+    fn validate_slot(&self, i: usize) -> Result<(), String> {
+        let desc = self.desc(i);
+        desc.validate().map_err(|e| e.to_string())?;
+        let derived = Derived::of(&desc);
+        let cols = |m: Mat3| m.to_cols_array().to_vec();
+        let pairs = [
+            (
+                "mass of an infinite-mass body is not zero",
+                vec![self.mass[i]],
+                vec![derived.mass],
+            ),
+            (
+                "inertia of an infinite-mass body is not zero",
+                cols(self.inertia[i]),
+                cols(derived.inertia),
+            ),
+            (
+                "inverse mass is not 1/mass",
+                vec![self.inverse_mass[i]],
+                vec![derived.inverse_mass],
+            ),
+            (
+                "inverse inertia is not the inertia's inverse",
+                cols(self.inverse_inertia[i]),
+                cols(derived.inverse_inertia),
+            ),
+        ];
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        if let Some((why, _, _)) = pairs
+            .iter()
+            .find(|(_, stored, expected)| bits(stored) != bits(expected))
+        {
+            return Err((*why).into());
+        }
+        if self.kind[i] == BodyKind::Static
+            && (self.linear_velocity[i] != Vec3::ZERO || self.angular_velocity[i] != Vec3::ZERO)
+        {
+            return Err("a static body moves".into());
+        }
+        self.check_low_part(i)?;
+        check_finite("accumulated force", self.force[i]).map_err(|e| e.to_string())?;
+        check_finite("accumulated torque", self.torque[i]).map_err(|e| e.to_string())
+    }
+
+    /// Slot `i`'s low position part is what `displace` leaves: finite, and
+    /// no larger than a unit in the last place of the coordinate.
+    fn check_low_part(&self, i: usize) -> Result<(), String> {
+        let (high, low) = (self.position[i], self.position_low[i]);
+        let ulp = |x: f32| f32::from_bits(x.abs().to_bits() + 1) - x.abs();
+        let fits = (0..3).all(|k| low[k].abs() <= ulp(high[k]));
+        if low.is_finite() && fits {
+            Ok(())
+        } else {
+            Err("the position's low part is larger than the position's last digit".into())
+        }
+    }
+
+    /// Slot `i` as the description `insert` would have been given.
+    fn desc(&self, i: usize) -> BodyDesc {
+        BodyDesc {
+            kind: self.kind[i],
+            position: self.position[i],
+            orientation: self.orientation[i],
+            linear_velocity: self.linear_velocity[i],
+            angular_velocity: self.angular_velocity[i],
+            mass: (self.kind[i] == BodyKind::Dynamic).then_some(MassProperties {
+                mass: self.mass[i],
+                inertia: self.inertia[i],
+            }),
+            linear_damping: self.linear_damping[i],
+            angular_damping: self.angular_damping[i],
+        }
+    }
+
+    /// Makes the handles this store issues from now on newer than every
+    /// handle `other` issued (see [`Slots::issue_after`]).
+    pub fn issue_after(&mut self, other: &BodyStore) {
+        self.slots.issue_after(&other.slots);
     }
 
     /// Adds a body after validating `desc`; nothing changes on error.
@@ -228,11 +330,7 @@ impl BodyStore {
         if i == self.kind.len() {
             self.grow();
         }
-        let (mass, inertia) = match (desc.kind, desc.mass) {
-            (BodyKind::Dynamic, Some(m)) => (m.mass, m.inertia),
-            _ => (0.0, Mat3::ZERO),
-        };
-        let dynamic = desc.kind == BodyKind::Dynamic;
+        let derived = Derived::of(desc);
         let (velocity, spin) = match desc.kind {
             BodyKind::Static => (Vec3::ZERO, Vec3::ZERO),
             _ => (desc.linear_velocity, desc.angular_velocity),
@@ -243,14 +341,10 @@ impl BodyStore {
         self.orientation[i] = desc.orientation.normalize();
         self.linear_velocity[i] = velocity;
         self.angular_velocity[i] = spin;
-        self.mass[i] = mass;
-        self.inverse_mass[i] = if dynamic { 1.0 / mass } else { 0.0 };
-        self.inertia[i] = inertia;
-        self.inverse_inertia[i] = if dynamic {
-            inertia.inverse()
-        } else {
-            Mat3::ZERO
-        };
+        self.mass[i] = derived.mass;
+        self.inverse_mass[i] = derived.inverse_mass;
+        self.inertia[i] = derived.inertia;
+        self.inverse_inertia[i] = derived.inverse_inertia;
         self.force[i] = Vec3::ZERO;
         self.torque[i] = Vec3::ZERO;
         self.linear_damping[i] = desc.linear_damping;
@@ -275,22 +369,18 @@ impl BodyStore {
         self.angular_damping.push(0.0);
     }
 
-    /// Removes a body; `StaleHandle` if it was already gone.
+    /// Removes a body; `StaleHandle` if it was already gone,
+    /// `ForeignHandle` for another world's handle.
     pub fn remove(&mut self, handle: BodyHandle) -> Result<(), Error> {
-        if self.slots.remove(handle) {
-            Ok(())
-        } else {
-            Err(Error::StaleHandle("body"))
-        }
+        self.index(handle)?;
+        self.slots.remove(handle);
+        Ok(())
     }
 
-    /// `Ok(slot index)` for a live handle.
+    /// `Ok(slot index)` for a live handle; `StaleHandle` for a removed
+    /// body, `ForeignHandle` for another world's handle.
     pub fn index(&self, handle: BodyHandle) -> Result<usize, Error> {
-        if self.slots.contains(handle) {
-            Ok(handle.index())
-        } else {
-            Err(Error::StaleHandle("body"))
-        }
+        self.slots.check(handle, "body")
     }
 
     /// Whether `handle` names a live body.
@@ -440,5 +530,68 @@ impl BodyStore {
     /// Whether the body is dynamic, or the error for a stale handle.
     pub fn is_dynamic(&self, handle: BodyHandle) -> Result<bool, Error> {
         Ok(self.kind[self.index(handle)?] == BodyKind::Dynamic)
+    }
+}
+
+/// Mass, inertia and their inverses as `insert` stores them: the
+/// description's for a dynamic body, zero (infinite mass) otherwise.
+struct Derived {
+    mass: f32,
+    inverse_mass: f32,
+    inertia: Mat3,
+    inverse_inertia: Mat3,
+}
+
+impl Derived {
+    fn of(desc: &BodyDesc) -> Self {
+        match (desc.kind, desc.mass) {
+            (BodyKind::Dynamic, Some(m)) => Self {
+                mass: m.mass,
+                inverse_mass: 1.0 / m.mass,
+                inertia: m.inertia,
+                inverse_inertia: m.inertia.inverse(),
+            },
+            _ => Self {
+                mass: 0.0,
+                inverse_mass: 0.0,
+                inertia: Mat3::ZERO,
+                inverse_inertia: Mat3::ZERO,
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Shape;
+
+    fn store_with_a_body(x: f32) -> BodyStore {
+        let mass = Shape::Sphere { radius: 0.1 }
+            .mass_properties_with_mass(1.0)
+            .expect("valid sphere");
+        let mut store = BodyStore::default();
+        let desc = BodyDesc::dynamic(mass).with_position(Vec3::new(x, 0.0, 0.0));
+        store.insert(&desc).expect("valid body");
+        store
+    }
+
+    /// What `displace` leaves passes, whatever the coordinate; a low part
+    /// beyond the coordinate's last digit, or not finite, is refused.
+    #[test]
+    fn a_decoded_low_part_must_be_what_displace_leaves() {
+        for x in [0.0, 1.0, 1.0e5, 1.0e6] {
+            let mut store = store_with_a_body(x);
+            for _ in 0..100 {
+                store.displace(0, Vec3::new(0.0033, -1.0e-9, 7.0e-4));
+                store.validate().expect("displace keeps the invariant");
+            }
+        }
+        for low in [f32::NAN, f32::INFINITY, 0.01] {
+            let mut store = store_with_a_body(1.0e5);
+            store.position_low[0].x = low;
+            let error = store.validate().expect_err("refused").to_string();
+            assert!(error.contains("body 0: the position's low part"), "{error}");
+        }
     }
 }

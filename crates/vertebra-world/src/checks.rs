@@ -36,3 +36,11 @@ pub(crate) fn joint_bodies(bodies: &BodyStore, a: BodyHandle, b: BodyHandle) -> 
     }
     Ok(())
 }
+
+/// A joint's or contact's bodies as the colouring sees them: the slot of
+/// each dynamic one (static and kinematic bodies are never written).
+pub(crate) fn dynamic_bodies(bodies: &BodyStore, a: BodyHandle, b: BodyHandle) -> [Option<u32>; 2] {
+    let dynamic =
+        |h: BodyHandle| (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32);
+    [dynamic(a), dynamic(b)]
+}

@@ -59,6 +59,12 @@ impl Contact {
         Ok(())
     }
 
+    /// Checks the bodies too: live, and at least one dynamic.
+    pub(crate) fn validate_with(&self, bodies: &BodyStore) -> Result<(), Error> {
+        self.validate()?;
+        crate::checks::joint_bodies(bodies, self.body_a, self.body_b)
+    }
+
     /// Solver data at the bodies' current poses and velocities: the points
     /// on each surface, `depth / 2` either side of `point` along the normal,
     /// with the depth capped at `max_depth`. The cap is the push-out limit:
@@ -158,9 +164,5 @@ impl ContactLayout {
 /// Checks a whole contact list (bodies live, at least one dynamic) before
 /// any is used.
 pub(crate) fn validate_all(contacts: &[Contact], bodies: &BodyStore) -> Result<(), Error> {
-    for c in contacts {
-        c.validate()?;
-        crate::checks::joint_bodies(bodies, c.body_a, c.body_b)?;
-    }
-    Ok(())
+    contacts.iter().try_for_each(|c| c.validate_with(bodies))
 }

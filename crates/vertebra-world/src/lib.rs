@@ -55,8 +55,6 @@ pub use vertebra_store::{
 
 /// Bodies, joints and the solver that steps them.
 pub struct World {
-    /// Names this world in its snapshots.
-    id: u64,
     config: SolverConfig,
     backend: Backend,
     pool: Option<rayon::ThreadPool>,
@@ -96,16 +94,16 @@ impl World {
         } else {
             None
         };
+        let lineage = snapshot::new_lineage();
         Ok(Self {
-            id: snapshot::new_world_id(),
             config,
             backend,
             pool,
-            bodies: BodyStore::default(),
+            bodies: BodyStore::with_lineage(lineage),
             joints_at: Vec::new(),
-            socket_slots: Slots::default(),
+            socket_slots: Slots::new(lineage),
             sockets: Vec::new(),
-            rod_slots: Slots::default(),
+            rod_slots: Slots::new(lineage),
             rods: Vec::new(),
             colouring: Colouring::new(),
             layout: layout::Layout::default(),
@@ -219,9 +217,8 @@ impl World {
 
     /// Removes a socket joint.
     pub fn remove_socket(&mut self, handle: SocketHandle) -> Result<(), Error> {
-        if !self.socket_slots.remove(handle) {
-            return Err(Error::StaleHandle("socket"));
-        }
+        self.socket_slots.check(handle, "socket")?;
+        self.socket_slots.remove(handle);
         let desc = self.sockets[handle.index()]
             .take()
             .expect("live socket has a description");
@@ -247,9 +244,8 @@ impl World {
 
     /// Removes a rod constraint.
     pub fn remove_rod(&mut self, handle: RodHandle) -> Result<(), Error> {
-        if !self.rod_slots.remove(handle) {
-            return Err(Error::StaleHandle("rod"));
-        }
+        self.rod_slots.check(handle, "rod")?;
+        self.rod_slots.remove(handle);
         let desc = self.rods[handle.index()]
             .take()
             .expect("live rod has a description");
@@ -282,19 +278,14 @@ impl World {
 
     /// A rod's description.
     pub fn rod(&self, handle: RodHandle) -> Result<RodDesc, Error> {
-        if !self.rod_slots.contains(handle) {
-            return Err(Error::StaleHandle("rod"));
-        }
+        self.rod_slots.check(handle, "rod")?;
         Ok(self.rods[handle.index()].expect("live rod has a description"))
     }
 
     /// Colours a new joint and counts it at its bodies.
     fn connect(&mut self, key: u64, a: BodyHandle, b: BodyHandle) {
-        let dynamic = |h: BodyHandle| {
-            (self.bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
-        };
-        let bodies = [dynamic(a), dynamic(b)];
-        self.colouring.add(key, bodies);
+        self.colouring
+            .add(key, checks::dynamic_bodies(&self.bodies, a, b));
         self.joints_at[a.index()] += 1;
         self.joints_at[b.index()] += 1;
         self.layout_dirty = true;
@@ -326,9 +317,7 @@ impl World {
 
     /// A socket's description.
     pub fn socket(&self, handle: SocketHandle) -> Result<SocketDesc, Error> {
-        if !self.socket_slots.contains(handle) {
-            return Err(Error::StaleHandle("socket"));
-        }
+        self.socket_slots.check(handle, "socket")?;
         Ok(self.sockets[handle.index()].expect("live socket has a description"))
     }
 

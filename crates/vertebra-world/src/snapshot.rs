@@ -1,30 +1,67 @@
-//! Saving a world's full state and restoring it bit for bit (rollback).
+//! Saving a world's full state and restoring it bit for bit: rollback,
+//! save games, a server's state sent to its clients.
 //!
 //! A snapshot holds everything a step reads that outlives a step: the body
 //! store (poses, velocities, masses, pending forces, slots), the joints and
 //! their slots, the colouring (its history decides the solve order, so it
 //! is saved, not rebuilt), and the contacts set for the next step. The
 //! block layout is rebuilt from those on the next step, exactly as it was
-//! built before. The solver settings are not part of it: they belong to the
-//! world, and stepping is bit-identical across backends and thread counts.
+//! built before.
 //!
-//! Bytes: `"VTBSNAP1"`, the world's id (u64 LE), the xxh3 hash of the
-//! payload (u64 LE), then the payload (postcard).
+//! **Portable.** A snapshot restores into any world of the same build: the
+//! world that took it, or a fresh one in another process or on another
+//! machine. Nothing of the [`SolverConfig`](crate::SolverConfig) has to
+//! match for the snapshot to be accepted (the settings are the world's,
+//! not the snapshot's). To step on bit for bit as the original would have,
+//! the settings that change results must match: `substeps`, `iterations`,
+//! `gravity`, `max_push_out_speed`, `max_linear_speed`,
+//! `max_angular_speed`; `backend`, `threads` and `parallel_min_blocks` may
+//! differ (stepping is bit-identical across them). "The same build" is the
+//! same vertebra version and snapshot format; identity across compilers and
+//! targets is not promised (see `docs/robustness.md`).
+//!
+//! **Handles.** The snapshot carries its world's lineage (see
+//! [`Slots`]): a world that restores it takes on that lineage, so the
+//! handles of the world that took it are valid here (a client acting on
+//! its server's handles, a save game's handles after loading) and handles
+//! of any other world are refused as foreign. Generations only ever rise:
+//! restoring never lowers the world's counter, so a handle issued after the
+//! snapshot was taken stays stale after it is restored, and the world never
+//! issues it again.
+//!
+//! **Untrusted.** The checksum only catches accidents: anyone can write a
+//! payload that passes it. Restoring decodes and validates the whole state
+//! before anything is assigned, with the checks the API applies to the same
+//! values (bodies as [`BodyStore::validate`], joints and contacts by their
+//! `validate`, with their bodies live and the right lineage) and structural
+//! ones (slot tables, array lengths, each body's joint count, the colouring
+//! as [`Colouring::validate`]). A refused snapshot gets
+//! `Err(CorruptSnapshot)` naming the item and the reason (or
+//! `Err(IncompatibleSnapshot)` for another build) and the world is
+//! unchanged.
+//!
+//! Bytes: `"VTBSNAP2"` (the format), the build id (u64 LE: a hash of the
+//! crate version and the format), the xxh3 hash of the payload (u64 LE),
+//! then the payload (postcard).
 
+use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use serde::{Deserialize, Serialize};
 use vertebra_scheduler::Colouring;
-use vertebra_store::{BodyStore, Error, Slots};
+use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 
-use crate::{Contact, RodDesc, SocketDesc, World};
+use crate::{Contact, RodDesc, SocketDesc, World, checks, layout::ROD_KEY};
 
-const MAGIC: &[u8; 8] = b"VTBSNAP1";
+/// Bump with every change to [`State`] or anything in it.
+const FORMAT: u8 = b'3';
+const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
 /// A world's full state at one instant: [`World::snapshot`] takes it,
-/// [`World::restore`] puts it back. Stepping on from a restored world gives
-/// the same bits as stepping on from the original did.
+/// [`World::restore`] puts it back, into this world or any other of the
+/// same build (see the module documentation). Stepping on from a restored
+/// world gives the same bits as stepping on from the original did.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Snapshot {
     bytes: Vec<u8>,
@@ -36,19 +73,25 @@ impl Snapshot {
         &self.bytes
     }
 
-    /// A snapshot from bytes [`Snapshot::as_bytes`] gave; checked when it is
-    /// restored.
+    /// A snapshot from bytes [`Snapshot::as_bytes`] gave (in any process);
+    /// checked in full when it is restored.
     pub fn from_bytes(bytes: Vec<u8>) -> Self {
         Self { bytes }
     }
 }
 
-/// A process-unique id, different across processes too (hashed with the
-/// process's random hasher keys).
-pub(crate) fn new_world_id() -> u64 {
+/// A new world's lineage: different for every world, across processes too
+/// (hashed with the process's random hasher keys).
+pub(crate) fn new_lineage() -> u32 {
     use std::hash::{BuildHasher, RandomState};
     static NEXT: AtomicU64 = AtomicU64::new(0);
-    RandomState::new().hash_one(NEXT.fetch_add(1, Ordering::Relaxed))
+    RandomState::new().hash_one(NEXT.fetch_add(1, Ordering::Relaxed)) as u32
+}
+
+/// The build a snapshot must come from: this crate's version and the format.
+fn build_id() -> u64 {
+    let name = concat!("vertebra-world ", env!("CARGO_PKG_VERSION"), " snapshot ");
+    xxhash_rust::xxh3::xxh3_64(&[name.as_bytes(), MAGIC].concat())
 }
 
 #[derive(Serialize, Deserialize)]
@@ -63,21 +106,134 @@ struct State {
     contacts: Vec<Contact>,
 }
 
+fn corrupt(why: String) -> Error {
+    Error::CorruptSnapshot(why)
+}
+
 impl State {
-    fn is_consistent(&self) -> bool {
-        let b = &self.bodies;
-        let sound = |i: usize| {
-            b.is_finite(i)
-                && vertebra_store::check_unit_quat("orientation", b.orientation[i]).is_ok()
-        };
-        self.bodies.is_consistent()
-            && self.joints_at.len() == self.bodies.capacity()
-            && self.socket_slots.is_consistent()
-            && self.rod_slots.is_consistent()
-            && self.sockets.len() == self.socket_slots.capacity()
-            && self.rods.len() == self.rod_slots.capacity()
-            && (0..b.capacity()).all(sound)
+    /// The header checked, the payload decoded (nothing validated yet).
+    fn decode(bytes: &[u8]) -> Result<Self, Error> {
+        if bytes.len() < HEADER || &bytes[..7] != b"VTBSNAP" {
+            return Err(corrupt("not a vertebra snapshot".into()));
+        }
+        if bytes[7] != FORMAT {
+            return Err(Error::IncompatibleSnapshot("another snapshot format"));
+        }
+        let word = |k: usize| u64::from_le_bytes(bytes[k..k + 8].try_into().expect("8 bytes"));
+        if word(8) != build_id() {
+            return Err(Error::IncompatibleSnapshot(
+                "written by another vertebra version",
+            ));
+        }
+        let payload = &bytes[HEADER..];
+        if xxhash_rust::xxh3::xxh3_64(payload) != word(16) {
+            return Err(corrupt("checksum mismatch".into()));
+        }
+        match postcard::take_from_bytes(payload) {
+            Ok((state, [])) => Ok(state),
+            Ok(_) => Err(corrupt("bytes after the state".into())),
+            Err(e) => Err(corrupt(format!("undecodable state ({e})"))),
+        }
     }
+
+    /// The state's bytes with their header.
+    fn encode(&self) -> Vec<u8> {
+        let payload = postcard::to_allocvec(self).expect("the state always encodes");
+        let mut bytes = Vec::with_capacity(HEADER + payload.len());
+        bytes.extend_from_slice(MAGIC);
+        bytes.extend_from_slice(&build_id().to_le_bytes());
+        bytes.extend_from_slice(&xxhash_rust::xxh3::xxh3_64(&payload).to_le_bytes());
+        bytes.extend_from_slice(&payload);
+        bytes
+    }
+
+    /// Everything a world built through the API would satisfy (see the
+    /// module documentation); the error names the item.
+    fn validate(&self) -> Result<(), Error> {
+        let bodies = &self.bodies;
+        bodies.validate()?;
+        if self.joints_at.len() != bodies.capacity() {
+            return Err(corrupt(format!(
+                "{} joint counts for {} body slots",
+                self.joints_at.len(),
+                bodies.capacity()
+            )));
+        }
+        let mut edges = BTreeMap::new();
+        let mut joints_at = vec![0u32; bodies.capacity()];
+        let mut joint = |key: u64, a: BodyHandle, b: BodyHandle| {
+            edges.insert(key, checks::dynamic_bodies(bodies, a, b));
+            for h in [a, b] {
+                joints_at[h.index()] += 1;
+            }
+        };
+        let sockets = joints("socket", &self.socket_slots, &self.sockets, |d| {
+            d.validate_with(bodies)
+        })?;
+        for (slot, d) in sockets {
+            joint(slot as u64, d.body_a, d.body_b);
+        }
+        let rods = joints("rod", &self.rod_slots, &self.rods, |d| {
+            d.validate_with(bodies)
+        })?;
+        for (slot, d) in rods {
+            joint(slot as u64 + ROD_KEY, d.body_a, d.body_b);
+        }
+        if let Some(i) = (0..joints_at.len()).find(|&i| joints_at[i] != self.joints_at[i]) {
+            return Err(corrupt(format!(
+                "body {i}: counted in {} joints, used by {}",
+                self.joints_at[i], joints_at[i]
+            )));
+        }
+        self.colouring
+            .validate(&edges, bodies.capacity())
+            .map_err(|why| corrupt(format!("colouring: {why}")))?;
+        for (k, c) in self.contacts.iter().enumerate() {
+            c.validate_with(bodies)
+                .map_err(|e| corrupt(format!("contact {k}: {e}")))?;
+        }
+        Ok(())
+    }
+}
+
+/// The live joints of one kind, each checked by `validate` (the API's own
+/// check), with their slots; a description must be present exactly where
+/// its slot is live.
+fn joints<'s, D>(
+    kind: &str,
+    slots: &Slots,
+    descs: &'s [Option<D>],
+    validate: impl Fn(&D) -> Result<(), Error>,
+) -> Result<Vec<(usize, &'s D)>, Error> {
+    slots.validate(kind)?;
+    if descs.len() != slots.capacity() {
+        return Err(corrupt(format!(
+            "{} {kind} descriptions for {} slots",
+            descs.len(),
+            slots.capacity()
+        )));
+    }
+    let mut live = Vec::new();
+    for (slot, desc) in descs.iter().enumerate() {
+        match (slots.is_live(slot), desc) {
+            (true, Some(d)) => {
+                validate(d).map_err(|e| corrupt(format!("{kind} {slot}: {e}")))?;
+                live.push((slot, d));
+            }
+            (false, None) => {}
+            (true, None) => {
+                return Err(corrupt(format!(
+                    "{kind} {slot}: live without a description"
+                )));
+            }
+            (false, Some(_)) => {
+                return Err(corrupt(format!(
+                    "{kind} {slot}: a description in a free slot"
+                )));
+            }
+        }
+    }
+    Ok(live)
 }
 
 impl World {
@@ -93,38 +249,24 @@ impl World {
             colouring: self.colouring.clone(),
             contacts: self.contacts.clone(),
         };
-        let payload = postcard::to_allocvec(&state).expect("the state always encodes");
-        let mut bytes = Vec::with_capacity(HEADER + payload.len());
-        bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&self.id.to_le_bytes());
-        bytes.extend_from_slice(&xxhash_rust::xxh3::xxh3_64(&payload).to_le_bytes());
-        bytes.extend_from_slice(&payload);
-        Snapshot { bytes }
+        Snapshot {
+            bytes: state.encode(),
+        }
     }
 
-    /// Puts the world back to `snapshot`: bodies, joints and contacts added
-    /// since are gone, removed ones are back, and the handles of the time
-    /// are valid again. `Err(ForeignSnapshot)` for another world's snapshot,
-    /// `Err(CorruptSnapshot)` for damaged bytes; the world is unchanged on
-    /// error.
+    /// Puts the world in `snapshot`'s state: bodies, joints and contacts
+    /// added since are gone, removed ones are back, and the handles of the
+    /// snapshot's world are valid (see the module documentation for what
+    /// another world's snapshot needs). Handles issued after the snapshot
+    /// was taken stay stale. `Err(IncompatibleSnapshot)` for another
+    /// build's snapshot, `Err(CorruptSnapshot)` naming the item for damaged
+    /// or crafted bytes; the world is unchanged on error.
     pub fn restore(&mut self, snapshot: &Snapshot) -> Result<(), Error> {
-        let bytes = &snapshot.bytes;
-        if bytes.len() < HEADER || &bytes[..8] != MAGIC {
-            return Err(Error::CorruptSnapshot("not a vertebra snapshot"));
-        }
-        let word = |k: usize| u64::from_le_bytes(bytes[k..k + 8].try_into().expect("8 bytes"));
-        if word(8) != self.id {
-            return Err(Error::ForeignSnapshot);
-        }
-        let payload = &bytes[HEADER..];
-        if xxhash_rust::xxh3::xxh3_64(payload) != word(16) {
-            return Err(Error::CorruptSnapshot("checksum mismatch"));
-        }
-        let state: State = postcard::from_bytes(payload)
-            .map_err(|_| Error::CorruptSnapshot("undecodable state"))?;
-        if !state.is_consistent() {
-            return Err(Error::CorruptSnapshot("inconsistent state"));
-        }
+        let mut state = State::decode(&snapshot.bytes)?;
+        state.validate()?;
+        state.bodies.issue_after(&self.bodies);
+        state.socket_slots.issue_after(&self.socket_slots);
+        state.rod_slots.issue_after(&self.rod_slots);
         self.bodies = state.bodies;
         self.joints_at = state.joints_at;
         self.socket_slots = state.socket_slots;
@@ -141,10 +283,276 @@ impl World {
 
 #[cfg(test)]
 mod tests {
+    use glam::{Quat, Vec3};
+
     use super::*;
+    use crate::{AngularDrive, BodyDesc, RodStiffness, Shape, SolverConfig};
 
     #[test]
-    fn world_ids_differ() {
-        assert_ne!(new_world_id(), new_world_id());
+    fn lineages_differ() {
+        assert_ne!(new_lineage(), new_lineage());
+    }
+
+    /// Ground, three capsules hanging from it by a socket, a rod and a
+    /// driven socket, a contact pending, a removed body's slot: every part
+    /// of the state in use.
+    fn world() -> World {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let ground = world.add_body(BodyDesc::fixed()).unwrap();
+        let mass = Shape::capsule(-0.2 * Vec3::Y, 0.2 * Vec3::Y, 0.05)
+            .mass_properties_with_mass(2.0)
+            .unwrap();
+        let links: Vec<_> = (1..=3)
+            .map(|k| {
+                let at = Vec3::new(0.0, -0.5 * k as f32, 0.0);
+                world
+                    .add_body(BodyDesc::dynamic(mass).with_position(at))
+                    .unwrap()
+            })
+            .collect();
+        let gone = world.add_body(BodyDesc::fixed()).unwrap();
+        world.remove_body(gone).unwrap();
+        let bodies = world.bodies();
+        let socket =
+            SocketDesc::at_world_anchor(bodies, ground, links[0], -0.25 * Vec3::Y, -Vec3::Y)
+                .unwrap()
+                .with_swing_limit(1.0);
+        let rod = RodDesc::from_pose(bodies, links[0], links[1], &[])
+            .unwrap()
+            .with_stiffness(RodStiffness::Kirchhoff(5.0), RodStiffness::Relaxation(0.5));
+        let drive = AngularDrive {
+            target: Quat::IDENTITY,
+            compliance: 0.01,
+            damping: 1.0,
+        };
+        let driven =
+            SocketDesc::at_world_anchor(bodies, links[1], links[2], -1.25 * Vec3::Y, -Vec3::Y)
+                .unwrap()
+                .with_drive(drive);
+        world.add_socket(socket).unwrap();
+        world.add_rod(rod).unwrap();
+        world.add_socket(driven).unwrap();
+        world.set_body_velocity(links[2], Vec3::X, Vec3::Z).unwrap();
+        for _ in 0..5 {
+            world.step(1.0 / 60.0).unwrap();
+        }
+        let contact = Contact {
+            body_a: ground,
+            body_b: links[2],
+            point: -1.6 * Vec3::Y,
+            normal: -Vec3::Y,
+            depth: 0.01,
+            friction: 0.5,
+            restitution: 0.0,
+        };
+        world.set_contacts(&[contact]).unwrap();
+        world
+    }
+
+    /// `world`'s snapshot decoded, changed by `change` and encoded again
+    /// with a correct checksum: what an attacker can send.
+    fn crafted(world: &World, change: impl FnOnce(&mut State)) -> Snapshot {
+        let mut state = State::decode(world.snapshot().as_bytes()).unwrap();
+        change(&mut state);
+        Snapshot::from_bytes(state.encode())
+    }
+
+    /// The error restoring `snapshot` gives, after checking that the world
+    /// is exactly as it was.
+    fn refusal(world: &mut World, snapshot: &Snapshot) -> String {
+        let before = world.snapshot();
+        let error = world.restore(snapshot).unwrap_err();
+        assert_eq!(world.snapshot(), before, "{error} changed the world");
+        error.to_string()
+    }
+
+    #[test]
+    fn an_unchanged_state_round_trips() {
+        let mut world = world();
+        let snapshot = crafted(&world, |_| {});
+        assert_eq!(snapshot, world.snapshot());
+        world.restore(&snapshot).unwrap();
+    }
+
+    /// One change to a decoded state.
+    type Change = Box<dyn FnOnce(&mut State)>;
+
+    /// Payloads that were accepted and put NaN into the world, or panicked
+    /// in `restore` or the next step, before restore validated the state.
+    #[test]
+    fn crafted_states_are_refused_by_name_and_change_nothing() {
+        let mut world = world();
+        const NAN: f32 = f32::NAN;
+        let cases: Vec<(Change, &str)> = vec![
+            (
+                Box::new(|s| s.sockets[0].as_mut().unwrap().anchor_a.x = NAN),
+                "socket 0: anchor a is not finite",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().rest_length = -0.4),
+                "rod 0: rod rest length must be positive",
+            ),
+            (
+                Box::new(|s| s.bodies.inverse_mass[1] = NAN),
+                "body 1: inverse mass is not 1/mass",
+            ),
+            (
+                Box::new(|s| s.bodies.inverse_mass[2] *= 2.0),
+                "body 2: inverse mass is not 1/mass",
+            ),
+            (
+                Box::new(|s| s.bodies.inverse_inertia[3].x_axis.x = 1e30),
+                "body 3: inverse inertia is not the inertia's inverse",
+            ),
+            (
+                Box::new(|s| s.bodies.mass[0] = 1.0),
+                "body 0: mass of an infinite-mass body is not zero",
+            ),
+            (
+                Box::new(|s| s.bodies.position[3].y = 2e6),
+                "body 3: position is out of range",
+            ),
+            (
+                Box::new(|s| s.bodies.orientation[1] = Quat::from_xyzw(0.0, 0.0, 0.0, 2.0)),
+                "body 1: orientation is not normalised",
+            ),
+            (
+                Box::new(|s| s.bodies.linear_velocity[0] = Vec3::X),
+                "body 0: a static body moves",
+            ),
+            (
+                // The removed body's slot: the step uploads every slot.
+                Box::new(|s| s.bodies.angular_velocity[4].z = f32::INFINITY),
+                "body 4: angular velocity is not finite",
+            ),
+            (
+                Box::new(|s| s.bodies.force[2].y = NAN),
+                "body 2: accumulated force is not finite",
+            ),
+            (
+                Box::new(|s| s.bodies.linear_damping[1] = -1.0),
+                "body 1: linear damping must be positive",
+            ),
+            (
+                Box::new(|s| {
+                    s.bodies.mass.pop();
+                }),
+                "bodies: 4 mass entries for 5 slots",
+            ),
+            (
+                Box::new(|s| s.joints_at[1] -= 1),
+                "body 1: counted in 1 joints, used by 2",
+            ),
+            (
+                Box::new(|s| s.joints_at.push(0)),
+                "6 joint counts for 5 body slots",
+            ),
+            (
+                Box::new(|s| s.sockets[1] = None),
+                "socket 1: live without a description",
+            ),
+            (
+                Box::new(|s| s.rods.push(None)),
+                "2 rod descriptions for 1 slots",
+            ),
+            (
+                Box::new(|s| {
+                    let rod = s.rods[0].as_mut().unwrap();
+                    rod.body_b = rod.body_a;
+                }),
+                "rod 0: a joint needs two different bodies",
+            ),
+            (
+                Box::new(|s| {
+                    let socket = s.sockets[1].as_mut().unwrap();
+                    socket.drive.as_mut().unwrap().compliance = -1.0;
+                }),
+                "socket 1: drive compliance must be positive",
+            ),
+            (
+                Box::new(|s| s.colouring = Colouring::new()),
+                "colouring: constraint 0 is not coloured",
+            ),
+            (
+                Box::new(|s| {
+                    s.colouring.remove(0);
+                    s.colouring.add(0, [Some(3), None]);
+                }),
+                "colouring: constraint 0 is coloured over other bodies",
+            ),
+            (
+                Box::new(|s| s.contacts[0].normal = Vec3::ZERO),
+                "contact 0: contact normal is not normalised",
+            ),
+            (
+                Box::new(|s| s.contacts[0].body_b = s.contacts[0].body_a),
+                "contact 0: a joint needs two different bodies",
+            ),
+        ];
+        for (change, expected) in cases {
+            let snapshot = crafted(&world, change);
+            assert_eq!(
+                refusal(&mut world, &snapshot),
+                format!("corrupt snapshot: {expected}")
+            );
+        }
+        world.step(1.0 / 60.0).unwrap();
+    }
+
+    #[test]
+    fn a_removed_or_foreign_body_in_a_joint_is_refused() {
+        let mut world = world();
+        let mut other = World::new(SolverConfig::default()).unwrap();
+        let foreign = other.add_body(BodyDesc::fixed()).unwrap();
+        let removed = {
+            let mut w = World::new(SolverConfig::default()).unwrap();
+            w.restore(&world.snapshot()).unwrap();
+            let h = w.add_body(BodyDesc::fixed()).unwrap();
+            w.remove_body(h).unwrap();
+            h
+        };
+        let cases = [
+            (foreign, "socket 0: body handle of another world"),
+            (removed, "socket 0: stale or unknown body handle"),
+        ];
+        for (body, expected) in cases {
+            let snapshot = crafted(&world, |s| s.sockets[0].as_mut().unwrap().body_a = body);
+            assert_eq!(
+                refusal(&mut world, &snapshot),
+                format!("corrupt snapshot: {expected}")
+            );
+        }
+    }
+
+    #[test]
+    fn other_formats_builds_and_damage_are_refused() {
+        let mut world = world();
+        let good = world.snapshot().as_bytes().to_vec();
+        let mut other_format = good.clone();
+        other_format[7] = b'1';
+        let mut other_build = good.clone();
+        other_build[8] ^= 1;
+        let mut trailing = State::decode(&good).unwrap().encode();
+        trailing.push(0);
+        let sum = xxhash_rust::xxh3::xxh3_64(&trailing[HEADER..]);
+        trailing[16..24].copy_from_slice(&sum.to_le_bytes());
+        let cases = [
+            (
+                other_format,
+                "incompatible snapshot: another snapshot format",
+            ),
+            (
+                other_build,
+                "incompatible snapshot: written by another vertebra version",
+            ),
+            (trailing, "corrupt snapshot: bytes after the state"),
+            (
+                good[..HEADER - 1].to_vec(),
+                "corrupt snapshot: not a vertebra snapshot",
+            ),
+        ];
+        for (bytes, expected) in cases {
+            assert_eq!(refusal(&mut world, &Snapshot::from_bytes(bytes)), expected);
+        }
     }
 }

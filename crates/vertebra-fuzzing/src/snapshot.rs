@@ -1,0 +1,407 @@
+//! Crafted snapshots: a valid world's snapshot decoded, its state changed
+//! field by field (or its payload byte by byte), encoded again with a
+//! correct checksum, and restored.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use glam::{Mat3, Quat, Vec3};
+use serde::{Deserialize, Serialize};
+use vertebra_world::{
+    BodyHandle, BodyKind, Contact, RodDesc, RodStiffness, Snapshot, SocketDesc, SolverConfig, World,
+};
+
+use crate::input::Input;
+use crate::world::{Seen, add_body, add_rod, add_socket, set_contacts};
+
+// The payload's layout as the fuzzer sees it: `vertebra_world`'s private
+// `State` field for field (postcard is not self-describing). Every valid
+// snapshot must decode through it and encode back to the same bytes (the
+// target asserts it), so the two cannot drift apart unnoticed.
+
+#[derive(Clone, Serialize, Deserialize)]
+struct Slots {
+    lineage: u32,
+    next_generation: u64,
+    generation: Vec<u64>,
+    live: Vec<bool>,
+    free: BTreeSet<u32>,
+}
+
+#[derive(Clone, Serialize, Deserialize)]
+struct Bodies {
+    slots: Slots,
+    kind: Vec<BodyKind>,
+    position: Vec<Vec3>,
+    position_low: Vec<Vec3>,
+    orientation: Vec<Quat>,
+    linear_velocity: Vec<Vec3>,
+    angular_velocity: Vec<Vec3>,
+    mass: Vec<f32>,
+    inverse_mass: Vec<f32>,
+    inertia: Vec<Mat3>,
+    inverse_inertia: Vec<Mat3>,
+    force: Vec<Vec3>,
+    torque: Vec<Vec3>,
+    linear_damping: Vec<f32>,
+    angular_damping: Vec<f32>,
+}
+
+#[derive(Clone, Copy, Serialize, Deserialize)]
+enum Slot {
+    Colour(u8),
+    Overflow,
+}
+
+#[derive(Clone, Serialize, Deserialize)]
+struct Colouring {
+    body_colours: Vec<u32>,
+    members: Vec<BTreeSet<u64>>,
+    overflow: BTreeSet<u64>,
+    placed: BTreeMap<u64, (Slot, [Option<u32>; 2])>,
+}
+
+#[derive(Clone, Serialize, Deserialize)]
+struct State {
+    bodies: Bodies,
+    joints_at: Vec<u32>,
+    socket_slots: Slots,
+    sockets: Vec<Option<SocketDesc>>,
+    rod_slots: Slots,
+    rods: Vec<Option<RodDesc>>,
+    colouring: Colouring,
+    contacts: Vec<Contact>,
+}
+
+const HEADER: usize = 24;
+
+/// A body handle with any fields (through its serialised form).
+fn handle(index: u32, lineage: u32, generation: u64) -> BodyHandle {
+    let bytes = postcard::to_allocvec(&(index, lineage, generation)).expect("encodes");
+    postcard::from_bytes(&bytes).expect("a handle is its three fields")
+}
+
+/// A float that breaks things more often than not.
+fn value(input: &mut Input) -> f32 {
+    const SPECIAL: [f32; 12] = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        0.0,
+        -0.0,
+        -1.0,
+        1e30,
+        2e6,
+        1e-40,
+        f32::MAX,
+        f32::MIN_POSITIVE,
+        4.0,
+    ];
+    match input.pick(SPECIAL.len() + 1) {
+        k if k < SPECIAL.len() => SPECIAL[k],
+        _ => input.float(10.0),
+    }
+}
+
+fn vec3(input: &mut Input, v: &mut Vec3) {
+    v[input.pick(3)] = value(input);
+}
+
+fn quat(input: &mut Input, q: &mut Quat) {
+    let mut a = q.to_array();
+    a[input.pick(4)] = value(input);
+    *q = Quat::from_array(a);
+}
+
+fn mat3(input: &mut Input, m: &mut Mat3) {
+    let mut a = m.to_cols_array();
+    a[input.pick(9)] = value(input);
+    *m = Mat3::from_cols_array(&a);
+}
+
+/// An index near `n`: in range, just past it, or far past it.
+fn index(input: &mut Input, n: usize) -> usize {
+    match input.pick(4) {
+        0 => n,
+        1 => input.pick(1 << 16),
+        _ => input.pick(n),
+    }
+}
+
+fn slots(input: &mut Input, s: &mut Slots) {
+    let n = s.live.len();
+    match input.pick(6) {
+        0 if n > 0 => s.live[input.pick(n)] ^= true,
+        1 if n > 0 => s.generation[input.pick(n)] = input.pick(1 << 20) as u64,
+        2 => {
+            s.free.insert(index(input, n) as u32);
+        }
+        3 => s.next_generation = [0, 1, 7, 1 << 48, (1 << 48) + 1, u64::MAX][input.pick(6)],
+        4 => s.lineage ^= 1 + input.pick(255) as u32,
+        _ => {
+            s.generation.push(0);
+            s.live.push(input.flag());
+        }
+    }
+}
+
+fn body(input: &mut Input, b: &mut Bodies) {
+    // Earlier changes may have shortened `position` (and only it).
+    let n = b.kind.len().min(b.position.len());
+    if n == 0 {
+        return slots(input, &mut b.slots);
+    }
+    let i = input.pick(n);
+    match input.pick(17) {
+        0 => vec3(input, &mut b.position[i]),
+        1 => quat(input, &mut b.orientation[i]),
+        2 => vec3(input, &mut b.linear_velocity[i]),
+        3 => vec3(input, &mut b.angular_velocity[i]),
+        4 => b.mass[i] = value(input),
+        5 => b.inverse_mass[i] = value(input),
+        6 => mat3(input, &mut b.inertia[i]),
+        7 => mat3(input, &mut b.inverse_inertia[i]),
+        8 => vec3(input, &mut b.force[i]),
+        9 => vec3(input, &mut b.torque[i]),
+        10 => b.linear_damping[i] = value(input),
+        11 => b.angular_damping[i] = value(input),
+        12 => b.kind[i] = [BodyKind::Dynamic, BodyKind::Kinematic, BodyKind::Static][input.pick(3)],
+        13 => {
+            b.position.pop();
+        }
+        14 => b.inverse_mass.push(1.0),
+        15 => vec3(input, &mut b.position_low[i]),
+        _ => slots(input, &mut b.slots),
+    }
+}
+
+/// A body handle of `state`: live, dead, out of range or of another lineage.
+fn body_handle(input: &mut Input, state: &State) -> BodyHandle {
+    let s = &state.bodies.slots;
+    let i = index(input, s.live.len());
+    let generation = s.generation.get(i).copied().unwrap_or(0);
+    let lineage = if input.pick(8) == 0 {
+        !s.lineage
+    } else {
+        s.lineage
+    };
+    handle(i as u32, lineage, generation + (input.pick(8) == 0) as u64)
+}
+
+fn limit(input: &mut Input) -> Option<f32> {
+    input.flag().then(|| value(input))
+}
+
+fn socket(input: &mut Input, state: &mut State) {
+    let n = state.sockets.len();
+    if n == 0 {
+        return slots(input, &mut state.socket_slots);
+    }
+    let slot = input.pick(n);
+    let handle = body_handle(input, state);
+    let Some(s) = state.sockets[slot].as_mut() else {
+        return slots(input, &mut state.socket_slots);
+    };
+    match input.pick(10) {
+        0 => s.body_a = handle,
+        1 => s.body_b = handle,
+        2 => vec3(input, &mut s.anchor_a),
+        3 => quat(input, &mut s.frame_b),
+        4 => s.swing_limit = limit(input),
+        5 => s.twist_limit = Some([value(input), value(input)]),
+        6 => {
+            if let Some(d) = s.drive.as_mut() {
+                quat(input, &mut d.target);
+                d.compliance = value(input);
+            }
+        }
+        7 => state.sockets[slot] = None,
+        8 => state.sockets.push(None),
+        _ => slots(input, &mut state.socket_slots),
+    }
+}
+
+fn rod(input: &mut Input, state: &mut State) {
+    let n = state.rods.len();
+    if n == 0 {
+        return slots(input, &mut state.rod_slots);
+    }
+    let slot = input.pick(n);
+    let handle = body_handle(input, state);
+    let Some(r) = state.rods[slot].as_mut() else {
+        return slots(input, &mut state.rod_slots);
+    };
+    match input.pick(11) {
+        0 => r.body_a = handle,
+        1 => r.body_b = handle,
+        2 => quat(input, &mut r.frame_a),
+        3 => r.rest_length = value(input),
+        4 => vec3(input, &mut r.bend_rest),
+        5 => r.twist_rest = value(input),
+        6 => r.bending = RodStiffness::Kirchhoff(value(input)),
+        7 => r.twisting = RodStiffness::Relaxation(value(input)),
+        8 => r.bend_limit = limit(input),
+        9 => state.rods[slot] = None,
+        _ => slots(input, &mut state.rod_slots),
+    }
+}
+
+fn colouring(input: &mut Input, c: &mut Colouring) {
+    let keys: Vec<u64> = c.placed.keys().copied().collect();
+    let key = keys.get(input.pick(keys.len())).copied().unwrap_or(0);
+    match input.pick(6) {
+        0 => {
+            let colour = input.pick(30) as u8;
+            if let Some(p) = c.placed.get_mut(&key) {
+                p.0 = Slot::Colour(colour);
+            }
+            if let Some(m) = c.members.get_mut(colour as usize) {
+                m.insert(key);
+            }
+        }
+        1 => {
+            if let Some(p) = c.placed.get_mut(&key) {
+                p.1[input.pick(2)] = input.flag().then(|| input.pick(1 << 16) as u32);
+            }
+        }
+        2 => {
+            let n = c.body_colours.len();
+            if n > 0 {
+                c.body_colours[input.pick(n)] ^= 1 << input.pick(32);
+            }
+        }
+        3 => {
+            c.placed.remove(&key);
+        }
+        4 => {
+            c.overflow.insert(key);
+        }
+        _ => {
+            c.members.pop();
+        }
+    }
+}
+
+fn contact(input: &mut Input, state: &mut State) {
+    let handle = body_handle(input, state);
+    let Some(c) = state.contacts.first_mut() else {
+        return;
+    };
+    match input.pick(6) {
+        0 => c.body_a = handle,
+        1 => c.body_b = handle,
+        2 => vec3(input, &mut c.point),
+        3 => vec3(input, &mut c.normal),
+        4 => c.depth = value(input),
+        _ => c.restitution = value(input),
+    }
+}
+
+/// One change to the state, chosen by the input.
+fn change(input: &mut Input, state: &mut State) {
+    match input.pick(7) {
+        0 | 1 => body(input, &mut state.bodies),
+        2 => socket(input, state),
+        3 => rod(input, state),
+        4 => colouring(input, &mut state.colouring),
+        5 => contact(input, state),
+        _ => {
+            let n = state.joints_at.len();
+            match n {
+                0 => state.joints_at.push(1),
+                _ => state.joints_at[input.pick(n)] = input.pick(4) as u32,
+            }
+        }
+    }
+}
+
+/// A small valid world from the input: up to 6 bodies, sockets, rods,
+/// contacts, some steps and removals (refused calls skipped).
+fn build(input: &mut Input) -> World {
+    let mut world = World::new(SolverConfig::default()).expect("a valid config");
+    let mut seen = Seen::default();
+    for _ in 0..2 + input.pick(5) {
+        if let Ok(h) = add_body(&mut world, input) {
+            seen.bodies.push(h);
+        }
+    }
+    for _ in 0..input.pick(6) {
+        let _ = match input.pick(3) {
+            0 => add_socket(&mut world, &seen, input).map(|h| seen.sockets.push(h)),
+            1 => add_rod(&mut world, &seen, input).map(|h| seen.rods.push(h)),
+            _ => world.step(1.0 / 60.0),
+        };
+    }
+    if input.flag() && !seen.sockets.is_empty() {
+        let _ = world.remove_socket(seen.sockets[0]);
+    }
+    if input.flag() && !seen.bodies.is_empty() {
+        let _ = world.remove_body(seen.bodies[input.pick(seen.bodies.len())]);
+    }
+    let _ = set_contacts(&mut world, &seen, input);
+    world
+}
+
+/// `payload` under `header`'s format and build, with a correct checksum.
+fn sealed(header: &[u8], payload: &[u8]) -> Snapshot {
+    let mut bytes = header[..16].to_vec();
+    bytes.extend_from_slice(&xxhash_rust::xxh3::xxh3_64(payload).to_le_bytes());
+    bytes.extend_from_slice(payload);
+    Snapshot::from_bytes(bytes)
+}
+
+/// Builds a small world from the input, snapshots it, changes the decoded
+/// state (up to 4 field changes: floats to NaN, infinities, huge values;
+/// indices, generations, lineages, lengths, colours) or the payload's bytes
+/// (then re-checksummed), and restores the result into the world and into
+/// a fresh one. Each restore either refuses with a named error and leaves
+/// its world exactly as it was, or accepts, and then 3 steps keep every
+/// body finite without the step's NaN guard firing.
+pub fn snapshot(data: &[u8]) {
+    let mut input = Input::new(data);
+    let world = build(&mut input);
+    let original = world.snapshot();
+    let (header, payload) = original.as_bytes().split_at(HEADER);
+    let mut state: State = postcard::from_bytes(payload).expect("a valid snapshot decodes");
+    let encoded = postcard::to_allocvec(&state).expect("encodes");
+    assert_eq!(
+        encoded, payload,
+        "the fuzzer's State has drifted from the world's"
+    );
+    let crafted = if input.pick(4) == 0 {
+        let mut bytes = encoded;
+        for _ in 0..1 + input.pick(4) {
+            let k = input.pick(bytes.len());
+            match (input.pick(3), bytes.get_mut(k)) {
+                (0, Some(byte)) => *byte ^= 1 << input.pick(8),
+                (1, Some(byte)) => *byte = input.pick(256) as u8,
+                _ => bytes.truncate(k),
+            }
+        }
+        sealed(header, &bytes)
+    } else {
+        for _ in 0..1 + input.pick(4) {
+            change(&mut input, &mut state);
+        }
+        sealed(header, &postcard::to_allocvec(&state).expect("encodes"))
+    };
+    let fresh = World::new(SolverConfig::default()).expect("a valid config");
+    for mut target in [world, fresh] {
+        let before = target.snapshot();
+        match target.restore(&crafted) {
+            Err(error) => {
+                assert!(!error.to_string().is_empty());
+                assert_eq!(target.snapshot(), before, "refused ({error}) but changed");
+            }
+            Ok(()) => {
+                for _ in 0..3 {
+                    target.step(1.0 / 60.0).expect("a valid time step");
+                    let store = target.bodies();
+                    for i in 0..store.capacity() {
+                        assert!(store.is_finite(i), "body {i} went non-finite");
+                    }
+                }
+                assert_eq!(target.repaired_bodies(), 0, "the NaN guard fired");
+            }
+        }
+    }
+}
