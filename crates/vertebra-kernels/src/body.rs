@@ -326,10 +326,7 @@ impl StartLane {
         qb: glam::Quat,
         local_b: glam::Vec3,
     ) -> Self {
-        let arm = |q: glam::Quat, local: glam::Vec3| {
-            glam::Vec3::from(Quat::<f32>::from(q).rotate(Vec3::<f32>::from(local)))
-        };
-        let (arm_a, arm_b) = (arm(qa, local_a), arm(qb, local_b));
+        let (arm_a, arm_b) = (lever_arm(qa, local_a), lever_arm(qb, local_b));
         let gap = (pb + arm_b.as_dvec3()) - (pa + arm_a.as_dvec3());
         Self {
             gap: gap.as_vec3(),
@@ -337,6 +334,12 @@ impl StartLane {
             arm_b,
         }
     }
+}
+
+/// `q local` by the kernels' own rotation (the scalar twin of every
+/// backend's), so that it cancels exactly against a kernel's `q.rotate`.
+fn lever_arm(q: glam::Quat, local: glam::Vec3) -> glam::Vec3 {
+    glam::Vec3::from(Quat::<f32>::from(q).rotate(Vec3::<f32>::from(local)))
 }
 
 impl BodyPairs {
