@@ -27,13 +27,13 @@ mod config;
 mod contact;
 mod layout;
 mod metrics;
+mod parallel;
 mod rod;
 mod snapshot;
 mod socket;
 mod step;
 
 use glam::{Quat, Vec3};
-use vertebra_kernels::body::BodyRows;
 use vertebra_math::Backend;
 use vertebra_scheduler::Colouring;
 use vertebra_store::Slots;
@@ -68,7 +68,7 @@ pub struct World {
     layout_dirty: bool,
     contacts: Vec<Contact>,
     contact_layout: contact::ContactLayout,
-    rows: BodyRows,
+    rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
     residuals: Residuals,
     /// Bodies put back by the step's last-line NaN guard, ever.
@@ -109,7 +109,7 @@ impl World {
             layout_dirty: false,
             contacts: Vec::new(),
             contact_layout: contact::ContactLayout::default(),
-            rows: BodyRows::default(),
+            rows: parallel::Scratch::default(),
             previous: Vec::new(),
             residuals: Residuals::default(),
             repaired: 0,
@@ -380,7 +380,7 @@ impl World {
     /// right after building a ragdoll).
     pub fn measure_residuals(&mut self) -> &Residuals {
         self.refresh_layout();
-        step::upload(&self.bodies, &mut self.rows);
+        step::upload(&self.bodies, self.rows.get());
         self.residuals = metrics::residuals(self);
         &self.residuals
     }

@@ -63,8 +63,9 @@ fn collect<H>(
     joints.into_iter().map(|j| j.1).collect()
 }
 
-pub(crate) fn residuals(world: &World) -> Residuals {
-    let (sockets, rods, rows) = (&world.layout.sockets, &world.layout.rods, &world.rows);
+pub(crate) fn residuals(world: &mut World) -> Residuals {
+    let rows = &*world.rows.get();
+    let (sockets, rods) = (&world.layout.sockets, &world.layout.rods);
     let mut socket_lanes = vec![[0.0f32; 2]; sockets.blocks.len() * BLOCK_LANES];
     world.backend.dispatch(ResidualPass {
         blocks: &sockets.blocks,

@@ -3,7 +3,6 @@
 //! bodies, Müller et al. 2020, algorithm 2).
 
 use glam::{Quat, Vec3};
-use rayon::prelude::*;
 use vertebra_kernels::body::BodyRows;
 use vertebra_kernels::contact::{self, ContactBlock};
 use vertebra_kernels::rod::{self, RodBlock};
@@ -12,10 +11,11 @@ use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
 
 use crate::World;
+use crate::parallel::chunked;
 
 pub(crate) fn step(world: &mut World, dt: f32) {
     let h = dt / world.config.substeps as f32;
-    upload(&world.bodies, &mut world.rows);
+    upload(&world.bodies, world.rows.get());
     world
         .previous
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
@@ -101,7 +101,7 @@ fn predict(world: &mut World, h: f32) {
         world.previous[i] = (b.position[i], b.orientation[i]);
         b.position[i] += b.linear_velocity[i] * h;
         b.orientation[i] = integrate(b.orientation[i], b.angular_velocity[i], h);
-        world.rows.pose[i + 1].set(BodyRows::pose_row(
+        world.rows.get().pose[i + 1].set(BodyRows::pose_row(
             b.position[i],
             b.inverse_mass[i],
             b.orientation[i],
@@ -188,7 +188,7 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
     // is a fork-join among its workers, not a wake-up from outside.
     let threads = world.config.threads;
     let min_blocks = world.config.parallel_min_blocks;
-    let rows = &world.rows;
+    let rows = &*world.rows.get();
     // This step's contacts first, coloured on their own; the joints after.
     let contacts = &mut world.contact_layout;
     let groups = contacts.colours.iter().map(|r| (r.clone(), world.backend));
@@ -199,9 +199,15 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
         } else {
             threads
         };
-        chunked(parallel, min_blocks, &mut contacts.blocks[range], |c| {
-            pass.contacts(c, rows, backend)
-        });
+        let blocks = &mut contacts.blocks[range];
+        chunked(
+            parallel,
+            min_blocks,
+            contacts.disjoint,
+            blocks,
+            rows,
+            |c, rows| pass.contacts(c, rows, backend),
+        );
     }
     // The groups are read in place (no copy per iteration): they and the
     // blocks are disjoint fields of the layout.
@@ -215,30 +221,24 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
         };
         for (range, driven) in [(&group.driven, true), (&group.plain, false)] {
             let blocks = &mut layout.sockets.blocks[range.clone()];
-            chunked(parallel, min_blocks, blocks, |c| {
-                pass.sockets(c, driven, rows, backend)
-            });
+            chunked(
+                parallel,
+                min_blocks,
+                layout.disjoint,
+                blocks,
+                rows,
+                |c, rows| pass.sockets(c, driven, rows, backend),
+            );
         }
         let blocks = &mut layout.rods.blocks[group.rods.clone()];
-        chunked(parallel, min_blocks, blocks, |c| {
-            pass.rods(c, rows, backend)
-        });
-    }
-}
-
-/// Runs `run` on all `blocks`, split over `threads` (of the current rayon
-/// pool: the step runs inside the world's) when there are enough.
-fn chunked<B: Send>(
-    threads: usize,
-    min_blocks: usize,
-    blocks: &mut [B],
-    run: impl Fn(&mut [B]) + Sync,
-) {
-    if threads > 1 && blocks.len() >= min_blocks {
-        let chunk = blocks.len().div_ceil(threads * 2);
-        blocks.par_chunks_mut(chunk).for_each(&run);
-    } else {
-        run(blocks);
+        chunked(
+            parallel,
+            min_blocks,
+            layout.disjoint,
+            blocks,
+            rows,
+            |c, rows| pass.rods(c, rows, backend),
+        );
     }
 }
 
@@ -320,7 +320,7 @@ fn solve_velocities(world: &mut World, h: f32) {
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
-            let [vx, vy, vz, _, wx, wy, wz, _] = world.rows.velocity[i + 1].get();
+            let [vx, vy, vz, _, wx, wy, wz, _] = world.rows.get().velocity[i + 1].get();
             b.linear_velocity[i] = Vec3::new(vx, vy, vz);
             b.angular_velocity[i] = Vec3::new(wx, wy, wz);
         }
@@ -335,14 +335,14 @@ fn derive_velocities(world: &mut World, h: f32) {
         if !b.is_live(i) || b.kind[i] != BodyKind::Dynamic {
             continue;
         }
-        let [px, py, pz, _, qx, qy, qz, qw] = world.rows.pose[i + 1].get();
+        let [px, py, pz, _, qx, qy, qz, qw] = world.rows.get().pose[i + 1].get();
         let (p, q) = (Vec3::new(px, py, pz), Quat::from_xyzw(qx, qy, qz, qw));
         let (p0, q0) = world.previous[i];
         b.position[i] = p;
         b.orientation[i] = q;
         b.linear_velocity[i] = (p - p0) / h;
         b.angular_velocity[i] = angular_velocity(q, q0, h);
-        world.rows.velocity[i + 1].set(BodyRows::velocity_row(
+        world.rows.get().velocity[i + 1].set(BodyRows::velocity_row(
             b.linear_velocity[i],
             b.angular_velocity[i],
         ));
