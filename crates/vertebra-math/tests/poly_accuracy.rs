@@ -199,7 +199,7 @@ fn wrap_angle_lands_in_minus_pi_to_pi_on_the_same_angle() {
     use std::f32::consts::PI;
     let bound = 3.5e-7;
     let xs = grid(-4.0 * PI, 4.0 * PI, 2_000_000);
-    let got = assert_agree(&Wrap, &[xs.clone()]).remove(0);
+    let got = assert_agree(&Wrap, std::slice::from_ref(&xs)).remove(0);
     // The same angle: `got - x` is a whole number of turns, to within the bound.
     let tau = std::f64::consts::TAU;
     let off_turns = |(&x, &g): (&f32, &f32)| {
