@@ -34,7 +34,7 @@ mod socket;
 mod step;
 
 use glam::{Quat, Vec3};
-use vertebra_math::Backend;
+use vertebra_math::{Backend, DefaultFloatMode};
 use vertebra_scheduler::Colouring;
 use vertebra_store::Slots;
 
@@ -379,6 +379,7 @@ impl World {
     /// Residual joint error of the current poses, without stepping (e.g.
     /// right after building a ragdoll).
     pub fn measure_residuals(&mut self) -> &Residuals {
+        let _mode = DefaultFloatMode::enter();
         self.refresh_layout();
         step::upload(&self.bodies, self.rows.get());
         self.residuals = metrics::residuals(self);
@@ -411,7 +412,10 @@ impl World {
         metrics::state_hash(&self.bodies)
     }
 
-    /// Advances the world by `dt` seconds (finite, positive).
+    /// Advances the world by `dt` seconds (finite, positive). The step
+    /// computes in the default floating-point mode on every thread it uses,
+    /// whatever mode (FTZ, DAZ, rounding) the caller runs in, and gives the
+    /// caller's mode back ([`vertebra_math::float_mode`]).
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         if dt > vertebra_store::MAX_TIME_STEP {
@@ -422,6 +426,7 @@ impl World {
                 "time step (each substep at least 1e-6 s)",
             ));
         }
+        let _mode = DefaultFloatMode::enter();
         self.refresh_layout();
         let max_depth = self.config.max_push_out_speed * dt;
         self.contact_layout =
@@ -430,7 +435,10 @@ impl World {
         // among its workers (see step::for_each_colour).
         match self.pool.take() {
             Some(pool) => {
-                pool.install(|| step::step(self, dt));
+                pool.install(|| {
+                    let _mode = DefaultFloatMode::enter();
+                    step::step(self, dt)
+                });
                 self.pool = Some(pool);
             }
             None => step::step(self, dt),

@@ -13,6 +13,7 @@ use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
 use vertebra_kernels::body::{BodyPairs, BodyRows};
+use vertebra_math::DefaultFloatMode;
 use vertebra_math::row::NO_WRITE;
 
 /// The world's body rows: scratch of a step, reached only through
@@ -64,9 +65,11 @@ pub(crate) fn chunked<B: Send>(
     if threads > 1 && disjoint && blocks.len() >= min_blocks {
         let chunk = blocks.len().div_ceil(threads * 2);
         let shared = Shared(rows);
-        blocks
-            .par_chunks_mut(chunk)
-            .for_each(|c| run(c, shared.rows()));
+        blocks.par_chunks_mut(chunk).for_each(|c| {
+            // A worker starts in whatever mode its creator had.
+            let _mode = DefaultFloatMode::enter();
+            run(c, shared.rows())
+        });
     } else {
         run(blocks, rows);
     }
