@@ -406,10 +406,18 @@ impl World {
         self.repaired
     }
 
-    /// A 64-bit hash of every live body's state, bit for bit: two worlds
-    /// with the same hash are (with overwhelming likelihood) identical.
+    /// A 64-bit hash, bit for bit, of everything a step reads that outlives
+    /// the step (what a [`Snapshot`] holds): every body's kind, pose,
+    /// velocities, mass and inertia, damping and pending forces and torques;
+    /// the handles' generations and free slots; the joints; the colouring
+    /// (the solve order); the contacts set for the next step. Two worlds
+    /// with the same hash step on to the same bits (with overwhelming
+    /// likelihood): for rollback, a desync shows in the hash.
+    ///
+    /// Not covered: the settings ([`SolverConfig`]; backend and thread count
+    /// do not change results), residuals and counters.
     pub fn state_hash(&self) -> u64 {
-        metrics::state_hash(&self.bodies)
+        metrics::state_hash(self)
     }
 
     /// Advances the world by `dt` seconds (finite, positive). The step
