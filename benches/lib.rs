@@ -2,7 +2,7 @@
 //! count) benchmarks, so both measure exactly the same work.
 
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
-use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane};
@@ -339,6 +339,7 @@ impl ContactWorkload {
                 friction: 0.6,
                 restitution: 0.2,
                 approach: -1.0,
+                start: StartLane::default(),
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }

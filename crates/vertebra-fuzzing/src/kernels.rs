@@ -3,7 +3,7 @@
 use core::f32::consts::PI;
 
 use glam::{Mat3, Vec3};
-use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_kernels::socket::{self, SocketBlock, SocketLane};
@@ -70,6 +70,15 @@ fn softness(input: &mut Input) -> RodSoftness {
     }
 }
 
+/// A start of step for one lane (see `vertebra_kernels::body::PairStart`).
+fn start(input: &mut Input) -> StartLane {
+    StartLane {
+        gap: input.vec3(1.0),
+        arm_a: input.vec3(1.0),
+        arm_b: input.vec3(1.0),
+    }
+}
+
 fn socket_block(input: &mut Input, rows: &RawRows) -> SocketBlock {
     let mut block = SocketBlock::padding();
     for k in 0..BLOCK_LANES {
@@ -94,6 +103,7 @@ fn socket_block(input: &mut Input, rows: &RawRows) -> SocketBlock {
             }),
         };
         block.set(k, &lane);
+        block.bodies.set_start(k, &start(input));
     }
     block
 }
@@ -118,6 +128,7 @@ fn rod_block(input: &mut Input, rows: &RawRows) -> RodBlock {
             twist_range: sorted_range(input),
         };
         block.set(k, &lane);
+        block.bodies.set_start(k, &start(input));
     }
     block
 }
@@ -137,8 +148,10 @@ fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
             friction: input.float(2.0).abs(),
             restitution: input.float(1.0).abs().min(1.0),
             approach: input.float(10.0),
+            start: start(input),
         };
         block.set(k, &lane);
+        block.bodies.set_start(k, &start(input));
     }
     block
 }

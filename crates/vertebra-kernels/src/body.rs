@@ -7,6 +7,14 @@
 //! | inertia | `S.xx S.yy S.zz S.xy S.xz S.yz 0 0`: inverse inertia, body frame (1/(kg m^2)) |
 //! | velocity | `v.x v.y v.z 0 w.x w.y w.z 0` (m/s, rad/s, world) |
 //!
+//! `p` is the body's *displacement* since the step began, not its
+//! coordinate: everything the kernels compute from positions is a
+//! difference between two bodies, and [`PairStart`] holds each pair's
+//! difference at the start of the step, measured once in double precision.
+//! So a correction or a velocity `dp / h` keeps the f32 precision of the
+//! motion, however far from the origin the bodies are (Box2D v3 keeps a
+//! per-body delta position for the same reason).
+//!
 //! Row 0 of every table is the *null row*: identity pose, zero inverse mass
 //! and inertia. Padding lanes read it and write nothing, so they do nothing.
 //! A body in slot `i` of the store has row `i + 1`.
@@ -17,7 +25,7 @@
 //! `w = n^T I^-1 n`, with `I^-1 = R S R^T` the world-space inverse inertia.
 
 use bytemuck::{Pod, Zeroable};
-use vertebra_math::block::BLOCK_LANES;
+use vertebra_math::block::{BLOCK_LANES, Vec3Block};
 use vertebra_math::row::{NO_WRITE, ROW_LEN, Row};
 use vertebra_math::{Lane, Quat, Sym3, Vec3};
 
@@ -99,7 +107,7 @@ impl BodyRows {
 /// One body per lane: pose and body-frame inverse inertia.
 #[derive(Clone, Copy, Debug)]
 pub struct BodyLanes<L> {
-    /// Centre of mass (m, world).
+    /// Displacement of the centre of mass since the step began (m, world).
     pub p: Vec3<L>,
     /// Inverse mass (1/kg).
     pub inv_mass: L,
@@ -239,6 +247,96 @@ pub struct BodyPairs {
     pub write_a: [u32; BLOCK_LANES],
     /// Row written for body b (`NO_WRITE` unless dynamic).
     pub write_b: [u32; BLOCK_LANES],
+    /// Each lane's [`PairStart`]: the points' separation when the step
+    /// began (m, world).
+    pub start_gap: Vec3Block,
+    /// The world lever arm of a's point when the step began (m).
+    pub start_arm_a: Vec3Block,
+    /// The world lever arm of b's point when the step began (m).
+    pub start_arm_b: Vec3Block,
+}
+
+/// Where a pair of body points stood when the step began: their separation
+/// `gap = (P_b + arm_b) - (P_a + arm_a)`, measured in double precision from
+/// the bodies' coordinates `P`, and the lever arms `arm = q local` of that
+/// moment. With the rows holding displacements `p` since then, the points'
+/// separation now is
+///
+/// `d = gap + ((p_b + (r_b - arm_b)) - (p_a + (r_a - arm_a)))`
+///
+/// with every term the size of the motion or of the joint's error, never
+/// the size of a coordinate; a body that has not turned has `r = arm`
+/// exactly (the same rotation of the same numbers), so even a static body
+/// whose anchor lies kilometres from its centre adds nothing.
+#[derive(Clone, Copy, Debug)]
+pub struct PairStart<L> {
+    /// Separation of the points when the step began (m).
+    pub gap: Vec3<L>,
+    /// a's lever arm when the step began (m).
+    pub arm_a: Vec3<L>,
+    /// b's lever arm when the step began (m).
+    pub arm_b: Vec3<L>,
+}
+
+impl<L: Lane> PairStart<L> {
+    /// The points' separation now (m), from a's point to b's, for the
+    /// current lever arms `ra`, `rb`.
+    #[inline(always)]
+    pub fn separation(
+        &self,
+        a: &BodyLanes<L>,
+        b: &BodyLanes<L>,
+        ra: Vec3<L>,
+        rb: Vec3<L>,
+    ) -> Vec3<L> {
+        self.gap + ((b.p + (rb - self.arm_b)) - (a.p + (ra - self.arm_a)))
+    }
+
+    /// The chord between the centres of mass now (m), for pairs whose
+    /// points are the centres (zero arms).
+    #[inline(always)]
+    pub fn chord(&self, a: &BodyLanes<L>, b: &BodyLanes<L>) -> Vec3<L> {
+        self.gap + (b.p - a.p)
+    }
+}
+
+/// One lane's [`PairStart`], as the world computes it from the bodies at
+/// the start of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StartLane {
+    /// Separation of the points (m, world).
+    pub gap: glam::Vec3,
+    /// a's lever arm (m, world).
+    pub arm_a: glam::Vec3,
+    /// b's lever arm (m, world).
+    pub arm_b: glam::Vec3,
+}
+
+impl StartLane {
+    /// Points `local_a` on a and `local_b` on b (m, body frames) of bodies
+    /// at coordinates `pa`, `pb` (m, world, double precision) turned by
+    /// `qa`, `qb`. The arms are rotated by the kernels' own rotation (the
+    /// scalar twin of every backend), so an unturned body's arm cancels
+    /// exactly.
+    pub fn new(
+        pa: glam::DVec3,
+        qa: glam::Quat,
+        local_a: glam::Vec3,
+        pb: glam::DVec3,
+        qb: glam::Quat,
+        local_b: glam::Vec3,
+    ) -> Self {
+        let arm = |q: glam::Quat, local: glam::Vec3| {
+            glam::Vec3::from(Quat::<f32>::from(q).rotate(Vec3::<f32>::from(local)))
+        };
+        let (arm_a, arm_b) = (arm(qa, local_a), arm(qb, local_b));
+        let gap = (pb + arm_b.as_dvec3()) - (pa + arm_a.as_dvec3());
+        Self {
+            gap: gap.as_vec3(),
+            arm_a,
+            arm_b,
+        }
+    }
 }
 
 impl BodyPairs {
@@ -248,6 +346,23 @@ impl BodyPairs {
         self.body_b[lane] = b;
         self.write_a[lane] = if dynamic_a { a } else { NO_WRITE };
         self.write_b[lane] = if dynamic_b { b } else { NO_WRITE };
+    }
+
+    /// Sets lane `lane`'s start of step.
+    pub fn set_start(&mut self, lane: usize, s: &StartLane) {
+        self.start_gap.set(lane, s.gap);
+        self.start_arm_a.set(lane, s.arm_a);
+        self.start_arm_b.set(lane, s.arm_b);
+    }
+
+    /// The start of step of lanes `start .. start + L::WIDTH`.
+    #[inline(always)]
+    pub fn start<L: Lane>(&self, start: usize) -> PairStart<L> {
+        PairStart {
+            gap: self.start_gap.load(start),
+            arm_a: self.start_arm_a.load(start),
+            arm_b: self.start_arm_b.load(start),
+        }
     }
 
     /// Gathers both bodies of lanes `start .. start + L::WIDTH`.

@@ -38,7 +38,8 @@ use glam::Vec3 as GVec3;
 use vertebra_math::block::{BLOCK_LANES, Vec3Block};
 use vertebra_math::{Lane, LaneKernel, Vec3};
 
-use crate::body::{BodyLanes, BodyPairs, BodyRows, VelocityLanes, safe_ratio};
+use crate::body::{BodyLanes, BodyPairs, BodyRows, StartLane, VelocityLanes, safe_ratio};
+use crate::parts::point;
 
 /// Eight contacts, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -89,6 +90,8 @@ pub struct ContactLane {
     pub restitution: f32,
     /// Approach velocity along the normal (m/s).
     pub approach: f32,
+    /// The two points when the step began.
+    pub start: StartLane,
 }
 
 impl ContactBlock {
@@ -101,6 +104,7 @@ impl ContactBlock {
     pub fn set(&mut self, lane: usize, c: &ContactLane) {
         self.bodies
             .set(lane, c.body_a, c.body_b, c.dynamic_a, c.dynamic_b);
+        self.bodies.set_start(lane, &c.start);
         self.point_a.set(lane, c.point_a);
         self.point_b.set(lane, c.point_b);
         self.normal.set(lane, c.normal);
@@ -118,7 +122,8 @@ impl ContactBlock {
     }
 }
 
-/// Lever arms and the world points' difference `(p_b + r_b) - (p_a + r_a)`.
+/// Lever arms and the world points' difference `(p_b + r_b) - (p_a + r_a)`
+/// (the point part's measure).
 #[inline(always)]
 fn arms<L: Lane>(
     block: &ContactBlock,
@@ -126,9 +131,13 @@ fn arms<L: Lane>(
     a: &BodyLanes<L>,
     b: &BodyLanes<L>,
 ) -> (Vec3<L>, Vec3<L>, Vec3<L>) {
-    let ra = a.q.rotate(block.point_a.load(start));
-    let rb = b.q.rotate(block.point_b.load(start));
-    (ra, rb, (b.p + rb) - (a.p + ra))
+    point::separation(
+        a,
+        b,
+        block.point_a.load(start),
+        block.point_b.load(start),
+        &block.bodies.start(start),
+    )
 }
 
 /// Moves both bodies by the positional impulse `impulse` (b) and its

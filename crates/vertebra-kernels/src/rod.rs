@@ -238,10 +238,17 @@ fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows,
     );
     twist::limit(&mut a, &mut b, &f, lo, hi);
 
+    let chord = block.bodies.start(start);
     let f = frames(&a, &b, frame_a, frame_b);
-    curve::solve(&mut a, &mut b, &f);
+    curve::solve(&mut a, &mut b, &f, &chord);
     let f = frames(&a, &b, frame_a, frame_b);
-    length::solve(&mut a, &mut b, &f, L::load(&block.rest_length[start..]));
+    length::solve(
+        &mut a,
+        &mut b,
+        &f,
+        L::load(&block.rest_length[start..]),
+        &chord,
+    );
 
     block.bodies.scatter(rows, start, &a, &b);
 }
@@ -259,8 +266,10 @@ impl Residual for RodBlock {
             self.frame_a.load::<L>(start),
             self.frame_b.load::<L>(start),
         );
-        let (_, c_len) = length::measure(&a, &b, &f, L::load(&self.rest_length[start..]));
-        let c_curve = curve::measure(&a, &b, &f).theta;
+        let chord = self.bodies.start(start);
+        let rest_length = L::load(&self.rest_length[start..]);
+        let (_, c_len) = length::measure(&a, &b, &f, rest_length, &chord);
+        let c_curve = curve::measure(&a, &b, &f, &chord).theta;
         let (_, bend_over) = bend::overshoot(&f, L::load(&self.bend_max[start..]));
         let (lo, hi) = (
             L::load(&self.twist_min[start..]),

@@ -198,6 +198,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
         &mut b,
         block.anchor_a.load(start),
         block.anchor_b.load(start),
+        &block.bodies.start(start),
     );
 
     block.bodies.scatter(rows, start, &a, &b);
@@ -243,8 +244,13 @@ impl Residual for SocketBlock {
     fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
         let (a, b) = self.bodies.gather::<L>(rows, start);
         let (fa, fb) = (self.frame_a.load::<L>(start), self.frame_b.load::<L>(start));
-        let (_, _, d) =
-            point::separation(&a, &b, self.anchor_a.load(start), self.anchor_b.load(start));
+        let (_, _, d) = point::separation(
+            &a,
+            &b,
+            self.anchor_a.load(start),
+            self.anchor_b.load(start),
+            &self.bodies.start(start),
+        );
         let (_, theta) = swing::measure(&a, &b, fa, fb);
         let (_, phi) = twist::measure(&a, &b, fa, fb);
         let (lo, hi) = (

@@ -100,6 +100,9 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>
                     },
                 },
             );
+            block
+                .bodies
+                .set_start(lane, &common::start(&mut r, adversarial));
         }
         out.push(block);
     }

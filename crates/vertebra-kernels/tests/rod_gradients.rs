@@ -4,7 +4,7 @@
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::body::BodyLanes;
+use vertebra_kernels::body::{BodyLanes, PairStart};
 use vertebra_kernels::parts::rod::{Frames, bend, curve, frames, length, twist};
 use vertebra_math::{Quat, Sym3, Vec3};
 
@@ -15,6 +15,16 @@ fn body(p: GVec3, q: GQuat) -> BodyLanes<f32> {
         inv_mass: 1.0,
         q: q.into(),
         inv_inertia: zero,
+    }
+}
+
+/// The start of a step at which the bodies' rows held their absolute
+/// positions: no gap, no arms (the chord is `p_b - p_a`).
+fn origin() -> PairStart<f32> {
+    PairStart {
+        gap: Vec3::zero(),
+        arm_a: Vec3::zero(),
+        arm_b: Vec3::zero(),
     }
 }
 
@@ -103,12 +113,13 @@ fn curve_gradients_match_finite_differences() {
     let mut r = StdRng::seed_from_u64(1);
     for _ in 0..300 {
         let (a, b, fa, fb) = configuration(&mut r);
-        let m = curve::measure(&a, &b, &f(&a, &b, fa, fb));
+        let m = curve::measure(&a, &b, &f(&a, &b, fa, fb), &origin());
         if m.theta < 0.05 || m.theta > 3.0 {
             continue; // the axis is ill-defined near 0 and pi
         }
-        let c =
-            |a: &BodyLanes<f32>, b: &BodyLanes<f32>| curve::measure(a, b, &f(a, b, fa, fb)).theta;
+        let c = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| {
+            curve::measure(a, b, &f(a, b, fa, fb), &origin()).theta
+        };
         check(
             "curve / b",
             m.n_b.into(),
@@ -143,9 +154,10 @@ fn length_gradients_match_finite_differences() {
     for _ in 0..300 {
         let (a, b, fa, fb) = configuration(&mut r);
         let l0 = r.random_range(0.2..1.5);
-        let (o, _) = length::measure(&a, &b, &f(&a, &b, fa, fb), l0);
-        let c =
-            |a: &BodyLanes<f32>, b: &BodyLanes<f32>| length::measure(a, b, &f(a, b, fa, fb), l0).1;
+        let (o, _) = length::measure(&a, &b, &f(&a, &b, fa, fb), l0, &origin());
+        let c = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| {
+            length::measure(a, b, &f(a, b, fa, fb), l0, &origin()).1
+        };
         check(
             "length / p_b",
             o.into(),

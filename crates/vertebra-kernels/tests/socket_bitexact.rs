@@ -92,6 +92,9 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
                         .then(|| (unit_quat(&mut r), compliance, r.random_range(0.0..20.0))),
                 },
             );
+            block
+                .bodies
+                .set_start(lane, &common::start(&mut r, adversarial));
         }
         out.push(block);
     }

@@ -13,7 +13,7 @@ mod store;
 
 pub use error::{
     Error, MAX_COORDINATE, MAX_TIME_STEP, MIN_TIME_STEP, check_coordinate, check_finite,
-    check_positive, check_unit_quat, check_unit_vec,
+    check_point, check_positive, check_unit_quat, check_unit_vec,
 };
 pub use handle::{Handle, Slots};
 pub use shape::{MASS_RANGE, MassProperties, Shape};

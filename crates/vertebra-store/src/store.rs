@@ -1,9 +1,11 @@
 //! The structure-of-arrays body store: one array per quantity, indexed by
 //! the body handle's slot.
 
-use glam::{Mat3, Quat, Vec3};
+use glam::{DVec3, Mat3, Quat, Vec3};
 
-use crate::error::{Error, check_coordinate, check_finite, check_unit_quat};
+use crate::error::{
+    Error, MAX_COORDINATE, check_coordinate, check_finite, check_point, check_unit_quat,
+};
 use crate::handle::{Handle, Slots};
 use crate::shape::MassProperties;
 
@@ -150,8 +152,15 @@ pub struct BodyStore {
     slots: Slots,
     /// How each body moves.
     pub kind: Vec<BodyKind>,
-    /// Centres of mass (m, world).
+    /// Centres of mass (m, world): the `f32` nearest to each body's
+    /// coordinate, which the step keeps to double precision (see
+    /// [`BodyStore::precise_position`]).
     pub position: Vec<Vec3>,
+    /// What each coordinate has beyond its `f32` (m): `position +
+    /// position_low` is the body's coordinate. A body moving 3 mm per step
+    /// at x = 100 km, where an `f32` resolves 7.8 mm, moves here until the
+    /// sum carries into `position`.
+    position_low: Vec<Vec3>,
     /// Orientations.
     pub orientation: Vec<Quat>,
     /// Linear velocities (m/s, world).
@@ -193,6 +202,7 @@ impl BodyStore {
         [
             self.kind.len(),
             self.position.len(),
+            self.position_low.len(),
             self.orientation.len(),
             self.linear_velocity.len(),
             self.angular_velocity.len(),
@@ -229,6 +239,7 @@ impl BodyStore {
         };
         self.kind[i] = desc.kind;
         self.position[i] = desc.position;
+        self.position_low[i] = Vec3::ZERO;
         self.orientation[i] = desc.orientation.normalize();
         self.linear_velocity[i] = velocity;
         self.angular_velocity[i] = spin;
@@ -250,6 +261,7 @@ impl BodyStore {
     fn grow(&mut self) {
         self.kind.push(BodyKind::Static);
         self.position.push(Vec3::ZERO);
+        self.position_low.push(Vec3::ZERO);
         self.orientation.push(Quat::IDENTITY);
         self.linear_velocity.push(Vec3::ZERO);
         self.angular_velocity.push(Vec3::ZERO);
@@ -333,8 +345,40 @@ impl BodyStore {
         check_coordinate("position", position)?;
         check_unit_quat("orientation", orientation)?;
         self.position[i] = position;
+        self.position_low[i] = Vec3::ZERO;
         self.orientation[i] = orientation.normalize();
         Ok(())
+    }
+
+    /// Slot `i`'s centre of mass in double precision (m, world): the
+    /// coordinate the step integrates, of which `position[i]` is the
+    /// nearest `f32`.
+    pub fn precise_position(&self, i: usize) -> DVec3 {
+        self.position[i].as_dvec3() + self.position_low[i].as_dvec3()
+    }
+
+    /// The low parts of every coordinate (m), in slot order: for hashing
+    /// and checking the full state.
+    pub fn position_low(&self) -> &[Vec3] {
+        &self.position_low
+    }
+
+    /// Moves slot `i` by `displacement` (m, world), in double precision,
+    /// and keeps it inside the world: a coordinate beyond
+    /// [`MAX_COORDINATE`] is held at it, and the velocity that carried it
+    /// out is stopped on that axis (the world's edge is a wall, so a body
+    /// there keeps a pose and contacts the API accepts).
+    pub fn displace(&mut self, i: usize, displacement: Vec3) {
+        let moved = self.precise_position(i) + displacement.as_dvec3();
+        let edge = f64::from(MAX_COORDINATE);
+        let inside = moved.clamp(DVec3::splat(-edge), DVec3::splat(edge));
+        let held = moved.cmpne(inside);
+        let v = self.linear_velocity[i];
+        let outward = held & (v.as_dvec3() * (moved - inside)).cmpgt(DVec3::ZERO);
+        self.linear_velocity[i] = Vec3::select(outward, Vec3::ZERO, v);
+        let high = inside.as_vec3();
+        self.position[i] = high;
+        self.position_low[i] = (inside - high.as_dvec3()).as_vec3();
     }
 
     /// Sets a body's velocities (m/s and rad/s, world); a static body keeps zero.
@@ -373,7 +417,7 @@ impl BodyStore {
     ) -> Result<(), Error> {
         let i = self.index(handle)?;
         check_finite("force", force)?;
-        check_coordinate("point", point)?;
+        check_point("point", point)?;
         let total = self.force[i] + force;
         let torque = self.torque[i] + (point - self.position[i]).cross(force);
         check_finite("accumulated force", total)?;

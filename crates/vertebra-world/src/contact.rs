@@ -5,10 +5,11 @@
 use core::ops::Range;
 
 use glam::Vec3;
+use vertebra_kernels::body::StartLane;
 use vertebra_kernels::contact::{ContactBlock, ContactLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::{Colouring, MAX_COLOURS};
-use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_coordinate, check_unit_vec};
+use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_point, check_unit_vec};
 
 /// A contact between two bodies for the next step.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -35,7 +36,7 @@ impl Contact {
         if self.body_a == self.body_b {
             return Err(Error::SameBody);
         }
-        check_coordinate("contact point", self.point)?;
+        check_point("contact point", self.point)?;
         check_unit_vec("contact normal", self.normal)?;
         if !self.depth.is_finite() {
             return Err(Error::NonFinite("contact depth"));
@@ -69,17 +70,27 @@ impl Contact {
         let velocity = |i: usize, p: Vec3| {
             bodies.linear_velocity[i] + bodies.angular_velocity[i].cross(p - bodies.position[i])
         };
+        let (point_a, point_b) = (local(ia, on_a), local(ib, on_b));
+        let start = StartLane::new(
+            bodies.precise_position(ia),
+            bodies.orientation[ia],
+            point_a,
+            bodies.precise_position(ib),
+            bodies.orientation[ib],
+            point_b,
+        );
         ContactLane {
             body_a: ia as u32 + 1,
             body_b: ib as u32 + 1,
             dynamic_a: bodies.kind[ia] == BodyKind::Dynamic,
             dynamic_b: bodies.kind[ib] == BodyKind::Dynamic,
-            point_a: local(ia, on_a),
-            point_b: local(ib, on_b),
+            point_a,
+            point_b,
             normal: n,
             friction: self.friction,
             restitution: self.restitution,
             approach: (velocity(ib, self.point) - velocity(ia, self.point)).dot(n),
+            start,
         }
     }
 }

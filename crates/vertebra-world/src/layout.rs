@@ -8,6 +8,7 @@ use core::f32::consts::PI;
 use core::ops::Range;
 use std::collections::BTreeSet;
 
+use vertebra_kernels::body::{BodyPairs, StartLane};
 use vertebra_kernels::rod::{RodBlock, RodLane};
 use vertebra_kernels::socket::{SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
@@ -129,6 +130,24 @@ impl Layout {
         layout
     }
 
+    /// Measures where every joint's bodies stand as the step begins (the
+    /// rows then hold displacements from there): each socket's anchors,
+    /// each rod's chord between centres of mass.
+    pub fn start_step(&mut self, bodies: &BodyStore) {
+        for block in &mut self.sockets.blocks {
+            for lane in 0..BLOCK_LANES {
+                let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
+                start_lane(&mut block.bodies, lane, anchors, bodies);
+            }
+        }
+        for block in &mut self.rods.blocks {
+            for lane in 0..BLOCK_LANES {
+                let centres = (glam::Vec3::ZERO, glam::Vec3::ZERO);
+                start_lane(&mut block.bodies, lane, centres, bodies);
+            }
+        }
+    }
+
     fn append(
         &mut self,
         keys: &BTreeSet<u64>,
@@ -167,6 +186,25 @@ impl Layout {
             rods,
         }
     }
+}
+
+/// Sets `lane`'s start of step for points `local` (m, body frames) on its
+/// bodies; padding lanes (the null row) start at the origin.
+fn start_lane(
+    pairs: &mut BodyPairs,
+    lane: usize,
+    (local_a, local_b): (glam::Vec3, glam::Vec3),
+    bodies: &BodyStore,
+) {
+    let pose = |row: u32| match row.checked_sub(1) {
+        Some(i) => (
+            bodies.precise_position(i as usize),
+            bodies.orientation[i as usize],
+        ),
+        None => (glam::DVec3::ZERO, glam::Quat::IDENTITY),
+    };
+    let ((pa, qa), (pb, qb)) = (pose(pairs.body_a[lane]), pose(pairs.body_b[lane]));
+    pairs.set_start(lane, &StartLane::new(pa, qa, local_a, pb, qb, local_b));
 }
 
 /// Body rows are slots + 1 (row 0 is the null row).

@@ -382,6 +382,7 @@ impl World {
         let _mode = DefaultFloatMode::enter();
         self.refresh_layout();
         step::upload(&self.bodies, self.rows.get());
+        self.layout.start_step(&self.bodies);
         self.residuals = metrics::residuals(self);
         &self.residuals
     }

@@ -139,12 +139,8 @@ mod tests {
     }
 
     fn pairs(lanes: &[(u32, u32, bool, bool)]) -> BodyPairs {
-        let mut p = BodyPairs {
-            body_a: [0; 8],
-            body_b: [0; 8],
-            write_a: [NO_WRITE; 8],
-            write_b: [NO_WRITE; 8],
-        };
+        // A padding block's pairs: the null row, written nowhere.
+        let mut p = vertebra_kernels::socket::SocketBlock::padding().bodies;
         for (lane, &(a, b, da, db)) in lanes.iter().enumerate() {
             p.set(lane, a, b, da, db);
         }

@@ -16,6 +16,7 @@ use crate::parallel::chunked;
 pub(crate) fn step(world: &mut World, dt: f32) {
     let h = dt / world.config.substeps as f32;
     upload(&world.bodies, world.rows.get());
+    world.layout.start_step(&world.bodies);
     world
         .previous
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
@@ -41,15 +42,17 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         derive_velocities(world, h);
         solve_velocities(world, h);
         damp(&mut world.bodies, h);
-        world.repaired += repair(&mut world.bodies, &world.previous);
+        world.repaired += repair(world);
     }
+    commit(world);
     let bodies = &mut world.bodies;
     bodies.force.iter_mut().for_each(|f| *f = Vec3::ZERO);
     bodies.torque.iter_mut().for_each(|t| *t = Vec3::ZERO);
 }
 
 /// Rows for every slot (stale slots hold harmless old data: no joint
-/// references them).
+/// references them), every body at zero displacement: the rows hold each
+/// body's motion since the step began (see `vertebra_kernels::body`).
 pub(crate) fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
     if rows.pose.len() != bodies.capacity() + 1 {
         *rows = BodyRows::with_bodies(bodies.capacity());
@@ -61,16 +64,38 @@ pub(crate) fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
             bodies.angular_velocity[i],
         ));
         rows.pose[i + 1].set(BodyRows::pose_row(
-            bodies.position[i],
+            Vec3::ZERO,
             bodies.inverse_mass[i],
             bodies.orientation[i],
         ));
     }
 }
 
+/// A body's displacement since the step began and its orientation, as the
+/// rows hold them.
+fn pose(rows: &BodyRows, i: usize) -> (Vec3, Quat) {
+    let [px, py, pz, _, qx, qy, qz, qw] = rows.pose[i + 1].get();
+    (Vec3::new(px, py, pz), Quat::from_xyzw(qx, qy, qz, qw))
+}
+
+/// Moves every body by its displacement over the step, in double
+/// precision (`BodyStore::displace`: the coordinate keeps what an `f32`
+/// cannot hold, and the world's edge holds bodies in).
+fn commit(world: &mut World) {
+    let b = &mut world.bodies;
+    for i in 0..b.capacity() {
+        if b.is_live(i) && b.kind[i] != BodyKind::Static {
+            let (displacement, orientation) = pose(world.rows.get(), i);
+            b.displace(i, displacement);
+            b.orientation[i] = orientation;
+        }
+    }
+}
+
 /// Integration of velocities (gravity, forces, the implicit gyroscopic
-/// term in the body frame) and positions; the previous pose is kept for
-/// deriving velocities afterwards.
+/// term in the body frame) and of the rows' displacements and
+/// orientations; the previous ones are kept for deriving velocities
+/// afterwards.
 fn predict(world: &mut World, h: f32) {
     let g = world.config.gravity;
     let (max_linear, max_angular) = (
@@ -98,13 +123,12 @@ fn predict(world: &mut World, h: f32) {
             b.linear_velocity[i] = limit(b.linear_velocity[i], max_linear);
             b.angular_velocity[i] = w;
         }
-        world.previous[i] = (b.position[i], b.orientation[i]);
-        b.position[i] += b.linear_velocity[i] * h;
-        b.orientation[i] = integrate(b.orientation[i], b.angular_velocity[i], h);
+        let (displacement, orientation) = pose(world.rows.get(), i);
+        world.previous[i] = (displacement, orientation);
         world.rows.get().pose[i + 1].set(BodyRows::pose_row(
-            b.position[i],
+            displacement + b.linear_velocity[i] * h,
             b.inverse_mass[i],
-            b.orientation[i],
+            integrate(orientation, b.angular_velocity[i], h),
         ));
     }
 }
@@ -327,21 +351,25 @@ fn solve_velocities(world: &mut World, h: f32) {
     }
 }
 
-/// Reads the solved poses back and derives velocities from the motion:
-/// `v = (p - p0) / h`, `w = log(q q0*) / h` (shortest arc).
+/// Derives velocities from the solved motion: `v = (d - d0) / h` from the
+/// displacements since the step began (exact to the precision of the
+/// motion, wherever the body is), `w = log(q q0*) / h` (shortest arc);
+/// both held to the speed limits, which a hard correction can exceed.
 fn derive_velocities(world: &mut World, h: f32) {
+    let (max_linear, max_angular) = (
+        world.config.max_linear_speed,
+        world.config.max_angular_speed,
+    );
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if !b.is_live(i) || b.kind[i] != BodyKind::Dynamic {
             continue;
         }
-        let [px, py, pz, _, qx, qy, qz, qw] = world.rows.get().pose[i + 1].get();
-        let (p, q) = (Vec3::new(px, py, pz), Quat::from_xyzw(qx, qy, qz, qw));
-        let (p0, q0) = world.previous[i];
-        b.position[i] = p;
+        let (d, q) = pose(world.rows.get(), i);
+        let (d0, q0) = world.previous[i];
         b.orientation[i] = q;
-        b.linear_velocity[i] = (p - p0) / h;
-        b.angular_velocity[i] = angular_velocity(q, q0, h);
+        b.linear_velocity[i] = limit((d - d0) / h, max_linear);
+        b.angular_velocity[i] = limit(angular_velocity(q, q0, h), max_angular);
         world.rows.get().velocity[i + 1].set(BodyRows::velocity_row(
             b.linear_velocity[i],
             b.angular_velocity[i],
@@ -349,26 +377,34 @@ fn derive_velocities(world: &mut World, h: f32) {
     }
 }
 
-/// Linear and angular damping: `v /= 1 + h c`.
-/// The last line of defence: a body whose state is no longer finite goes
+/// The last line of defence: a body whose motion is no longer finite goes
 /// back to its pose before the substep, at rest, and is counted. Validated
 /// input keeps every body finite: it never fired in any test, scene or in
 /// 390,000 fuzzed call sequences run with it made to panic
 /// (docs/robustness.md). It stays so that a case nobody found yet costs a
 /// body a substep, not the world.
-fn repair(b: &mut BodyStore, previous: &[(Vec3, Quat)]) -> u64 {
+fn repair(world: &mut World) -> u64 {
+    let b = &mut world.bodies;
     let mut repaired = 0;
-    for (i, &(position, orientation)) in previous.iter().enumerate().take(b.capacity()) {
-        if b.is_live(i) && b.kind[i] != BodyKind::Static && !b.is_finite(i) {
-            (b.position[i], b.orientation[i]) = (position, orientation);
+    for (i, &(displacement, orientation)) in world.previous.iter().enumerate().take(b.capacity()) {
+        let (d, q) = pose(world.rows.get(), i);
+        let finite = b.is_finite(i) && d.is_finite() && q.is_finite();
+        if b.is_live(i) && b.kind[i] != BodyKind::Static && !finite {
+            b.orientation[i] = orientation;
             b.linear_velocity[i] = Vec3::ZERO;
             b.angular_velocity[i] = Vec3::ZERO;
+            world.rows.get().pose[i + 1].set(BodyRows::pose_row(
+                displacement,
+                b.inverse_mass[i],
+                orientation,
+            ));
             repaired += 1;
         }
     }
     repaired
 }
 
+/// Linear and angular damping: `v /= 1 + h c`.
 fn damp(b: &mut BodyStore, h: f32) {
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {

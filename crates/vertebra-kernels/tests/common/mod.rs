@@ -4,7 +4,7 @@
 use glam::{Mat3, Quat, Vec3};
 use rand::RngExt;
 use rand::rngs::StdRng;
-use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_math::Backend;
 use vertebra_math::check::same_bits;
 
@@ -132,5 +132,19 @@ pub fn agree_over_seeds<B>(
     for seed in seeds {
         let (rows, blocks) = scene(seed, 6, adversarial);
         assert_backends_agree(seed, |b| run(b, &rows, &blocks));
+    }
+}
+
+/// A random start of step for one lane (adversarial: zero, as for a pair
+/// whose points coincided when the step began and whose rows hold absolute
+/// positions).
+pub fn start(r: &mut StdRng, adversarial: bool) -> StartLane {
+    if adversarial && r.random_bool(0.3) {
+        return StartLane::default();
+    }
+    StartLane {
+        gap: vec(r, 0.5),
+        arm_a: vec(r, 0.5),
+        arm_b: vec(r, 0.5),
     }
 }

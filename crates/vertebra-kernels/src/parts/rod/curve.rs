@@ -2,6 +2,9 @@
 //! reflection of `t_a` about the chord direction `o = (p_b - p_a)/|p_b - p_a|`,
 //! so that a circular arc joins the bodies.
 //!
+//! The chord `p_b - p_a` is measured from the start of the step
+//! ([`PairStart::chord`]).
+//!
 //! The reflection `r = 2 (t_a . o) o - t_a` is a half turn about `o`. The
 //! error is the angle `theta = atan2(|r x t_b|, r . t_b)` about
 //! `n = (r x t_b)/|r x t_b|`, one angle per iteration as the angle part
@@ -27,7 +30,7 @@
 use vertebra_math::{Lane, Vec3, poly};
 
 use super::Frames;
-use crate::body::{BodyLanes, safe_ratio};
+use crate::body::{BodyLanes, PairStart, safe_ratio};
 
 /// The curve error and its gradients.
 #[derive(Clone, Copy, Debug)]
@@ -44,9 +47,14 @@ pub struct Curve<L> {
 
 /// Measures the curve error and its gradients.
 #[inline(always)]
-pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>) -> Curve<L> {
+pub fn measure<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    f: &Frames<L>,
+    start: &PairStart<L>,
+) -> Curve<L> {
     let two = L::splat(2.0);
-    let (o, distance) = (b.p - a.p).normalize_or_zero();
+    let (o, distance) = start.chord(a, b).normalize_or_zero();
     let apart = distance.gt(L::splat(0.0));
     let ta_o = f.ta.dot(o);
     let r = o.scale(two * ta_o) - f.ta;
@@ -67,8 +75,13 @@ pub fn measure<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, f: &Frames<L>) -> Cu
 /// Moves and turns the bodies toward an admissible arc; returns the error
 /// before the correction (rad).
 #[inline(always)]
-pub fn solve<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, f: &Frames<L>) -> L {
-    let c = measure(a, b, f);
+pub fn solve<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    f: &Frames<L>,
+    start: &PairStart<L>,
+) -> L {
+    let c = measure(a, b, f, start);
     let w = a.angular_weight(c.n_a)
         + b.angular_weight(c.n_b)
         + c.g.length_squared() * (a.inv_mass + b.inv_mass);

@@ -12,7 +12,7 @@
 use vertebra_math::{Lane, Vec3, poly};
 
 use super::{Frames, bend_angle};
-use crate::body::{BodyLanes, safe_ratio};
+use crate::body::{BodyLanes, PairStart, safe_ratio};
 
 /// The chord length of an arc of `rest_length` bent by `psi` (m).
 #[inline(always)]
@@ -20,15 +20,17 @@ pub fn chord<L: Lane>(rest_length: L, psi: L) -> L {
     L::splat(2.0) * rest_length * poly::half_sinc(psi)
 }
 
-/// The chord direction `o` and the length error `C` (m).
+/// The chord direction `o` and the length error `C` (m); the chord is
+/// measured from the start of the step ([`PairStart::chord`]).
 #[inline(always)]
 pub fn measure<L: Lane>(
     a: &BodyLanes<L>,
     b: &BodyLanes<L>,
     f: &Frames<L>,
     rest_length: L,
+    start: &PairStart<L>,
 ) -> (Vec3<L>, L) {
-    let (o, distance) = (b.p - a.p).normalize_or_zero();
+    let (o, distance) = start.chord(a, b).normalize_or_zero();
     let (_, psi) = bend_angle(f.ta, f.tb);
     (o, distance - chord(rest_length, psi))
 }
@@ -41,8 +43,9 @@ pub fn solve<L: Lane>(
     b: &mut BodyLanes<L>,
     f: &Frames<L>,
     rest_length: L,
+    start: &PairStart<L>,
 ) -> L {
-    let (o, c) = measure(a, b, f, rest_length);
+    let (o, c) = measure(a, b, f, rest_length, start);
     let dlambda = safe_ratio(-c, a.inv_mass + b.inv_mass);
     b.p += o.scale(dlambda * b.inv_mass);
     a.p -= o.scale(dlambda * a.inv_mass);
