@@ -10,19 +10,32 @@
 //! are both static or kinematic; pairs excluded by [`Collisions::exclude`]
 //! (a ragdoll's jointed pairs: `Ragdoll::non_colliding_pairs`); and pairs
 //! whose [`CollisionGroups`] do not match.
+//!
+//! Removal is the set's business too: a body's colliders go with
+//! [`Collisions::remove_body`] (before or after `World::remove_body`), a
+//! ragdoll's bodies, joints and colliders with
+//! [`Collisions::remove_ragdoll`]. A collider whose body is gone makes
+//! [`Collisions::find_contacts`] refuse with [`Error::Collider`], naming the
+//! collider and its body. The set is saved and restored alongside the world
+//! with [`Collisions::snapshot`] and [`Collisions::restore`].
 
-use std::collections::HashSet;
+mod snapshot;
+
+use std::collections::{HashMap, HashSet};
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::SharedShape;
+use vertebra_ragdoll::{Ragdoll, RagdollError};
 use vertebra_world::{BodyHandle, BodyKind, Contact, Error, Shape, World};
+
+pub use snapshot::CollisionSnapshot;
 
 /// Which colliders may touch: a pair is tested when each one's
 /// `membership` meets the other's `filter` (both bit sets).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct CollisionGroups {
     /// The groups this collider is in.
     pub membership: u32,
@@ -41,7 +54,7 @@ impl Default for CollisionGroups {
 
 /// A collider's geometry, in its body's frame (centred on the centre of
 /// mass, as the store's shapes are).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum ColliderShape {
     /// A body shape: sphere, box or capsule.
     Solid(Shape),
@@ -51,7 +64,7 @@ pub enum ColliderShape {
 }
 
 /// A collider on a body.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Collider {
     /// The body it moves with.
     pub body: BodyHandle,
@@ -77,6 +90,80 @@ impl Collider {
             groups: CollisionGroups::default(),
         }
     }
+
+    /// Its parry geometry (body frame), or why it is refused: a degenerate
+    /// shape or one beyond [`MAX_COLLIDER_EXTENT`], a non-unit plane
+    /// normal, bad friction or restitution.
+    fn geometry(&self) -> Result<SharedShape, Error> {
+        let shape = match self.shape {
+            ColliderShape::Solid(s) => {
+                s.validate()?;
+                check_extent(&s)?;
+                match s {
+                    Shape::Sphere { radius } => SharedShape::ball(radius),
+                    Shape::Box { half_extents: h } => SharedShape::cuboid(h.x, h.y, h.z),
+                    Shape::Capsule {
+                        half_segment,
+                        radius,
+                    } => SharedShape::capsule(-half_segment, half_segment, radius),
+                }
+            }
+            ColliderShape::Plane(n) => {
+                vertebra_world::check_unit_vec("plane normal", n)?;
+                SharedShape::halfspace(n.normalize())
+            }
+        };
+        if !(self.friction.is_finite() && self.friction >= 0.0) {
+            return Err(Error::NonPositive("collider friction"));
+        }
+        if !(0.0..=1.0).contains(&self.restitution) {
+            return Err(Error::InvalidLimit("restitution (must be in [0, 1])"));
+        }
+        Ok(shape)
+    }
+
+    /// `reason` as the refusal of this collider at `index`.
+    fn refused(&self, index: usize, reason: Error) -> Error {
+        Error::Collider {
+            index,
+            body: self.body,
+            reason: Box::new(reason),
+        }
+    }
+}
+
+/// The largest size (m) of a collider: a sphere's radius, a box's half
+/// extent, a capsule's half segment plus radius. 10 km is larger than any
+/// level's floor, and at 1e4 m an `f32` still resolves a millimetre; far
+/// beyond it parry's contact points are no longer finite (1e30 gave NaN).
+pub const MAX_COLLIDER_EXTENT: f32 = 1.0e4;
+
+/// Checks a solid's size against [`MAX_COLLIDER_EXTENT`] (after
+/// `Shape::validate`: finite and positive).
+fn check_extent(shape: &Shape) -> Result<(), Error> {
+    let extent = match *shape {
+        Shape::Sphere { radius } => radius,
+        Shape::Box { half_extents } => half_extents.max_element(),
+        Shape::Capsule {
+            half_segment,
+            radius,
+        } => half_segment.length() + radius,
+    };
+    if extent > MAX_COLLIDER_EXTENT {
+        return Err(Error::OutOfRange("collider size (at most 1e4 m)"));
+    }
+    Ok(())
+}
+
+/// Checks a prediction margin (m): finite, not negative.
+fn check_prediction(prediction: f32) -> Result<(), Error> {
+    if !prediction.is_finite() {
+        return Err(Error::NonFinite("collision prediction"));
+    }
+    if prediction < 0.0 {
+        return Err(Error::NonPositive("collision prediction"));
+    }
+    Ok(())
 }
 
 /// All colliders and the rules for which pairs are tested.
@@ -84,9 +171,7 @@ impl Collider {
 pub struct Collisions {
     colliders: Vec<(Collider, SharedShape)>,
     excluded: HashSet<(BodyHandle, BodyHandle)>,
-    /// Contacts are made for gaps up to this size too (m), on top of how far
-    /// each body can move in the step (see [`Collisions::find_contacts`]).
-    pub prediction: f32,
+    prediction: f32,
 }
 
 fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {
@@ -106,50 +191,116 @@ impl Collisions {
         }
     }
 
-    /// Adds a collider; `Err` for a degenerate shape, a non-unit plane
-    /// normal or bad friction and restitution.
+    /// The prediction margin (m): contacts are made for gaps up to this
+    /// size too, on top of how far each body can move in the step (see
+    /// [`Collisions::find_contacts`]).
+    pub fn prediction(&self) -> f32 {
+        self.prediction
+    }
+
+    /// Sets the prediction margin (m, finite, not negative); `Err` (and no
+    /// change) otherwise.
+    pub fn set_prediction(&mut self, margin: f32) -> Result<(), Error> {
+        check_prediction(margin)?;
+        self.prediction = margin;
+        Ok(())
+    }
+
+    /// Adds a collider; returns its index in [`Collisions::colliders`]
+    /// (until a collider before it is removed). `Err(Error::Collider)`,
+    /// naming the index it would have had and its body, for a degenerate
+    /// shape or one beyond [`MAX_COLLIDER_EXTENT`], a non-unit plane normal
+    /// or bad friction and restitution. Its
+    /// body must be live in the world the set is used with when contacts
+    /// are found.
     pub fn add(&mut self, collider: Collider) -> Result<usize, Error> {
-        let shape = match collider.shape {
-            ColliderShape::Solid(s) => {
-                s.validate()?;
-                match s {
-                    Shape::Sphere { radius } => SharedShape::ball(radius),
-                    Shape::Box { half_extents: h } => SharedShape::cuboid(h.x, h.y, h.z),
-                    Shape::Capsule {
-                        half_segment,
-                        radius,
-                    } => SharedShape::capsule(-half_segment, half_segment, radius),
-                }
-            }
-            ColliderShape::Plane(n) => {
-                vertebra_world::check_unit_vec("plane normal", n)?;
-                SharedShape::halfspace(n.normalize())
-            }
-        };
-        if !(collider.friction.is_finite() && collider.friction >= 0.0) {
-            return Err(Error::NonPositive("collider friction"));
-        }
-        if !(0.0..=1.0).contains(&collider.restitution) {
-            return Err(Error::InvalidLimit("restitution (must be in [0, 1])"));
-        }
+        let index = self.colliders.len();
+        let shape = collider
+            .geometry()
+            .map_err(|e| collider.refused(index, e))?;
         self.colliders.push((collider, shape));
-        Ok(self.colliders.len() - 1)
+        Ok(index)
     }
 
     /// Adds a solid collider per `(body, shape)` (default friction and
-    /// groups) and never tests the `excluded` pairs: how a ragdoll joins,
-    /// with `Ragdoll::collision_shapes` and `Ragdoll::non_colliding_pairs`.
+    /// groups) and never tests the `excluded` pairs: how a ragdoll joins
+    /// (see [`Collisions::add_ragdoll`]). All or nothing: every collider is
+    /// checked before any is added; the first refused is named.
     pub fn add_jointed(
         &mut self,
         shapes: &[(BodyHandle, Shape)],
         excluded: &[(BodyHandle, BodyHandle)],
     ) -> Result<(), Error> {
-        for &(body, shape) in shapes {
-            self.add(Collider::new(body, ColliderShape::Solid(shape)))?;
-        }
+        let start = self.colliders.len();
+        let checked = shapes
+            .iter()
+            .enumerate()
+            .map(|(k, &(body, shape))| {
+                let collider = Collider::new(body, ColliderShape::Solid(shape));
+                let geometry = collider.geometry();
+                geometry
+                    .map(|g| (collider, g))
+                    .map_err(|e| collider.refused(start + k, e))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        self.colliders.extend(checked);
         for &(a, b) in excluded {
             self.exclude(a, b);
         }
+        Ok(())
+    }
+
+    /// Adds a ragdoll's capsules (one per body, default friction and
+    /// groups), its jointed pairs never tested. All or nothing.
+    pub fn add_ragdoll(&mut self, ragdoll: &Ragdoll) -> Result<(), Error> {
+        self.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())
+    }
+
+    /// Removes a ragdoll from `world` (its joints and bodies, see
+    /// `Ragdoll::remove`) and its bodies' colliders and excluded pairs from
+    /// this set, in one call. All or nothing: when the ragdoll cannot be
+    /// removed (a body or joint already gone, a body held by another
+    /// joint) the world, the set and the ragdoll are unchanged.
+    pub fn remove_ragdoll(
+        &mut self,
+        world: &mut World,
+        ragdoll: &mut Ragdoll,
+    ) -> Result<(), RagdollError> {
+        let bodies: Vec<BodyHandle> = ragdoll.bodies.iter().flatten().copied().collect();
+        ragdoll.remove(world)?;
+        for body in bodies {
+            self.remove_body(body);
+        }
+        Ok(())
+    }
+
+    /// Re-creates a ragdoll at `pose` (see `Ragdoll::recreate`) and moves
+    /// its colliders and excluded pairs from the old bodies to the new ones
+    /// (friction, groups and any extra colliders kept, in their places in
+    /// the set). All or nothing, as `Ragdoll::recreate`.
+    pub fn recreate_ragdoll(
+        &mut self,
+        world: &mut World,
+        ragdoll: &mut Ragdoll,
+        pose: &vertebra_ragdoll::Pose,
+        previous: Option<(&vertebra_ragdoll::Pose, f32)>,
+    ) -> Result<(), RagdollError> {
+        let old = ragdoll.bodies.clone();
+        ragdoll.recreate(world, pose, previous)?;
+        let moved: HashMap<BodyHandle, BodyHandle> = old
+            .iter()
+            .zip(&ragdoll.bodies)
+            .filter_map(|(&from, &to)| Some((from?, to?)))
+            .collect();
+        let to = |body: BodyHandle| moved.get(&body).copied().unwrap_or(body);
+        for (collider, _) in &mut self.colliders {
+            collider.body = to(collider.body);
+        }
+        self.excluded = self
+            .excluded
+            .iter()
+            .map(|&(a, b)| ordered(to(a), to(b)))
+            .collect();
         Ok(())
     }
 
@@ -174,7 +325,9 @@ impl Collisions {
         self.excluded.contains(&ordered(a, b))
     }
 
-    /// Forgets the colliders of `body` (before removing it from the world).
+    /// Forgets the colliders and excluded pairs of `body` (before or after
+    /// removing it from the world); the colliders after them move down in
+    /// [`Collisions::colliders`]. Nothing to forget is not an error.
     pub fn remove_body(&mut self, body: BodyHandle) {
         self.colliders.retain(|c| c.0.body != body);
         self.excluded.retain(|&(a, b)| a != body && b != body);
@@ -186,13 +339,15 @@ impl Collisions {
     /// to `prediction` plus how far its bodies can close in within `dt`
     /// (linear speed plus angular speed times the collider's extent), so a
     /// fast body meets the floor instead of passing into it; a gap does
-    /// nothing until it closes.
+    /// nothing until it closes. `Err(Error::Collider)` names the first
+    /// collider whose body is no longer in `world` (remove a body's
+    /// colliders with [`Collisions::remove_body`]).
     pub fn find_contacts(&self, world: &World, dt: f32) -> Result<Vec<Contact>, Error> {
         vertebra_world::check_positive("time step", dt)?;
         let mut poses = Vec::with_capacity(self.colliders.len());
         let mut reach = Vec::with_capacity(self.colliders.len());
-        for (c, shape) in &self.colliders {
-            let s = world.body(c.body)?;
+        for (index, (c, shape)) in self.colliders.iter().enumerate() {
+            let s = world.body(c.body).map_err(|e| c.refused(index, e))?;
             poses.push(Pose::from_parts(s.position, s.orientation));
             let extent = shape.compute_local_bounding_sphere().radius;
             let extent = if extent.is_finite() { extent } else { 0.0 };

@@ -14,13 +14,19 @@
 //!   floats: no panic, a rejected call changes nothing, no non-finite state.
 //! - [`ragdoll_loader`]: arbitrary bytes as a ragdoll file: an error or a
 //!   ragdoll that builds, never a panic.
+//! - [`collisions`]: bodies, colliders and ragdolls added and removed, the
+//!   world and the collision set saved and restored (also from crafted
+//!   bytes), steps with detection: a refused call changes nothing, no
+//!   collider or contact outlives its body.
 
+mod collisions;
 mod input;
 mod kernels;
 mod loader;
 mod math;
 mod world;
 
+pub use collisions::collisions;
 pub use kernels::kernels;
 pub use loader::ragdoll_loader;
 pub use math::math_backends;
@@ -30,9 +36,10 @@ pub use world::world_api;
 pub type Target = fn(&[u8]);
 
 /// Every target, by its cargo-fuzz name.
-pub const TARGETS: [(&str, Target); 4] = [
+pub const TARGETS: [(&str, Target); 5] = [
     ("math_backends", math_backends),
     ("kernels", kernels),
     ("world_api", world_api),
     ("ragdoll_loader", ragdoll_loader),
+    ("collisions", collisions),
 ];

@@ -155,7 +155,7 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
 /// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
 /// removed, poses, velocities and forces set, steps) with arbitrary floats
 /// one time in eight: no panic; every refused call leaves the world as it
-/// was; every body stays finite.
+/// was; every body stays finite; no pending contact names a removed body.
 pub fn world_api(data: &[u8]) {
     let mut input = Input::new(data);
     let config = SolverConfig {
@@ -183,5 +183,13 @@ pub fn world_api(data: &[u8]) {
         for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
             assert!(store.is_finite(i), "body {i} went non-finite");
         }
+        let live = |b: BodyHandle| store.contains(b);
+        assert!(
+            world
+                .contacts()
+                .iter()
+                .all(|c| live(c.body_a) && live(c.body_b)),
+            "a pending contact names a removed body"
+        );
     }
 }

@@ -57,6 +57,13 @@ pub enum RagdollError {
     BadPose(String),
     /// The world refused a body or joint.
     World(vertebra_world::Error),
+    /// A ragdoll that cannot be removed as it is (nothing was removed).
+    NotRemovable {
+        /// The item, e.g. `body `hips`` or `joint `knee_l``.
+        item: String,
+        /// Why, e.g. `is no longer in the world`.
+        reason: &'static str,
+    },
 }
 
 impl fmt::Display for RagdollError {
@@ -86,6 +93,9 @@ impl fmt::Display for RagdollError {
             RagdollError::SpineNotChain(m) => write!(f, "[spine]: {m}"),
             RagdollError::BadPose(m) => write!(f, "bad pose: {m}"),
             RagdollError::World(e) => write!(f, "{e}"),
+            RagdollError::NotRemovable { item, reason } => {
+                write!(f, "the ragdoll cannot be removed: {item} {reason}")
+            }
         }
     }
 }

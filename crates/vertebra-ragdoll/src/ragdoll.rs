@@ -1,6 +1,8 @@
 //! Building a ragdoll in a world: standard (every body and joint) or
 //! simplified (the spine chain replaced by one rod, paper section 6).
 
+use std::collections::{HashMap, HashSet};
+
 use glam::{Quat, Vec3};
 use vertebra_world::{
     BodyDesc, BodyHandle, RodDesc, RodHandle, RodStiffness, Shape, SocketDesc, SocketHandle, World,
@@ -229,8 +231,17 @@ impl Ragdoll {
         Ok(())
     }
 
-    /// Removes every joint and body of the ragdoll from `world`.
+    /// Removes every joint and body of the ragdoll from `world` (with the
+    /// contacts set for the next step that name them); the ragdoll is left
+    /// with no handles. All or nothing: refused with nothing removed
+    /// ([`RagdollError::NotRemovable`], naming the item) when one of its
+    /// bodies or joints is no longer in the world (removed by hand, or a
+    /// world restored to before the ragdoll was built) or a joint that is
+    /// not the ragdoll's still holds one of its bodies (remove that joint
+    /// first). A collision layer's colliders on its bodies are the layer's
+    /// (`vertebra_collide::Collisions::remove_ragdoll` removes both).
     pub fn remove(&mut self, world: &mut World) -> Result<(), RagdollError> {
+        self.check_removable(world)?;
         if let Some(rod) = self.rod.take() {
             world.remove_rod(rod)?;
         }
@@ -243,10 +254,59 @@ impl Ragdoll {
         Ok(())
     }
 
+    /// Whether [`Ragdoll::remove`] would remove everything: every handle
+    /// live, and no other joint on a body of the ragdoll.
+    fn check_removable(&self, world: &World) -> Result<(), RagdollError> {
+        let refuse = |item: String, reason| RagdollError::NotRemovable { item, reason };
+        const GONE: &str = "is no longer in the world";
+        if let Some(rod) = self.rod {
+            world
+                .rod(rod)
+                .map_err(|_| refuse("the spine rod".to_owned(), GONE))?;
+        }
+        for (joint, socket) in self.desc.joints.iter().zip(&self.sockets) {
+            if let Some(socket) = *socket {
+                world
+                    .socket(socket)
+                    .map_err(|_| refuse(format!("joint `{}`", joint.name), GONE))?;
+            }
+        }
+        let mut owner = HashMap::new();
+        for (def, body) in self.desc.bodies.iter().zip(&self.bodies) {
+            if let Some(body) = *body {
+                world
+                    .body(body)
+                    .map_err(|_| refuse(format!("body `{}`", def.name), GONE))?;
+                owner.insert(body, def);
+            }
+        }
+        let own_sockets: HashSet<_> = self.sockets.iter().flatten().collect();
+        let foreign = world
+            .sockets()
+            .filter(|(h, _)| !own_sockets.contains(h))
+            .map(|(_, d)| (d.body_a, d.body_b))
+            .chain(
+                world
+                    .rods()
+                    .filter(|(h, _)| Some(*h) != self.rod)
+                    .map(|(_, d)| (d.body_a, d.body_b)),
+            );
+        for (a, b) in foreign {
+            if let Some(def) = owner.get(&a).or_else(|| owner.get(&b)) {
+                return Err(refuse(
+                    format!("body `{}`", def.name),
+                    "is held by a joint that is not the ragdoll's (remove that joint first)",
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Re-creates the ragdoll at `pose` (the transition from animation to
     /// physics): the old bodies and joints go, new ones come, the rod
-    /// re-instantiated to hold exactly at the new pose. On error the
-    /// ragdoll is unchanged.
+    /// re-instantiated to hold exactly at the new pose. On error (a bad
+    /// pose, a world refusal, an old ragdoll that [`Ragdoll::remove`] would
+    /// refuse) the ragdoll and the world are unchanged.
     pub fn recreate(
         &mut self,
         world: &mut World,
@@ -254,6 +314,7 @@ impl Ragdoll {
         previous: Option<(&Pose, f32)>,
     ) -> Result<(), RagdollError> {
         pose.validate(&self.desc)?;
+        self.check_removable(world)?;
         let fresh = Self::build(world, &self.desc.clone(), self.options, pose, previous)?;
         let mut old = core::mem::replace(self, fresh);
         old.remove(world)

@@ -368,3 +368,96 @@ fn stabilisation_bounds_mass_ratios_and_keeps_the_total() {
         );
     }
 }
+
+/// Everything a refused removal must leave as it was: the world's bodies,
+/// joints and state, and the ragdoll's handles.
+fn removal_state(w: &World, ragdoll: &Ragdoll) -> impl PartialEq + std::fmt::Debug + use<> {
+    (
+        w.state_hash(),
+        w.bodies().len(),
+        w.sockets().count(),
+        w.rods().count(),
+        ragdoll.bodies.clone(),
+        ragdoll.sockets.clone(),
+        ragdoll.rod,
+    )
+}
+
+#[test]
+fn a_ragdoll_held_by_a_foreign_joint_is_not_removed_at_all() {
+    // Failed before the fix: the rod and every socket were removed, then
+    // the hips were refused (a pin still held them), leaving half a ragdoll.
+    let desc = RagdollDesc::reference_humanoid();
+    let mut w = world();
+    let mut ragdoll = Ragdoll::build(
+        &mut w,
+        &desc,
+        BuildOptions::new(SpineMode::Rod),
+        &Pose::bind(&desc),
+        None,
+    )
+    .unwrap();
+    let hips = ragdoll.bodies[desc.root].unwrap();
+    let at = w.body(hips).unwrap().position;
+    let anchor = w.add_body(BodyDesc::fixed().with_position(at)).unwrap();
+    let pin = SocketDesc::at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap();
+    let pin = w.add_socket(pin).unwrap();
+    let before = removal_state(&w, &ragdoll);
+    let refused = ragdoll.remove(&mut w).unwrap_err();
+    assert_eq!(removal_state(&w, &ragdoll), before, "nothing was removed");
+    let name = &desc.bodies[desc.root].name;
+    assert!(
+        refused.to_string().contains(&format!("body `{name}`")),
+        "the body is named: {refused}"
+    );
+    w.remove_socket(pin).unwrap();
+    ragdoll.remove(&mut w).unwrap();
+    assert_eq!((w.bodies().len(), w.sockets().count()), (1, 0));
+}
+
+#[test]
+fn a_ragdoll_missing_a_joint_is_not_removed_at_all() {
+    // Failed before the fix: the rod and the sockets before the missing one
+    // were removed, then the stale socket was refused without a name.
+    let desc = RagdollDesc::reference_humanoid();
+    let mut w = world();
+    let mut ragdoll = Ragdoll::build(
+        &mut w,
+        &desc,
+        BuildOptions::new(SpineMode::Rod),
+        &Pose::bind(&desc),
+        None,
+    )
+    .unwrap();
+    let k = desc.joints.len() - 1;
+    w.remove_socket(ragdoll.sockets[k].unwrap()).unwrap();
+    let before = removal_state(&w, &ragdoll);
+    let refused = ragdoll.remove(&mut w).unwrap_err();
+    assert_eq!(removal_state(&w, &ragdoll), before, "nothing was removed");
+    let name = &desc.joints[k].name;
+    assert!(
+        refused.to_string().contains(&format!("joint `{name}`")),
+        "the joint is named: {refused}"
+    );
+}
+
+#[test]
+fn a_ragdoll_that_cannot_be_removed_is_not_recreated() {
+    // Failed before the fix: the new ragdoll was built and swapped in, then
+    // removing the old one failed, leaving both in the world.
+    let desc = RagdollDesc::reference_humanoid();
+    let mut w = world();
+    let mut ragdoll = Ragdoll::build(
+        &mut w,
+        &desc,
+        BuildOptions::new(SpineMode::Sockets),
+        &Pose::bind(&desc),
+        None,
+    )
+    .unwrap();
+    w.remove_socket(ragdoll.sockets[0].unwrap()).unwrap();
+    let before = removal_state(&w, &ragdoll);
+    let pose = Pose::bind(&desc).moved(Vec3::ZERO, Quat::IDENTITY, Vec3::X);
+    assert!(ragdoll.recreate(&mut w, &pose, None).is_err());
+    assert_eq!(removal_state(&w, &ragdoll), before, "nothing changed");
+}

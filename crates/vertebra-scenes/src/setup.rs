@@ -399,7 +399,7 @@ pub fn ragdoll_drop(
             + u * (0.6 * (slot as f32 - 1.0));
         let pose = Pose::bind(desc).moved(hips, turn, at - hips);
         let ragdoll = Ragdoll::build(&mut world, desc, BuildOptions::new(spine), &pose, None)?;
-        collisions.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())?;
+        collisions.add_ragdoll(&ragdoll)?;
         ragdolls.push(ragdoll);
     }
     Ok((world, collisions, ragdolls))

@@ -3,6 +3,8 @@
 
 use core::fmt;
 
+use crate::BodyHandle;
+
 /// Why a call was rejected.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Error {
@@ -37,6 +39,17 @@ pub enum Error {
     ForeignSnapshot,
     /// A snapshot whose bytes are damaged or not a snapshot at all.
     CorruptSnapshot(&'static str),
+    /// A collider (of a collision layer such as `vertebra-collide`) that was
+    /// refused, or whose body is no longer in the world.
+    Collider {
+        /// Its index in the collision set (the index it would have had, for
+        /// one refused as it was added).
+        index: usize,
+        /// The body it is on.
+        body: BodyHandle,
+        /// Why.
+        reason: Box<Error>,
+    },
 }
 
 impl fmt::Display for Error {
@@ -59,6 +72,11 @@ impl fmt::Display for Error {
             Error::OutOfRange(what) => write!(f, "{what} is out of range"),
             Error::ForeignSnapshot => write!(f, "the snapshot was taken of another world"),
             Error::CorruptSnapshot(why) => write!(f, "corrupt snapshot: {why}"),
+            Error::Collider {
+                index,
+                body,
+                reason,
+            } => write!(f, "collider {index} on body {body:?}: {reason}"),
         }
     }
 }

@@ -8,7 +8,7 @@ use glam::{Mat3, Vec3};
 use crate::error::{Error, check_finite, check_positive};
 
 /// A solid centred on its body's centre of mass, in the body frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
     /// A ball of `radius` metres.
     Sphere {

@@ -141,13 +141,19 @@ impl World {
         Ok(handle)
     }
 
-    /// Removes a body that no joint uses.
+    /// Removes a body that no joint uses, with the contacts set for the
+    /// next step that name it (nothing acts on a removed body, nor on a new
+    /// body that reuses its slot). A collision layer's colliders on it are
+    /// the layer's to remove (`Collisions::remove_body`).
     pub fn remove_body(&mut self, handle: BodyHandle) -> Result<(), Error> {
         let i = self.bodies.index(handle)?;
         if self.joints_at[i] > 0 {
             return Err(Error::BodyInUse);
         }
-        self.bodies.remove(handle)
+        self.bodies.remove(handle)?;
+        self.contacts
+            .retain(|c| c.body_a != handle && c.body_b != handle);
+        Ok(())
     }
 
     /// A body's position, orientation and velocities.

@@ -131,3 +131,55 @@ fn static_friction_holds_below_atan_mu_and_slides_above() {
         }
     }
 }
+
+/// Two boxes side by side (slots 1 and 2), the second one deep in the
+/// ground; `contact` says whether a contact is set between it and the
+/// ground before it is removed.
+fn removal_world(contact: bool) -> (World, BodyHandle, BodyHandle) {
+    let (mut w, ground, first, half) = box_world(1);
+    let props = Shape::Box { half_extents: half }
+        .mass_properties(500.0)
+        .unwrap();
+    let sunk = BodyDesc::dynamic(props).with_position(Vec3::new(1.0, 0.0, 0.0));
+    let doomed = w.add_body(sunk).unwrap();
+    if contact {
+        let mut contacts = corner_contacts(&w, ground, doomed, half, 0.6, Vec3::Y);
+        contacts.push(Contact {
+            body_a: first,
+            body_b: doomed,
+            point: Vec3::new(0.5, 0.1, 0.0),
+            normal: Vec3::X,
+            depth: 0.2,
+            friction: 0.6,
+            restitution: 0.0,
+        });
+        w.set_contacts(&contacts).unwrap();
+    }
+    w.remove_body(doomed).unwrap();
+    let reborn = w.add_body(sunk).unwrap();
+    assert_eq!(reborn.index(), doomed.index(), "the slot is reused");
+    (w, first, reborn)
+}
+
+#[test]
+fn removing_a_body_drops_its_pending_contacts() {
+    // Failed before the fix: the contacts named the removed body's slot, so
+    // the step pushed the body that reused the slot up out of the ground
+    // and the other box away from a ghost.
+    let (mut w, first, reborn) = removal_world(true);
+    let (mut reference, ..) = removal_world(false);
+    assert!(w.contacts().is_empty(), "no contact names a removed body");
+    w.step(DT).unwrap();
+    reference.step(DT).unwrap();
+    assert_eq!(
+        w.body(reborn),
+        reference.body(reborn),
+        "the new body is not pushed"
+    );
+    assert_eq!(
+        w.body(first),
+        reference.body(first),
+        "nothing is pushed by a ghost"
+    );
+    assert_eq!(w.state_hash(), reference.state_hash());
+}

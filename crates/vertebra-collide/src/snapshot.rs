@@ -1,0 +1,127 @@
+//! Saving a collision set and restoring it, alongside `World::snapshot`:
+//! rollback and save games need both, since contacts come from the set.
+//!
+//! Bytes: `"VTBCOLLS"`, the format version (u32 LE), the xxh3 hash of the
+//! payload (u64 LE), then the payload (postcard): the prediction margin,
+//! every collider as it was added (body, shape, friction, restitution,
+//! groups) in the set's order, and the excluded pairs in a canonical order
+//! (so equal sets give equal bytes). The parry geometry is rebuilt from
+//! the shapes, exactly as [`Collisions::add`] builds it.
+//!
+//! The bytes are untrusted input: the checksum only catches accidents (it
+//! is not keyed), so [`Collisions::restore`] checks every value as
+//! strictly as the API does, and every collider's body against the world.
+
+use serde::{Deserialize, Serialize};
+use vertebra_world::{BodyHandle, Error, World};
+
+use crate::{Collider, Collisions, check_prediction, ordered};
+
+const MAGIC: &[u8; 8] = b"VTBCOLLS";
+const VERSION: u32 = 1;
+const HEADER: usize = 20;
+
+/// A collision set's full state at one instant: [`Collisions::snapshot`]
+/// takes it, [`Collisions::restore`] puts it back.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CollisionSnapshot {
+    bytes: Vec<u8>,
+}
+
+impl CollisionSnapshot {
+    /// The encoded snapshot (to store or send).
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.bytes
+    }
+
+    /// A snapshot from bytes (any bytes: they are checked when restored).
+    pub fn from_bytes(bytes: Vec<u8>) -> Self {
+        Self { bytes }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+struct State {
+    prediction: f32,
+    colliders: Vec<Collider>,
+    excluded: Vec<(BodyHandle, BodyHandle)>,
+}
+
+impl Collisions {
+    /// The set's full state now (see [`CollisionSnapshot`]).
+    pub fn snapshot(&self) -> CollisionSnapshot {
+        let mut excluded: Vec<_> = self.excluded.iter().copied().collect();
+        excluded.sort_by_cached_key(encode);
+        let state = State {
+            prediction: self.prediction,
+            colliders: self.colliders().copied().collect(),
+            excluded,
+        };
+        let payload = encode(&state);
+        let mut bytes = Vec::with_capacity(HEADER + payload.len());
+        bytes.extend_from_slice(MAGIC);
+        bytes.extend_from_slice(&VERSION.to_le_bytes());
+        bytes.extend_from_slice(&xxhash_rust::xxh3::xxh3_64(&payload).to_le_bytes());
+        bytes.extend_from_slice(&payload);
+        CollisionSnapshot { bytes }
+    }
+
+    /// Puts the set back to `snapshot`, for use with `world` (restore the
+    /// world first: every collider's body must be live in it).
+    /// `Err(CorruptSnapshot)` for bytes that are not a collision-set
+    /// snapshot of this version, damaged or undecodable; `Err(Collider)`
+    /// naming the collider and its body for a collider [`Collisions::add`]
+    /// would refuse or whose body is not in `world`; `NonFinite` or
+    /// `NonPositive` for a margin [`Collisions::set_prediction`] would
+    /// refuse. A set's own snapshot always restores into its world. The set is unchanged on
+    /// error.
+    pub fn restore(&mut self, snapshot: &CollisionSnapshot, world: &World) -> Result<(), Error> {
+        let state = decode(&snapshot.bytes)?;
+        check_prediction(state.prediction)?;
+        let mut restored = Collisions {
+            prediction: state.prediction,
+            ..Collisions::default()
+        };
+        for (index, collider) in state.colliders.into_iter().enumerate() {
+            if let Err(e) = world.body(collider.body) {
+                return Err(collider.refused(index, e));
+            }
+            restored.add(collider)?;
+        }
+        restored.excluded = state
+            .excluded
+            .into_iter()
+            .map(|(a, b)| ordered(a, b))
+            .collect();
+        *self = restored;
+        Ok(())
+    }
+}
+
+/// Postcard bytes of a value (our types always encode).
+fn encode<T: Serialize>(value: &T) -> Vec<u8> {
+    postcard::to_allocvec(value).expect("a collision set always encodes")
+}
+
+/// The state in `bytes`, if they are an intact snapshot of this version.
+fn decode(bytes: &[u8]) -> Result<State, Error> {
+    if bytes.len() < HEADER || &bytes[..8] != MAGIC {
+        return Err(Error::CorruptSnapshot("not a collision-set snapshot"));
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if version != VERSION {
+        return Err(Error::CorruptSnapshot(
+            "a collision-set snapshot of another format version",
+        ));
+    }
+    let checksum = u64::from_le_bytes(bytes[12..HEADER].try_into().expect("8 bytes"));
+    let payload = &bytes[HEADER..];
+    if xxhash_rust::xxh3::xxh3_64(payload) != checksum {
+        return Err(Error::CorruptSnapshot("checksum mismatch"));
+    }
+    match postcard::take_from_bytes::<State>(payload) {
+        Ok((state, [])) => Ok(state),
+        Ok(_) => Err(Error::CorruptSnapshot("bytes after the collision set")),
+        Err(_) => Err(Error::CorruptSnapshot("undecodable collision set")),
+    }
+}

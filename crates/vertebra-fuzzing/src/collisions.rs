@@ -1,0 +1,274 @@
+//! Arbitrary sequences of adding and removing bodies, colliders and
+//! ragdolls, with snapshots of the world and the collision set (intact and
+//! crafted) and steps with collision detection.
+
+use glam::{Quat, Vec3};
+use vertebra_collide::{Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions};
+use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
+use vertebra_world::{BodyDesc, BodyHandle, Error, Shape, Snapshot, SolverConfig, World};
+
+use crate::input::Input;
+
+const DT: f32 = 1.0 / 60.0;
+
+/// The world, the collision set and the ragdolls in it, with the bodies
+/// added one by one.
+struct Scene {
+    world: World,
+    collisions: Collisions,
+    ragdolls: Vec<Ragdoll>,
+    bodies: Vec<BodyHandle>,
+    desc: RagdollDesc,
+}
+
+/// What a refused call must leave as it was: the world (state hash and
+/// counts), the set (its snapshot bytes) and every ragdoll's handles.
+type Fingerprint = (u64, usize, usize, usize, CollisionSnapshot, Vec<String>);
+
+impl Scene {
+    fn fingerprint(&self) -> Fingerprint {
+        (
+            self.world.state_hash(),
+            self.world.bodies().len(),
+            self.world.sockets().count(),
+            self.world.rods().count(),
+            self.collisions.snapshot(),
+            self.ragdolls
+                .iter()
+                .map(|r| format!("{:?} {:?} {:?}", r.bodies, r.sockets, r.rod))
+                .collect(),
+        )
+    }
+
+    fn body(&self, input: &mut Input) -> Option<BodyHandle> {
+        (!self.bodies.is_empty()).then(|| self.bodies[input.pick(self.bodies.len())])
+    }
+
+    fn ragdoll(&self, input: &mut Input) -> Option<usize> {
+        (!self.ragdolls.is_empty()).then(|| input.pick(self.ragdolls.len()))
+    }
+
+    /// A dynamic body with an arbitrary collider on it; the body goes again
+    /// if the set refuses the collider.
+    fn add_body(&mut self, input: &mut Input) -> Result<(), Error> {
+        let shape = match input.pick(3) {
+            0 => Shape::Sphere {
+                radius: input.float(0.5),
+            },
+            1 => Shape::Box {
+                half_extents: input.vec3(0.5),
+            },
+            _ => Shape::capsule(input.vec3(0.5), input.vec3(0.5), input.float(0.2)),
+        };
+        let body = self.world.add_body(
+            BodyDesc::dynamic(Shape::Sphere { radius: 0.2 }.mass_properties(500.0)?)
+                .with_position(input.vec3(3.0) + Vec3::Y * 3.0)
+                .with_velocity(input.vec3(5.0), input.vec3(5.0)),
+        )?;
+        let collider = Collider {
+            body,
+            shape: ColliderShape::Solid(shape),
+            friction: input.float(1.0),
+            restitution: input.float(1.0),
+            groups: CollisionGroups {
+                membership: input.pick(4) as u32,
+                filter: input.pick(4) as u32,
+            },
+        };
+        if let Err(e) = self.collisions.add(collider) {
+            self.world.remove_body(body)?;
+            return Err(e);
+        }
+        self.bodies.push(body);
+        Ok(())
+    }
+
+    fn add_ragdoll(&mut self, input: &mut Input) -> Result<(), Error> {
+        let spine = [SpineMode::Rod, SpineMode::Sockets][input.pick(2)];
+        let pose = Pose::bind(&self.desc).moved(Vec3::ZERO, input.quat(), input.vec3(3.0));
+        let ragdoll = Ragdoll::build(
+            &mut self.world,
+            &self.desc,
+            BuildOptions::new(spine),
+            &pose,
+            None,
+        )
+        .map_err(|_| Error::InvalidConfig("ragdoll refused"))?;
+        self.collisions.add_ragdoll(&ragdoll)?;
+        self.ragdolls.push(ragdoll);
+        Ok(())
+    }
+
+    /// A body out of the world and the set, the world's way first.
+    fn remove_body(&mut self, input: &mut Input) -> Result<(), Error> {
+        let Some(body) = self.body(input) else {
+            return Ok(());
+        };
+        self.world.remove_body(body)?;
+        self.collisions.remove_body(body);
+        Ok(())
+    }
+
+    /// The last world and set snapshots with the ragdolls of the time
+    /// restored together: the set after the world, as documented.
+    fn restore(&mut self, saved: &(Snapshot, CollisionSnapshot, Vec<Ragdoll>)) {
+        self.world.restore(&saved.0).expect("its own snapshot");
+        self.collisions
+            .restore(&saved.1, &self.world)
+            .expect("the set saved with the world");
+        self.ragdolls = saved.2.clone();
+    }
+
+    /// A crafted collision snapshot: the saved bytes with a few bytes
+    /// overwritten and the checksum made right again (the format is
+    /// documented: magic 8, version 4, xxh3 8, payload).
+    fn restore_crafted(
+        &mut self,
+        saved: &CollisionSnapshot,
+        input: &mut Input,
+    ) -> Result<(), Error> {
+        let mut bytes = saved.as_bytes().to_vec();
+        for _ in 0..1 + input.pick(4) {
+            let at = input.pick(bytes.len());
+            bytes[at] = input.pick(256) as u8;
+        }
+        if bytes.len() >= 20 && input.pick(4) > 0 {
+            let sum = xxhash_rust::xxh3::xxh3_64(&bytes[20..]);
+            bytes[12..20].copy_from_slice(&sum.to_le_bytes());
+        }
+        self.collisions
+            .restore(&CollisionSnapshot::from_bytes(bytes), &self.world)
+    }
+
+    /// Collision detection and a step: contacts always come (no collider
+    /// outlives its body here), and the world always takes them.
+    fn step(&mut self) -> Result<(), Error> {
+        let contacts = self
+            .collisions
+            .find_contacts(&self.world, DT)
+            .expect("every collider's body is in the world");
+        self.world
+            .set_contacts(&contacts)
+            .expect("the world takes every contact found");
+        self.world.step(DT)
+    }
+
+    /// Every collider's body is in the world, every pending contact's too,
+    /// and every body is finite.
+    fn check(&self) {
+        let live = |b: BodyHandle| self.world.body(b).is_ok();
+        assert!(self.collisions.colliders().all(|c| live(c.body)));
+        assert!(
+            self.world
+                .contacts()
+                .iter()
+                .all(|c| live(c.body_a) && live(c.body_b))
+        );
+        let store = self.world.bodies();
+        for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
+            assert!(store.is_finite(i), "body {i} went non-finite");
+        }
+    }
+}
+
+/// Up to 48 calls on a world with a ground plane, its collision set and
+/// ragdolls: bodies with arbitrary colliders added and removed, ragdolls
+/// added, removed, recreated (also after a joint of theirs was removed by
+/// hand), pairs excluded, the margin set, both snapshots taken and
+/// restored, crafted collision snapshots restored, steps with detection.
+/// No panic; a refused call leaves the world, the set and the ragdolls as
+/// they were; no collider or contact outlives its body.
+pub fn collisions(data: &[u8]) {
+    let mut input = Input::new(data);
+    let mut world = World::new(SolverConfig::default()).expect("a valid config");
+    let mut collisions = Collisions::new();
+    let ground = world
+        .add_body(BodyDesc::fixed())
+        .expect("a fixed body at the origin");
+    collisions
+        .add(Collider::new(ground, ColliderShape::Plane(Vec3::Y)))
+        .expect("the ground plane");
+    let mut scene = Scene {
+        world,
+        collisions,
+        ragdolls: Vec::new(),
+        bodies: Vec::new(),
+        desc: RagdollDesc::reference_humanoid(),
+    };
+    let mut saved = (
+        scene.world.snapshot(),
+        scene.collisions.snapshot(),
+        Vec::new(),
+    );
+    for _ in 0..48 {
+        if input.is_empty() {
+            break;
+        }
+        let before = scene.fingerprint();
+        let result = match input.pick(11) {
+            0 => scene.add_body(&mut input),
+            1 => scene.add_ragdoll(&mut input),
+            2 => scene.remove_body(&mut input),
+            3 => match scene.ragdoll(&mut input) {
+                Some(k) => scene
+                    .collisions
+                    .remove_ragdoll(&mut scene.world, &mut scene.ragdolls[k])
+                    .map_err(|_| Error::InvalidConfig("ragdoll removal refused")),
+                None => Ok(()),
+            },
+            4 => match scene.ragdoll(&mut input) {
+                Some(k) => {
+                    let pose = Pose::bind(&scene.desc).moved(
+                        Vec3::ZERO,
+                        Quat::IDENTITY,
+                        input.vec3(3.0) + Vec3::Y,
+                    );
+                    scene
+                        .collisions
+                        .recreate_ragdoll(&mut scene.world, &mut scene.ragdolls[k], &pose, None)
+                        .map_err(|_| Error::InvalidConfig("ragdoll recreation refused"))
+                }
+                None => Ok(()),
+            },
+            5 => match scene.ragdoll(&mut input) {
+                Some(k) => {
+                    let sockets = &scene.ragdolls[k].sockets;
+                    match sockets[input.pick(sockets.len())] {
+                        Some(socket) => scene.world.remove_socket(socket),
+                        None => Ok(()),
+                    }
+                }
+                None => Ok(()),
+            },
+            6 => {
+                saved = (
+                    scene.world.snapshot(),
+                    scene.collisions.snapshot(),
+                    scene.ragdolls.clone(),
+                );
+                Ok(())
+            }
+            7 => {
+                scene.restore(&saved);
+                Ok(())
+            }
+            8 => scene.restore_crafted(&saved.1, &mut input),
+            9 => {
+                if let (Some(a), Some(b)) = (scene.body(&mut input), scene.body(&mut input)) {
+                    scene.collisions.exclude(a, b);
+                }
+                Ok(())
+            }
+            10 => scene.collisions.set_prediction(input.float(0.1)),
+            _ => scene.step(),
+        };
+        if let Err(error) = result {
+            assert!(!error.to_string().is_empty());
+            assert!(
+                scene.fingerprint() == before,
+                "refused ({error}) but changed something"
+            );
+        }
+        scene.check();
+    }
+}
