@@ -333,7 +333,7 @@ fn assert_refused(bad: &CollisionSnapshot, expected: Option<Error>) {
 
 #[test]
 fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
-    let (_, c, [_, _, b]) = boxes();
+    let (mut own, c, [_, _, b]) = boxes();
     let good = c.snapshot().as_bytes().to_vec();
     let corrupt = |why: &str| Some(Error::CorruptSnapshot(why.into()));
     assert_refused(
@@ -366,14 +366,23 @@ fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
         &resealed([&good[..], &[0]].concat()),
         corrupt("bytes after the collision set"),
     );
-    // A world without the boxes: the first collider whose body is not in it
-    // is named.
+    // Another world's bodies are foreign (its handles carry another
+    // lineage): the first collider is named.
     let mut other = World::new(SolverConfig::default()).unwrap();
     other.add_body(BodyDesc::fixed()).unwrap();
     other.add_body(BodyDesc::fixed()).unwrap();
     let mut set = Collisions::new();
+    let result = set.restore(&c.snapshot(), &other);
+    assert!(
+        matches!(&result, Err(Error::Collider { index: 0, reason, .. })
+            if **reason == Error::ForeignHandle("body")),
+        "{result:?}"
+    );
+    assert_eq!(set.colliders().count(), 0);
+    // The boxes' own world without the third box: its collider is named.
+    own.remove_body(b).unwrap();
     assert_eq!(
-        set.restore(&c.snapshot(), &other),
+        set.restore(&c.snapshot(), &own),
         Err(Error::Collider {
             index: 2,
             body: b,

@@ -159,6 +159,11 @@ pub trait Lane:
     /// Gathers body rows: lane `i` of element `k` is `rows[indices[i]][k]`
     /// (the loads and the transpose; `indices` holds `WIDTH` entries).
     ///
+    /// Safe for any caller and any indices: rows are cells that cannot be
+    /// shared between threads ([`Row`] is not `Sync`), so the plain vector
+    /// loads and stores of this and [`Lane::scatter_rows`] never race (see
+    /// [`crate::row`]).
+    ///
     /// # Panics
     /// If an index is out of bounds.
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN];

@@ -11,6 +11,8 @@
 //! - [`row`]: body rows, gathered into lanes and scattered back.
 //! - [`map`]: one lane function applied across arrays on any backend.
 //! - [`check`]: comparing every backend with the scalar reference, bit for bit.
+//! - [`float_mode`]: the default floating-point mode for a solver step,
+//!   whatever mode (FTZ, DAZ, rounding) the caller's thread runs in.
 //!
 //! Public values outside kernels are `glam` types; `Vec3<f32>` and
 //! `Quat<f32>` convert to and from them.
@@ -18,6 +20,7 @@
 pub mod backend;
 pub mod block;
 pub mod check;
+pub mod float_mode;
 pub mod lane;
 pub mod map;
 pub mod poly;
@@ -27,6 +30,7 @@ pub mod sym3;
 pub mod vec3;
 
 pub use backend::{Backend, BackendChoice, BackendError, LaneKernel};
+pub use float_mode::DefaultFloatMode;
 pub use lane::{Lane, Mask};
 pub use quat::Quat;
 pub use sym3::Sym3;

@@ -9,6 +9,7 @@
 //! | [`acos`] | [-1, 1] | 2.6e-7 | 2.5e-7 | clamped to [-1, 1]; NaN: NaN |
 //! | [`atan2`] | all (y, x), both infinite too | 2.7e-7 | 2.6e-7 | NaN in either: NaN |
 //! | [`half_sinc`] `sin(x/2)/x` | [-pi, pi] | 5.0e-8 | 4.3e-8 | clamped to [-pi, pi]; NaN: NaN |
+//! | [`wrap_angle`] to [-pi, pi] | \|x\| <= 4 pi | 3.5e-7 | 3.5e-7 | finite: a value near [-pi, pi], off by the rounding of `x / 2 pi`; inf, NaN: NaN |
 //!
 //! For scale: one ulp of pi in `f32` is 2.4e-7, so the inverse functions are
 //! within about one ulp of their largest results. `acos` is also accurate
@@ -48,6 +49,16 @@ pub(crate) fn pi_minus<L: Lane>(half: bool, a: L) -> L {
         (PI, PI_LO)
     };
     (L::splat(lo) - a) + L::splat(hi)
+}
+
+/// `x` wrapped to [-pi, pi] (rad), branch-free: `x - 2 pi round(x / 2 pi)`
+/// (ties to even, so `pi` and `-pi` stay as they are). The difference of
+/// two angles in [-pi, pi] is exact to within one rounding of `2 pi`; an
+/// angle error wrapped so turns the short way round.
+#[inline(always)]
+pub fn wrap_angle<L: Lane>(x: L) -> L {
+    const TAU: f32 = 2.0 * PI;
+    x - L::splat(TAU) * (x * L::splat(1.0 / TAU)).round()
 }
 
 /// Evaluates the polynomial with `coefficients` (highest degree first) at

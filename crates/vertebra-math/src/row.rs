@@ -2,13 +2,32 @@
 //! scattered back (Box2D v3 gathers body rows this way instead of using
 //! hardware gathers, which are slower than loads and transposes).
 //!
-//! The floats are stored as `AtomicU32` bits so that batches of one colour
-//! can write their (disjoint) rows from several threads through a shared
-//! reference without `unsafe`: relaxed loads and stores compile to plain
-//! moves, and the colouring guarantees no two batches of a colour touch
-//! the same written row, so no value is ever raced on.
+//! # Rows and threads
+//!
+//! Kernels read and write rows through a shared reference (`&[Row]`): a
+//! row is a [`Cell`], and the SIMD backends load and store it with plain
+//! vector moves. Plain stores are not atomic, so two threads must never
+//! reach the same row at once: that is why `Row` is **not `Sync`**. Safe
+//! code can therefore never share rows between threads, and
+//! [`Lane::gather_rows`](crate::Lane::gather_rows) /
+//! [`Lane::scatter_rows`](crate::Lane::scatter_rows) are sound from any
+//! safe caller: whatever the indices (bounds-checked, repeated or not),
+//! every access happens on the one thread that holds the rows.
+//!
+//! Solving one colour on several threads needs the rows shared, so the one
+//! place that does it (`vertebra-world`'s `parallel.rs`) claims `Sync` for
+//! them with `unsafe`, and keeps the condition that makes it sound: the
+//! blocks run at once write rows no other of them reads or writes (checked
+//! when the layout is built).
+//!
+//! ```compile_fail
+//! // Rows cannot cross threads by reference: two threads scattering into
+//! // the same row would race.
+//! fn shared<T: Sync>() {}
+//! shared::<vertebra_math::row::Row>();
+//! ```
 
-use core::sync::atomic::{AtomicU32, Ordering};
+use core::cell::Cell;
 
 /// Floats per row.
 pub const ROW_LEN: usize = 8;
@@ -17,42 +36,37 @@ pub const ROW_LEN: usize = 8;
 /// written (static, kinematic, padding).
 pub const NO_WRITE: u32 = u32::MAX;
 
-/// Eight floats, 32-byte aligned so that one AVX load reads a row.
-#[derive(Debug, Default)]
+/// Eight floats, 32-byte aligned so that one AVX load reads a row. `Send`
+/// but not `Sync` (see [the module documentation](self)).
+#[derive(Clone, Debug, Default)]
 #[repr(C, align(32))]
-pub struct Row([AtomicU32; ROW_LEN]);
+pub struct Row(Cell<[f32; ROW_LEN]>);
 
 impl Row {
     /// A row holding `values`.
     pub fn new(values: [f32; ROW_LEN]) -> Self {
-        Self(values.map(|v| AtomicU32::new(v.to_bits())))
+        Self(Cell::new(values))
     }
 
     /// The row's values.
     #[inline(always)]
     pub fn get(&self) -> [f32; ROW_LEN] {
-        core::array::from_fn(|k| f32::from_bits(self.0[k].load(Ordering::Relaxed)))
+        self.0.get()
     }
 
     /// Overwrites the row's values.
     #[inline(always)]
     pub fn set(&self, values: [f32; ROW_LEN]) {
-        for (cell, v) in self.0.iter().zip(values) {
-            cell.store(v.to_bits(), Ordering::Relaxed);
-        }
+        self.0.set(values);
     }
 
-    /// The first float, for the lane types' vector loads and stores.
+    /// The first float, for the lane types' vector loads and stores (valid
+    /// for reads and writes of the row's eight floats while `self` is
+    /// borrowed, on this thread: the cell allows writes through `&self`).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     pub(crate) fn as_ptr(&self) -> *mut f32 {
-        self.0.as_ptr().cast::<u32>().cast_mut().cast::<f32>()
-    }
-}
-
-impl Clone for Row {
-    fn clone(&self) -> Self {
-        Self::new(self.get())
+        self.0.as_ptr().cast::<f32>()
     }
 }
 

@@ -191,3 +191,32 @@ fn outside_the_domain_results_stay_finite_and_bounded() {
     let nan = eval(&[f32::NAN], &[1.0]);
     assert!(nan.iter().all(|o| o[0].is_nan()));
 }
+
+lane_map!(Wrap, 1 -> 1, |i, o| { o[0] = poly::wrap_angle(i[0]); });
+
+#[test]
+fn wrap_angle_lands_in_minus_pi_to_pi_on_the_same_angle() {
+    use std::f32::consts::PI;
+    let bound = 3.5e-7;
+    let xs = grid(-4.0 * PI, 4.0 * PI, 2_000_000);
+    let got = assert_agree(&Wrap, std::slice::from_ref(&xs)).remove(0);
+    // The same angle: `got - x` is a whole number of turns, to within the bound.
+    let tau = std::f64::consts::TAU;
+    let off_turns = |(&x, &g): (&f32, &f32)| {
+        let d = g as f64 - x as f64;
+        ((d - tau * (d / tau).round()).abs(), x)
+    };
+    let worst = xs
+        .iter()
+        .zip(&got)
+        .map(off_turns)
+        .fold((0.0, 0.0), |a, b| if b.0 > a.0 { b } else { a });
+    report("wrap_angle", bound, worst);
+    let widest = got.iter().map(|&g| g.abs() as f64).fold(0.0, f64::max);
+    assert!(widest <= PI as f64 + bound, "wrapped to {widest}");
+    // Pi stays pi (ties to even), and just past it the short way is taken.
+    let edges = assert_agree(&Wrap, &[vec![PI, -PI, 3.3, -3.3]]).remove(0);
+    assert_eq!(edges[..2], [PI, -PI]);
+    assert!((edges[2] - (3.3 - 2.0 * PI)).abs() < 1e-6, "{edges:?}");
+    assert!((edges[3] + (3.3 - 2.0 * PI)).abs() < 1e-6, "{edges:?}");
+}

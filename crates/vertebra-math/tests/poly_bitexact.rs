@@ -19,6 +19,7 @@ lane_map!(Inverse, 1 -> 3, |i, o| {
     o[2] = poly::half_sinc(i[0]);
 });
 lane_map!(Atan2, 2 -> 1, |i, o| { o[0] = poly::atan2(i[0], i[1]); });
+lane_map!(Wrap, 1 -> 1, |i, o| { o[0] = poly::wrap_angle(i[0]); });
 
 #[test]
 fn sin_cos_agree() {
@@ -42,4 +43,11 @@ fn atan2_agrees() {
     let y = uniform(&mut r, 50_000, -2.0..2.0);
     let x = uniform(&mut r, 50_000, -2.0..2.0);
     assert_agree(&Atan2, &[y, x]);
+}
+
+#[test]
+fn wrap_angle_agrees() {
+    assert_agree(&Wrap, &arguments(1, 50_000, 17));
+    let mut r = rng(18);
+    assert_agree(&Wrap, &[uniform(&mut r, 50_000, -20.0..20.0)]);
 }

@@ -14,9 +14,38 @@
 //!   another world's snapshot (a save game, a server's state) takes on that
 //!   world's handles, and its own earlier handles become foreign.
 
+use core::cell::Cell;
 use core::marker::PhantomData;
 
+use serde::ser::{Serialize, SerializeStruct, Serializer};
+
 use crate::error::Error;
+
+thread_local! {
+    static PHYSICAL_ONLY: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Runs `f` with handles and slot tables serialising only what a step can
+/// read of them (slot indices, which slots are live and which free), not
+/// the lineage of the world that issued them or their generations: state
+/// serialised inside `f` is equal for equal worlds, whichever world built
+/// them and however often their handles were reissued. (`World::state_hash`
+/// hashes the world so.) Nothing serialised inside `f` can be decoded.
+pub fn serialize_physical_only<R>(f: impl FnOnce() -> R) -> R {
+    /// Puts the caller's setting back, even if `f` unwinds.
+    struct Restore(bool);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            PHYSICAL_ONLY.with(|p| p.set(self.0));
+        }
+    }
+    let _restore = Restore(PHYSICAL_ONLY.with(|p| p.replace(true)));
+    f()
+}
+
+fn physical_only() -> bool {
+    PHYSICAL_ONLY.with(Cell::get)
+}
 
 /// The most generations a table issues: 2^48 insertions, a million a
 /// second for nine years. A decoded table whose counter is beyond it is
@@ -24,13 +53,27 @@ use crate::error::Error;
 pub const MAX_GENERATION: u64 = 1 << 48;
 
 /// A stable reference to an item of kind `T` in a [`Slots`] table.
-#[derive(serde::Serialize, serde::Deserialize)]
+#[derive(serde::Deserialize)]
 #[serde(bound = "")]
 pub struct Handle<T> {
     index: u32,
     lineage: u32,
     generation: u64,
+    #[serde(skip)]
     _kind: PhantomData<fn() -> T>,
+}
+
+impl<T> Serialize for Handle<T> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        if physical_only() {
+            return self.index.serialize(s);
+        }
+        let mut out = s.serialize_struct("Handle", 3)?;
+        out.serialize_field("index", &self.index)?;
+        out.serialize_field("lineage", &self.lineage)?;
+        out.serialize_field("generation", &self.generation)?;
+        out.end()
+    }
 }
 
 impl<T> Handle<T> {
@@ -74,7 +117,7 @@ impl<T> core::fmt::Debug for Handle<T> {
 /// Slot bookkeeping: which indices are live, the generation each live one
 /// was issued with, and a free list that reuses the lowest freed index
 /// first (deterministic).
-#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, serde::Deserialize)]
 pub struct Slots {
     lineage: u32,
     /// The generation the next insertion gets; above every one issued.
@@ -82,6 +125,21 @@ pub struct Slots {
     generation: Vec<u64>,
     live: Vec<bool>,
     free: std::collections::BTreeSet<u32>,
+}
+
+impl Serialize for Slots {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        if physical_only() {
+            return (&self.live, &self.free).serialize(s);
+        }
+        let mut out = s.serialize_struct("Slots", 5)?;
+        out.serialize_field("lineage", &self.lineage)?;
+        out.serialize_field("next_generation", &self.next_generation)?;
+        out.serialize_field("generation", &self.generation)?;
+        out.serialize_field("live", &self.live)?;
+        out.serialize_field("free", &self.free)?;
+        out.end()
+    }
 }
 
 impl Slots {

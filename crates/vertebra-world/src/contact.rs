@@ -115,6 +115,8 @@ pub(crate) struct ContactLayout {
     pub colours: Vec<Range<usize>>,
     /// Block range of the overflow set.
     pub overflow: Range<usize>,
+    /// Every colour passed [`crate::parallel::colour_is_disjoint`].
+    pub disjoint: bool,
 }
 
 impl ContactLayout {
@@ -136,6 +138,9 @@ impl ContactLayout {
             }
         }
         layout.overflow = layout.append(colouring.overflow().iter(), contacts, bodies, max_depth);
+        layout.disjoint = layout.colours.iter().all(|r| {
+            crate::parallel::colour_is_disjoint(layout.blocks[r.clone()].iter().map(|b| &b.bodies))
+        });
         layout
     }
 

@@ -96,6 +96,9 @@ pub(crate) struct Layout {
     pub colours: Vec<Group>,
     /// The overflow set (solved by the scalar kernel).
     pub overflow: Group,
+    /// Every colour passed [`crate::parallel::colour_is_disjoint`]: its
+    /// blocks may run on several threads.
+    pub disjoint: bool,
 }
 
 impl Layout {
@@ -115,6 +118,15 @@ impl Layout {
             }
         }
         layout.overflow = layout.append(colouring.overflow(), sockets, rods, bodies);
+        layout.disjoint = layout.colours.iter().all(|g| {
+            let sockets = layout.sockets.blocks[g.driven.clone()]
+                .iter()
+                .chain(&layout.sockets.blocks[g.plain.clone()]);
+            let rods = layout.rods.blocks[g.rods.clone()].iter();
+            crate::parallel::colour_is_disjoint(
+                sockets.map(|b| &b.bodies).chain(rods.map(|b| &b.bodies)),
+            )
+        });
         layout
     }
 

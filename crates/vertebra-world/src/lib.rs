@@ -27,14 +27,14 @@ mod config;
 mod contact;
 mod layout;
 mod metrics;
+mod parallel;
 mod rod;
 mod snapshot;
 mod socket;
 mod step;
 
 use glam::{Quat, Vec3};
-use vertebra_kernels::body::BodyRows;
-use vertebra_math::Backend;
+use vertebra_math::{Backend, DefaultFloatMode};
 use vertebra_scheduler::Colouring;
 use vertebra_store::Slots;
 
@@ -69,7 +69,7 @@ pub struct World {
     layout_dirty: bool,
     contacts: Vec<Contact>,
     contact_layout: contact::ContactLayout,
-    rows: BodyRows,
+    rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
     residuals: Residuals,
     /// Bodies put back by the step's last-line NaN guard, ever.
@@ -110,7 +110,7 @@ impl World {
             layout_dirty: false,
             contacts: Vec::new(),
             contact_layout: contact::ContactLayout::default(),
-            rows: BodyRows::default(),
+            rows: parallel::Scratch::default(),
             previous: Vec::new(),
             residuals: Residuals::default(),
             repaired: 0,
@@ -377,8 +377,9 @@ impl World {
     /// Residual joint error of the current poses, without stepping (e.g.
     /// right after building a ragdoll).
     pub fn measure_residuals(&mut self) -> &Residuals {
+        let _mode = DefaultFloatMode::enter();
         self.refresh_layout();
-        step::upload(&self.bodies, &mut self.rows);
+        step::upload(&self.bodies, self.rows.get());
         self.layout.start_step(&self.bodies);
         self.residuals = metrics::residuals(self);
         &self.residuals
@@ -404,13 +405,28 @@ impl World {
         self.repaired
     }
 
-    /// A 64-bit hash of every live body's state, bit for bit: two worlds
-    /// with the same hash are (with overwhelming likelihood) identical.
+    /// A 64-bit hash, bit for bit, of everything a step reads that outlives
+    /// the step (what a [`Snapshot`] holds): every body's kind, pose (its
+    /// coordinate to double precision), velocities, mass and inertia,
+    /// damping and pending forces and torques; which slots are live and
+    /// free; the joints; the colouring (the solve order); the contacts set
+    /// for the next step. Two worlds with the same hash step on to the same
+    /// bits (with overwhelming likelihood): for rollback, a desync shows in
+    /// the hash.
+    ///
+    /// Not covered: the settings ([`SolverConfig`]; backend and thread count
+    /// do not change results), residuals and counters, and what no step
+    /// reads of the handles: the world's lineage and the generations. Equal
+    /// worlds built apart (in two processes, or restored from a snapshot)
+    /// hash alike.
     pub fn state_hash(&self) -> u64 {
-        metrics::state_hash(&self.bodies)
+        metrics::state_hash(self)
     }
 
-    /// Advances the world by `dt` seconds (finite, positive).
+    /// Advances the world by `dt` seconds (finite, positive). The step
+    /// computes in the default floating-point mode on every thread it uses,
+    /// whatever mode (FTZ, DAZ, rounding) the caller runs in, and gives the
+    /// caller's mode back ([`vertebra_math::float_mode`]).
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         if dt > vertebra_store::MAX_TIME_STEP {
@@ -421,6 +437,7 @@ impl World {
                 "time step (each substep at least 1e-6 s)",
             ));
         }
+        let _mode = DefaultFloatMode::enter();
         self.refresh_layout();
         let (max_linear, max_angular) =
             (self.config.max_linear_speed, self.config.max_angular_speed);
@@ -432,7 +449,10 @@ impl World {
         // among its workers (see step::for_each_colour).
         match self.pool.take() {
             Some(pool) => {
-                pool.install(|| step::step(self, dt));
+                pool.install(|| {
+                    let _mode = DefaultFloatMode::enter();
+                    step::step(self, dt)
+                });
                 self.pool = Some(pool);
             }
             None => step::step(self, dt),

@@ -3,12 +3,13 @@
 
 use vertebra_kernels::residual::ResidualPass;
 use vertebra_math::block::BLOCK_LANES;
-use vertebra_store::BodyStore;
+use vertebra_scheduler::Colouring;
+use vertebra_store::{BodyStore, Slots};
 
-use crate::World;
 use crate::layout::EMPTY;
 use crate::rod::RodHandle;
 use crate::socket::SocketHandle;
+use crate::{Contact, RodDesc, SocketDesc, World};
 
 /// One joint's residual error.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,8 +64,9 @@ fn collect<H>(
     joints.into_iter().map(|j| j.1).collect()
 }
 
-pub(crate) fn residuals(world: &World) -> Residuals {
-    let (sockets, rods, rows) = (&world.layout.sockets, &world.layout.rods, &world.rows);
+pub(crate) fn residuals(world: &mut World) -> Residuals {
+    let rows = &*world.rows.get();
+    let (sockets, rods) = (&world.layout.sockets, &world.layout.rods);
     let mut socket_lanes = vec![[0.0f32; 2]; sockets.blocks.len() * BLOCK_LANES];
     world.backend.dispatch(ResidualPass {
         blocks: &sockets.blocks,
@@ -99,24 +101,42 @@ pub(crate) fn residuals(world: &World) -> Residuals {
     }
 }
 
-/// xxh3 over the bits of every live body's slot, position, orientation and
-/// velocities, in slot order.
-pub(crate) fn state_hash(bodies: &BodyStore) -> u64 {
-    let mut bytes = Vec::with_capacity(bodies.capacity() * 56);
-    for i in 0..bodies.capacity() {
-        if !bodies.is_live(i) {
-            continue;
-        }
-        bytes.extend_from_slice(&(i as u32).to_le_bytes());
-        let values = bodies.position[i]
-            .to_array()
-            .into_iter()
-            .chain(bodies.orientation[i].to_array())
-            .chain(bodies.linear_velocity[i].to_array())
-            .chain(bodies.angular_velocity[i].to_array());
-        for v in values {
-            bytes.extend_from_slice(&v.to_bits().to_le_bytes());
-        }
-    }
+/// What [`World::state_hash`] covers: everything a step reads that
+/// outlives the step, as a snapshot holds it. Each piece of state is one
+/// field here; a new one is hashed by adding its line (a new body quantity
+/// is a `BodyStore` field, hashed with the store).
+#[derive(serde::Serialize)]
+struct Hashed<'a> {
+    /// Every slot's kind, pose, velocities, mass and inertia (and their
+    /// inverses), pending force and torque, damping, each coordinate's low
+    /// part; which slots are live and free (where the next body goes).
+    bodies: &'a BodyStore,
+    joints_at: &'a [u32],
+    socket_slots: &'a Slots,
+    sockets: &'a [Option<SocketDesc>],
+    rod_slots: &'a Slots,
+    rods: &'a [Option<RodDesc>],
+    /// The solve order.
+    colouring: &'a Colouring,
+    /// The contacts set for the next step.
+    contacts: &'a [Contact],
+}
+
+/// xxh3 over the bits of [`Hashed`] (postcard: floats as their bits).
+pub(crate) fn state_hash(world: &World) -> u64 {
+    let state = Hashed {
+        bodies: &world.bodies,
+        joints_at: &world.joints_at,
+        socket_slots: &world.socket_slots,
+        sockets: &world.sockets,
+        rod_slots: &world.rod_slots,
+        rods: &world.rods,
+        colouring: &world.colouring,
+        contacts: &world.contacts,
+    };
+    // Which world issued the handles, and their generations, change no
+    // step: equal worlds hash alike whoever built them.
+    let bytes = vertebra_store::serialize_physical_only(|| postcard::to_allocvec(&state))
+        .expect("the state always encodes");
     xxhash_rust::xxh3::xxh3_64(&bytes)
 }

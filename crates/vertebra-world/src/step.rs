@@ -3,7 +3,6 @@
 //! bodies, Müller et al. 2020, algorithm 2).
 
 use glam::{Quat, Vec3};
-use rayon::prelude::*;
 use vertebra_kernels::body::BodyRows;
 use vertebra_kernels::contact::{self, ContactBlock};
 use vertebra_kernels::rod::{self, RodBlock};
@@ -12,10 +11,11 @@ use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
 
 use crate::World;
+use crate::parallel::chunked;
 
 pub(crate) fn step(world: &mut World, dt: f32) {
     let h = dt / world.config.substeps as f32;
-    upload(&world.bodies, &mut world.rows);
+    upload(&world.bodies, world.rows.get());
     world.layout.start_step(&world.bodies);
     world
         .previous
@@ -85,7 +85,7 @@ fn commit(world: &mut World) {
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] != BodyKind::Static {
-            let (displacement, orientation) = pose(&world.rows, i);
+            let (displacement, orientation) = pose(world.rows.get(), i);
             b.displace(i, displacement);
             b.orientation[i] = orientation;
         }
@@ -123,9 +123,9 @@ fn predict(world: &mut World, h: f32) {
             b.linear_velocity[i] = limit(b.linear_velocity[i], max_linear);
             b.angular_velocity[i] = w;
         }
-        let (displacement, orientation) = pose(&world.rows, i);
+        let (displacement, orientation) = pose(world.rows.get(), i);
         world.previous[i] = (displacement, orientation);
-        world.rows.pose[i + 1].set(BodyRows::pose_row(
+        world.rows.get().pose[i + 1].set(BodyRows::pose_row(
             displacement + b.linear_velocity[i] * h,
             b.inverse_mass[i],
             integrate(orientation, b.angular_velocity[i], h),
@@ -225,7 +225,7 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
     // is a fork-join among its workers, not a wake-up from outside.
     let threads = world.config.threads;
     let min_blocks = world.config.parallel_min_blocks;
-    let rows = &world.rows;
+    let rows = &*world.rows.get();
     // This step's contacts first, coloured on their own; the joints after.
     let contacts = &mut world.contact_layout;
     let groups = contacts.colours.iter().map(|r| (r.clone(), world.backend));
@@ -236,9 +236,15 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
         } else {
             threads
         };
-        chunked(parallel, min_blocks, &mut contacts.blocks[range], |c| {
-            pass.contacts(c, rows, backend)
-        });
+        let blocks = &mut contacts.blocks[range];
+        chunked(
+            parallel,
+            min_blocks,
+            contacts.disjoint,
+            blocks,
+            rows,
+            |c, rows| pass.contacts(c, rows, backend),
+        );
     }
     // The groups are read in place (no copy per iteration): they and the
     // blocks are disjoint fields of the layout.
@@ -252,30 +258,24 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
         };
         for (range, driven) in [(&group.driven, true), (&group.plain, false)] {
             let blocks = &mut layout.sockets.blocks[range.clone()];
-            chunked(parallel, min_blocks, blocks, |c| {
-                pass.sockets(c, driven, rows, backend)
-            });
+            chunked(
+                parallel,
+                min_blocks,
+                layout.disjoint,
+                blocks,
+                rows,
+                |c, rows| pass.sockets(c, driven, rows, backend),
+            );
         }
         let blocks = &mut layout.rods.blocks[group.rods.clone()];
-        chunked(parallel, min_blocks, blocks, |c| {
-            pass.rods(c, rows, backend)
-        });
-    }
-}
-
-/// Runs `run` on all `blocks`, split over `threads` (of the current rayon
-/// pool: the step runs inside the world's) when there are enough.
-fn chunked<B: Send>(
-    threads: usize,
-    min_blocks: usize,
-    blocks: &mut [B],
-    run: impl Fn(&mut [B]) + Sync,
-) {
-    if threads > 1 && blocks.len() >= min_blocks {
-        let chunk = blocks.len().div_ceil(threads * 2);
-        blocks.par_chunks_mut(chunk).for_each(&run);
-    } else {
-        run(blocks);
+        chunked(
+            parallel,
+            min_blocks,
+            layout.disjoint,
+            blocks,
+            rows,
+            |c, rows| pass.rods(c, rows, backend),
+        );
     }
 }
 
@@ -361,7 +361,7 @@ fn solve_velocities(world: &mut World, h: f32) {
     let b = &mut world.bodies;
     for i in 0..b.capacity() {
         if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
-            let [vx, vy, vz, _, wx, wy, wz, _] = world.rows.velocity[i + 1].get();
+            let [vx, vy, vz, _, wx, wy, wz, _] = world.rows.get().velocity[i + 1].get();
             b.linear_velocity[i] = limit(Vec3::new(vx, vy, vz), max_linear);
             b.angular_velocity[i] = limit(Vec3::new(wx, wy, wz), max_angular);
         }
@@ -382,12 +382,12 @@ fn derive_velocities(world: &mut World, h: f32) {
         if !b.is_live(i) || b.kind[i] != BodyKind::Dynamic {
             continue;
         }
-        let (d, q) = pose(&world.rows, i);
+        let (d, q) = pose(world.rows.get(), i);
         let (d0, q0) = world.previous[i];
         b.orientation[i] = q;
         b.linear_velocity[i] = limit((d - d0) / h, max_linear);
         b.angular_velocity[i] = limit(angular_velocity(q, q0, h), max_angular);
-        world.rows.velocity[i + 1].set(BodyRows::velocity_row(
+        world.rows.get().velocity[i + 1].set(BodyRows::velocity_row(
             b.linear_velocity[i],
             b.angular_velocity[i],
         ));
@@ -404,13 +404,13 @@ fn repair(world: &mut World) -> u64 {
     let b = &mut world.bodies;
     let mut repaired = 0;
     for (i, &(displacement, orientation)) in world.previous.iter().enumerate().take(b.capacity()) {
-        let (d, q) = pose(&world.rows, i);
+        let (d, q) = pose(world.rows.get(), i);
         let finite = b.is_finite(i) && d.is_finite() && q.is_finite();
         if b.is_live(i) && b.kind[i] != BodyKind::Static && !finite {
             b.orientation[i] = orientation;
             b.linear_velocity[i] = Vec3::ZERO;
             b.angular_velocity[i] = Vec3::ZERO;
-            world.rows.pose[i + 1].set(BodyRows::pose_row(
+            world.rows.get().pose[i + 1].set(BodyRows::pose_row(
                 displacement,
                 b.inverse_mass[i],
                 orientation,

@@ -36,10 +36,26 @@ fn world() -> (
 /// Runs `bad`, expects `expected`, and checks nothing changed: the state
 /// hash, the counts, and the next step's result.
 fn rejected(expected: Error, bad: impl FnOnce(&mut World) -> Result<(), Error>) {
+    rejected_after(|_| (), expected, |w, ()| bad(w));
+}
+
+/// [`rejected`], after `prepare` (adding the bodies the refused call
+/// names, say) ran on the world and on the reference alike.
+fn rejected_after<T>(
+    prepare: impl Fn(&mut World) -> T,
+    expected: Error,
+    bad: impl FnOnce(&mut World, T) -> Result<(), Error>,
+) {
     let (mut w, ..) = world();
     let (mut reference, ..) = world();
+    let prepared = prepare(&mut w);
+    prepare(&mut reference);
     let before = (w.state_hash(), w.bodies().len());
-    assert_eq!(bad(&mut w), Err(expected.clone()), "expected {expected}");
+    assert_eq!(
+        bad(&mut w, prepared),
+        Err(expected.clone()),
+        "expected {expected}"
+    );
     assert_eq!(
         (w.state_hash(), w.bodies().len()),
         before,
@@ -140,22 +156,21 @@ fn bad_joints_are_refused() {
         )?)
         .map(drop)
     });
-    rejected(Error::NoDynamicBody, |w| {
+    let kinematic = |w: &mut World| {
+        let c = w.add_body(BodyDesc::fixed()).unwrap();
+        w.remove_body(c).unwrap();
+        w.add_body(BodyDesc::kinematic()).unwrap()
+    };
+    rejected_after(kinematic, Error::NoDynamicBody, |w, k| {
         let a = w.bodies().handle_at(0).unwrap();
-        let c = w.add_body(BodyDesc::fixed())?;
-        w.remove_body(c)?;
-        let k = w.add_body(BodyDesc::kinematic())?;
-        let result = w
-            .add_socket(SocketDesc::at_world_anchor(
-                w.bodies(),
-                a,
-                k,
-                Vec3::ZERO,
-                Vec3::X,
-            )?)
-            .map(drop);
-        w.remove_body(k)?;
-        result
+        w.add_socket(SocketDesc::at_world_anchor(
+            w.bodies(),
+            a,
+            k,
+            Vec3::ZERO,
+            Vec3::X,
+        )?)
+        .map(drop)
     });
     rejected(Error::InvalidLimit("swing"), |w| {
         let (a, b) = (
@@ -321,57 +336,51 @@ fn bad_configs_are_refused() {
 #[test]
 fn bad_rods_are_refused() {
     use vertebra_world::{RodDesc, RodStiffness};
-    // A rod between the first dynamic body and a new one above it.
-    let rod = |w: &mut World| -> Result<RodDesc, Error> {
-        let b = w.bodies().handle_at(1).unwrap();
-        let c =
-            w.add_body(BodyDesc::dynamic(unit_mass()).with_position(Vec3::new(0.0, 0.5, 0.0)))?;
-        RodDesc::from_pose(w.bodies(), b, c, &[])
+    // A rod between the first dynamic body and a new one (added first,
+    // to the reference too) above it, or where it is.
+    let new_body = |offset: Vec3| {
+        move |w: &mut World| {
+            let b = w.bodies().handle_at(1).unwrap();
+            let at = w.body(b).unwrap().position + offset;
+            let c = w.add_body(BodyDesc::dynamic(unit_mass()).with_position(at));
+            (b, c.unwrap())
+        }
     };
-    rejected(Error::NotNormalized("rod frame a"), |w| {
-        let mut r = rod(w)?;
+    let above = new_body(Vec3::new(0.0, 0.5, 0.0));
+    let rod = |w: &World, (b, c)| RodDesc::from_pose(w.bodies(), b, c, &[]);
+    rejected_after(above, Error::NotNormalized("rod frame a"), |w, ends| {
+        let mut r = rod(w, ends)?;
         r.frame_a = Quat::from_xyzw(0.0, 0.0, 0.0, 3.0);
-        let result = w.add_rod(r).map(drop);
-        w.remove_body(r.body_b)?;
-        result
+        w.add_rod(r).map(drop)
     });
-    rejected(Error::NonPositive("rod rest length"), |w| {
-        let mut r = rod(w)?;
+    rejected_after(above, Error::NonPositive("rod rest length"), |w, ends| {
+        let mut r = rod(w, ends)?;
         r.rest_length = -0.1;
-        let result = w.add_rod(r).map(drop);
-        w.remove_body(r.body_b)?;
-        result
+        w.add_rod(r).map(drop)
     });
-    rejected(
+    rejected_after(
+        above,
         Error::InvalidLimit("relaxation factor (must be in [0, 1])"),
-        |w| {
-            let r =
-                rod(w)?.with_stiffness(RodStiffness::Relaxation(1.5), RodStiffness::Kirchhoff(1.0));
-            let result = w.add_rod(r).map(drop);
-            w.remove_body(r.body_b)?;
-            result
+        |w, ends| {
+            let r = rod(w, ends)?
+                .with_stiffness(RodStiffness::Relaxation(1.5), RodStiffness::Kirchhoff(1.0));
+            w.add_rod(r).map(drop)
         },
     );
-    rejected(Error::NonPositive("rod bending"), |w| {
-        let r = rod(w)?.with_stiffness(RodStiffness::Kirchhoff(-2.0), RodStiffness::Kirchhoff(1.0));
-        let result = w.add_rod(r).map(drop);
-        w.remove_body(r.body_b)?;
-        result
+    rejected_after(above, Error::NonPositive("rod bending"), |w, ends| {
+        let r = rod(w, ends)?
+            .with_stiffness(RodStiffness::Kirchhoff(-2.0), RodStiffness::Kirchhoff(1.0));
+        w.add_rod(r).map(drop)
     });
-    rejected(Error::InvalidLimit("bend"), |w| {
-        let r = rod(w)?.with_bend_limit(4.0);
-        let result = w.add_rod(r).map(drop);
-        w.remove_body(r.body_b)?;
-        result
+    rejected_after(above, Error::InvalidLimit("bend"), |w, ends| {
+        let r = rod(w, ends)?.with_bend_limit(4.0);
+        w.add_rod(r).map(drop)
     });
-    rejected(Error::DegenerateShape("the rod's ends coincide"), |w| {
-        let b = w.bodies().handle_at(1).unwrap();
-        let at = w.body(b)?.position;
-        let c = w.add_body(BodyDesc::dynamic(unit_mass()).with_position(at))?;
-        let result = RodDesc::from_pose(w.bodies(), b, c, &[]).map(drop);
-        w.remove_body(c)?;
-        result
-    });
+    rejected_after(
+        new_body(Vec3::ZERO),
+        Error::DegenerateShape("the rod's ends coincide"),
+        |w, ends| rod(w, ends).map(drop),
+    );
 }
 
 #[test]

@@ -390,3 +390,30 @@ fn compliance_is_independent_of_iterations_and_relaxation_is_not() {
     assert!((k5 - k40).abs() < 0.02 * k40, "{k5} vs {k40}");
     assert!(r40 < 0.5 * r5, "{r5} vs {r40}");
 }
+
+#[test]
+fn a_rod_twisted_past_pi_from_its_rest_turns_back_the_short_way() {
+    // A straight rod along +x; b is twisted about the rod so that its twist
+    // is 0.3 rad past pi from the rest twist: 2.0 - (pi + 0.3) = -1.44 rad.
+    // The short way back to 2.0 is to twist further down, through -pi
+    // (2.84 rad); up through 0 is the long way (3.44 rad). The twist is
+    // soft, so one step turns b a little and its spin shows the direction.
+    let rest = 2.0;
+    let twist = rest - (core::f32::consts::PI + 0.3);
+    let mut w = no_gravity();
+    let a = ball(&mut w, Vec3::ZERO, true);
+    let b = ball(&mut w, Vec3::new(0.3, 0.0, 0.0), false);
+    let mut rod = RodDesc::from_pose(w.bodies(), a, b, &[])
+        .unwrap()
+        .with_stiffness(RodStiffness::Kirchhoff(0.0), RodStiffness::Kirchhoff(1e-3));
+    rod.twist_rest = rest;
+    w.add_rod(rod).unwrap();
+    w.set_body_pose(b, Vec3::new(0.3, 0.0, 0.0), Quat::from_rotation_x(twist))
+        .unwrap();
+    w.step(DT).unwrap();
+    let spin = w.body(b).unwrap().angular_velocity;
+    assert!(
+        spin.x < -1e-3,
+        "b must twist down through -pi (the short way), spins {spin}"
+    );
+}

@@ -233,7 +233,8 @@ impl Lane for F32x8 {
         for (lane, &index) in loaded.iter_mut().zip(&indices[..8]) {
             let p = rows[index as usize].as_ptr();
             // SAFETY: `p` is a live, 32-byte aligned row of eight floats
-            // (bounds-checked above); AVX was detected.
+            // (bounds-checked) that no other thread writes now (`Row` is not
+            // `Sync`; shared rows are written disjointly: crate::row); AVX detected.
             *lane = unsafe { _mm256_load_ps(p) };
         }
         transpose8(loaded).map(Self)
@@ -249,8 +250,8 @@ impl Lane for F32x8 {
             if index != NO_WRITE {
                 let p = rows[index as usize].as_ptr();
                 // SAFETY: `p` is a live, aligned row of eight floats that no
-                // other thread accesses during this colour (the colouring
-                // keeps written rows disjoint); AVX was detected.
+                // other thread reads or writes now (`Row` is not `Sync`; shared
+                // rows are written disjointly: crate::row); AVX detected.
                 unsafe { _mm256_store_ps(p, lanes[lane]) };
             }
         }

@@ -227,7 +227,8 @@ impl Lane for F32x4 {
         for lane in 0..4 {
             let p = rows[indices[lane] as usize].as_ptr();
             // SAFETY: `p` is a live, 32-byte aligned row of eight floats
-            // (bounds-checked above); SSE4.1 was detected.
+            // (bounds-checked) that no other thread writes now (`Row` is not
+            // `Sync`; shared rows are written disjointly: crate::row); SSE4.1 detected.
             unsafe {
                 lo[lane] = _mm_load_ps(p);
                 hi[lane] = _mm_load_ps(p.add(4));
@@ -244,8 +245,8 @@ impl Lane for F32x4 {
             if index != NO_WRITE {
                 let p = rows[index as usize].as_ptr();
                 // SAFETY: `p` is a live, aligned row of eight floats that no
-                // other thread accesses during this colour (the colouring
-                // keeps written rows disjoint); SSE4.1 was detected.
+                // other thread reads or writes now (`Row` is not `Sync`; shared
+                // rows are written disjointly: crate::row); SSE4.1 detected.
                 unsafe {
                     _mm_store_ps(p, lo[lane]);
                     _mm_store_ps(p.add(4), hi[lane]);

@@ -21,7 +21,7 @@
 //! differences in `tests/rod_gradients.rs`). The energy
 //! `1/2 k_t (tau/l0)^2 l0` gives the compliance `l0 / k_t`, as for bending.
 
-use vertebra_math::{Lane, Quat, Vec3};
+use vertebra_math::{Lane, Quat, Vec3, poly};
 
 use super::Frames;
 use crate::body::{BodyLanes, safe_ratio};
@@ -55,6 +55,8 @@ pub fn measure<L: Lane>(f: &Frames<L>) -> L {
 }
 
 /// One soft twisting correction toward `rest`; returns the new `lambda`.
+/// The error `tau - rest` is wrapped to [-pi, pi]: a rod twisted past pi
+/// from its rest twist turns back the short way, not the long way round.
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
@@ -64,7 +66,7 @@ pub fn solve<L: Lane>(
     soft: Softness<L>,
     lambda: L,
 ) -> L {
-    let c = measure(f) - rest;
+    let c = poly::wrap_angle(measure(f) - rest);
     let (n_a, n_b) = axes(f);
     lambda + angle::correct_axes(a, b, n_a, n_b, c, soft, lambda)
 }

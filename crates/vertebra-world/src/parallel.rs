@@ -1,0 +1,169 @@
+//! Body rows and threads: the one place rows are shared between threads.
+//!
+//! Rows are cells that the SIMD kernels load and store with plain vector
+//! moves, so they are not `Sync` (`vertebra_math::row`): safe code cannot
+//! race on them. Solving a colour on several threads needs every worker to
+//! reach the rows, and that is sound only because no row a worker writes is
+//! read or written by another worker at the same time. The condition is not
+//! taken on trust from the colouring (a restored snapshot carries one): each
+//! layout checks it when it is built ([`colour_is_disjoint`]) and a layout
+//! that fails the check runs on one thread.
+
+use std::sync::{Mutex, PoisonError};
+
+use rayon::prelude::*;
+use vertebra_kernels::body::{BodyPairs, BodyRows};
+use vertebra_math::DefaultFloatMode;
+use vertebra_math::row::NO_WRITE;
+
+/// The world's body rows: scratch of a step, reached only through
+/// `&mut World`. The mutex is never locked (`get_mut` takes no lock): it
+/// keeps `World` `Sync`, which rows alone are not.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch(Mutex<BodyRows>);
+
+impl Scratch {
+    /// The rows (no lock: `&mut self` is exclusive already).
+    pub fn get(&mut self) -> &mut BodyRows {
+        self.0.get_mut().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// Rows handed to the workers of one colour.
+struct Shared<'a>(&'a BodyRows);
+
+impl<'a> Shared<'a> {
+    /// The rows, on a worker (a method, so closures capture `Shared`).
+    fn rows(&self) -> &'a BodyRows {
+        self.0
+    }
+}
+
+// `Shared` exists only inside `chunked`, and only for blocks whose layout
+// passed `colour_is_disjoint`: every row one block writes is read and
+// written by that block's lane alone, and rows nobody writes (static,
+// kinematic, the null row) are only read.
+// SAFETY: so no two workers touch a row that one of them writes, and the
+// kernels' plain loads and stores of rows never race.
+unsafe impl Sync for Shared<'_> {}
+
+/// Runs `run` on all `blocks` and `rows`, split over `threads` (of the
+/// current rayon pool: the step runs inside the world's) when there are at
+/// least `min_blocks` of them and `disjoint` holds.
+///
+/// `disjoint` must be a layout's verdict from [`colour_is_disjoint`] on
+/// every colour, and `blocks` one colour's blocks of that layout (their
+/// body pairs unchanged since): that is what makes sharing `rows` sound.
+pub(crate) fn chunked<B: Send>(
+    threads: usize,
+    min_blocks: usize,
+    disjoint: bool,
+    blocks: &mut [B],
+    rows: &BodyRows,
+    run: impl Fn(&mut [B], &BodyRows) + Sync,
+) {
+    if threads > 1 && disjoint && blocks.len() >= min_blocks {
+        let chunk = blocks.len().div_ceil(threads * 2);
+        let shared = Shared(rows);
+        blocks.par_chunks_mut(chunk).for_each(|c| {
+            // A worker starts in whatever mode its creator had.
+            let _mode = DefaultFloatMode::enter();
+            run(c, shared.rows())
+        });
+    } else {
+        run(blocks, rows);
+    }
+}
+
+/// Whether one colour's blocks may run on several threads at once: every
+/// lane writes only its own body's row (or nothing), and a row that is
+/// written is read by no other lane of the colour. True for every colouring
+/// `vertebra_scheduler` makes; a crafted one fails it.
+pub(crate) fn colour_is_disjoint<'a>(pairs: impl Iterator<Item = &'a BodyPairs> + Clone) -> bool {
+    let mut reads: Vec<u32> = Vec::new();
+    for p in pairs.clone() {
+        for &row in p.body_a.iter().chain(&p.body_b) {
+            let row = row as usize;
+            if row >= reads.len() {
+                reads.resize(row + 1, 0);
+            }
+            reads[row] += 1;
+        }
+    }
+    let alone =
+        |read: u32, write: u32| write == NO_WRITE || (write == read && reads[read as usize] == 1);
+    pairs.into_iter().all(|p| {
+        (0..p.body_a.len())
+            .all(|l| alone(p.body_a[l], p.write_a[l]) && alone(p.body_b[l], p.write_b[l]))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use vertebra_scheduler::Colouring;
+
+    use super::*;
+    use crate::layout::Layout;
+    use crate::{BodyDesc, Shape, SocketDesc, SolverConfig, World};
+
+    #[test]
+    fn the_world_stays_send_and_sync() {
+        fn send_sync<T: Send + Sync>() {}
+        send_sync::<World>();
+    }
+
+    #[test]
+    fn a_colouring_that_shares_a_dynamic_body_in_a_colour_runs_on_one_thread() {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let fixed = world.add_body(BodyDesc::fixed()).unwrap();
+        let mass = Shape::Sphere { radius: 0.1 }
+            .mass_properties_with_mass(1.0)
+            .unwrap();
+        let bob = world.add_body(BodyDesc::dynamic(mass)).unwrap();
+        let other = world.add_body(BodyDesc::dynamic(mass)).unwrap();
+        for (a, b) in [(fixed, bob), (bob, other)] {
+            let desc = SocketDesc::at_world_anchor(world.bodies(), a, b, Vec3::ZERO, Vec3::Y);
+            world.add_socket(desc.unwrap()).unwrap();
+        }
+        world.refresh_layout();
+        assert!(world.layout.disjoint, "the scheduler's colouring passes");
+        // A crafted colouring (a snapshot carries one) with both sockets,
+        // which share the dynamic `bob`, in colour 0.
+        let mut crafted = Colouring::new();
+        crafted.add(0, [None, None]);
+        crafted.add(1, [None, None]);
+        let layout = Layout::build(&crafted, &world.sockets, &world.rods, &world.bodies);
+        assert_eq!(layout.colours.len(), 1);
+        assert!(!layout.disjoint);
+    }
+
+    fn pairs(lanes: &[(u32, u32, bool, bool)]) -> BodyPairs {
+        // A padding block's pairs: the null row, written nowhere.
+        let mut p = vertebra_kernels::socket::SocketBlock::padding().bodies;
+        for (lane, &(a, b, da, db)) in lanes.iter().enumerate() {
+            p.set(lane, a, b, da, db);
+        }
+        p
+    }
+
+    #[test]
+    fn shared_static_rows_are_disjoint_shared_dynamic_rows_are_not() {
+        // Row 1 static (read by both blocks), rows 2..5 dynamic, once each.
+        let good = [
+            pairs(&[(1, 2, false, true), (3, 4, true, true)]),
+            pairs(&[(1, 5, false, true)]),
+        ];
+        assert!(colour_is_disjoint(good.iter()));
+        // Row 2 written by one lane and read by another (another block).
+        let written_twice = [pairs(&[(1, 2, false, true)]), pairs(&[(2, 5, false, true)])];
+        assert!(!colour_is_disjoint(written_twice.iter()));
+        // Two lanes of one block writing row 3.
+        let in_one_block = [pairs(&[(3, 4, true, true), (3, 5, true, true)])];
+        assert!(!colour_is_disjoint(in_one_block.iter()));
+        // A lane writing a row it does not read.
+        let mut stray = pairs(&[(1, 2, false, true)]);
+        stray.write_a[0] = 6;
+        assert!(!colour_is_disjoint([stray].iter()));
+    }
+}

@@ -1,0 +1,120 @@
+//! A step gives the same bits whatever floating-point mode its caller runs
+//! in: here a host that set flush-to-zero and denormals-are-zero (as game
+//! engines do), on its own thread and on the threads it creates.
+#![cfg(target_arch = "x86_64")]
+
+use glam::Vec3;
+use vertebra_world::{BodyDesc, Shape, SocketDesc, SolverConfig, World};
+
+/// MXCSR's flush-to-zero (bit 15) and denormals-are-zero (bit 6).
+const FTZ_DAZ: u32 = 0x8040;
+
+fn read_mxcsr() -> u32 {
+    let mut value = 0u32;
+    // SAFETY: stores MXCSR to a writable u32.
+    unsafe {
+        core::arch::asm!("stmxcsr [{}]", in(reg) &mut value, options(nostack, preserves_flags));
+    }
+    value
+}
+
+fn write_mxcsr(value: u32) {
+    // SAFETY: loads MXCSR from a readable u32 holding only valid bits.
+    unsafe {
+        core::arch::asm!("ldmxcsr [{}]", in(reg) &value, options(nostack, preserves_flags, readonly));
+    }
+}
+
+/// Runs `f` with FTZ and DAZ set on this thread, as a host would.
+fn as_a_host_with_ftz_daz<T>(f: impl FnOnce() -> T) -> T {
+    let before = read_mxcsr();
+    write_mxcsr(before | FTZ_DAZ);
+    let out = f();
+    let during = read_mxcsr();
+    write_mxcsr(before);
+    assert_eq!(
+        during & FTZ_DAZ,
+        FTZ_DAZ,
+        "the step gave the host its mode back"
+    );
+    out
+}
+
+/// 400 balls a few subnormals from a static anchor at the origin, drifting
+/// at 1e-38 m/s (damped) and held by sockets: positions, velocities and
+/// the sockets' errors are subnormal. All sockets share the anchor, so they
+/// are one colour of 50 blocks, which `threads` workers split.
+///
+/// The descriptions are computed once, in the default mode
+/// ([`descriptions`]): this is about the step, not about helpers such as
+/// `SocketDesc::at_world_anchor`, which compute in their caller's mode.
+fn subnormal_scene(threads: usize, (bodies, sockets): &(Vec<BodyDesc>, Vec<SocketDesc>)) -> World {
+    let mut world = World::new(SolverConfig {
+        gravity: Vec3::ZERO,
+        threads,
+        parallel_min_blocks: 1,
+        ..SolverConfig::default()
+    })
+    .unwrap();
+    for body in bodies {
+        world.add_body(*body).unwrap();
+    }
+    for socket in sockets {
+        world.add_socket(*socket).unwrap();
+    }
+    world
+}
+
+fn descriptions() -> (Vec<BodyDesc>, Vec<SocketDesc>) {
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let mut bodies = vec![BodyDesc::fixed()];
+    let anchor = world.add_body(bodies[0]).unwrap();
+    let mass = Shape::Sphere { radius: 0.05 }
+        .mass_properties_with_mass(1.0)
+        .unwrap();
+    let mut sockets = Vec::new();
+    for k in 1..=400 {
+        let k = k as f32;
+        let ball = BodyDesc::dynamic(mass)
+            .with_position(Vec3::new(k * 1.0e-39, -k * 2.0e-40, 0.0))
+            .with_velocity(Vec3::new(k * 1.0e-38, 0.0, 0.0), Vec3::ZERO)
+            .with_damping(5.0, 5.0);
+        bodies.push(ball);
+        let ball = world.add_body(ball).unwrap();
+        let socket = SocketDesc::at_world_anchor(world.bodies(), anchor, ball, Vec3::ZERO, Vec3::Y);
+        sockets.push(socket.unwrap());
+    }
+    (bodies, sockets)
+}
+
+/// The state hash after each of 20 steps.
+fn run(mut world: World) -> (Vec<u64>, World) {
+    let hashes = (0..20)
+        .map(|_| {
+            world.step(1.0 / 60.0).unwrap();
+            world.state_hash()
+        })
+        .collect();
+    (hashes, world)
+}
+
+#[test]
+fn ftz_and_daz_on_the_callers_threads_change_no_bit() {
+    let scene = descriptions();
+    for threads in [1, 2, 4] {
+        let (expected, world) = run(subnormal_scene(threads, &scene));
+        // The scene does reach subnormals (else the test proves nothing).
+        let subnormal = world
+            .bodies()
+            .position
+            .iter()
+            .any(|p| p.to_array().iter().any(|v| v.is_subnormal()));
+        assert!(subnormal, "the scene keeps subnormal positions");
+        // Built under FTZ/DAZ, so the pool's workers inherit the mode too.
+        let (got, _) = as_a_host_with_ftz_daz(|| run(subnormal_scene(threads, &scene)));
+        assert_eq!(
+            got, expected,
+            "{threads} thread(s): FTZ/DAZ changed the step"
+        );
+    }
+}
