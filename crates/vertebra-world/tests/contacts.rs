@@ -167,18 +167,18 @@ fn removing_a_body_drops_its_pending_contacts() {
     // the step pushed the body that reused the slot up out of the ground
     // and the other box away from a ghost.
     let (mut w, first, reborn) = removal_world(true);
-    let (mut reference, ..) = removal_world(false);
+    let (mut reference, reference_first, reference_reborn) = removal_world(false);
     assert!(w.contacts().is_empty(), "no contact names a removed body");
     w.step(DT).unwrap();
     reference.step(DT).unwrap();
     assert_eq!(
         w.body(reborn),
-        reference.body(reborn),
+        reference.body(reference_reborn),
         "the new body is not pushed"
     );
     assert_eq!(
         w.body(first),
-        reference.body(first),
+        reference.body(reference_first),
         "nothing is pushed by a ghost"
     );
     assert_eq!(w.state_hash(), reference.state_hash());

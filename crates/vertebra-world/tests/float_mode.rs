@@ -4,7 +4,7 @@
 #![cfg(target_arch = "x86_64")]
 
 use glam::Vec3;
-use vertebra_world::{BodyDesc, Shape, SocketDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, BodyHandle, Shape, SocketDesc, SolverConfig, World};
 
 /// MXCSR's flush-to-zero (bit 15) and denormals-are-zero (bit 6).
 const FTZ_DAZ: u32 = 0x8040;
@@ -59,8 +59,19 @@ fn subnormal_scene(threads: usize, (bodies, sockets): &(Vec<BodyDesc>, Vec<Socke
     for body in bodies {
         world.add_body(*body).unwrap();
     }
+    // The descriptions name the bodies of the world that made them; this
+    // world's bodies sit in the same slots.
+    let here = |h: BodyHandle| world.bodies().handle_at(h.index()).unwrap();
+    let sockets: Vec<SocketDesc> = sockets
+        .iter()
+        .map(|s| SocketDesc {
+            body_a: here(s.body_a),
+            body_b: here(s.body_b),
+            ..*s
+        })
+        .collect();
     for socket in sockets {
-        world.add_socket(*socket).unwrap();
+        world.add_socket(socket).unwrap();
     }
     world
 }
