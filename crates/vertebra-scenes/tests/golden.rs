@@ -59,7 +59,10 @@ fn ragdoll_drop_rod() {
     check(Scene::RagdollDrop, SpineMode::Rod, GOLDEN_DROP_ROD);
 }
 
-const GOLDEN_BENDING_SOCKETS: u64 = 0;
-const GOLDEN_BENDING_ROD: u64 = 0;
-const GOLDEN_DROP_SOCKETS: u64 = 0;
-const GOLDEN_DROP_ROD: u64 = 0;
+// Set 2026-11-29 by the commit that introduced them (issue 13), on the
+// state the whole issue left: displacement rows, double-precision
+// coordinates, the rod's wrapped twist, the lineage-free state hash.
+const GOLDEN_BENDING_SOCKETS: u64 = 0x40d2_7cf5_71a4_7432;
+const GOLDEN_BENDING_ROD: u64 = 0xc330_bf11_d54b_3d63;
+const GOLDEN_DROP_SOCKETS: u64 = 0x582b_a7b9_e88f_ade4;
+const GOLDEN_DROP_ROD: u64 = 0xbe56_05b5_2ea7_072c;
