@@ -51,15 +51,7 @@ impl Scene {
     /// A dynamic body with an arbitrary collider on it; the body goes again
     /// if the set refuses the collider.
     fn add_body(&mut self, input: &mut Input) -> Result<(), Error> {
-        let shape = match input.pick(3) {
-            0 => Shape::Sphere {
-                radius: input.float(0.5),
-            },
-            1 => Shape::Box {
-                half_extents: input.vec3(0.5),
-            },
-            _ => Shape::capsule(input.vec3(0.5), input.vec3(0.5), input.float(0.2)),
-        };
+        let shape = crate::world::shape(input);
         let body = self.world.add_body(
             BodyDesc::dynamic(Shape::Sphere { radius: 0.2 }.mass_properties(500.0)?)
                 .with_position(input.vec3(3.0) + Vec3::Y * 3.0)

@@ -34,22 +34,25 @@ impl Seen {
     }
 }
 
+/// A sphere, box or capsule of arbitrary size (m), for a body's mass or a
+/// collider.
+pub(crate) fn shape(input: &mut Input) -> Shape {
+    match input.pick(3) {
+        0 => Shape::Sphere {
+            radius: input.float(0.5),
+        },
+        1 => Shape::Box {
+            half_extents: input.vec3(0.5),
+        },
+        _ => Shape::capsule(input.vec3(0.5), input.vec3(0.5), input.float(0.2)),
+    }
+}
+
 pub(crate) fn add_body(world: &mut World, input: &mut Input) -> Result<BodyHandle, Error> {
     let desc = match input.pick(3) {
         0 => BodyDesc::fixed(),
         1 => BodyDesc::kinematic(),
-        _ => {
-            let shape = match input.pick(3) {
-                0 => Shape::Sphere {
-                    radius: input.float(0.5),
-                },
-                1 => Shape::Box {
-                    half_extents: input.vec3(0.5),
-                },
-                _ => Shape::capsule(input.vec3(0.5), input.vec3(0.5), input.float(0.2)),
-            };
-            BodyDesc::dynamic(shape.mass_properties_with_mass(input.float(100.0))?)
-        }
+        _ => BodyDesc::dynamic(shape(input).mass_properties_with_mass(input.float(100.0))?),
     };
     world.add_body(
         desc.with_position(input.vec3(5.0))
