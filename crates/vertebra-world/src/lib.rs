@@ -54,6 +54,12 @@ pub use vertebra_store::{
 };
 
 /// Bodies, joints and the solver that steps them.
+///
+/// Every call that computes (adding bodies and joints, setting poses,
+/// forces, rods, drives and contacts, restoring, stepping) does so in the
+/// default floating-point mode, whatever mode (FTZ, DAZ, rounding) the
+/// caller's thread runs in, and gives the caller its mode back: equal calls
+/// give equal worlds on every host ([`vertebra_math::float_mode`]).
 pub struct World {
     config: SolverConfig,
     backend: Backend,
@@ -134,6 +140,7 @@ impl World {
 
     /// Adds a body; `Err` (and no change) for invalid input.
     pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyHandle, Error> {
+        let _mode = DefaultFloatMode::enter();
         let handle = self.bodies.insert(&desc)?;
         if self.joints_at.len() < self.bodies.capacity() {
             self.joints_at.resize(self.bodies.capacity(), 0);
@@ -169,6 +176,7 @@ impl World {
         position: Vec3,
         orientation: Quat,
     ) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         self.bodies.set_pose(handle, position, orientation)
     }
 
@@ -184,6 +192,7 @@ impl World {
 
     /// Adds a force (N, world) through the centre of mass, for the next step.
     pub fn add_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         self.bodies.add_force(handle, force)
     }
 
@@ -194,16 +203,19 @@ impl World {
         force: Vec3,
         point: Vec3,
     ) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         self.bodies.add_force_at(handle, force, point)
     }
 
     /// Adds a torque (N m, world), for the next step.
     pub fn add_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         self.bodies.add_torque(handle, torque)
     }
 
     /// Adds a socket joint; `Err` (and no change) for invalid input.
     pub fn add_socket(&mut self, desc: SocketDesc) -> Result<SocketHandle, Error> {
+        let _mode = DefaultFloatMode::enter();
         desc.validate_with(&self.bodies)?;
         let handle: SocketHandle = self.socket_slots.insert();
         let slot = handle.index();
@@ -231,6 +243,7 @@ impl World {
 
     /// Adds a rod constraint; `Err` (and no change) for invalid input.
     pub fn add_rod(&mut self, desc: RodDesc) -> Result<RodHandle, Error> {
+        let _mode = DefaultFloatMode::enter();
         desc.validate_with(&self.bodies)?;
         let handle: RodHandle = self.rod_slots.insert();
         let slot = handle.index();
@@ -260,6 +273,7 @@ impl World {
     /// Changes a rod's rest shape, stiffness and limits in place (its bodies
     /// must stay the same): how a powered ragdoll drives its spine.
     pub fn set_rod(&mut self, handle: RodHandle, desc: RodDesc) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         let old = self.rod(handle)?;
         if (old.body_a, old.body_b) != (desc.body_a, desc.body_b) {
             return Err(Error::InvalidConfig("set_rod cannot change a rod's bodies"));
@@ -329,6 +343,7 @@ impl World {
         handle: SocketHandle,
         drive: Option<AngularDrive>,
     ) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         let mut desc = self.socket(handle)?;
         if let Some(d) = &drive {
             socket::validate_drive(d)?;
@@ -364,6 +379,7 @@ impl World {
     /// feed them every step). The whole list is checked first; on error
     /// the previous list stays.
     pub fn set_contacts(&mut self, contacts: &[Contact]) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         contact::validate_all(contacts, &self.bodies)?;
         self.contacts = contacts.to_vec();
         Ok(())

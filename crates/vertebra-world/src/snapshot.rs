@@ -262,6 +262,7 @@ impl World {
     /// build's snapshot, `Err(CorruptSnapshot)` naming the item for damaged
     /// or crafted bytes; the world is unchanged on error.
     pub fn restore(&mut self, snapshot: &Snapshot) -> Result<(), Error> {
+        let _mode = vertebra_math::DefaultFloatMode::enter();
         let mut state = State::decode(&snapshot.bytes)?;
         state.validate()?;
         state.bodies.issue_after(&self.bodies);

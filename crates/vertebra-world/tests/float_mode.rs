@@ -4,7 +4,10 @@
 #![cfg(target_arch = "x86_64")]
 
 use glam::Vec3;
-use vertebra_world::{BodyDesc, BodyHandle, Shape, SocketDesc, SolverConfig, World};
+use vertebra_world::{
+    BodyDesc, BodyHandle, MassProperties, RodDesc, RodStiffness, Shape, SocketDesc, SolverConfig,
+    World,
+};
 
 /// MXCSR's flush-to-zero (bit 15) and denormals-are-zero (bit 6).
 const FTZ_DAZ: u32 = 0x8040;
@@ -127,5 +130,90 @@ fn ftz_and_daz_on_the_callers_threads_change_no_bit() {
             got, expected,
             "{threads} thread(s): FTZ/DAZ changed the step"
         );
+    }
+}
+
+/// Runs `f` with `bits` set in MXCSR on this thread (FTZ and DAZ, or
+/// 0x6000: round toward zero), then gives the thread its mode back.
+fn in_mode<T>(bits: u32, f: impl FnOnce() -> T) -> T {
+    let before = read_mxcsr();
+    write_mxcsr(before | bits);
+    let out = f();
+    write_mxcsr(before);
+    out
+}
+
+/// A body whose inverse inertia has a subnormal cofactor (normal inputs:
+/// off-diagonal 1e-20), and one under round-toward-zero: `add_body`
+/// computes in the default mode too, so the worlds hash alike and each
+/// one's snapshot restores into the other's kind of host. (Found by an
+/// adversarial session: both hashes differed, and the snapshots were
+/// refused, "inverse mass is not 1/mass".)
+#[test]
+fn adding_a_body_does_not_depend_on_the_callers_mode() {
+    let world = || {
+        let mut w = World::new(SolverConfig::default()).unwrap();
+        let t = std::hint::black_box(1.0e-20f32);
+        let inertia = glam::Mat3::from_cols(
+            Vec3::new(1.0, 0.0, t),
+            Vec3::new(0.0, 1.0, t),
+            Vec3::new(t, t, 1.0),
+        );
+        let tilted = MassProperties::new(1.0, inertia).unwrap();
+        let plain =
+            MassProperties::new(3.0, glam::Mat3::from_diagonal(Vec3::new(0.3, 0.7, 1.1))).unwrap();
+        for mass in [tilted, plain] {
+            w.add_body(BodyDesc::dynamic(mass).with_velocity(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0)))
+                .unwrap();
+        }
+        w
+    };
+    let reference = world();
+    for bits in [FTZ_DAZ, 0x6000] {
+        let host = in_mode(bits, world);
+        assert_eq!(host.state_hash(), reference.state_hash(), "mode {bits:#x}");
+        let mut fresh = World::new(SolverConfig::default()).unwrap();
+        fresh
+            .restore(&host.snapshot())
+            .expect("the host's snapshot restores");
+        let mut fresh = World::new(SolverConfig::default()).unwrap();
+        in_mode(bits, || fresh.restore(&reference.snapshot())).expect("restores on the host");
+    }
+}
+
+/// A rod given subnormal stiffness and rest length in place under DAZ:
+/// accepted as in the default mode, and the worlds step on alike.
+#[test]
+fn setting_a_rod_does_not_depend_on_the_callers_mode() {
+    let build = || {
+        let mut w = World::new(SolverConfig::default()).unwrap();
+        let m = Shape::Sphere { radius: 0.1 }
+            .mass_properties_with_mass(1.0)
+            .unwrap();
+        let a = w.add_body(BodyDesc::fixed()).unwrap();
+        let b = w
+            .add_body(BodyDesc::dynamic(m).with_position(Vec3::new(1.0, 0.0, 0.0)))
+            .unwrap();
+        let rod = RodDesc::from_pose(w.bodies(), a, b, &[]).unwrap();
+        let rod = w.add_rod(rod).unwrap();
+        w.step(1.0 / 60.0).unwrap();
+        (w, rod)
+    };
+    let tiny = |w: &World, rod| {
+        let mut d = w.rod(rod).unwrap();
+        let k = std::hint::black_box(1.0e-40f32);
+        d.bending = RodStiffness::Kirchhoff(k);
+        d.twisting = RodStiffness::Kirchhoff(k);
+        d.rest_length = std::hint::black_box(2.0e-38);
+        d
+    };
+    let ((mut w1, r1), (mut w2, r2)) = (build(), build());
+    w1.set_rod(r1, tiny(&w1, r1)).unwrap();
+    let d2 = tiny(&w2, r2);
+    in_mode(FTZ_DAZ, || w2.set_rod(r2, d2)).expect("accepted as in the default mode");
+    for _ in 0..60 {
+        w1.step(1.0 / 60.0).unwrap();
+        w2.step(1.0 / 60.0).unwrap();
+        assert_eq!(w1.state_hash(), w2.state_hash());
     }
 }
