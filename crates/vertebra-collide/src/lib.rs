@@ -29,7 +29,7 @@ use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::SharedShape;
 use vertebra_ragdoll::{Ragdoll, RagdollError};
-use vertebra_world::{BodyHandle, BodyKind, Contact, Error, Shape, World};
+use vertebra_world::{BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, World};
 
 pub use snapshot::CollisionSnapshot;
 
@@ -436,7 +436,10 @@ impl Collisions {
 }
 
 /// A manifold's points as solver contacts: the normal from the first shape
-/// to the second, the point midway between the surfaces, depth = -distance.
+/// to the second, the point midway between the surfaces, depth = -distance,
+/// held to the depths the world accepts (`MAX_COORDINATE` either way): a
+/// body a million metres under a ground plane is as deep as a contact
+/// gets, and the rest of the list is still accepted.
 fn push_manifold(
     out: &mut Vec<Contact>,
     m: &ContactManifold<(), ()>,
@@ -454,7 +457,7 @@ fn push_manifold(
             body_b,
             point: (pa + pb) * 0.5,
             normal,
-            depth: -point.dist,
+            depth: (-point.dist).clamp(-MAX_COORDINATE, MAX_COORDINATE),
             friction,
             restitution,
         });
