@@ -127,8 +127,10 @@ impl Ragdoll {
     /// Creates the ragdoll at `pose`, at rest, or moving as the animation
     /// did from `previous` (a pose `dt` seconds earlier) to `pose`. Every
     /// joint holds exactly at creation; the rod is instantiated from the
-    /// pose and the spine bones between its ends. On error nothing is added
-    /// to the world.
+    /// pose and the spine bones between its ends. On error the world is
+    /// put back as it was (its state, and so its state hash: the world
+    /// restores a snapshot taken before the first body went in); only the
+    /// handles the refused build drew are never issued again.
     pub fn build(
         world: &mut World,
         desc: &RagdollDesc,
@@ -156,10 +158,13 @@ impl Ragdoll {
             rod: None,
             rod_rest: None,
         };
+        // Removing what went in would leave the slots it took behind (a
+        // longer table, a free list): the snapshot puts them back too.
+        let before = world.snapshot();
         match ragdoll.populate(world, pose, previous) {
             Ok(()) => Ok(ragdoll),
             Err(e) => {
-                ragdoll.remove(world)?;
+                world.restore(&before)?;
                 Err(e)
             }
         }

@@ -461,3 +461,47 @@ fn a_ragdoll_that_cannot_be_removed_is_not_recreated() {
     assert!(ragdoll.recreate(&mut w, &pose, None).is_err());
     assert_eq!(removal_state(&w, &ragdoll), before, "nothing changed");
 }
+
+/// The spine's middle bones folded back past the hips: the rod refuses it.
+fn folded_spine(desc: &RagdollDesc) -> Pose {
+    let mut folded = Pose::bind(desc);
+    let spine = desc.spine.as_ref().unwrap();
+    let hips = folded.bones[spine.bodies[0]].0;
+    let chest = folded.bones[*spine.bodies.last().unwrap()].0;
+    for &b in &spine.bodies[1..spine.bodies.len() - 1] {
+        folded.bones[b].0 = hips + (hips - chest) + Vec3::new(0.05, 0.0, 0.0);
+    }
+    folded
+}
+
+/// A build refused part way (a body beyond the coordinate range, a rod the
+/// pose folds) and a refused recreate leave the world's state as it was:
+/// the same hash, and the next body goes where it would have gone. (Found
+/// by an adversarial session: the rolled-back bodies left their slots
+/// behind, so the hash and the next slot changed.)
+#[test]
+fn refused_builds_leave_the_world_as_it_was() {
+    let desc = RagdollDesc::reference_humanoid();
+    let mut w = world();
+    w.add_body(BodyDesc::fixed()).unwrap();
+    let hash = w.state_hash();
+    let far = Pose::bind(&desc).moved(Vec3::ZERO, Quat::IDENTITY, Vec3::new(1e6 - 0.1, 0.0, 0.0));
+    let sockets = BuildOptions::new(SpineMode::Sockets);
+    assert!(Ragdoll::build(&mut w, &desc, sockets, &far, None).is_err());
+    assert_eq!(w.state_hash(), hash, "a body out of range");
+    let rod = BuildOptions::new(SpineMode::Rod);
+    assert!(Ragdoll::build(&mut w, &desc, rod, &folded_spine(&desc), None).is_err());
+    assert_eq!(w.state_hash(), hash, "a folded rod");
+    assert_eq!(w.add_body(BodyDesc::fixed()).unwrap().index(), 1);
+
+    let mut w = world();
+    let mut ragdoll = Ragdoll::build(&mut w, &desc, rod, &Pose::bind(&desc), None).unwrap();
+    w.step(1.0 / 60.0).unwrap();
+    let hash = w.state_hash();
+    assert!(
+        ragdoll
+            .recreate(&mut w, &folded_spine(&desc), None)
+            .is_err()
+    );
+    assert_eq!(w.state_hash(), hash, "a refused recreate");
+}
