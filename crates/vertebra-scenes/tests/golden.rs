@@ -64,5 +64,5 @@ fn ragdoll_drop_rod() {
 // coordinates, the rod's wrapped twist, the lineage-free state hash.
 const GOLDEN_BENDING_SOCKETS: u64 = 0x40d2_7cf5_71a4_7432;
 const GOLDEN_BENDING_ROD: u64 = 0xc330_bf11_d54b_3d63;
-const GOLDEN_DROP_SOCKETS: u64 = 0x582b_a7b9_e88f_ade4;
-const GOLDEN_DROP_ROD: u64 = 0xbe56_05b5_2ea7_072c;
+const GOLDEN_DROP_SOCKETS: u64 = 0x554e_4f30_f575_bb42;
+const GOLDEN_DROP_ROD: u64 = 0x00b1_096d_8ec3_4b5d;
