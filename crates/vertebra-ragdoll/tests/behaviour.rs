@@ -136,14 +136,7 @@ fn recreating_at_a_new_pose_replaces_the_ragdoll() {
     let desc = RagdollDesc::reference_humanoid();
     let mut r = StdRng::seed_from_u64(2);
     let mut w = world();
-    let mut ragdoll = Ragdoll::build(
-        &mut w,
-        &desc,
-        BuildOptions::new(SpineMode::Rod),
-        &Pose::bind(&desc),
-        None,
-    )
-    .unwrap();
+    let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Rod);
     for _ in 0..10 {
         w.step(1.0 / 60.0).unwrap();
     }
@@ -389,14 +382,7 @@ fn a_ragdoll_held_by_a_foreign_joint_is_not_removed_at_all() {
     // the hips were refused (a pin still held them), leaving half a ragdoll.
     let desc = RagdollDesc::reference_humanoid();
     let mut w = world();
-    let mut ragdoll = Ragdoll::build(
-        &mut w,
-        &desc,
-        BuildOptions::new(SpineMode::Rod),
-        &Pose::bind(&desc),
-        None,
-    )
-    .unwrap();
+    let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Rod);
     let hips = ragdoll.bodies[desc.root].unwrap();
     let at = w.body(hips).unwrap().position;
     let anchor = w.add_body(BodyDesc::fixed().with_position(at)).unwrap();
@@ -421,14 +407,7 @@ fn a_ragdoll_missing_a_joint_is_not_removed_at_all() {
     // were removed, then the stale socket was refused without a name.
     let desc = RagdollDesc::reference_humanoid();
     let mut w = world();
-    let mut ragdoll = Ragdoll::build(
-        &mut w,
-        &desc,
-        BuildOptions::new(SpineMode::Rod),
-        &Pose::bind(&desc),
-        None,
-    )
-    .unwrap();
+    let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Rod);
     let k = desc.joints.len() - 1;
     w.remove_socket(ragdoll.sockets[k].unwrap()).unwrap();
     let before = removal_state(&w, &ragdoll);
@@ -447,14 +426,7 @@ fn a_ragdoll_that_cannot_be_removed_is_not_recreated() {
     // removing the old one failed, leaving both in the world.
     let desc = RagdollDesc::reference_humanoid();
     let mut w = world();
-    let mut ragdoll = Ragdoll::build(
-        &mut w,
-        &desc,
-        BuildOptions::new(SpineMode::Sockets),
-        &Pose::bind(&desc),
-        None,
-    )
-    .unwrap();
+    let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Sockets);
     w.remove_socket(ragdoll.sockets[0].unwrap()).unwrap();
     let before = removal_state(&w, &ragdoll);
     let pose = Pose::bind(&desc).moved(Vec3::ZERO, Quat::IDENTITY, Vec3::X);
@@ -504,4 +476,9 @@ fn refused_builds_leave_the_world_as_it_was() {
             .is_err()
     );
     assert_eq!(w.state_hash(), hash, "a refused recreate");
+}
+
+/// `desc` built into `w` at its bind pose, at rest.
+fn at_bind(w: &mut World, desc: &RagdollDesc, spine: SpineMode) -> Ragdoll {
+    Ragdoll::build(w, desc, BuildOptions::new(spine), &Pose::bind(desc), None).unwrap()
 }
