@@ -16,7 +16,7 @@ fn collisions(c: &mut Criterion) {
     ] {
         let world = World::new(SolverConfig::default()).expect("default config");
         let (mut world, colliders, _) =
-            vertebra_scenes::ragdoll_drop(world, &RagdollDesc::reference_humanoid(), spine, 30)
+            vertebra_scenes::ragdoll_drop(world, &RagdollDesc::reference_humanoid(), spine, 30, 0)
                 .expect("the drop world");
         for _ in 0..60 {
             let contacts = colliders

@@ -55,6 +55,7 @@ pub fn run_json(config: &SceneConfig, run: &SceneRun) -> serde_json::Value {
         "substeps": config.substeps,
         "backend": run.backend.name(),
         "threads": config.threads,
+        "seed": config.seed,
         "frames": run.frames.iter().map(|f| json!({
             "eps_lin_cm": f.eps_lin_cm,
             "eps_ang_rad": f.eps_ang_rad,

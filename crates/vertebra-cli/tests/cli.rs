@@ -34,6 +34,7 @@ fn scene_json_has_every_field() {
         "substeps",
         "backend",
         "threads",
+        "seed",
         "frames",
         "summary",
         "state_hash",
@@ -77,6 +78,21 @@ fn scene_json_has_every_field() {
         again["state_hash"], v["state_hash"],
         "every backend gives the same bits"
     );
+    // Another start: another state, named in the output.
+    let (_, seeded, _) = vertebra(&[
+        "scene",
+        "passive-bending",
+        "--spine",
+        "rod",
+        "--frames",
+        "12",
+        "--json",
+        "--seed",
+        "3",
+    ]);
+    let seeded: serde_json::Value = serde_json::from_str(seeded.trim()).unwrap();
+    assert_eq!((&v["seed"], &seeded["seed"]), (&0.into(), &3.into()));
+    assert_ne!(seeded["state_hash"], v["state_hash"]);
 }
 
 /// A failing run: non-zero status, one line on stderr naming the problem,

@@ -5,6 +5,7 @@
 
 mod kinematics;
 mod run;
+pub mod seed;
 mod setup;
 
 pub use kinematics::{Locus, kinematics};

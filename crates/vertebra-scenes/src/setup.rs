@@ -92,6 +92,9 @@ pub struct SceneConfig {
     /// Ragdolls dropped in the ragdoll-drop scene (the paper's 30; see
     /// [`ragdoll_drop`] for more).
     pub ragdolls: usize,
+    /// The start: 0 is the paper's scene exactly; any other seed moves each
+    /// ragdoll by at most 1 mm and 0.1 degree ([`crate::seed`]).
+    pub seed: u64,
 }
 
 impl SceneConfig {
@@ -107,6 +110,7 @@ impl SceneConfig {
             threads: 1,
             ragdoll: None,
             ragdolls: 30,
+            seed: 0,
         }
     }
 
@@ -283,11 +287,12 @@ pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
                 Quat::from_rotation_x(30f32.to_radians()),
                 Vec3::ZERO,
             );
+            let pose = seeded(pose, &desc, config.seed, 0);
             let ragdoll = ragdoll_with_fixed_hips(&mut world, &desc, config.spine, &pose)?;
             Ok(SceneWorld::new(world, None, vec![ragdoll], None, None))
         }
         Scene::Controllability => {
-            let pose = Pose::bind(&desc);
+            let pose = seeded(Pose::bind(&desc), &desc, config.seed, 0);
             let ragdoll = ragdoll_with_fixed_hips(&mut world, &desc, config.spine, &pose)?;
             ragdoll.drive_to(
                 &mut world,
@@ -306,7 +311,7 @@ pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
         }
         Scene::RagdollDrop => {
             let (world, collisions, ragdolls) =
-                ragdoll_drop(world, &desc, config.spine, config.ragdolls)?;
+                ragdoll_drop(world, &desc, config.spine, config.ragdolls, config.seed)?;
             Ok(SceneWorld::new(
                 world,
                 Some(collisions),
@@ -316,6 +321,17 @@ pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
             ))
         }
     }
+}
+
+/// `pose` moved and turned about its root by ragdoll `index`'s seeded
+/// perturbation; `pose` itself, bit for bit, for seed 0.
+fn seeded(pose: Pose, desc: &RagdollDesc, seed: u64, index: usize) -> Pose {
+    if seed == 0 {
+        return pose;
+    }
+    let (offset, turn) = crate::seed::perturbation(seed, index);
+    let root = pose.bones[desc.root].0;
+    pose.moved(root, turn, offset)
 }
 
 /// The top of the spine chain (the chest), or the root when there is none.
@@ -339,12 +355,15 @@ const PIT_SPACING: f32 = 4.0;
 /// static boxes of half-extents (0.3, 0.15, 0.3). A pit's ragdolls lie face
 /// down in 10 layers of 3, layer `j` turned by 37 j degrees about +Y, hips
 /// at (0, 1 + 0.5 j, 0) + (i - 1) 0.6 u_j from its centre. A ragdoll's
-/// jointed pairs never collide. With 30 this is exactly the paper's scene.
+/// jointed pairs never collide. With 30 and seed 0 this is exactly the
+/// paper's scene; another seed moves each ragdoll by at most 1 mm and 0.1
+/// degree ([`crate::seed`]).
 pub fn ragdoll_drop(
     mut world: World,
     desc: &RagdollDesc,
     spine: SpineMode,
     count: usize,
+    seed: u64,
 ) -> Result<(World, Collisions, Vec<Ragdoll>), RagdollError> {
     let mut collisions = Collisions::new();
     let mut fixed = |world: &mut World,
@@ -388,8 +407,8 @@ pub fn ragdoll_drop(
     }
     let hips = desc.bodies[desc.root].centre();
     let mut ragdolls = Vec::new();
-    for k in 0..count {
-        let (pit, k) = (k / RAGDOLLS_PER_PIT, k % RAGDOLLS_PER_PIT);
+    for index in 0..count {
+        let (pit, k) = (index / RAGDOLLS_PER_PIT, index % RAGDOLLS_PER_PIT);
         let (layer, slot) = (k / 3, k % 3);
         let yaw = (37.0 * layer as f32).to_radians();
         let turn = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
@@ -397,7 +416,12 @@ pub fn ragdoll_drop(
         let at = centre(pit)
             + Vec3::new(0.0, 1.0 + 0.5 * layer as f32, 0.0)
             + u * (0.6 * (slot as f32 - 1.0));
-        let pose = Pose::bind(desc).moved(hips, turn, at - hips);
+        let pose = seeded(
+            Pose::bind(desc).moved(hips, turn, at - hips),
+            desc,
+            seed,
+            index,
+        );
         let ragdoll = Ragdoll::build(&mut world, desc, BuildOptions::new(spine), &pose, None)?;
         collisions.add_ragdoll(&ragdoll)?;
         ragdolls.push(ragdoll);
