@@ -7,7 +7,7 @@ use vertebra_collide::{
     Collider, ColliderShape, CollisionSnapshot, Collisions, MAX_COLLIDER_EXTENT,
 };
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
-use vertebra_world::{BodyDesc, BodyHandle, Error, Shape, SocketDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, BodyHandle, Error, JointDesc, Shape, SolverConfig, World};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -206,16 +206,16 @@ fn a_refused_ragdoll_removal_leaves_world_set_and_ragdoll_as_they_were() {
     let hips = ragdolls[0].bodies[desc.root].unwrap();
     let at = w.body(hips).unwrap().position;
     let anchor = w.add_body(BodyDesc::fixed().with_position(at)).unwrap();
-    w.add_socket(SocketDesc::at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap())
+    w.add_joint(JointDesc::at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap())
         .unwrap();
     let before = (
         w.state_hash(),
         w.bodies().len(),
-        w.sockets().count(),
+        w.joints().count(),
         w.rods().count(),
         c.snapshot(),
         ragdolls[0].bodies.clone(),
-        ragdolls[0].sockets.clone(),
+        ragdolls[0].joints.clone(),
         ragdolls[0].rod,
     );
     let refused = c.remove_ragdoll(&mut w, &mut ragdolls[0]).unwrap_err();
@@ -226,11 +226,11 @@ fn a_refused_ragdoll_removal_leaves_world_set_and_ragdoll_as_they_were() {
     let after = (
         w.state_hash(),
         w.bodies().len(),
-        w.sockets().count(),
+        w.joints().count(),
         w.rods().count(),
         c.snapshot(),
         ragdolls[0].bodies.clone(),
-        ragdolls[0].sockets.clone(),
+        ragdolls[0].joints.clone(),
         ragdolls[0].rod,
     );
     assert_eq!(after, before);

@@ -30,12 +30,12 @@ impl Scene {
         (
             self.world.state_hash(),
             self.world.bodies().len(),
-            self.world.sockets().count(),
+            self.world.joints().count(),
             self.world.rods().count(),
             self.collisions.snapshot(),
             self.ragdolls
                 .iter()
-                .map(|r| format!("{:?} {:?} {:?}", r.bodies, r.sockets, r.rod))
+                .map(|r| format!("{:?} {:?} {:?}", r.bodies, r.joints, r.rod))
                 .collect(),
         )
     }
@@ -232,9 +232,9 @@ pub fn collisions(data: &[u8]) {
             },
             5 => match scene.ragdoll(&mut input) {
                 Some(k) => {
-                    let sockets = &scene.ragdolls[k].sockets;
+                    let sockets = &scene.ragdolls[k].joints;
                     match sockets[input.pick(sockets.len())] {
-                        Some(socket) => scene.world.remove_socket(socket),
+                        Some(socket) => scene.world.remove_joint(socket),
                         None => Ok(()),
                     }
                 }

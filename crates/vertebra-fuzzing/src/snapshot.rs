@@ -7,11 +7,11 @@ use std::collections::{BTreeMap, BTreeSet};
 use glam::{Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
-    BodyHandle, BodyKind, Contact, RodDesc, RodStiffness, Snapshot, SocketDesc, SolverConfig, World,
+    BodyHandle, BodyKind, Contact, JointDesc, RodDesc, RodStiffness, Snapshot, SolverConfig, World,
 };
 
 use crate::input::Input;
-use crate::world::{Seen, add_body, add_rod, add_socket, set_contacts};
+use crate::world::{Seen, add_body, add_joint, add_rod, set_contacts};
 
 // The payload's layout as the fuzzer sees it: `vertebra_world`'s private
 // `State` field for field (postcard is not self-describing). Every valid
@@ -64,8 +64,8 @@ struct Colouring {
 struct State {
     bodies: Bodies,
     joints_at: Vec<u32>,
-    socket_slots: Slots,
-    sockets: Vec<Option<SocketDesc>>,
+    joint_slots: Slots,
+    joints: Vec<Option<JointDesc>>,
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
@@ -192,14 +192,14 @@ fn limit(input: &mut Input) -> Option<f32> {
 }
 
 fn socket(input: &mut Input, state: &mut State) {
-    let n = state.sockets.len();
+    let n = state.joints.len();
     if n == 0 {
-        return slots(input, &mut state.socket_slots);
+        return slots(input, &mut state.joint_slots);
     }
     let slot = input.pick(n);
     let handle = body_handle(input, state);
-    let Some(s) = state.sockets[slot].as_mut() else {
-        return slots(input, &mut state.socket_slots);
+    let Some(s) = state.joints[slot].as_mut() else {
+        return slots(input, &mut state.joint_slots);
     };
     match input.pick(10) {
         0 => s.body_a = handle,
@@ -214,9 +214,9 @@ fn socket(input: &mut Input, state: &mut State) {
                 d.compliance = value(input);
             }
         }
-        7 => state.sockets[slot] = None,
-        8 => state.sockets.push(None),
-        _ => slots(input, &mut state.socket_slots),
+        7 => state.joints[slot] = None,
+        8 => state.joints.push(None),
+        _ => slots(input, &mut state.joint_slots),
     }
 }
 
@@ -326,13 +326,13 @@ fn build(input: &mut Input) -> World {
     }
     for _ in 0..input.pick(6) {
         let _ = match input.pick(3) {
-            0 => add_socket(&mut world, &seen, input).map(|h| seen.sockets.push(h)),
+            0 => add_joint(&mut world, &seen, input).map(|h| seen.joints.push(h)),
             1 => add_rod(&mut world, &seen, input).map(|h| seen.rods.push(h)),
             _ => world.step(1.0 / 60.0),
         };
     }
-    if input.flag() && !seen.sockets.is_empty() {
-        let _ = world.remove_socket(seen.sockets[0]);
+    if input.flag() && !seen.joints.is_empty() {
+        let _ = world.remove_joint(seen.joints[0]);
     }
     if input.flag() && !seen.bodies.is_empty() {
         let _ = world.remove_body(seen.bodies[input.pick(seen.bodies.len())]);

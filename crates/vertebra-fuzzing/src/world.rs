@@ -2,8 +2,8 @@
 
 use glam::Vec3;
 use vertebra_world::{
-    AngularDrive, BodyDesc, BodyHandle, Contact, Error, MAX_ANGULAR_SPEED_LIMIT,
-    MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle, RodStiffness, Shape, SocketDesc, SocketHandle,
+    AngularDrive, BodyDesc, BodyHandle, Contact, Error, JointDesc, JointHandle,
+    MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle, RodStiffness, Shape,
     SolverConfig, World,
 };
 
@@ -15,7 +15,7 @@ fn fingerprint(world: &World) -> (u64, usize, usize, usize) {
     (
         world.state_hash(),
         world.bodies().len(),
-        world.sockets().count(),
+        world.joints().count(),
         world.rods().count(),
     )
 }
@@ -24,7 +24,7 @@ fn fingerprint(world: &World) -> (u64, usize, usize, usize) {
 #[derive(Default)]
 pub(crate) struct Seen {
     pub bodies: Vec<BodyHandle>,
-    pub sockets: Vec<SocketHandle>,
+    pub joints: Vec<JointHandle>,
     pub rods: Vec<RodHandle>,
 }
 
@@ -62,16 +62,16 @@ pub(crate) fn add_body(world: &mut World, input: &mut Input) -> Result<BodyHandl
     )
 }
 
-pub(crate) fn add_socket(
+pub(crate) fn add_joint(
     world: &mut World,
     seen: &Seen,
     input: &mut Input,
-) -> Result<SocketHandle, Error> {
+) -> Result<JointHandle, Error> {
     let (Some(a), Some(b)) = (seen.body(input), seen.body(input)) else {
         return Err(Error::SameBody);
     };
     let mut socket =
-        SocketDesc::at_world_anchor(world.bodies(), a, b, input.vec3(5.0), input.vec3(1.0))?;
+        JointDesc::at_world_anchor(world.bodies(), a, b, input.vec3(5.0), input.vec3(1.0))?;
     if input.flag() {
         socket = socket.with_swing_limit(input.float(4.0));
     }
@@ -85,7 +85,7 @@ pub(crate) fn add_socket(
             damping: input.float(10.0),
         });
     }
-    world.add_socket(socket)
+    world.add_joint(socket)
 }
 
 pub(crate) fn add_rod(
@@ -137,9 +137,9 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
             Some(h) => world.remove_body(h),
             None => Ok(()),
         },
-        2 => add_socket(world, seen, input).map(|h| seen.sockets.push(h)),
-        3 if !seen.sockets.is_empty() => {
-            world.remove_socket(seen.sockets[input.pick(seen.sockets.len())])
+        2 => add_joint(world, seen, input).map(|h| seen.joints.push(h)),
+        3 if !seen.joints.is_empty() => {
+            world.remove_joint(seen.joints[input.pick(seen.joints.len())])
         }
         4 => add_rod(world, seen, input).map(|h| seen.rods.push(h)),
         5 if !seen.rods.is_empty() => world.remove_rod(seen.rods[input.pick(seen.rods.len())]),

@@ -7,7 +7,7 @@ use glam::Vec3;
 use parry3d::math::Pose;
 use rapier3d::prelude::*;
 use vertebra_scenes::SceneWorld;
-use vertebra_world::{BodyHandle, BodyKind, SocketDesc, World};
+use vertebra_world::{BodyHandle, BodyKind, JointDesc, World};
 
 /// Rapier's solver budget per frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -115,7 +115,7 @@ impl RapierScene {
         // inserted. In slot order (root first) the passive-bending ragdoll
         // lost its hips-spine swing limit (72 degrees against 20); from the
         // leaves in, every limit holds (tests/peer.rs).
-        let sockets: Vec<_> = world.sockets().map(|(_, s)| s).collect();
+        let sockets: Vec<_> = world.joints().map(|(_, s)| s).collect();
         for socket in sockets.into_iter().rev() {
             let joint = translate_socket(&socket)?;
             let (a, b) = (handle[&socket.body_a], handle[&socket.body_b]);
@@ -248,7 +248,7 @@ fn translate_colliders(
 /// the cone, so the angular error our metric reports is rapier's own
 /// violation, not the corners of a square the cone does not contain. A pin (a drive of zero
 /// compliance and damping) is a fixed joint at the drive's target.
-fn translate_socket(socket: &SocketDesc) -> Result<GenericJoint, PeerError> {
+fn translate_socket(socket: &JointDesc) -> Result<GenericJoint, PeerError> {
     let frame_a = Pose::from_parts(socket.anchor_a, socket.frame_a);
     let frame_b = Pose::from_parts(socket.anchor_b, socket.frame_b);
     if let Some(drive) = socket.drive {

@@ -90,7 +90,7 @@ impl Ragdoll {
     ) -> Result<(), RagdollError> {
         target.validate(&self.desc)?;
         settings.validate(self.desc.joints.len())?;
-        for (k, (j, socket)) in self.desc.joints.iter().zip(&self.sockets).enumerate() {
+        for (k, (j, socket)) in self.desc.joints.iter().zip(&self.joints).enumerate() {
             let Some(socket) = socket else { continue };
             let frame = Quat::from_rotation_arc(Vec3::X, j.axis);
             let relative =
@@ -105,7 +105,7 @@ impl Ragdoll {
                 damping: settings.damping,
             };
             world
-                .set_socket_drive(*socket, Some(drive))
+                .set_joint_drive(*socket, Some(drive))
                 .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
         }
         if let (Some(rod), Some(rest), Some(spine)) = (self.rod, self.rod_rest, &self.desc.spine) {
@@ -132,10 +132,10 @@ impl Ragdoll {
     /// Turns every drive off: sockets without drives, the rod back to its
     /// rest shape and passive stiffness.
     pub fn release_drives(&self, world: &mut World) -> Result<(), RagdollError> {
-        for (socket, j) in self.sockets.iter().zip(&self.desc.joints) {
+        for (socket, j) in self.joints.iter().zip(&self.desc.joints) {
             if let Some(socket) = socket {
                 world
-                    .set_socket_drive(*socket, None)
+                    .set_joint_drive(*socket, None)
                     .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
             }
         }

@@ -5,8 +5,8 @@ use std::collections::{HashMap, HashSet};
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, BodyHandle, MIN_TIME_STEP, MassProperties, RodDesc, RodHandle, RodStiffness, Shape,
-    SocketDesc, SocketHandle, World,
+    BodyDesc, BodyHandle, JointDesc, JointHandle, MIN_TIME_STEP, MassProperties, RodDesc,
+    RodHandle, RodStiffness, Shape, World,
 };
 
 use crate::description::RagdollDesc;
@@ -66,9 +66,9 @@ pub struct Ragdoll {
     /// Per described body: its handle, or `None` for a spine interior body
     /// of a simplified ragdoll (an animation-only bone).
     pub bodies: Vec<Option<BodyHandle>>,
-    /// Per described joint: its socket, or `None` for a spine joint of a
+    /// Per described joint: its joint, or `None` for a spine joint of a
     /// simplified ragdoll.
-    pub sockets: Vec<Option<SocketHandle>>,
+    pub joints: Vec<Option<JointHandle>>,
     /// The spine rod of a simplified ragdoll.
     pub rod: Option<RodHandle>,
     /// The rod as created (its rest shape), to return to after driving.
@@ -154,7 +154,7 @@ impl Ragdoll {
             desc: desc.clone(),
             options,
             bodies: vec![None; desc.bodies.len()],
-            sockets: vec![None; desc.joints.len()],
+            joints: vec![None; desc.joints.len()],
             rod: None,
             rod_rest: None,
         };
@@ -216,7 +216,7 @@ impl Ragdoll {
             // Joint frames from bind pose (bodies unrotated there): +X along
             // the twist axis; limits are measured from bind pose.
             let frame = Quat::from_rotation_arc(Vec3::X, j.axis);
-            let socket = SocketDesc {
+            let socket = JointDesc {
                 body_a: a,
                 body_b: b,
                 anchor_a: j.anchor - desc.bodies[j.parent].centre(),
@@ -227,9 +227,9 @@ impl Ragdoll {
                 twist_limit: Some(j.twist),
                 drive: None,
             };
-            self.sockets[k] = Some(
+            self.joints[k] = Some(
                 world
-                    .add_socket(socket)
+                    .add_joint(socket)
                     .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?,
             );
         }
@@ -275,10 +275,10 @@ impl Ragdoll {
                 .remove_rod(rod)
                 .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
         }
-        for (socket, j) in self.sockets.iter_mut().zip(&self.desc.joints) {
+        for (socket, j) in self.joints.iter_mut().zip(&self.desc.joints) {
             if let Some(socket) = socket.take() {
                 world
-                    .remove_socket(socket)
+                    .remove_joint(socket)
                     .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
             }
         }
@@ -302,10 +302,10 @@ impl Ragdoll {
                 .rod(rod)
                 .map_err(|_| refuse("the spine rod".to_owned(), GONE))?;
         }
-        for (joint, socket) in self.desc.joints.iter().zip(&self.sockets) {
+        for (joint, socket) in self.desc.joints.iter().zip(&self.joints) {
             if let Some(socket) = *socket {
                 world
-                    .socket(socket)
+                    .joint(socket)
                     .map_err(|_| refuse(format!("joint `{}`", joint.name), GONE))?;
             }
         }
@@ -318,10 +318,10 @@ impl Ragdoll {
                 owner.insert(body, def);
             }
         }
-        let own_sockets: HashSet<_> = self.sockets.iter().flatten().collect();
+        let own_joints: HashSet<_> = self.joints.iter().flatten().collect();
         let foreign = world
-            .sockets()
-            .filter(|(h, _)| !own_sockets.contains(h))
+            .joints()
+            .filter(|(h, _)| !own_joints.contains(h))
             .map(|(_, d)| (d.body_a, d.body_b))
             .chain(
                 world
@@ -386,7 +386,7 @@ impl Ragdoll {
             .desc
             .joints
             .iter()
-            .zip(&self.sockets)
+            .zip(&self.joints)
             .filter(|(_, s)| s.is_some())
             .map(|(j, _)| {
                 (

@@ -8,7 +8,7 @@ use vertebra_ragdoll::{
     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMapping, SpineMode, Strength,
     body_masses,
 };
-use vertebra_world::{BodyDesc, SocketDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, JointDesc, SolverConfig, World};
 
 fn world() -> World {
     World::new(SolverConfig::default()).unwrap()
@@ -274,7 +274,7 @@ fn a_driven_ragdoll_with_fixed_hips_returns_to_its_pose_after_a_push() {
         let anchor = w
             .add_body(BodyDesc::fixed().with_position(target.bones[desc.root].0))
             .unwrap();
-        let pin = SocketDesc::at_world_anchor(
+        let pin = JointDesc::at_world_anchor(
             w.bodies(),
             anchor,
             hips,
@@ -282,7 +282,7 @@ fn a_driven_ragdoll_with_fixed_hips_returns_to_its_pose_after_a_push() {
             Vec3::Y,
         )
         .unwrap();
-        w.add_socket(pin.with_drive(vertebra_world::AngularDrive {
+        w.add_joint(pin.with_drive(vertebra_world::AngularDrive {
             target: Quat::IDENTITY,
             compliance: 0.0,
             damping: 0.0,
@@ -368,10 +368,10 @@ fn removal_state(w: &World, ragdoll: &Ragdoll) -> impl PartialEq + std::fmt::Deb
     (
         w.state_hash(),
         w.bodies().len(),
-        w.sockets().count(),
+        w.joints().count(),
         w.rods().count(),
         ragdoll.bodies.clone(),
-        ragdoll.sockets.clone(),
+        ragdoll.joints.clone(),
         ragdoll.rod,
     )
 }
@@ -386,8 +386,8 @@ fn a_ragdoll_held_by_a_foreign_joint_is_not_removed_at_all() {
     let hips = ragdoll.bodies[desc.root].unwrap();
     let at = w.body(hips).unwrap().position;
     let anchor = w.add_body(BodyDesc::fixed().with_position(at)).unwrap();
-    let pin = SocketDesc::at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap();
-    let pin = w.add_socket(pin).unwrap();
+    let pin = JointDesc::at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap();
+    let pin = w.add_joint(pin).unwrap();
     let before = removal_state(&w, &ragdoll);
     let refused = ragdoll.remove(&mut w).unwrap_err();
     assert_eq!(removal_state(&w, &ragdoll), before, "nothing was removed");
@@ -396,9 +396,9 @@ fn a_ragdoll_held_by_a_foreign_joint_is_not_removed_at_all() {
         refused.to_string().contains(&format!("body `{name}`")),
         "the body is named: {refused}"
     );
-    w.remove_socket(pin).unwrap();
+    w.remove_joint(pin).unwrap();
     ragdoll.remove(&mut w).unwrap();
-    assert_eq!((w.bodies().len(), w.sockets().count()), (1, 0));
+    assert_eq!((w.bodies().len(), w.joints().count()), (1, 0));
 }
 
 #[test]
@@ -409,7 +409,7 @@ fn a_ragdoll_missing_a_joint_is_not_removed_at_all() {
     let mut w = world();
     let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Rod);
     let k = desc.joints.len() - 1;
-    w.remove_socket(ragdoll.sockets[k].unwrap()).unwrap();
+    w.remove_joint(ragdoll.joints[k].unwrap()).unwrap();
     let before = removal_state(&w, &ragdoll);
     let refused = ragdoll.remove(&mut w).unwrap_err();
     assert_eq!(removal_state(&w, &ragdoll), before, "nothing was removed");
@@ -427,7 +427,7 @@ fn a_ragdoll_that_cannot_be_removed_is_not_recreated() {
     let desc = RagdollDesc::reference_humanoid();
     let mut w = world();
     let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Sockets);
-    w.remove_socket(ragdoll.sockets[0].unwrap()).unwrap();
+    w.remove_joint(ragdoll.joints[0].unwrap()).unwrap();
     let before = removal_state(&w, &ragdoll);
     let pose = Pose::bind(&desc).moved(Vec3::ZERO, Quat::IDENTITY, Vec3::X);
     assert!(ragdoll.recreate(&mut w, &pose, None).is_err());

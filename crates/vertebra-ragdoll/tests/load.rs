@@ -24,7 +24,7 @@ fn the_reference_humanoid_builds_both_ways_with_the_same_mass() {
         )
         .unwrap();
         assert_eq!(w.bodies().len(), bodies, "{spine:?}");
-        assert_eq!(r.sockets.iter().flatten().count(), sockets, "{spine:?}");
+        assert_eq!(r.joints.iter().flatten().count(), sockets, "{spine:?}");
         assert_eq!(r.rod.is_some() as usize, rods, "{spine:?}");
         let mass: f32 = r
             .bodies

@@ -10,7 +10,7 @@ use vertebra_ragdoll::{
     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode, Strength,
 };
 use vertebra_world::{
-    AngularDrive, BackendChoice, BodyDesc, BodyHandle, RodHandle, Shape, SocketDesc, SocketHandle,
+    AngularDrive, BackendChoice, BodyDesc, BodyHandle, JointDesc, JointHandle, RodHandle, Shape,
     SolverConfig, World,
 };
 
@@ -149,7 +149,7 @@ pub struct SceneWorld {
     pub push: Option<(BodyHandle, Vec3)>,
     /// The ragdolls' joints: the residual error counts these (not the pins
     /// holding hips in place).
-    sockets: HashSet<SocketHandle>,
+    joints: HashSet<JointHandle>,
     rods: HashSet<RodHandle>,
 }
 
@@ -161,9 +161,9 @@ impl SceneWorld {
         target: Option<Pose>,
         push: Option<(BodyHandle, Vec3)>,
     ) -> Self {
-        let sockets = ragdolls
+        let joints = ragdolls
             .iter()
-            .flat_map(|r| r.sockets.iter().flatten().copied())
+            .flat_map(|r| r.joints.iter().flatten().copied())
             .collect();
         let rods = ragdolls.iter().filter_map(|r| r.rod).collect();
         Self {
@@ -172,7 +172,7 @@ impl SceneWorld {
             ragdolls,
             target,
             push,
-            sockets,
+            joints,
             rods,
         }
     }
@@ -206,17 +206,17 @@ impl SceneWorld {
     /// joints under the same handles (the peer comparison's mirror).
     pub fn measure(&self, world: &World) -> Frame {
         let r = world.residuals();
-        let socket_errors = r
-            .sockets
+        let joint_errors = r
+            .joints
             .iter()
-            .filter(|j| self.sockets.contains(&j.joint))
+            .filter(|j| self.joints.contains(&j.joint))
             .map(|j| (j.linear_cm, j.angular_rad));
         let rod_errors = r
             .rods
             .iter()
             .filter(|j| self.rods.contains(&j.joint))
             .map(|j| (j.linear_cm, j.angular_rad));
-        let (eps_lin_cm, eps_ang_rad) = socket_errors
+        let (eps_lin_cm, eps_ang_rad) = joint_errors
             .chain(rod_errors)
             .fold((0.0, 0.0), |(l, a), (dl, da)| (l + dl, a + da));
         let (mut deviation_cm, mut deviation_rad) = (0.0, 0.0);
@@ -263,14 +263,14 @@ fn fix(world: &mut World, body: BodyHandle) -> Result<(), RagdollError> {
             .with_position(at)
             .with_orientation(world.body(body)?.orientation),
     )?;
-    let pin = SocketDesc::at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?.with_drive(
+    let pin = JointDesc::at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?.with_drive(
         AngularDrive {
             target: Quat::IDENTITY,
             compliance: 0.0,
             damping: 0.0,
         },
     );
-    world.add_socket(pin)?;
+    world.add_joint(pin)?;
     Ok(())
 }
 

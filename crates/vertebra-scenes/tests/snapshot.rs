@@ -46,18 +46,18 @@ fn stepping_on_from_a_restored_drop_is_bit_identical() {
             )
             .unwrap();
         let socket = scene.ragdolls[0]
-            .sockets
+            .joints
             .iter()
             .flatten()
             .next()
             .copied()
             .unwrap();
-        scene.world.remove_socket(socket).unwrap();
+        scene.world.remove_joint(socket).unwrap();
         scene.world.restore(&snapshot).unwrap();
         assert_eq!(scene.world.state_hash(), at_snapshot);
         assert!(scene.world.body(extra).is_err(), "the added body is gone");
         assert!(
-            scene.world.socket(socket).is_ok(),
+            scene.world.joint(socket).is_ok(),
             "the removed socket is back"
         );
         assert_eq!(run(&mut scene, 40..80), ahead, "{spine:?}: replay differs");

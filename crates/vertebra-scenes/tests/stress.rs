@@ -6,7 +6,7 @@ use glam::{Quat, Vec3};
 use vertebra_collide::{Collider, ColliderShape, Collisions};
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
 use vertebra_scenes::{Scene, SceneConfig, build};
-use vertebra_world::{BodyDesc, BodyHandle, Shape, SocketDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, BodyHandle, JointDesc, Shape, SolverConfig, World};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -38,7 +38,7 @@ fn three_hundred_ragdolls_dropped_at_once() {
         let mut config = SceneConfig::new(Scene::RagdollDrop, spine);
         config.ragdolls = 300;
         let mut scene = build(&config).unwrap();
-        let joints = (scene.world.sockets().count() + scene.world.rods().count()) as f32;
+        let joints = (scene.world.joints().count() + scene.world.rods().count()) as f32;
         let mut worst = 0.0f32;
         for frame in 0..240 {
             scene.advance(config.scene, frame, DT).unwrap();
@@ -94,7 +94,7 @@ fn mass_ratio(light_on_top: bool, substeps: u32) -> (f32, f32) {
                     .with_position(centre),
             )
             .unwrap();
-        let socket = SocketDesc::at_world_anchor(
+        let socket = JointDesc::at_world_anchor(
             world.bodies(),
             parent,
             body,
@@ -102,7 +102,7 @@ fn mass_ratio(light_on_top: bool, substeps: u32) -> (f32, f32) {
             (bottom - top).normalize(),
         )
         .unwrap();
-        world.add_socket(socket).unwrap();
+        world.add_joint(socket).unwrap();
         (parent, top) = (body, bottom);
     }
     let mut worst = 0.0f32;

@@ -15,8 +15,8 @@ use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::{Colouring, MAX_COLOURS};
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 
+use crate::joint::JointDesc;
 use crate::rod::RodDesc;
-use crate::socket::SocketDesc;
 
 /// No joint in this lane.
 pub(crate) const EMPTY: u32 = u32::MAX;
@@ -106,7 +106,7 @@ impl Layout {
     /// `Some` when live.
     pub fn build(
         colouring: &Colouring,
-        sockets: &[Option<SocketDesc>],
+        sockets: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
     ) -> Self {
@@ -151,14 +151,14 @@ impl Layout {
     fn append(
         &mut self,
         keys: &BTreeSet<u64>,
-        sockets: &[Option<SocketDesc>],
+        sockets: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
     ) -> Group {
         let socket = |slot: usize| sockets[slot].as_ref().expect("coloured sockets are live");
-        let socket_slots = || keys.iter().filter(|&&k| k < ROD_KEY).map(|&k| k as usize);
-        let driven = socket_slots().filter(|&s| socket(s).drive.is_some());
-        let plain = socket_slots().filter(|&s| socket(s).drive.is_none());
+        let joint_slots = || keys.iter().filter(|&&k| k < ROD_KEY).map(|&k| k as usize);
+        let driven = joint_slots().filter(|&s| socket(s).drive.is_some());
+        let plain = joint_slots().filter(|&s| socket(s).drive.is_none());
         let set_socket = |block: &mut SocketBlock, lane: usize, slot: usize| {
             block.set(lane, &socket_lane(socket(slot), bodies))
         };
@@ -215,7 +215,7 @@ fn rows(a: BodyHandle, b: BodyHandle, bodies: &BodyStore) -> (u32, u32, bool, bo
 }
 
 /// A socket's lane data.
-pub(crate) fn socket_lane(desc: &SocketDesc, bodies: &BodyStore) -> SocketLane {
+pub(crate) fn socket_lane(desc: &JointDesc, bodies: &BodyStore) -> SocketLane {
     let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
     SocketLane {
         body_a,

@@ -4,7 +4,7 @@
 //!
 //! ```
 //! use glam::{Quat, Vec3};
-//! use vertebra_world::{BodyDesc, Shape, SocketDesc, SolverConfig, World};
+//! use vertebra_world::{BodyDesc, Shape, JointDesc, SolverConfig, World};
 //!
 //! let mut world = World::new(SolverConfig::default())?;
 //! let ground = world.add_body(BodyDesc::fixed())?;
@@ -12,9 +12,9 @@
 //! let bob = world.add_body(
 //!     BodyDesc::dynamic(shape.mass_properties_with_mass(2.0)?).with_position(Vec3::new(0.0, -0.25, 0.0)),
 //! )?;
-//! let socket = SocketDesc::at_world_anchor(world.bodies(), ground, bob, Vec3::ZERO, -Vec3::Y)?
+//! let joint = JointDesc::at_world_anchor(world.bodies(), ground, bob, Vec3::ZERO, -Vec3::Y)?
 //!     .with_swing_limit(0.5);
-//! world.add_socket(socket)?;
+//! world.add_joint(joint)?;
 //! for _ in 0..60 {
 //!     world.step(1.0 / 60.0)?;
 //! }
@@ -25,12 +25,12 @@
 mod checks;
 mod config;
 mod contact;
+mod joint;
 mod layout;
 mod metrics;
 mod parallel;
 mod rod;
 mod snapshot;
-mod socket;
 mod step;
 
 use glam::{Quat, Vec3};
@@ -42,10 +42,10 @@ pub use config::{
     MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
 };
 pub use contact::Contact;
+pub use joint::{AngularDrive, JointDesc, JointHandle};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use snapshot::Snapshot;
-pub use socket::{AngularDrive, SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
@@ -66,8 +66,8 @@ pub struct World {
     pool: Option<rayon::ThreadPool>,
     bodies: BodyStore,
     joints_at: Vec<u32>,
-    socket_slots: Slots,
-    sockets: Vec<Option<socket::SocketDesc>>,
+    joint_slots: Slots,
+    joints: Vec<Option<joint::JointDesc>>,
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
@@ -107,8 +107,8 @@ impl World {
             pool,
             bodies: BodyStore::with_lineage(lineage),
             joints_at: Vec::new(),
-            socket_slots: Slots::new(lineage),
-            sockets: Vec::new(),
+            joint_slots: Slots::new(lineage),
+            joints: Vec::new(),
             rod_slots: Slots::new(lineage),
             rods: Vec::new(),
             colouring: Colouring::new(),
@@ -213,27 +213,27 @@ impl World {
         self.bodies.add_torque(handle, torque)
     }
 
-    /// Adds a socket joint; `Err` (and no change) for invalid input.
-    pub fn add_socket(&mut self, desc: SocketDesc) -> Result<SocketHandle, Error> {
+    /// Adds a joint; `Err` (and no change) for invalid input.
+    pub fn add_joint(&mut self, desc: JointDesc) -> Result<JointHandle, Error> {
         let _mode = DefaultFloatMode::enter();
         desc.validate_with(&self.bodies)?;
-        let handle: SocketHandle = self.socket_slots.insert();
+        let handle: JointHandle = self.joint_slots.insert();
         let slot = handle.index();
-        if slot == self.sockets.len() {
-            self.sockets.push(None);
+        if slot == self.joints.len() {
+            self.joints.push(None);
         }
-        self.sockets[slot] = Some(desc);
+        self.joints[slot] = Some(desc);
         self.connect(slot as u64, desc.body_a, desc.body_b);
         Ok(handle)
     }
 
-    /// Removes a socket joint.
-    pub fn remove_socket(&mut self, handle: SocketHandle) -> Result<(), Error> {
-        self.socket_slots.check(handle, "socket")?;
-        self.socket_slots.remove(handle);
-        let desc = self.sockets[handle.index()]
+    /// Removes a joint.
+    pub fn remove_joint(&mut self, handle: JointHandle) -> Result<(), Error> {
+        self.joint_slots.check(handle, "joint")?;
+        self.joint_slots.remove(handle);
+        let desc = self.joints[handle.index()]
             .take()
-            .expect("live socket has a description");
+            .expect("live joint has a description");
         self.colouring.remove(handle.index() as u64);
         self.joints_at[desc.body_a.index()] -= 1;
         self.joints_at[desc.body_b.index()] -= 1;
@@ -313,10 +313,10 @@ impl World {
         self.layout_dirty = true;
     }
 
-    /// Every live socket with its description, in slot order.
-    pub fn sockets(&self) -> impl Iterator<Item = (SocketHandle, SocketDesc)> + '_ {
-        self.sockets.iter().enumerate().filter_map(|(i, desc)| {
-            let handle = self.socket_slots.handle_at(i)?;
+    /// Every live joint with its description, in slot order.
+    pub fn joints(&self) -> impl Iterator<Item = (JointHandle, JointDesc)> + '_ {
+        self.joints.iter().enumerate().filter_map(|(i, desc)| {
+            let handle = self.joint_slots.handle_at(i)?;
             desc.map(|d| (handle, d))
         })
     }
@@ -329,28 +329,28 @@ impl World {
         })
     }
 
-    /// A socket's description.
-    pub fn socket(&self, handle: SocketHandle) -> Result<SocketDesc, Error> {
-        self.socket_slots.check(handle, "socket")?;
-        Ok(self.sockets[handle.index()].expect("live socket has a description"))
+    /// A joint's description.
+    pub fn joint(&self, handle: JointHandle) -> Result<JointDesc, Error> {
+        self.joint_slots.check(handle, "joint")?;
+        Ok(self.joints[handle.index()].expect("live joint has a description"))
     }
 
-    /// Sets or clears a socket's drive. Changing a drive's settings is done
-    /// in place; adding or removing one moves the socket to other blocks at
+    /// Sets or clears a joint's drive. Changing a drive's settings is done
+    /// in place; adding or removing one moves the joint to other blocks at
     /// the next step (no re-colouring).
-    pub fn set_socket_drive(
+    pub fn set_joint_drive(
         &mut self,
-        handle: SocketHandle,
+        handle: JointHandle,
         drive: Option<AngularDrive>,
     ) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
-        let mut desc = self.socket(handle)?;
+        let mut desc = self.joint(handle)?;
         if let Some(d) = &drive {
-            socket::validate_drive(d)?;
+            joint::validate_drive(d)?;
         }
         let regroup = desc.drive.is_some() != drive.is_some();
         desc.drive = drive;
-        self.sockets[handle.index()] = Some(desc);
+        self.joints[handle.index()] = Some(desc);
         if regroup {
             // Driven and plain sockets live in different blocks.
             self.layout_dirty = true;
@@ -404,7 +404,7 @@ impl World {
     fn refresh_layout(&mut self) {
         if self.layout_dirty {
             self.layout =
-                layout::Layout::build(&self.colouring, &self.sockets, &self.rods, &self.bodies);
+                layout::Layout::build(&self.colouring, &self.joints, &self.rods, &self.bodies);
             self.layout_dirty = false;
         }
     }

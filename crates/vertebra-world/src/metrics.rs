@@ -6,17 +6,17 @@ use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyStore, Slots};
 
+use crate::joint::JointHandle;
 use crate::layout::EMPTY;
 use crate::rod::RodHandle;
-use crate::socket::SocketHandle;
-use crate::{Contact, RodDesc, SocketDesc, World};
+use crate::{Contact, JointDesc, RodDesc, World};
 
 /// One joint's residual error.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointResidual<H> {
     /// The joint.
     pub joint: H,
-    /// Linear error (cm): a socket's anchor separation, a rod's `|C_len|`.
+    /// Linear error (cm): a joint's anchor separation, a rod's `|C_len|`.
     pub linear_cm: f32,
     /// Angular error (rad): limit overshoot, plus a rod's curve error (the
     /// angle between `t_b` and the reflection of `t_a`).
@@ -32,8 +32,8 @@ pub struct Residuals {
     pub eps_lin_cm: f32,
     /// Sum of angular errors (rad).
     pub eps_ang_rad: f32,
-    /// Per socket, in slot order.
-    pub sockets: Vec<JointResidual<SocketHandle>>,
+    /// Per joint, in slot order.
+    pub joints: Vec<JointResidual<JointHandle>>,
     /// Per rod, in slot order.
     pub rods: Vec<JointResidual<RodHandle>>,
 }
@@ -79,24 +79,24 @@ pub(crate) fn residuals(world: &mut World) -> Residuals {
         rows,
         out: &mut rod_lanes,
     });
-    let sockets = collect(&sockets.lane_slot, &socket_lanes, |s| {
-        world.socket_slots.handle_at(s)
+    let joints = collect(&sockets.lane_slot, &socket_lanes, |s| {
+        world.joint_slots.handle_at(s)
     });
     let rods = collect(&rods.lane_slot, &rod_lanes, |s| {
         world.rod_slots.handle_at(s)
     });
-    let lin = sockets
+    let lin = joints
         .iter()
         .map(|j| j.linear_cm)
         .chain(rods.iter().map(|j| j.linear_cm));
-    let ang = sockets
+    let ang = joints
         .iter()
         .map(|j| j.angular_rad)
         .chain(rods.iter().map(|j| j.angular_rad));
     Residuals {
         eps_lin_cm: lin.sum(),
         eps_ang_rad: ang.sum(),
-        sockets,
+        joints,
         rods,
     }
 }
@@ -112,8 +112,8 @@ struct Hashed<'a> {
     /// part; which slots are live and free (where the next body goes).
     bodies: &'a BodyStore,
     joints_at: &'a [u32],
-    socket_slots: &'a Slots,
-    sockets: &'a [Option<SocketDesc>],
+    joint_slots: &'a Slots,
+    joints: &'a [Option<JointDesc>],
     rod_slots: &'a Slots,
     rods: &'a [Option<RodDesc>],
     /// The solve order.
@@ -127,8 +127,8 @@ pub(crate) fn state_hash(world: &World) -> u64 {
     let state = Hashed {
         bodies: &world.bodies,
         joints_at: &world.joints_at,
-        socket_slots: &world.socket_slots,
-        sockets: &world.sockets,
+        joint_slots: &world.joint_slots,
+        joints: &world.joints,
         rod_slots: &world.rod_slots,
         rods: &world.rods,
         colouring: &world.colouring,

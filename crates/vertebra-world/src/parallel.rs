@@ -105,7 +105,7 @@ mod tests {
 
     use super::*;
     use crate::layout::Layout;
-    use crate::{BodyDesc, Shape, SocketDesc, SolverConfig, World};
+    use crate::{BodyDesc, JointDesc, Shape, SolverConfig, World};
 
     #[test]
     fn the_world_stays_send_and_sync() {
@@ -123,8 +123,8 @@ mod tests {
         let bob = world.add_body(BodyDesc::dynamic(mass)).unwrap();
         let other = world.add_body(BodyDesc::dynamic(mass)).unwrap();
         for (a, b) in [(fixed, bob), (bob, other)] {
-            let desc = SocketDesc::at_world_anchor(world.bodies(), a, b, Vec3::ZERO, Vec3::Y);
-            world.add_socket(desc.unwrap()).unwrap();
+            let desc = JointDesc::at_world_anchor(world.bodies(), a, b, Vec3::ZERO, Vec3::Y);
+            world.add_joint(desc.unwrap()).unwrap();
         }
         world.refresh_layout();
         assert!(world.layout.disjoint, "the scheduler's colouring passes");
@@ -133,7 +133,7 @@ mod tests {
         let mut crafted = Colouring::new();
         crafted.add(0, [None, None]);
         crafted.add(1, [None, None]);
-        let layout = Layout::build(&crafted, &world.sockets, &world.rods, &world.bodies);
+        let layout = Layout::build(&crafted, &world.joints, &world.rods, &world.bodies);
         assert_eq!(layout.colours.len(), 1);
         assert!(!layout.disjoint);
     }

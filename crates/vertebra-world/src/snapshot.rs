@@ -51,7 +51,7 @@ use serde::{Deserialize, Serialize};
 use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 
-use crate::{Contact, RodDesc, SocketDesc, World, checks, layout::ROD_KEY};
+use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
 const FORMAT: u8 = b'3';
@@ -98,8 +98,8 @@ fn build_id() -> u64 {
 struct State {
     bodies: BodyStore,
     joints_at: Vec<u32>,
-    socket_slots: Slots,
-    sockets: Vec<Option<SocketDesc>>,
+    joint_slots: Slots,
+    joints: Vec<Option<JointDesc>>,
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
@@ -167,10 +167,10 @@ impl State {
                 joints_at[h.index()] += 1;
             }
         };
-        let sockets = joints("socket", &self.socket_slots, &self.sockets, |d| {
+        let live = joints("joint", &self.joint_slots, &self.joints, |d| {
             d.validate_with(bodies)
         })?;
-        for (slot, d) in sockets {
+        for (slot, d) in live {
             joint(slot as u64, d.body_a, d.body_b);
         }
         let rods = joints("rod", &self.rod_slots, &self.rods, |d| {
@@ -242,8 +242,8 @@ impl World {
         let state = State {
             bodies: self.bodies.clone(),
             joints_at: self.joints_at.clone(),
-            socket_slots: self.socket_slots.clone(),
-            sockets: self.sockets.clone(),
+            joint_slots: self.joint_slots.clone(),
+            joints: self.joints.clone(),
             rod_slots: self.rod_slots.clone(),
             rods: self.rods.clone(),
             colouring: self.colouring.clone(),
@@ -266,12 +266,12 @@ impl World {
         let mut state = State::decode(&snapshot.bytes)?;
         state.validate()?;
         state.bodies.issue_after(&self.bodies);
-        state.socket_slots.issue_after(&self.socket_slots);
+        state.joint_slots.issue_after(&self.joint_slots);
         state.rod_slots.issue_after(&self.rod_slots);
         self.bodies = state.bodies;
         self.joints_at = state.joints_at;
-        self.socket_slots = state.socket_slots;
-        self.sockets = state.sockets;
+        self.joint_slots = state.joint_slots;
+        self.joints = state.joints;
         self.rod_slots = state.rod_slots;
         self.rods = state.rods;
         self.colouring = state.colouring;
@@ -315,7 +315,7 @@ mod tests {
         world.remove_body(gone).unwrap();
         let bodies = world.bodies();
         let socket =
-            SocketDesc::at_world_anchor(bodies, ground, links[0], -0.25 * Vec3::Y, -Vec3::Y)
+            JointDesc::at_world_anchor(bodies, ground, links[0], -0.25 * Vec3::Y, -Vec3::Y)
                 .unwrap()
                 .with_swing_limit(1.0);
         let rod = RodDesc::from_pose(bodies, links[0], links[1], &[])
@@ -327,12 +327,12 @@ mod tests {
             damping: 1.0,
         };
         let driven =
-            SocketDesc::at_world_anchor(bodies, links[1], links[2], -1.25 * Vec3::Y, -Vec3::Y)
+            JointDesc::at_world_anchor(bodies, links[1], links[2], -1.25 * Vec3::Y, -Vec3::Y)
                 .unwrap()
                 .with_drive(drive);
-        world.add_socket(socket).unwrap();
+        world.add_joint(socket).unwrap();
         world.add_rod(rod).unwrap();
-        world.add_socket(driven).unwrap();
+        world.add_joint(driven).unwrap();
         world.set_body_velocity(links[2], Vec3::X, Vec3::Z).unwrap();
         for _ in 0..5 {
             world.step(1.0 / 60.0).unwrap();
@@ -386,8 +386,8 @@ mod tests {
         const NAN: f32 = f32::NAN;
         let cases: Vec<(Change, &str)> = vec![
             (
-                Box::new(|s| s.sockets[0].as_mut().unwrap().anchor_a.x = NAN),
-                "socket 0: anchor a is not finite",
+                Box::new(|s| s.joints[0].as_mut().unwrap().anchor_a.x = NAN),
+                "joint 0: anchor a is not finite",
             ),
             (
                 Box::new(|s| s.rods[0].as_mut().unwrap().rest_length = -0.4),
@@ -449,8 +449,8 @@ mod tests {
                 "6 joint counts for 5 body slots",
             ),
             (
-                Box::new(|s| s.sockets[1] = None),
-                "socket 1: live without a description",
+                Box::new(|s| s.joints[1] = None),
+                "joint 1: live without a description",
             ),
             (
                 Box::new(|s| s.rods.push(None)),
@@ -465,10 +465,10 @@ mod tests {
             ),
             (
                 Box::new(|s| {
-                    let socket = s.sockets[1].as_mut().unwrap();
+                    let socket = s.joints[1].as_mut().unwrap();
                     socket.drive.as_mut().unwrap().compliance = -1.0;
                 }),
-                "socket 1: drive compliance must be positive",
+                "joint 1: drive compliance must be positive",
             ),
             (
                 Box::new(|s| s.colouring = Colouring::new()),
@@ -513,11 +513,11 @@ mod tests {
             h
         };
         let cases = [
-            (foreign, "socket 0: body handle of another world"),
-            (removed, "socket 0: stale or unknown body handle"),
+            (foreign, "joint 0: body handle of another world"),
+            (removed, "joint 0: stale or unknown body handle"),
         ];
         for (body, expected) in cases {
-            let snapshot = crafted(&world, |s| s.sockets[0].as_mut().unwrap().body_a = body);
+            let snapshot = crafted(&world, |s| s.joints[0].as_mut().unwrap().body_a = body);
             assert_eq!(
                 refusal(&mut world, &snapshot),
                 format!("corrupt snapshot: {expected}")

@@ -6,7 +6,7 @@ mod common;
 use common::capsule;
 use glam::{Mat3, Quat, Vec3};
 use vertebra_world::{
-    AngularDrive, BackendChoice, BodyDesc, Error, MassProperties, Shape, SocketDesc, SolverConfig,
+    AngularDrive, BackendChoice, BodyDesc, Error, JointDesc, MassProperties, Shape, SolverConfig,
     World,
 };
 
@@ -21,13 +21,13 @@ fn world() -> (
     World,
     vertebra_world::BodyHandle,
     vertebra_world::BodyHandle,
-    vertebra_world::SocketHandle,
+    vertebra_world::JointHandle,
 ) {
     let mut w = World::new(SolverConfig::default()).unwrap();
     let a = w.add_body(BodyDesc::fixed()).unwrap();
     let b = capsule(&mut w, Vec3::ZERO, -Vec3::Y * 0.4, 1.0);
     let s = w
-        .add_socket(SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, -Vec3::Y).unwrap())
+        .add_joint(JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, -Vec3::Y).unwrap())
         .unwrap();
     w.step(1.0 / 60.0).unwrap();
     (w, a, b, s)
@@ -147,7 +147,7 @@ fn bad_bodies_are_refused_with_the_field_named() {
 fn bad_joints_are_refused() {
     rejected(Error::SameBody, |w| {
         let b = w.bodies().handle_at(1).unwrap();
-        w.add_socket(SocketDesc::at_world_anchor(
+        w.add_joint(JointDesc::at_world_anchor(
             w.bodies(),
             b,
             b,
@@ -163,7 +163,7 @@ fn bad_joints_are_refused() {
     };
     rejected_after(kinematic, Error::NoDynamicBody, |w, k| {
         let a = w.bodies().handle_at(0).unwrap();
-        w.add_socket(SocketDesc::at_world_anchor(
+        w.add_joint(JointDesc::at_world_anchor(
             w.bodies(),
             a,
             k,
@@ -177,8 +177,8 @@ fn bad_joints_are_refused() {
             w.bodies().handle_at(0).unwrap(),
             w.bodies().handle_at(1).unwrap(),
         );
-        w.add_socket(
-            SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
+        w.add_joint(
+            JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
                 .with_swing_limit(4.0),
         )
         .map(drop)
@@ -188,8 +188,8 @@ fn bad_joints_are_refused() {
             w.bodies().handle_at(0).unwrap(),
             w.bodies().handle_at(1).unwrap(),
         );
-        w.add_socket(
-            SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
+        w.add_joint(
+            JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
                 .with_twist_limit(0.5, -0.5),
         )
         .map(drop)
@@ -199,7 +199,7 @@ fn bad_joints_are_refused() {
             w.bodies().handle_at(0).unwrap(),
             w.bodies().handle_at(1).unwrap(),
         );
-        w.add_socket(SocketDesc::at_world_anchor(
+        w.add_joint(JointDesc::at_world_anchor(
             w.bodies(),
             a,
             b,
@@ -209,31 +209,31 @@ fn bad_joints_are_refused() {
         .map(drop)
     });
     rejected(Error::NonPositive("drive compliance"), |w| {
-        let s = w.residuals().sockets[0].joint;
+        let s = w.residuals().joints[0].joint;
         let drive = AngularDrive {
             target: Quat::IDENTITY,
             compliance: -1.0,
             damping: 0.0,
         };
-        w.set_socket_drive(s, Some(drive))
+        w.set_joint_drive(s, Some(drive))
     });
     rejected(Error::NotNormalized("drive target"), |w| {
-        let s = w.residuals().sockets[0].joint;
+        let s = w.residuals().joints[0].joint;
         let drive = AngularDrive {
             target: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
             compliance: 0.0,
             damping: 0.0,
         };
-        w.set_socket_drive(s, Some(drive))
+        w.set_joint_drive(s, Some(drive))
     });
 }
 
 #[test]
 fn stale_handles_are_refused() {
     let (mut w, a, b, s) = world();
-    w.remove_socket(s).unwrap();
-    assert_eq!(w.remove_socket(s), Err(Error::StaleHandle("socket")));
-    assert_eq!(w.socket(s), Err(Error::StaleHandle("socket")));
+    w.remove_joint(s).unwrap();
+    assert_eq!(w.remove_joint(s), Err(Error::StaleHandle("joint")));
+    assert_eq!(w.joint(s), Err(Error::StaleHandle("joint")));
     w.remove_body(b).unwrap();
     assert_eq!(w.body(b), Err(Error::StaleHandle("body")));
     assert_eq!(
@@ -246,7 +246,7 @@ fn stale_handles_are_refused() {
     assert_eq!(c.index(), b.index());
     assert_ne!(c, b);
     assert_eq!(w.body(b), Err(Error::StaleHandle("body")));
-    assert!(SocketDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X).is_err());
+    assert!(JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X).is_err());
     w.step(1.0 / 60.0).unwrap();
 }
 

@@ -7,7 +7,7 @@ use common::capsule;
 use glam::{Quat, Vec3};
 use vertebra_math::Backend;
 use vertebra_world::{
-    AngularDrive, BackendChoice, BodyDesc, RodDesc, RodStiffness, SocketDesc, SolverConfig, World,
+    AngularDrive, BackendChoice, BodyDesc, JointDesc, RodDesc, RodStiffness, SolverConfig, World,
 };
 
 /// 30 branching chains (hundreds of bodies and sockets, several colours),
@@ -34,7 +34,7 @@ fn build(backend: Backend, threads: usize) -> World {
                     let bottom = top + dir * 0.3;
                     let body = capsule(&mut w, top + dir * 0.02, bottom, 1.0 + 0.5 * depth as f32);
                     let mut desc =
-                        SocketDesc::at_world_anchor(w.bodies(), parent, body, top, dir).unwrap();
+                        JointDesc::at_world_anchor(w.bodies(), parent, body, top, dir).unwrap();
                     if (tree + depth) % 3 == 0 {
                         desc = desc.with_swing_limit(0.4).with_twist_limit(-0.2, 0.3);
                     }
@@ -45,7 +45,7 @@ fn build(backend: Backend, threads: usize) -> World {
                             damping: 2.0,
                         });
                     }
-                    w.add_socket(desc).unwrap();
+                    w.add_joint(desc).unwrap();
                     next.push((body, bottom));
                 }
             }
@@ -92,8 +92,8 @@ fn build(backend: Backend, threads: usize) -> World {
         let dir = Vec3::new(angle.cos(), 0.0, angle.sin());
         let anchor = Vec3::new(-3.0, 1.9, 0.0) + dir * 0.1;
         let spoke = capsule(&mut w, anchor, anchor + dir * 0.3, 0.5);
-        let desc = SocketDesc::at_world_anchor(w.bodies(), hub, spoke, anchor, dir).unwrap();
-        w.add_socket(desc).unwrap();
+        let desc = JointDesc::at_world_anchor(w.bodies(), hub, spoke, anchor, dir).unwrap();
+        w.add_joint(desc).unwrap();
     }
     w
 }
@@ -118,7 +118,7 @@ fn the_world_uses_many_colours_and_the_overflow_set() {
     assert!(w.bodies().len() > 200, "{} bodies", w.bodies().len());
     let mut w = w;
     w.step(1.0 / 60.0).unwrap();
-    assert!(w.residuals().sockets.len() > 200);
+    assert!(w.residuals().joints.len() > 200);
     assert!(
         w.residuals().rods.len() >= 10,
         "rods: {}",

@@ -10,7 +10,7 @@ mod common;
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, BodyHandle, Contact, MAX_COORDINATE, Shape, SocketDesc, SolverConfig, World,
+    BodyDesc, BodyHandle, Contact, JointDesc, MAX_COORDINATE, Shape, SolverConfig, World,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -210,8 +210,8 @@ fn a_far_anchor_on_a_static_body_holds() {
         w.set_body_velocity(bob, Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO)
             .expect("push");
         let socket =
-            SocketDesc::at_world_anchor(w.bodies(), ground, bob, top, -Vec3::Y).expect("socket");
-        w.add_socket(socket).expect("valid socket");
+            JointDesc::at_world_anchor(w.bodies(), ground, bob, top, -Vec3::Y).expect("socket");
+        w.add_joint(socket).expect("valid socket");
         let mut worst = 0.0f32;
         for _ in 0..120 {
             w.step(DT).expect("step");

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 use vertebra_world::{
-    BodyDesc, BodyHandle, MassProperties, RodDesc, RodStiffness, Shape, SocketDesc, SolverConfig,
+    BodyDesc, BodyHandle, JointDesc, MassProperties, RodDesc, RodStiffness, Shape, SolverConfig,
     World,
 };
 
@@ -50,8 +50,8 @@ fn as_a_host_with_ftz_daz<T>(f: impl FnOnce() -> T) -> T {
 ///
 /// The descriptions are computed once, in the default mode
 /// ([`descriptions`]): this is about the step, not about helpers such as
-/// `SocketDesc::at_world_anchor`, which compute in their caller's mode.
-fn subnormal_scene(threads: usize, (bodies, sockets): &(Vec<BodyDesc>, Vec<SocketDesc>)) -> World {
+/// `JointDesc::at_world_anchor`, which compute in their caller's mode.
+fn subnormal_scene(threads: usize, (bodies, sockets): &(Vec<BodyDesc>, Vec<JointDesc>)) -> World {
     let mut world = World::new(SolverConfig {
         gravity: Vec3::ZERO,
         threads,
@@ -65,21 +65,21 @@ fn subnormal_scene(threads: usize, (bodies, sockets): &(Vec<BodyDesc>, Vec<Socke
     // The descriptions name the bodies of the world that made them; this
     // world's bodies sit in the same slots.
     let here = |h: BodyHandle| world.bodies().handle_at(h.index()).unwrap();
-    let sockets: Vec<SocketDesc> = sockets
+    let sockets: Vec<JointDesc> = sockets
         .iter()
-        .map(|s| SocketDesc {
+        .map(|s| JointDesc {
             body_a: here(s.body_a),
             body_b: here(s.body_b),
             ..*s
         })
         .collect();
     for socket in sockets {
-        world.add_socket(socket).unwrap();
+        world.add_joint(socket).unwrap();
     }
     world
 }
 
-fn descriptions() -> (Vec<BodyDesc>, Vec<SocketDesc>) {
+fn descriptions() -> (Vec<BodyDesc>, Vec<JointDesc>) {
     let mut world = World::new(SolverConfig::default()).unwrap();
     let mut bodies = vec![BodyDesc::fixed()];
     let anchor = world.add_body(bodies[0]).unwrap();
@@ -95,7 +95,7 @@ fn descriptions() -> (Vec<BodyDesc>, Vec<SocketDesc>) {
             .with_damping(5.0, 5.0);
         bodies.push(ball);
         let ball = world.add_body(ball).unwrap();
-        let socket = SocketDesc::at_world_anchor(world.bodies(), anchor, ball, Vec3::ZERO, Vec3::Y);
+        let socket = JointDesc::at_world_anchor(world.bodies(), anchor, ball, Vec3::ZERO, Vec3::Y);
         sockets.push(socket.unwrap());
     }
     (bodies, sockets)

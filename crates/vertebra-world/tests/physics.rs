@@ -5,7 +5,7 @@ mod common;
 
 use common::{angle_between, capsule, hanging_chain, world};
 use glam::{Mat3, Quat, Vec3};
-use vertebra_world::{AngularDrive, BodyDesc, Shape, SocketDesc, SolverConfig, World};
+use vertebra_world::{AngularDrive, BodyDesc, JointDesc, Shape, SolverConfig, World};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -27,7 +27,7 @@ fn compound_pendulum_period_matches_the_closed_form() {
                 .with_orientation(rotation),
         )
         .unwrap();
-    let socket = SocketDesc {
+    let socket = JointDesc {
         body_a: pivot_body,
         body_b: bob,
         anchor_a: Vec3::ZERO,
@@ -38,7 +38,7 @@ fn compound_pendulum_period_matches_the_closed_form() {
         twist_limit: None,
         drive: None,
     };
-    w.add_socket(socket).unwrap();
+    w.add_joint(socket).unwrap();
     // I about the pivot = I_cm + m d^2 (about the z axis, across the rod).
     let i_pivot = props.inertia.z_axis.z + mass * d * d;
     let period = 2.0 * std::f32::consts::PI * (i_pivot / (mass * 9.81 * d)).sqrt();
@@ -178,9 +178,9 @@ fn internal_corrections_conserve_linear_momentum() {
     for k in 1..8 {
         let anchor = Vec3::new(0.0, -0.25 * k as f32 + 0.025, 0.0);
         let desc =
-            SocketDesc::at_world_anchor(w.bodies(), bodies[k - 1], bodies[k], anchor, -Vec3::Y)
+            JointDesc::at_world_anchor(w.bodies(), bodies[k - 1], bodies[k], anchor, -Vec3::Y)
                 .unwrap();
-        w.add_socket(desc).unwrap();
+        w.add_joint(desc).unwrap();
     }
     for (k, &b) in bodies.iter().enumerate() {
         let v = Vec3::new(
@@ -225,11 +225,11 @@ fn arm(
 ) -> (
     vertebra_world::BodyHandle,
     vertebra_world::BodyHandle,
-    SocketDesc,
+    JointDesc,
 ) {
     let parent = w.add_body(BodyDesc::fixed()).unwrap();
     let child = capsule(w, dir * 0.05, dir * 0.45, 2.0);
-    let desc = SocketDesc::at_world_anchor(w.bodies(), parent, child, Vec3::ZERO, dir).unwrap();
+    let desc = JointDesc::at_world_anchor(w.bodies(), parent, child, Vec3::ZERO, dir).unwrap();
     (parent, child, desc)
 }
 
@@ -238,7 +238,7 @@ fn the_swing_cone_holds_a_horizontal_arm_at_its_limit() {
     let mut w = world(1, 20);
     let (_, child, desc) = arm(&mut w, Vec3::X);
     let limit = 30f32.to_radians();
-    w.add_socket(desc.with_swing_limit(limit)).unwrap();
+    w.add_joint(desc.with_swing_limit(limit)).unwrap();
     let mut worst = 0.0f32;
     for frame in 0..240 {
         w.step(DT).unwrap();
@@ -265,7 +265,7 @@ fn the_swing_cone_holds_a_horizontal_arm_at_its_limit() {
 fn the_twist_range_holds_against_a_steady_torque() {
     let mut w = world(1, 20);
     let (_, child, desc) = arm(&mut w, -Vec3::Y);
-    w.add_socket(desc.with_twist_limit(-0.3, 0.3)).unwrap();
+    w.add_joint(desc.with_twist_limit(-0.3, 0.3)).unwrap();
     for _ in 0..180 {
         w.add_torque(child, Vec3::new(0.0, -2.0, 0.0)).unwrap();
         w.step(DT).unwrap();
@@ -293,7 +293,7 @@ fn push_driven_arm(compliance: f32) -> (f32, f32, f32) {
         compliance,
         damping: 5.0,
     };
-    w.add_socket(desc.with_drive(drive)).unwrap();
+    w.add_joint(desc.with_drive(drive)).unwrap();
     let error = |w: &World| {
         angle_between(
             w.body(child).unwrap().orientation * desc.frame_b,
@@ -351,8 +351,8 @@ fn a_kinematic_body_carries_its_joints_and_ignores_them() {
         .add_body(BodyDesc::kinematic().with_velocity(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO))
         .unwrap();
     let bob = capsule(&mut w, Vec3::ZERO, -Vec3::Y * 0.4, 1.0);
-    let desc = SocketDesc::at_world_anchor(w.bodies(), carrier, bob, Vec3::ZERO, -Vec3::Y).unwrap();
-    w.add_socket(desc).unwrap();
+    let desc = JointDesc::at_world_anchor(w.bodies(), carrier, bob, Vec3::ZERO, -Vec3::Y).unwrap();
+    w.add_joint(desc).unwrap();
     for _ in 0..120 {
         w.step(DT).unwrap();
     }

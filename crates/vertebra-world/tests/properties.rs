@@ -7,7 +7,7 @@ mod common;
 use common::capsule;
 use glam::{Quat, Vec3};
 use proptest::prelude::*;
-use vertebra_world::{BodyDesc, BodyHandle, SocketDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, BodyHandle, JointDesc, SolverConfig, World};
 
 /// The solver settings of these tests: `iterations` and `substeps`,
 /// gravity on or off.
@@ -47,13 +47,13 @@ fn chain(
         let body = capsule(&mut world, start, start + Vec3::X * 0.3, mass);
         if let Some(p) = parent {
             let socket =
-                SocketDesc::at_world_anchor(world.bodies(), p, body, start, Vec3::X).unwrap();
+                JointDesc::at_world_anchor(world.bodies(), p, body, start, Vec3::X).unwrap();
             let socket = if free {
                 socket
             } else {
                 socket.with_swing_limit(0.6)
             };
-            world.add_socket(socket).unwrap();
+            world.add_joint(socket).unwrap();
         }
         bodies.push(body);
         parent = Some(body);

@@ -57,7 +57,7 @@ fn within_speed_limits(world: &World) {
 fn hard_corrections_report_within_the_speed_limits() {
     let mut world = World::new(SolverConfig::default()).expect("default config");
     let (a, b) = two_bodies(&mut world);
-    let socket = vertebra_world::SocketDesc::at_world_anchor(
+    let socket = vertebra_world::JointDesc::at_world_anchor(
         world.bodies(),
         a,
         b,
@@ -65,7 +65,7 @@ fn hard_corrections_report_within_the_speed_limits() {
         -Vec3::Y,
     )
     .expect("socket");
-    world.add_socket(socket).expect("socket");
+    world.add_joint(socket).expect("socket");
     world
         .set_body_pose(b, Vec3::new(100.0, 0.0, 0.0), Quat::IDENTITY)
         .expect("pose");
@@ -192,7 +192,7 @@ fn settings_at_their_limits_step_finite_and_bounded() {
         world
             .set_body_velocity(a, Vec3::splat(1e30), Vec3::splat(1e30))
             .unwrap();
-        let socket = vertebra_world::SocketDesc::at_world_anchor(
+        let socket = vertebra_world::JointDesc::at_world_anchor(
             world.bodies(),
             a,
             b,
@@ -205,7 +205,7 @@ fn settings_at_their_limits_step_finite_and_bounded() {
             compliance: f32::MAX,
             damping: f32::MAX,
         };
-        world.add_socket(socket.with_drive(drive)).unwrap();
+        world.add_joint(socket.with_drive(drive)).unwrap();
         // 60 steps of at most MAX_LINEAR_SPEED_LIMIT / 60 m each.
         steps_clean(&mut world, MAX_LINEAR_SPEED_LIMIT * 1.01);
     }

@@ -93,7 +93,7 @@ fn another_worlds_handles_are_refused() {
     let mut ours = swinging_chain();
     let mut theirs = swinging_chain();
     let body = theirs.bodies().handle_at(3).unwrap();
-    let socket = theirs.sockets().next().unwrap().0;
+    let socket = theirs.joints().next().unwrap().0;
     let rod = theirs.rods().next().unwrap().0;
     let before = ours.snapshot();
     assert_eq!(ours.body(body), Err(Error::ForeignHandle("body")));
@@ -106,8 +106,8 @@ fn another_worlds_handles_are_refused() {
         Err(Error::ForeignHandle("body"))
     );
     assert_eq!(
-        ours.remove_socket(socket),
-        Err(Error::ForeignHandle("socket"))
+        ours.remove_joint(socket),
+        Err(Error::ForeignHandle("joint"))
     );
     assert_eq!(ours.remove_rod(rod), Err(Error::ForeignHandle("rod")));
     let contact = Contact {

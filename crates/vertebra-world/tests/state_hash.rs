@@ -3,8 +3,8 @@
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    AngularDrive, BodyDesc, BodyHandle, Contact, RodDesc, RodHandle, RodStiffness, Shape,
-    SocketDesc, SocketHandle, SolverConfig, World,
+    AngularDrive, BodyDesc, BodyHandle, Contact, JointDesc, JointHandle, RodDesc, RodHandle,
+    RodStiffness, Shape, SolverConfig, World,
 };
 
 struct Scene {
@@ -12,7 +12,7 @@ struct Scene {
     ground: BodyHandle,
     a: BodyHandle,
     b: BodyHandle,
-    socket: SocketHandle,
+    socket: JointHandle,
     rod: RodHandle,
 }
 
@@ -30,8 +30,8 @@ fn scene(tweak: impl FnOnce(&mut BodyDesc)) -> Scene {
     let mut desc_b = BodyDesc::dynamic(mass).with_position(Vec3::new(0.0, -0.75, 0.0));
     tweak(&mut desc_b);
     let b = world.add_body(desc_b).unwrap();
-    let socket = SocketDesc::at_world_anchor(world.bodies(), ground, a, Vec3::ZERO, -Vec3::Y);
-    let socket = world.add_socket(socket.unwrap()).unwrap();
+    let socket = JointDesc::at_world_anchor(world.bodies(), ground, a, Vec3::ZERO, -Vec3::Y);
+    let socket = world.add_joint(socket.unwrap()).unwrap();
     let rod = RodDesc::from_pose(world.bodies(), a, b, &[]).unwrap();
     let rod = world.add_rod(rod).unwrap();
     Scene {
@@ -90,10 +90,10 @@ fn every_piece_of_state_a_step_reads_changes_the_hash() {
                 compliance: 0.0,
                 damping: 0.0,
             };
-            s.world.set_socket_drive(s.socket, Some(drive)).unwrap();
+            s.world.set_joint_drive(s.socket, Some(drive)).unwrap();
         }),
         ("socket removed", |s| {
-            s.world.remove_socket(s.socket).unwrap()
+            s.world.remove_joint(s.socket).unwrap()
         }),
         ("rod stiffness", |s| {
             let rod = s.world.rod(s.rod).unwrap();

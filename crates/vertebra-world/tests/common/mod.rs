@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use glam::{Quat, Vec3};
-use vertebra_world::{BodyDesc, BodyHandle, Shape, SocketDesc, SocketHandle, SolverConfig, World};
+use vertebra_world::{BodyDesc, BodyHandle, JointDesc, JointHandle, Shape, SolverConfig, World};
 
 /// A capsule body of `mass` kg whose core segment runs from `top` to
 /// `bottom` (world, m), radius 0.05 m, at rest with identity orientation.
@@ -24,7 +24,7 @@ pub fn hanging_chain(
     top: Vec3,
     links: usize,
     length: f32,
-) -> (Vec<BodyHandle>, Vec<SocketHandle>) {
+) -> (Vec<BodyHandle>, Vec<JointHandle>) {
     let anchor_body = world
         .add_body(BodyDesc::fixed().with_position(top))
         .expect("static body");
@@ -35,9 +35,9 @@ pub fn hanging_chain(
         let lower = upper - Vec3::Y * length;
         let body = capsule(world, upper, lower, 1.0);
         let parent = *bodies.last().expect("a parent");
-        let desc = SocketDesc::at_world_anchor(world.bodies(), parent, body, upper, -Vec3::Y)
+        let desc = JointDesc::at_world_anchor(world.bodies(), parent, body, upper, -Vec3::Y)
             .expect("socket");
-        sockets.push(world.add_socket(desc).expect("valid socket"));
+        sockets.push(world.add_joint(desc).expect("valid socket"));
         bodies.push(body);
     }
     (bodies, sockets)

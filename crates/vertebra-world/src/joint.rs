@@ -1,18 +1,18 @@
-//! The socket joint's public description and its validation.
+//! A joint's public description and its validation.
 
 use glam::{Quat, Vec3};
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
 };
 
-/// Marker for socket handles.
+/// Marker for joint handles.
 #[derive(Debug)]
-pub enum SocketTag {}
+pub enum JointTag {}
 
-/// A stable reference to a socket joint.
-pub type SocketHandle = Handle<SocketTag>;
+/// A stable reference to a joint.
+pub type JointHandle = Handle<JointTag>;
 
-/// Drives a socket's body b toward an orientation relative to body a.
+/// Drives a joint's body b toward an orientation relative to body a.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AngularDrive {
     /// b's joint frame relative to a's joint frame (unit quaternion).
@@ -31,7 +31,7 @@ pub struct AngularDrive {
 /// the twist axes: the swing cone limits the angle between them, the twist
 /// range the rotation about them.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SocketDesc {
+pub struct JointDesc {
     /// The parent body.
     pub body_a: BodyHandle,
     /// The child body.
@@ -52,7 +52,7 @@ pub struct SocketDesc {
     pub drive: Option<AngularDrive>,
 }
 
-impl SocketDesc {
+impl JointDesc {
     /// A socket whose anchor is the world point `anchor` and whose twist
     /// axis is the world direction `twist_axis` (unit, pointing from a to b)
     /// at the bodies' current poses. The frames are set so that the joint
