@@ -1,6 +1,7 @@
 //! Nanoseconds per joint per backend: one position iteration over a batch
 //! of sockets (point, swing cone and twist range, with and without the
-//! angular drive), rods and contacts, each lane on its own two bodies (as in
+//! angular drive; the shaped path's soft ellipse, pyramid and twist),
+//! hinges, fixed joints, rods and contacts, each lane on its own two bodies (as in
 //! one colour). In cache: 1024 joints on 2048 bodies in order. Out of
 //! cache: 2^18 joints on 2^19 bodies scattered through memory (about
 //! 90 MB).
@@ -10,8 +11,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use vertebra_benches::{
-    ConstraintWorkload, ContactWorkload, OUT_OF_CACHE_JOINTS, Placement, RodWorkload,
-    SocketWorkload,
+    ConstraintWorkload, ContactWorkload, FixedWorkload, HingeWorkload, OUT_OF_CACHE_JOINTS,
+    Placement, RodWorkload, SocketWorkload,
 };
 use vertebra_math::Backend;
 
@@ -26,13 +27,18 @@ type Kind = (
     fn(Backend, usize, Placement) -> Box<dyn ConstraintWorkload>,
 );
 
-const KINDS: [Kind; 4] = [
+const KINDS: [Kind; 7] = [
     ("socket_limits_drive", |b, n, p| {
         Box::new(SocketWorkload::new(b, n, true, p))
     }),
     ("socket_limits", |b, n, p| {
         Box::new(SocketWorkload::new(b, n, false, p))
     }),
+    ("socket_shaped", |b, n, p| {
+        Box::new(SocketWorkload::shaped(b, n, p))
+    }),
+    ("hinge", |b, n, p| Box::new(HingeWorkload::new(b, n, p))),
+    ("fixed", |b, n, p| Box::new(FixedWorkload::new(b, n, p))),
     ("rod", |b, n, p| Box::new(RodWorkload::new(b, n, p))),
     ("contact", |b, n, p| Box::new(ContactWorkload::new(b, n, p))),
 ];

@@ -4,8 +4,10 @@
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
+use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
+use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
-use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane};
+use vertebra_kernels::socket::{PositionPass, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::map::{LaneMap, map_arrays};
 use vertebra_math::{Backend, BackendChoice, Lane, Quat, Vec3, poly};
@@ -166,6 +168,7 @@ impl Placement {
 pub struct SocketWorkload {
     backend: Backend,
     drive: bool,
+    shaped: bool,
     rows: BodyRows,
     blocks: Vec<SocketBlock>,
 }
@@ -210,15 +213,40 @@ impl SocketWorkload {
                 swing_max: 0.2,
                 twist: [-0.1, 0.1],
                 drive: drive.then_some((GQuat::from_rotation_x(0.2), 0.001, 1.0)),
+                shaped: ShapedLimits::FREE,
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }
         Self {
             backend,
             drive,
+            shaped: false,
             rows,
             blocks: out,
         }
+    }
+
+    /// The same joints on the shaped path, without drives: an elliptical
+    /// cone (0.2 and 0.1 rad), a pyramid (+-0.15 rad about each axis) and
+    /// the twist range, all soft (compliance 1e-4 rad / (N m)), all
+    /// violated.
+    pub fn shaped(backend: Backend, sockets: usize, placement: Placement) -> Self {
+        let mut work = Self::new(backend, sockets, false, placement);
+        let (y, z) = ((0.1f32).sin(), (0.05f32).sin());
+        let range = [-0.15, 0.15];
+        for block in &mut work.blocks {
+            for lane in 0..BLOCK_LANES {
+                (block.ellipse_y[lane], block.ellipse_z[lane]) = (y, z);
+                for (k, bound) in range.into_iter().enumerate() {
+                    block.pyramid_y[k][lane] = bound;
+                    block.pyramid_z[k][lane] = bound;
+                }
+                block.swing_max[lane] = core::f32::consts::PI;
+                block.limit_compliance[lane] = 1e-4;
+            }
+        }
+        work.shaped = true;
+        work
     }
 
     /// The joints in the batch.
@@ -230,19 +258,129 @@ impl SocketWorkload {
 impl ConstraintWorkload for SocketWorkload {
     fn iterate(&mut self) {
         let (blocks, rows) = (&mut self.blocks, &self.rows);
-        if self.drive {
-            self.backend.dispatch(PositionPass::<true> {
+        match (self.drive, self.shaped) {
+            (true, false) => self.backend.dispatch(PositionPass::<true, false> {
                 blocks,
                 rows,
                 inv_h2: 3600.0,
-            });
-        } else {
-            self.backend.dispatch(PositionPass::<false> {
+            }),
+            (false, false) => self.backend.dispatch(PositionPass::<false, false> {
                 blocks,
                 rows,
                 inv_h2: 3600.0,
-            });
+            }),
+            (true, true) => self.backend.dispatch(PositionPass::<true, true> {
+                blocks,
+                rows,
+                inv_h2: 3600.0,
+            }),
+            (false, true) => self.backend.dispatch(PositionPass::<false, true> {
+                blocks,
+                rows,
+                inv_h2: 3600.0,
+            }),
         }
+    }
+    fn probe(&self) -> f32 {
+        self.rows.pose[1].get()[0]
+    }
+}
+
+/// A batch of hinges laid out as [`SocketWorkload`]'s joints, without
+/// drives: each lane's axes apart and its angle beyond a hard range, so
+/// every part works.
+pub struct HingeWorkload {
+    backend: Backend,
+    rows: BodyRows,
+    blocks: Vec<HingeBlock>,
+}
+
+impl HingeWorkload {
+    /// `hinges` hinges (a power of two, at least 8) on `backend`.
+    pub fn new(backend: Backend, hinges: usize, placement: Placement) -> Self {
+        let blocks = hinges.div_ceil(BLOCK_LANES);
+        let sockets = SocketWorkload::new(backend, blocks * BLOCK_LANES, false, placement);
+        let mut out = vec![HingeBlock::padding(); blocks];
+        for k in 0..blocks * BLOCK_LANES {
+            let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
+            let lane = HingeLane {
+                body_a,
+                body_b,
+                dynamic_a: true,
+                dynamic_b: true,
+                anchor_a: GVec3::new(0.05, 0.1, 0.0),
+                anchor_b: GVec3::new(-0.05, -0.1, 0.0),
+                frame_a: GQuat::IDENTITY,
+                frame_b: GQuat::from_rotation_z(0.3),
+                range: [0.0, 0.05],
+                compliance: 0.0,
+                drive: None,
+            };
+            out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
+        }
+        Self {
+            backend,
+            rows: sockets.rows,
+            blocks: out,
+        }
+    }
+}
+
+impl ConstraintWorkload for HingeWorkload {
+    fn iterate(&mut self) {
+        self.backend.dispatch(hinge::PositionPass::<false> {
+            blocks: &mut self.blocks,
+            rows: &self.rows,
+            inv_h2: 3600.0,
+        });
+    }
+    fn probe(&self) -> f32 {
+        self.rows.pose[1].get()[0]
+    }
+}
+
+/// A batch of fixed joints laid out as [`SocketWorkload`]'s joints, each
+/// off its anchor and its frame.
+pub struct FixedWorkload {
+    backend: Backend,
+    rows: BodyRows,
+    blocks: Vec<FixedBlock>,
+}
+
+impl FixedWorkload {
+    /// `joints` fixed joints (a power of two, at least 8) on `backend`.
+    pub fn new(backend: Backend, joints: usize, placement: Placement) -> Self {
+        let blocks = joints.div_ceil(BLOCK_LANES);
+        let sockets = SocketWorkload::new(backend, blocks * BLOCK_LANES, false, placement);
+        let mut out = vec![FixedBlock::padding(); blocks];
+        for k in 0..blocks * BLOCK_LANES {
+            let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
+            let lane = FixedLane {
+                body_a,
+                body_b,
+                dynamic_a: true,
+                dynamic_b: true,
+                anchor_a: GVec3::new(0.05, 0.1, 0.0),
+                anchor_b: GVec3::new(-0.05, -0.1, 0.0),
+                frame_a: GQuat::IDENTITY,
+                frame_b: GQuat::from_rotation_z(0.3),
+            };
+            out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
+        }
+        Self {
+            backend,
+            rows: sockets.rows,
+            blocks: out,
+        }
+    }
+}
+
+impl ConstraintWorkload for FixedWorkload {
+    fn iterate(&mut self) {
+        self.backend.dispatch(fixed::PositionPass {
+            blocks: &mut self.blocks,
+            rows: &self.rows,
+        });
     }
     fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]

@@ -206,7 +206,7 @@ fn a_refused_ragdoll_removal_leaves_world_set_and_ragdoll_as_they_were() {
     let hips = ragdolls[0].bodies[desc.root].unwrap();
     let at = w.body(hips).unwrap().position;
     let anchor = w.add_body(BodyDesc::fixed().with_position(at)).unwrap();
-    w.add_joint(JointDesc::at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap())
+    w.add_joint(JointDesc::socket_at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap())
         .unwrap();
     let before = (
         w.state_hash(),

@@ -1,12 +1,15 @@
-//! Arbitrary lanes through the socket, rod and contact kernels.
+//! Arbitrary lanes through the socket (plain and shaped), hinge, fixed,
+//! rod and contact kernels.
 
 use core::f32::consts::PI;
 
 use glam::{Mat3, Vec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
+use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
+use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
-use vertebra_kernels::socket::{self, SocketBlock, SocketLane};
+use vertebra_kernels::socket::{self, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::check::same_bits;
@@ -101,6 +104,66 @@ fn socket_block(input: &mut Input, rows: &RawRows) -> SocketBlock {
                     input.float(10.0).abs(),
                 )
             }),
+            shaped: shaped(input),
+        };
+        block.set(k, &lane);
+        block.bodies.set_start(k, &start(input));
+    }
+    block
+}
+
+/// Shaped limits: semi-axes in (0, 1], angle ranges within [-pi, pi].
+fn shaped(input: &mut Input) -> ShapedLimits {
+    let semi = |x: f32| x.abs().clamp(1e-3, 1.0);
+    ShapedLimits {
+        ellipse: [semi(input.float(1.0)), semi(input.float(1.0))],
+        pyramid: [sorted_range(input), sorted_range(input)],
+        compliance: input.float(1.0).abs(),
+    }
+}
+
+fn hinge_block(input: &mut Input, rows: &RawRows) -> HingeBlock {
+    let mut block = HingeBlock::padding();
+    for k in 0..BLOCK_LANES {
+        let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
+        let lane = HingeLane {
+            body_a,
+            body_b,
+            dynamic_a,
+            dynamic_b,
+            anchor_a: input.vec3(1.0),
+            anchor_b: input.vec3(1.0),
+            frame_a: input.quat(),
+            frame_b: input.quat(),
+            range: sorted_range(input),
+            compliance: input.float(1.0).abs(),
+            drive: input.flag().then(|| {
+                (
+                    input.quat(),
+                    input.float(1.0).abs(),
+                    input.float(10.0).abs(),
+                )
+            }),
+        };
+        block.set(k, &lane);
+        block.bodies.set_start(k, &start(input));
+    }
+    block
+}
+
+fn fixed_block(input: &mut Input, rows: &RawRows) -> FixedBlock {
+    let mut block = FixedBlock::padding();
+    for k in 0..BLOCK_LANES {
+        let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
+        let lane = FixedLane {
+            body_a,
+            body_b,
+            dynamic_a,
+            dynamic_b,
+            anchor_a: input.vec3(1.0),
+            anchor_b: input.vec3(1.0),
+            frame_a: input.quat(),
+            frame_b: input.quat(),
         };
         block.set(k, &lane);
         block.bodies.set_start(k, &start(input));
@@ -156,20 +219,33 @@ fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
     block
 }
 
+/// One block of each kernel.
+type Blocks = (SocketBlock, RodBlock, ContactBlock, HingeBlock, FixedBlock);
+
 /// One position pass of each kernel over the same rows, on `backend`:
 /// every row's pose afterwards.
-fn run(
-    backend: Backend,
-    raw: &RawRows,
-    blocks: &(SocketBlock, RodBlock, ContactBlock),
-    inv_h2: f32,
-) -> Vec<f32> {
+fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32> {
     let rows = BodyRows::from_raw(raw);
     let (mut sockets, mut rods, mut contacts) = ([blocks.0], [blocks.1], [blocks.2]);
-    backend.dispatch(socket::PositionPass::<true> {
+    let (mut hinges, mut fixed) = ([blocks.3], [blocks.4]);
+    backend.dispatch(socket::PositionPass::<true, false> {
         blocks: &mut sockets,
         rows: &rows,
         inv_h2,
+    });
+    backend.dispatch(socket::PositionPass::<true, true> {
+        blocks: &mut sockets,
+        rows: &rows,
+        inv_h2,
+    });
+    backend.dispatch(hinge::PositionPass::<true> {
+        blocks: &mut hinges,
+        rows: &rows,
+        inv_h2,
+    });
+    backend.dispatch(fixed::PositionPass {
+        blocks: &mut fixed,
+        rows: &rows,
     });
     backend.dispatch(rod::PositionPass {
         blocks: &mut rods,
@@ -186,8 +262,8 @@ fn run(
 }
 
 /// Arbitrary bodies and lanes (unit or arbitrary quaternions, any floats one
-/// time in eight) through the socket (with drive), rod and contact position
-/// passes: every backend gives the scalar reference's bits, and input with
+/// time in eight) through the socket (with drive, plain and shaped), hinge
+/// (with drive), fixed, rod and contact position passes: every backend gives the scalar reference's bits, and input with
 /// no wild value gives finite poses.
 pub fn kernels(data: &[u8]) {
     let mut input = Input::new(data);
@@ -196,6 +272,8 @@ pub fn kernels(data: &[u8]) {
         socket_block(&mut input, &raw),
         rod_block(&mut input, &raw),
         contact_block(&mut input, &raw),
+        hinge_block(&mut input, &raw),
+        fixed_block(&mut input, &raw),
     );
     let inv_h2 = 1.0 / (input.positive(0.05) * input.positive(0.05));
     let expected = run(Backend::Scalar, &raw, &blocks, inv_h2);

@@ -7,7 +7,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use glam::{Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
-    BodyHandle, BodyKind, Contact, JointDesc, RodDesc, RodStiffness, Snapshot, SolverConfig, World,
+    BodyHandle, BodyKind, Contact, JointDesc, JointKind, LimitSoftness, RodDesc, RodStiffness,
+    Snapshot, SolverConfig, Swing, SwingTwist, World,
 };
 
 use crate::input::Input;
@@ -191,6 +192,43 @@ fn limit(input: &mut Input) -> Option<f32> {
     input.flag().then(|| value(input))
 }
 
+fn range(input: &mut Input) -> Option<[f32; 2]> {
+    input.flag().then(|| [value(input), value(input)])
+}
+
+/// Any kind, its limits and softness from the special values.
+fn kind(input: &mut Input) -> JointKind {
+    let softness = if input.flag() {
+        LimitSoftness::Compliance(value(input))
+    } else {
+        LimitSoftness::Hard
+    };
+    let swing = match input.pick(4) {
+        0 => Swing::Free,
+        1 => Swing::Cone(value(input)),
+        2 => Swing::Ellipse {
+            y: value(input),
+            z: value(input),
+        },
+        _ => Swing::Pyramid {
+            y: [value(input), value(input)],
+            z: [value(input), value(input)],
+        },
+    };
+    match input.pick(3) {
+        0 => JointKind::Hinge {
+            range: range(input),
+            softness,
+        },
+        1 => JointKind::Fixed,
+        _ => JointKind::Socket(SwingTwist {
+            swing,
+            twist: range(input),
+            softness,
+        }),
+    }
+}
+
 fn socket(input: &mut Input, state: &mut State) {
     let n = state.joints.len();
     if n == 0 {
@@ -206,8 +244,12 @@ fn socket(input: &mut Input, state: &mut State) {
         1 => s.body_b = handle,
         2 => vec3(input, &mut s.anchor_a),
         3 => quat(input, &mut s.frame_b),
-        4 => s.swing_limit = limit(input),
-        5 => s.twist_limit = Some([value(input), value(input)]),
+        4 => s.kind = kind(input),
+        5 => {
+            if let JointKind::Socket(limits) = &mut s.kind {
+                limits.twist = Some([value(input), value(input)]);
+            }
+        }
         6 => {
             if let Some(d) = s.drive.as_mut() {
                 quat(input, &mut d.target);

@@ -2,9 +2,9 @@
 
 use glam::Vec3;
 use vertebra_world::{
-    AngularDrive, BodyDesc, BodyHandle, Contact, Error, JointDesc, JointHandle,
-    MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle, RodStiffness, Shape,
-    SolverConfig, World,
+    AngularDrive, BodyDesc, BodyHandle, Contact, Error, JointDesc, JointHandle, JointKind,
+    LimitSoftness, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle,
+    RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
 };
 
 use crate::input::Input;
@@ -70,22 +70,57 @@ pub(crate) fn add_joint(
     let (Some(a), Some(b)) = (seen.body(input), seen.body(input)) else {
         return Err(Error::SameBody);
     };
-    let mut socket =
-        JointDesc::at_world_anchor(world.bodies(), a, b, input.vec3(5.0), input.vec3(1.0))?;
+    let (anchor, axis) = (input.vec3(5.0), input.vec3(1.0));
+    let mut joint = match input.pick(4) {
+        0 => JointDesc::hinge_at_world_anchor(world.bodies(), a, b, anchor, axis)?.with_kind(
+            JointKind::Hinge {
+                range: input.flag().then(|| [input.float(4.0), input.float(4.0)]),
+                softness: limit_softness(input),
+            },
+        ),
+        1 => JointDesc::fixed_at(world.bodies(), a, b, anchor)?,
+        _ => {
+            let socket = JointDesc::socket_at_world_anchor(world.bodies(), a, b, anchor, axis)?;
+            socket.with_kind(JointKind::Socket(SwingTwist {
+                swing: swing(input),
+                twist: input.flag().then(|| [input.float(4.0), input.float(4.0)]),
+                softness: limit_softness(input),
+            }))
+        }
+    };
     if input.flag() {
-        socket = socket.with_swing_limit(input.float(4.0));
-    }
-    if input.flag() {
-        socket = socket.with_twist_limit(input.float(4.0), input.float(4.0));
-    }
-    if input.flag() {
-        socket = socket.with_drive(AngularDrive {
+        joint = joint.with_drive(AngularDrive {
             target: input.quat(),
             compliance: input.float(1.0),
             damping: input.float(10.0),
         });
     }
-    world.add_joint(socket)
+    world.add_joint(joint)
+}
+
+/// Any swing limit, valid or not.
+fn swing(input: &mut Input) -> Swing {
+    match input.pick(4) {
+        0 => Swing::Free,
+        1 => Swing::Cone(input.float(4.0)),
+        2 => Swing::Ellipse {
+            y: input.float(4.0),
+            z: input.float(4.0),
+        },
+        _ => Swing::Pyramid {
+            y: [input.float(4.0), input.float(4.0)],
+            z: [input.float(4.0), input.float(4.0)],
+        },
+    }
+}
+
+/// Hard, or any compliance.
+fn limit_softness(input: &mut Input) -> LimitSoftness {
+    if input.flag() {
+        LimitSoftness::Compliance(input.float(1.0))
+    } else {
+        LimitSoftness::Hard
+    }
 }
 
 pub(crate) fn add_rod(

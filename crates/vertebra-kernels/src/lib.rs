@@ -7,8 +7,11 @@
 //! - [`parts`]: the position-level constraint parts joints are composed of
 //!   (after Jolt's constraint parts): point, angle correction, swing cone,
 //!   twist range, angular drive. Each has its derivation in its header.
-//! - [`socket`]: the ball-and-socket joint: its lane block, its position
-//!   pass, its velocity (damping) pass, and its residual.
+//! - [`socket`]: the ball-and-socket joint (circular cone, or elliptical
+//!   cone and pyramid, and twist): its lane block, its position pass, the
+//!   drives' velocity (damping) pass, and its residual.
+//! - [`hinge`]: the hinge: one rotation axis with a range.
+//! - [`fixed`]: the fixed joint: no relative motion.
 //! - [`contact`]: contacts: non-penetration and static friction at the
 //!   position level, dynamic friction and restitution at the velocity level.
 //! - [`residual`]: one pass that measures any joint block's residual error.
@@ -20,6 +23,8 @@
 
 pub mod body;
 pub mod contact;
+pub mod fixed;
+pub mod hinge;
 pub mod parts;
 pub mod residual;
 pub mod rod;

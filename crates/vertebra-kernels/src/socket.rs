@@ -1,5 +1,12 @@
-//! The ball-and-socket joint: a point part, a swing cone, a twist range and
+//! The ball-and-socket joint: a point part, a swing limit, a twist range and
 //! an angular drive, solved together in one lane-generic kernel.
+//!
+//! Two swing paths, chosen per block at compile time (`SHAPED`): the plain
+//! one, a hard circular cone (`swing`) and a hard twist range (`twist`);
+//! and the shaped one, an elliptical cone (`ellipse`) and a pyramid
+//! (`pyramid`), each inactive at its widest, and the twist range, every
+//! limit hard or soft (`limit`). The layout keeps the two in separate
+//! blocks, so a plain socket computes exactly what it always did.
 //!
 //! Constraint data lives in [`SocketBlock`]s of eight lanes (AoSoA), laid
 //! out by the scheduler in colour order. A pass walks its blocks `L::WIDTH`
@@ -9,10 +16,10 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
-use vertebra_math::{Lane, LaneKernel};
+use vertebra_math::{Lane, LaneKernel, Vec3};
 
-use crate::body::{BodyPairs, BodyRows, VelocityLanes};
-use crate::parts::{drive, point, swing, twist};
+use crate::body::{BodyLanes, BodyPairs, BodyRows, VelocityLanes};
+use crate::parts::{drive, ellipse, limit, point, pyramid, swing, swing_direction, twist};
 use crate::residual::Residual;
 
 /// Eight sockets, field by field.
@@ -46,6 +53,46 @@ pub struct SocketBlock {
     /// The drive's accumulated XPBD multiplier (world vector), reset every
     /// substep.
     pub drive_lambda: Vec3Block,
+    /// Shaped path: the elliptical cone's semi-axis about Y,
+    /// `sin(theta_y / 2)` (1 disables).
+    pub ellipse_y: [f32; BLOCK_LANES],
+    /// Shaped path: the elliptical cone's semi-axis about Z.
+    pub ellipse_z: [f32; BLOCK_LANES],
+    /// Shaped path: the pyramid's range of the swing angle about Y,
+    /// `[min, max]` (rad; -pi, pi disable).
+    pub pyramid_y: [[f32; BLOCK_LANES]; 2],
+    /// Shaped path: the pyramid's range about Z (rad).
+    pub pyramid_z: [[f32; BLOCK_LANES]; 2],
+    /// Shaped path: the limits' compliance (rad / (N m)); 0 is hard.
+    pub limit_compliance: [f32; BLOCK_LANES],
+    /// Shaped path: accumulated multipliers of the ellipse, the pyramid's
+    /// two angles and the twist range, reset every substep.
+    pub limit_lambda: [[f32; BLOCK_LANES]; 4],
+}
+
+/// A socket's shaped limits (one lane), the shaped path's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapedLimits {
+    /// The elliptical cone's semi-axes `[sin(theta_y / 2), sin(theta_z /
+    /// 2)]`, each at least [`ellipse::MIN_SEMI_AXIS`]; `[1, 1]` is free.
+    pub ellipse: [f32; 2],
+    /// The pyramid's ranges of the swing angles about Y and Z (rad);
+    /// `[-pi, pi]` is free.
+    pub pyramid: [[f32; 2]; 2],
+    /// The limits' compliance (rad / (N m)); 0 is hard.
+    pub compliance: f32,
+}
+
+impl ShapedLimits {
+    /// No shaped limit: what the plain path's lanes hold.
+    pub const FREE: Self = Self {
+        ellipse: [1.0, 1.0],
+        pyramid: [
+            [-core::f32::consts::PI, core::f32::consts::PI],
+            [-core::f32::consts::PI, core::f32::consts::PI],
+        ],
+        compliance: 0.0,
+    };
 }
 
 /// One socket's solver data (one lane of a block).
@@ -73,6 +120,8 @@ pub struct SocketLane {
     pub twist: [f32; 2],
     /// Drive target, compliance (rad/(N m)) and damping (1/s), if driven.
     pub drive: Option<(GQuat, f32, f32)>,
+    /// The shaped path's limits ([`ShapedLimits::FREE`] on the plain path).
+    pub shaped: ShapedLimits,
 }
 
 impl SocketBlock {
@@ -101,6 +150,7 @@ impl SocketBlock {
                 swing_max: core::f32::consts::PI,
                 twist: [-core::f32::consts::PI, core::f32::consts::PI],
                 drive: None,
+                shaped: ShapedLimits::FREE,
             },
         );
     }
@@ -121,16 +171,34 @@ impl SocketBlock {
         self.drive_damping[lane] = damping;
         self.drive_enabled[lane] = if s.drive.is_some() { 1.0 } else { 0.0 };
         self.drive_lambda.set(lane, GVec3::ZERO);
+        let shaped = &s.shaped;
+        (self.ellipse_y[lane], self.ellipse_z[lane]) = (shaped.ellipse[0], shaped.ellipse[1]);
+        for k in 0..2 {
+            self.pyramid_y[k][lane] = shaped.pyramid[0][k];
+            self.pyramid_z[k][lane] = shaped.pyramid[1][k];
+        }
+        self.limit_compliance[lane] = shaped.compliance;
+        for lambda in &mut self.limit_lambda {
+            lambda[lane] = 0.0;
+        }
+    }
+
+    /// Zeroes every accumulated multiplier (the drive's and the shaped
+    /// limits'), as each substep begins.
+    pub fn reset_lambdas(&mut self) {
+        self.drive_lambda = Vec3Block::default();
+        self.limit_lambda = [[0.0; BLOCK_LANES]; 4];
     }
 }
 
 /// One XPBD iteration over `blocks`: every socket's parts, in the order
 /// drive, swing, twist, point (the point last, so that anchors are closest
 /// at the end of an iteration). `DRIVE` says whether the blocks' sockets
-/// have drives: the layout keeps driven and plain sockets in separate
-/// blocks, so a plain socket never pays for a drive multiplied by zero, and
-/// the choice is made at compile time, not per lane.
-pub struct PositionPass<'a, const DRIVE: bool> {
+/// have drives, `SHAPED` whether they take the shaped path: the layout
+/// keeps each combination in its own blocks, so a plain socket never pays
+/// for a drive multiplied by zero or an ellipse that cannot bind, and the
+/// choice is made at compile time, not per lane.
+pub struct PositionPass<'a, const DRIVE: bool, const SHAPED: bool> {
     /// The blocks to solve (one colour's, or the overflow set).
     pub blocks: &'a mut [SocketBlock],
     /// Body rows, read and written.
@@ -139,21 +207,21 @@ pub struct PositionPass<'a, const DRIVE: bool> {
     pub inv_h2: f32,
 }
 
-impl<const DRIVE: bool> LaneKernel for PositionPass<'_, DRIVE> {
+impl<const DRIVE: bool, const SHAPED: bool> LaneKernel for PositionPass<'_, DRIVE, SHAPED> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
         let inv_h2 = L::splat(self.inv_h2);
         for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h2);
+                solve_positions::<L, DRIVE, SHAPED>(block, start, self.rows, inv_h2);
             }
         }
     }
 }
 
 #[inline(always)]
-fn solve_positions<L: Lane, const DRIVE: bool>(
+fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
     block: &mut SocketBlock,
     start: usize,
     rows: &BodyRows,
@@ -181,18 +249,22 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
         block.drive_lambda.store(start, lambda);
     }
 
-    swing::solve(
-        &mut a,
-        &mut b,
-        frame_a,
-        frame_b,
-        L::load(&block.swing_max[start..]),
-    );
-    let (lo, hi) = (
-        L::load(&block.twist_min[start..]),
-        L::load(&block.twist_max[start..]),
-    );
-    twist::solve(&mut a, &mut b, frame_a, frame_b, lo, hi);
+    if SHAPED {
+        solve_shaped(block, start, &mut a, &mut b, inv_h2);
+    } else {
+        swing::solve(
+            &mut a,
+            &mut b,
+            frame_a,
+            frame_b,
+            L::load(&block.swing_max[start..]),
+        );
+        let (lo, hi) = (
+            L::load(&block.twist_min[start..]),
+            L::load(&block.twist_max[start..]),
+        );
+        twist::solve(&mut a, &mut b, frame_a, frame_b, lo, hi);
+    }
     point::solve(
         &mut a,
         &mut b,
@@ -204,41 +276,149 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     block.bodies.scatter(rows, start, &a, &b);
 }
 
+/// The shaped path's limits: the elliptical cone, the pyramid's two
+/// angles, the twist range, each hard or soft.
+#[inline(always)]
+fn solve_shaped<L: Lane>(
+    block: &mut SocketBlock,
+    start: usize,
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    inv_h2: L,
+) {
+    let frame_a = block.frame_a.load::<L>(start);
+    let frame_b = block.frame_b.load::<L>(start);
+    let alpha_tilde = L::load(&block.limit_compliance[start..]) * inv_h2;
+    let (semi_y, semi_z) = (
+        L::load(&block.ellipse_y[start..]),
+        L::load(&block.ellipse_z[start..]),
+    );
+    // The ellipse's error is in swing sines, half a radian per radian for
+    // small swings: a quarter of the compliance (see `ellipse`).
+    let dir = swing_direction::measure(a, b, frame_a, frame_b);
+    let (n, c) = ellipse::violation(&dir, semi_y, semi_z);
+    let quarter = alpha_tilde * L::splat(0.25);
+    solve_limit(block, 0, start, a, b, (n, c), quarter);
+
+    let dir = swing_direction::measure(a, b, frame_a, frame_b);
+    let [y, z] = pyramid::violations(
+        &dir,
+        load_range(&block.pyramid_y, start),
+        load_range(&block.pyramid_z, start),
+    );
+    solve_limit(block, 1, start, a, b, y, alpha_tilde);
+    solve_limit(block, 2, start, a, b, z, alpha_tilde);
+
+    let (lo, hi) = (
+        L::load(&block.twist_min[start..]),
+        L::load(&block.twist_max[start..]),
+    );
+    let twist = twist::violation(a, b, frame_a, frame_b, lo, hi);
+    solve_limit(block, 3, start, a, b, twist, alpha_tilde);
+}
+
+/// A `[min, max]` pair of arrays as lanes.
+#[inline(always)]
+fn load_range<L: Lane>(range: &[[f32; BLOCK_LANES]; 2], start: usize) -> [L; 2] {
+    [L::load(&range[0][start..]), L::load(&range[1][start..])]
+}
+
+/// One shaped limit (`k` its multiplier) through the limit part.
+#[inline(always)]
+fn solve_limit<L: Lane>(
+    block: &mut SocketBlock,
+    k: usize,
+    start: usize,
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    (n, c): (Vec3<L>, L),
+    alpha_tilde: L,
+) {
+    let lambda = L::load(&block.limit_lambda[k][start..]);
+    limit::solve(a, b, n, c, alpha_tilde, lambda).store(&mut block.limit_lambda[k][start..]);
+}
+
+/// A block of joints with angular drives: what the velocity pass needs.
+pub trait Driven {
+    /// The lanes' bodies.
+    fn bodies(&self) -> &BodyPairs;
+    /// Each lane's drive damping rate (1/s), 0 where undriven.
+    fn damping_rate<L: Lane>(&self, start: usize) -> L;
+}
+
+impl Driven for SocketBlock {
+    fn bodies(&self) -> &BodyPairs {
+        &self.bodies
+    }
+    #[inline(always)]
+    fn damping_rate<L: Lane>(&self, start: usize) -> L {
+        L::load(&self.drive_damping[start..]) * L::load(&self.drive_enabled[start..])
+    }
+}
+
 /// The velocity pass: drive damping, `min(damping h, 1)` of the relative
 /// angular velocity removed per substep of `h` seconds. Only driven blocks
-/// need it.
-pub struct VelocityPass<'a> {
+/// (sockets or hinges) need it.
+pub struct VelocityPass<'a, B> {
     /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a [SocketBlock],
+    pub blocks: &'a [B],
     /// Body rows: poses and inertia read, velocities read and written.
     pub rows: &'a BodyRows,
     /// The substep (s).
     pub h: f32,
 }
 
-impl LaneKernel for VelocityPass<'_> {
+impl<B: Driven> LaneKernel for VelocityPass<'_, B> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
         let h = L::splat(self.h);
         for block in self.blocks {
+            let bodies = block.bodies();
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let (a, b) = block.bodies.gather::<L>(self.rows, start);
-                let mut va = VelocityLanes::<L>::gather(self.rows, &block.bodies.body_a[start..]);
-                let mut vb = VelocityLanes::<L>::gather(self.rows, &block.bodies.body_b[start..]);
-                let rate =
-                    L::load(&block.drive_damping[start..]) * L::load(&block.drive_enabled[start..]);
-                let fraction = (rate * h).min(L::splat(1.0));
+                let (a, b) = bodies.gather::<L>(self.rows, start);
+                let mut va = VelocityLanes::<L>::gather(self.rows, &bodies.body_a[start..]);
+                let mut vb = VelocityLanes::<L>::gather(self.rows, &bodies.body_b[start..]);
+                let fraction = (block.damping_rate::<L>(start) * h).min(L::splat(1.0));
                 drive::damp(&a, &b, &mut va, &mut vb, fraction);
-                va.scatter(self.rows, &block.bodies.write_a[start..]);
-                vb.scatter(self.rows, &block.bodies.write_b[start..]);
+                va.scatter(self.rows, &bodies.write_a[start..]);
+                vb.scatter(self.rows, &bodies.write_b[start..]);
             }
         }
     }
 }
 
+/// How far the swing lies outside the elliptical cone (the angle from b's
+/// twist axis to the nearest allowed one, rad) and the pyramid (rad): 0 on
+/// the plain path, whose shapes are free.
+#[inline(always)]
+fn shaped_overshoot<L: Lane>(
+    block: &SocketBlock,
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    start: usize,
+) -> L {
+    let (fa, fb) = (
+        block.frame_a.load::<L>(start),
+        block.frame_b.load::<L>(start),
+    );
+    let dir = swing_direction::measure(a, b, fa, fb);
+    let (semi_y, semi_z) = (
+        L::load(&block.ellipse_y[start..]),
+        L::load(&block.ellipse_z[start..]),
+    );
+    let beyond_ellipse = ellipse::overshoot(&dir, semi_y, semi_z);
+    let [(_, y), (_, z)] = pyramid::violations(
+        &dir,
+        load_range(&block.pyramid_y, start),
+        load_range(&block.pyramid_z, start),
+    );
+    beyond_ellipse + y + z
+}
+
 /// A socket's residual error: anchor separation (m) and angular limit
-/// overshoot (swing + twist, rad), as the paper's figure 8 counts them.
+/// overshoot (swing, whatever its shape, + twist, rad), as the paper's
+/// figure 8 counts them.
 impl Residual for SocketBlock {
     #[inline(always)]
     fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
@@ -258,7 +438,8 @@ impl Residual for SocketBlock {
             L::load(&self.twist_max[start..]),
         );
         let overshoot = swing::overshoot(theta, L::load(&self.swing_max[start..]))
-            + twist::excess(phi, lo, hi).abs();
+            + twist::excess(phi, lo, hi).abs()
+            + shaped_overshoot(self, &a, &b, start);
         (d.length(), overshoot)
     }
 }

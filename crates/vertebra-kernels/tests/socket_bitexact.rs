@@ -1,5 +1,6 @@
-//! The socket kernel's passes give the scalar reference's bits on every
-//! backend, for random and adversarial joints.
+//! The socket kernel's passes (plain and shaped path, with and without
+//! drives) give the scalar reference's bits on every backend, for random
+//! and adversarial joints.
 
 mod common;
 
@@ -10,14 +11,15 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::residual::ResidualPass;
-use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane, VelocityPass};
+use vertebra_kernels::socket::{PositionPass, ShapedLimits, SocketBlock, SocketLane, VelocityPass};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
 const STATICS: usize = 4;
 
 /// Blocks of random sockets; `adversarial` mixes in coincident anchors,
-/// opposite or equal twist axes, zero anchors and extreme compliances.
+/// opposite or equal twist axes, zero anchors, extreme compliances and
+/// degenerate shapes (the smallest semi-axis, zero-width pyramids).
 fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlock>) {
     let mut r = StdRng::seed_from_u64(seed);
     let rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
@@ -90,6 +92,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
                     drive: r
                         .random_bool(0.6)
                         .then(|| (unit_quat(&mut r), compliance, r.random_range(0.0..20.0))),
+                    shaped: shaped(&mut r, adversarial, compliance),
                 },
             );
             block
@@ -101,19 +104,53 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
     (rows, out)
 }
 
+/// Random shaped limits: an ellipse, a pyramid (angle ranges) and
+/// a compliance; adversarial ones degenerate.
+fn shaped(r: &mut StdRng, adversarial: bool, compliance: f32) -> ShapedLimits {
+    let semi = |r: &mut StdRng| match r.random_range(0..4) {
+        0 if adversarial => 0.001,
+        1 => 1.0,
+        _ => r.random_range(0.001..1.0f32),
+    };
+    let pi = core::f32::consts::PI;
+    let range = |r: &mut StdRng| match r.random_range(0..4) {
+        0 if adversarial => [0.0, 0.0],
+        1 => [-pi, pi],
+        _ => {
+            let lo = r.random_range(-3.0..0.5f32);
+            [lo, r.random_range(lo..pi)]
+        }
+    };
+    ShapedLimits {
+        ellipse: [semi(r), semi(r)],
+        pyramid: [range(r), range(r)],
+        compliance: if r.random_bool(0.5) { 0.0 } else { compliance },
+    }
+}
+
 /// Every float the passes produce: rows, multipliers, residuals.
 fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
-    // Both kernel variants: with the drive part (disabled lanes multiply
-    // it by zero) and without.
+    // Every kernel variant: with the drive part (disabled lanes multiply
+    // it by zero) and without, plain and shaped path.
     for _ in 0..2 {
-        backend.dispatch(PositionPass::<true> {
+        backend.dispatch(PositionPass::<true, false> {
             blocks: &mut blocks,
             rows: &rows,
             inv_h2: 3600.0,
         });
-        backend.dispatch(PositionPass::<false> {
+        backend.dispatch(PositionPass::<false, false> {
+            blocks: &mut blocks,
+            rows: &rows,
+            inv_h2: 3600.0,
+        });
+        backend.dispatch(PositionPass::<true, true> {
+            blocks: &mut blocks,
+            rows: &rows,
+            inv_h2: 3600.0,
+        });
+        backend.dispatch(PositionPass::<false, true> {
             blocks: &mut blocks,
             rows: &rows,
             inv_h2: 3600.0,
@@ -135,6 +172,7 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
         out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
             &b.drive_lambda,
         )));
+        out.extend(b.limit_lambda.iter().flatten());
     }
     out.extend(residual.iter().flatten());
     out

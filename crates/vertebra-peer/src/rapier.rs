@@ -7,7 +7,9 @@ use glam::Vec3;
 use parry3d::math::Pose;
 use rapier3d::prelude::*;
 use vertebra_scenes::SceneWorld;
-use vertebra_world::{BodyHandle, BodyKind, JointDesc, World};
+use vertebra_world::{
+    BodyHandle, BodyKind, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist, World,
+};
 
 /// Rapier's solver budget per frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -262,16 +264,30 @@ fn translate_socket(socket: &JointDesc) -> Result<GenericJoint, PeerError> {
             .build();
         return Ok(joint.into());
     }
+    let limits = match socket.kind {
+        JointKind::Socket(
+            limits @ SwingTwist {
+                swing: Swing::Free | Swing::Cone(_),
+                softness: LimitSoftness::Hard,
+                ..
+            },
+        ) => limits,
+        _ => {
+            return Err(PeerError::Unsupported(
+                "a joint other than a socket with a hard circular cone",
+            ));
+        }
+    };
     let mut joint = SphericalJointBuilder::new()
         .local_frame1(frame_a)
         .local_frame2(frame_b);
-    if let Some(swing) = socket.swing_limit {
+    if let Swing::Cone(swing) = limits.swing {
         let swing = swing * core::f32::consts::FRAC_1_SQRT_2;
         joint = joint
             .limits(JointAxis::AngY, [-swing, swing])
             .limits(JointAxis::AngZ, [-swing, swing]);
     }
-    if let Some([min, max]) = socket.twist_limit {
+    if let Some([min, max]) = limits.twist {
         joint = joint.limits(JointAxis::AngX, [min, max]);
     }
     Ok(joint.build().into())

@@ -5,8 +5,8 @@ use std::collections::{HashMap, HashSet};
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, BodyHandle, JointDesc, JointHandle, MIN_TIME_STEP, MassProperties, RodDesc,
-    RodHandle, RodStiffness, Shape, World,
+    BodyDesc, BodyHandle, JointDesc, JointHandle, JointKind, LimitSoftness, MIN_TIME_STEP,
+    MassProperties, RodDesc, RodHandle, RodStiffness, Shape, Swing, SwingTwist, World,
 };
 
 use crate::description::RagdollDesc;
@@ -223,8 +223,11 @@ impl Ragdoll {
                 anchor_b: j.anchor - desc.bodies[j.child].centre(),
                 frame_a: frame,
                 frame_b: frame,
-                swing_limit: Some(j.swing),
-                twist_limit: Some(j.twist),
+                kind: JointKind::Socket(SwingTwist {
+                    swing: Swing::Cone(j.swing),
+                    twist: Some(j.twist),
+                    softness: LimitSoftness::Hard,
+                }),
                 drive: None,
             };
             self.joints[k] = Some(

@@ -274,7 +274,7 @@ fn a_driven_ragdoll_with_fixed_hips_returns_to_its_pose_after_a_push() {
         let anchor = w
             .add_body(BodyDesc::fixed().with_position(target.bones[desc.root].0))
             .unwrap();
-        let pin = JointDesc::at_world_anchor(
+        let pin = JointDesc::socket_at_world_anchor(
             w.bodies(),
             anchor,
             hips,
@@ -386,7 +386,7 @@ fn a_ragdoll_held_by_a_foreign_joint_is_not_removed_at_all() {
     let hips = ragdoll.bodies[desc.root].unwrap();
     let at = w.body(hips).unwrap().position;
     let anchor = w.add_body(BodyDesc::fixed().with_position(at)).unwrap();
-    let pin = JointDesc::at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap();
+    let pin = JointDesc::socket_at_world_anchor(w.bodies(), anchor, hips, at, Vec3::Y).unwrap();
     let pin = w.add_joint(pin).unwrap();
     let before = removal_state(&w, &ragdoll);
     let refused = ragdoll.remove(&mut w).unwrap_err();

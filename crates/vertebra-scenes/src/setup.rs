@@ -263,13 +263,12 @@ fn fix(world: &mut World, body: BodyHandle) -> Result<(), RagdollError> {
             .with_position(at)
             .with_orientation(world.body(body)?.orientation),
     )?;
-    let pin = JointDesc::at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?.with_drive(
-        AngularDrive {
+    let pin = JointDesc::socket_at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?
+        .with_drive(AngularDrive {
             target: Quat::IDENTITY,
             compliance: 0.0,
             damping: 0.0,
-        },
-    );
+        });
     world.add_joint(pin)?;
     Ok(())
 }

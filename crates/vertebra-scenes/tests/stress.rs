@@ -94,7 +94,7 @@ fn mass_ratio(light_on_top: bool, substeps: u32) -> (f32, f32) {
                     .with_position(centre),
             )
             .unwrap();
-        let socket = JointDesc::at_world_anchor(
+        let socket = JointDesc::socket_at_world_anchor(
             world.bodies(),
             parent,
             body,

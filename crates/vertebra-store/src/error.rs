@@ -38,6 +38,8 @@ pub enum Error {
     InvalidLimit(&'static str),
     /// A solver setting out of its range.
     InvalidConfig(&'static str),
+    /// A joint setting its kind does not take (a drive on a fixed joint).
+    InvalidJoint(&'static str),
     /// A finite value beyond what the solver can work with: a coordinate
     /// beyond [`MAX_COORDINATE`], a time step above [`MAX_TIME_STEP`].
     OutOfRange(&'static str),
@@ -79,6 +81,7 @@ impl fmt::Display for Error {
             Error::NoDynamicBody => write!(f, "a joint needs at least one dynamic body"),
             Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
             Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
+            Error::InvalidJoint(what) => write!(f, "invalid joint: {what}"),
             Error::OutOfRange(what) => write!(f, "{what} is out of range"),
             Error::IncompatibleSnapshot(why) => write!(f, "incompatible snapshot: {why}"),
             Error::CorruptSnapshot(why) => write!(f, "corrupt snapshot: {why}"),

@@ -4,6 +4,8 @@ use core::f32::consts::PI;
 
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error};
 
+use crate::joint::LimitSoftness;
+
 /// A largest angle (rad) in [0, pi], if set.
 pub(crate) fn max_angle(limit: Option<f32>, what: &'static str) -> Result<(), Error> {
     match limit {
@@ -19,7 +21,24 @@ pub(crate) fn twist_range(limit: Option<[f32; 2]>) -> Result<(), Error> {
         Some([lo, hi]) if !lo.is_finite() || !hi.is_finite() => {
             Err(Error::NonFinite("twist limit"))
         }
-        Some([lo, hi]) if !(-PI <= lo && lo <= hi && hi <= PI) => Err(Error::InvalidLimit("twist")),
+        _ => angle_range(limit, "twist"),
+    }
+}
+
+/// An angle range `[min, max]` (rad) within [-pi, pi], if set.
+pub(crate) fn angle_range(limit: Option<[f32; 2]>, what: &'static str) -> Result<(), Error> {
+    match limit {
+        Some([lo, hi]) if !lo.is_finite() || !hi.is_finite() => Err(Error::NonFinite(what)),
+        Some([lo, hi]) if !(-PI <= lo && lo <= hi && hi <= PI) => Err(Error::InvalidLimit(what)),
+        _ => Ok(()),
+    }
+}
+
+/// A limit's softness: a compliance finite and not negative.
+pub(crate) fn softness(softness: LimitSoftness) -> Result<(), Error> {
+    match softness {
+        LimitSoftness::Compliance(c) if !c.is_finite() => Err(Error::NonFinite("limit compliance")),
+        LimitSoftness::Compliance(c) if c < 0.0 => Err(Error::NonPositive("limit compliance")),
         _ => Ok(()),
     }
 }

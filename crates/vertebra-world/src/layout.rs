@@ -2,20 +2,28 @@
 //! type, the blocks ordered by colour, then the overflow set. Rebuilt only
 //! when the colouring changes (a joint added or removed), never per step.
 //!
-//! Colouring keys: a socket is its slot, a rod its slot plus [`ROD_KEY`].
+//! Colouring keys: a joint is its slot, a rod its slot plus [`ROD_KEY`].
+//! Each joint kind has its own blocks (sockets of the plain and the shaped
+//! path apart, driven and undriven apart), so that no lane pays for a part
+//! it does not use; inside a colour the order of the blocks changes no
+//! result (they share no dynamic body).
 
 use core::f32::consts::PI;
 use core::ops::Range;
 use std::collections::BTreeSet;
 
 use vertebra_kernels::body::{BodyPairs, StartLane};
+use vertebra_kernels::fixed::{FixedBlock, FixedLane};
+use vertebra_kernels::hinge::{HingeBlock, HingeLane};
+use vertebra_kernels::parts::ellipse::MIN_SEMI_AXIS;
 use vertebra_kernels::rod::{RodBlock, RodLane};
-use vertebra_kernels::socket::{SocketBlock, SocketLane};
+use vertebra_kernels::socket::{ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
+use vertebra_math::poly;
 use vertebra_scheduler::{Colouring, MAX_COLOURS};
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 
-use crate::joint::JointDesc;
+use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
 use crate::rod::RodDesc;
 
 /// No joint in this lane.
@@ -27,17 +35,45 @@ pub(crate) const ROD_KEY: u64 = 1 << 32;
 /// One colour's (or the overflow set's) blocks, by kind.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Group {
-    /// Socket blocks with drives.
+    /// Socket blocks with drives (plain path).
     pub driven: Range<usize>,
-    /// Socket blocks without.
+    /// Socket blocks without (plain path).
     pub plain: Range<usize>,
+    /// Shaped-path socket blocks with drives.
+    pub shaped_driven: Range<usize>,
+    /// Shaped-path socket blocks without.
+    pub shaped_plain: Range<usize>,
+    /// Hinge blocks with drives.
+    pub hinges_driven: Range<usize>,
+    /// Hinge blocks without.
+    pub hinges_plain: Range<usize>,
+    /// Fixed-joint blocks.
+    pub fixed: Range<usize>,
     /// Rod blocks.
     pub rods: Range<usize>,
 }
 
 impl Group {
     fn is_empty(&self) -> bool {
-        self.driven.is_empty() && self.plain.is_empty() && self.rods.is_empty()
+        self.socket_ranges().iter().all(|(r, ..)| r.is_empty())
+            && self.hinge_ranges().iter().all(|(r, _)| r.is_empty())
+            && self.fixed.is_empty()
+            && self.rods.is_empty()
+    }
+
+    /// The socket blocks: (range, driven, shaped).
+    pub fn socket_ranges(&self) -> [(&Range<usize>, bool, bool); 4] {
+        [
+            (&self.driven, true, false),
+            (&self.plain, false, false),
+            (&self.shaped_driven, true, true),
+            (&self.shaped_plain, false, true),
+        ]
+    }
+
+    /// The hinge blocks: (range, driven).
+    pub fn hinge_ranges(&self) -> [(&Range<usize>, bool); 2] {
+        [(&self.hinges_driven, true), (&self.hinges_plain, false)]
     }
 }
 
@@ -91,6 +127,8 @@ impl<B: Copy> Blocks<B> {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Layout {
     pub sockets: Blocks<SocketBlock>,
+    pub hinges: Blocks<HingeBlock>,
+    pub fixed: Blocks<FixedBlock>,
     pub rods: Blocks<RodBlock>,
     /// The non-empty colours, in colour order.
     pub colours: Vec<Group>,
@@ -102,32 +140,71 @@ pub(crate) struct Layout {
 }
 
 impl Layout {
-    /// Lays out every coloured joint; `sockets[slot]`, `rods[slot]` are
+    /// Lays out every coloured joint; `joints[slot]`, `rods[slot]` are
     /// `Some` when live.
     pub fn build(
         colouring: &Colouring,
-        sockets: &[Option<JointDesc>],
+        joints: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
     ) -> Self {
         let mut layout = Self::default();
         for c in 0..MAX_COLOURS {
-            let group = layout.append(colouring.colour(c), sockets, rods, bodies);
+            let group = layout.append(colouring.colour(c), joints, rods, bodies);
             if !group.is_empty() {
                 layout.colours.push(group);
             }
         }
-        layout.overflow = layout.append(colouring.overflow(), sockets, rods, bodies);
-        layout.disjoint = layout.colours.iter().all(|g| {
-            let sockets = layout.sockets.blocks[g.driven.clone()]
-                .iter()
-                .chain(&layout.sockets.blocks[g.plain.clone()]);
-            let rods = layout.rods.blocks[g.rods.clone()].iter();
-            crate::parallel::colour_is_disjoint(
-                sockets.map(|b| &b.bodies).chain(rods.map(|b| &b.bodies)),
-            )
-        });
+        layout.overflow = layout.append(colouring.overflow(), joints, rods, bodies);
+        layout.disjoint = layout
+            .colours
+            .iter()
+            .all(|g| crate::parallel::colour_is_disjoint(layout.pairs(g)));
         layout
+    }
+
+    /// The body pairs of every block of `group`.
+    fn pairs<'a>(&'a self, g: &'a Group) -> impl Iterator<Item = &'a BodyPairs> + Clone + 'a {
+        let sockets = g
+            .socket_ranges()
+            .into_iter()
+            .flat_map(|(r, ..)| &self.sockets.blocks[r.clone()]);
+        let hinges = g
+            .hinge_ranges()
+            .into_iter()
+            .flat_map(|(r, _)| &self.hinges.blocks[r.clone()]);
+        let fixed = &self.fixed.blocks[g.fixed.clone()];
+        let rods = &self.rods.blocks[g.rods.clone()];
+        (sockets.map(|b| &b.bodies))
+            .chain(hinges.map(|b| &b.bodies))
+            .chain(fixed.iter().map(|b| &b.bodies))
+            .chain(rods.iter().map(|b| &b.bodies))
+    }
+
+    /// Writes a joint's new settings into its lane in place (its kind and
+    /// drive presence unchanged, so its blocks are), keeping its drive's
+    /// multiplier.
+    pub fn update_joint(&mut self, slot: usize, desc: &JointDesc, bodies: &BodyStore) {
+        match desc.kind {
+            JointKind::Socket(limits) => {
+                let (block, lane) = self.sockets.place[slot];
+                let block = &mut self.sockets.blocks[block];
+                let lambda = block.drive_lambda.get(lane);
+                block.set(lane, &socket_lane(desc, &limits, bodies));
+                block.drive_lambda.set(lane, lambda);
+            }
+            JointKind::Hinge { range, softness } => {
+                let (block, lane) = self.hinges.place[slot];
+                let block = &mut self.hinges.blocks[block];
+                let lambda = block.drive_lambda.get(lane);
+                block.set(lane, &hinge_lane(desc, range, softness, bodies));
+                block.drive_lambda.set(lane, lambda);
+            }
+            JointKind::Fixed => {
+                let (block, lane) = self.fixed.place[slot];
+                self.fixed.blocks[block].set(lane, &fixed_lane(desc, bodies));
+            }
+        }
     }
 
     /// Measures where every joint's bodies stand as the step begins (the
@@ -135,6 +212,18 @@ impl Layout {
     /// each rod's chord between centres of mass.
     pub fn start_step(&mut self, bodies: &BodyStore) {
         for block in &mut self.sockets.blocks {
+            for lane in 0..BLOCK_LANES {
+                let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
+                start_lane(&mut block.bodies, lane, anchors, bodies);
+            }
+        }
+        for block in &mut self.hinges.blocks {
+            for lane in 0..BLOCK_LANES {
+                let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
+                start_lane(&mut block.bodies, lane, anchors, bodies);
+            }
+        }
+        for block in &mut self.fixed.blocks {
             for lane in 0..BLOCK_LANES {
                 let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
                 start_lane(&mut block.bodies, lane, anchors, bodies);
@@ -151,23 +240,59 @@ impl Layout {
     fn append(
         &mut self,
         keys: &BTreeSet<u64>,
-        sockets: &[Option<JointDesc>],
+        joints: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
     ) -> Group {
-        let socket = |slot: usize| sockets[slot].as_ref().expect("coloured sockets are live");
+        let joint = |slot: usize| joints[slot].as_ref().expect("coloured joints are live");
         let joint_slots = || keys.iter().filter(|&&k| k < ROD_KEY).map(|&k| k as usize);
-        let driven = joint_slots().filter(|&s| socket(s).drive.is_some());
-        let plain = joint_slots().filter(|&s| socket(s).drive.is_none());
-        let set_socket = |block: &mut SocketBlock, lane: usize, slot: usize| {
-            block.set(lane, &socket_lane(socket(slot), bodies))
+        let sockets = |driven: bool, shaped: bool| {
+            joint_slots().filter(move |&s| {
+                let d = joint(s);
+                matches!(d.kind, JointKind::Socket(l) if l.is_plain() != shaped)
+                    && d.drive.is_some() == driven
+            })
         };
+        let set_socket = |block: &mut SocketBlock, lane: usize, slot: usize| {
+            let d = joint(slot);
+            if let JointKind::Socket(limits) = &d.kind {
+                block.set(lane, &socket_lane(d, limits, bodies));
+            }
+        };
+        let padding = SocketBlock::padding();
         let driven = self
             .sockets
-            .append(driven, SocketBlock::padding(), set_socket);
+            .append(sockets(true, false), padding, set_socket);
         let plain = self
             .sockets
-            .append(plain, SocketBlock::padding(), set_socket);
+            .append(sockets(false, false), padding, set_socket);
+        let shaped_driven = self
+            .sockets
+            .append(sockets(true, true), padding, set_socket);
+        let shaped_plain = self
+            .sockets
+            .append(sockets(false, true), padding, set_socket);
+        let hinges = |driven: bool| {
+            joint_slots().filter(move |&s| {
+                let d = joint(s);
+                matches!(d.kind, JointKind::Hinge { .. }) && d.drive.is_some() == driven
+            })
+        };
+        let set_hinge = |block: &mut HingeBlock, lane: usize, slot: usize| {
+            let d = joint(slot);
+            if let JointKind::Hinge { range, softness } = d.kind {
+                block.set(lane, &hinge_lane(d, range, softness, bodies));
+            }
+        };
+        let padding = HingeBlock::padding();
+        let hinges_driven = self.hinges.append(hinges(true), padding, set_hinge);
+        let hinges_plain = self.hinges.append(hinges(false), padding, set_hinge);
+        let fixed = joint_slots().filter(|&s| joint(s).kind == JointKind::Fixed);
+        let fixed = self
+            .fixed
+            .append(fixed, FixedBlock::padding(), |block, lane, slot| {
+                block.set(lane, &fixed_lane(joint(slot), bodies));
+            });
         let rod_slots = keys
             .iter()
             .filter(|&&k| k >= ROD_KEY)
@@ -183,6 +308,11 @@ impl Layout {
         Group {
             driven,
             plain,
+            shaped_driven,
+            shaped_plain,
+            hinges_driven,
+            hinges_plain,
+            fixed,
             rods,
         }
     }
@@ -214,9 +344,16 @@ fn rows(a: BodyHandle, b: BodyHandle, bodies: &BodyStore) -> (u32, u32, bool, bo
     (ia as u32 + 1, ib as u32 + 1, dynamic(ia), dynamic(ib))
 }
 
-/// A socket's lane data.
-pub(crate) fn socket_lane(desc: &JointDesc, bodies: &BodyStore) -> SocketLane {
+/// A socket's lane data: the plain path's cone, or the shaped path's
+/// ellipse (its semi-axes the sines of half the half-angles, by the
+/// project's own sine, so that every platform lays out the same bits) and
+/// pyramid.
+pub(crate) fn socket_lane(desc: &JointDesc, limits: &SwingTwist, bodies: &BodyStore) -> SocketLane {
     let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
+    let plain_cone = match limits.swing {
+        Swing::Cone(half) if limits.is_plain() => half,
+        _ => PI,
+    };
     SocketLane {
         body_a,
         body_b,
@@ -226,11 +363,83 @@ pub(crate) fn socket_lane(desc: &JointDesc, bodies: &BodyStore) -> SocketLane {
         anchor_b: desc.anchor_b,
         frame_a: desc.frame_a.normalize(),
         frame_b: desc.frame_b.normalize(),
-        swing_max: desc.swing_limit.unwrap_or(PI),
-        twist: desc.twist_limit.unwrap_or([-PI, PI]),
+        swing_max: plain_cone,
+        twist: limits.twist.unwrap_or([-PI, PI]),
         drive: desc
             .drive
             .map(|d| (d.target.normalize(), d.compliance, d.damping)),
+        shaped: if limits.is_plain() {
+            ShapedLimits::FREE
+        } else {
+            shaped_limits(limits)
+        },
+    }
+}
+
+/// `sin(angle / 2)` by the kernels' polynomial.
+fn half_sine(angle: f32) -> f32 {
+    poly::sin(0.5 * angle)
+}
+
+/// The shaped path's settings for a socket's limits.
+fn shaped_limits(limits: &SwingTwist) -> ShapedLimits {
+    let semi = |half: f32| half_sine(half).max(MIN_SEMI_AXIS);
+    let mut shaped = ShapedLimits::FREE;
+    match limits.swing {
+        Swing::Free => {}
+        Swing::Cone(half) => shaped.ellipse = [semi(half), semi(half)],
+        Swing::Ellipse { y, z } => shaped.ellipse = [semi(y), semi(z)],
+        Swing::Pyramid { y, z } => shaped.pyramid = [y, z],
+    }
+    shaped.compliance = compliance(limits.softness);
+    shaped
+}
+
+/// A limit's compliance (rad / (N m)); 0 when hard.
+fn compliance(softness: LimitSoftness) -> f32 {
+    match softness {
+        LimitSoftness::Hard => 0.0,
+        LimitSoftness::Compliance(c) => c,
+    }
+}
+
+/// A hinge's lane data.
+pub(crate) fn hinge_lane(
+    desc: &JointDesc,
+    range: Option<[f32; 2]>,
+    softness: LimitSoftness,
+    bodies: &BodyStore,
+) -> HingeLane {
+    let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
+    HingeLane {
+        body_a,
+        body_b,
+        dynamic_a,
+        dynamic_b,
+        anchor_a: desc.anchor_a,
+        anchor_b: desc.anchor_b,
+        frame_a: desc.frame_a.normalize(),
+        frame_b: desc.frame_b.normalize(),
+        range: range.unwrap_or([-PI, PI]),
+        compliance: compliance(softness),
+        drive: desc
+            .drive
+            .map(|d| (d.target.normalize(), d.compliance, d.damping)),
+    }
+}
+
+/// A fixed joint's lane data.
+pub(crate) fn fixed_lane(desc: &JointDesc, bodies: &BodyStore) -> FixedLane {
+    let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
+    FixedLane {
+        body_a,
+        body_b,
+        dynamic_a,
+        dynamic_b,
+        anchor_a: desc.anchor_a,
+        anchor_b: desc.anchor_b,
+        frame_a: desc.frame_a.normalize(),
+        frame_b: desc.frame_b.normalize(),
     }
 }
 

@@ -12,7 +12,7 @@
 //! let bob = world.add_body(
 //!     BodyDesc::dynamic(shape.mass_properties_with_mass(2.0)?).with_position(Vec3::new(0.0, -0.25, 0.0)),
 //! )?;
-//! let joint = JointDesc::at_world_anchor(world.bodies(), ground, bob, Vec3::ZERO, -Vec3::Y)?
+//! let joint = JointDesc::socket_at_world_anchor(world.bodies(), ground, bob, Vec3::ZERO, -Vec3::Y)?
 //!     .with_swing_limit(0.5);
 //! world.add_joint(joint)?;
 //! for _ in 0..60 {
@@ -26,6 +26,7 @@ mod checks;
 mod config;
 mod contact;
 mod joint;
+mod joint_wire;
 mod layout;
 mod metrics;
 mod parallel;
@@ -42,7 +43,9 @@ pub use config::{
     MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
 };
 pub use contact::Contact;
-pub use joint::{AngularDrive, JointDesc, JointHandle};
+pub use joint::{
+    AngularDrive, JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist,
+};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use snapshot::Snapshot;
@@ -345,21 +348,16 @@ impl World {
     ) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         let mut desc = self.joint(handle)?;
-        if let Some(d) = &drive {
-            joint::validate_drive(d)?;
-        }
+        joint::validate_drive_for(&desc.kind, drive.as_ref())?;
         let regroup = desc.drive.is_some() != drive.is_some();
         desc.drive = drive;
         self.joints[handle.index()] = Some(desc);
         if regroup {
-            // Driven and plain sockets live in different blocks.
+            // Driven and plain joints live in different blocks.
             self.layout_dirty = true;
         } else if !self.layout_dirty {
-            let (block, lane) = self.layout.sockets.place[handle.index()];
-            let block = &mut self.layout.sockets.blocks[block];
-            let lambda = block.drive_lambda.get(lane);
-            block.set(lane, &layout::socket_lane(&desc, &self.bodies));
-            block.drive_lambda.set(lane, lambda);
+            self.layout
+                .update_joint(handle.index(), &desc, &self.bodies);
         }
         Ok(())
     }

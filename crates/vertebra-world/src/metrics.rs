@@ -1,7 +1,9 @@
 //! What a step reports: residual joint error (the paper's figure 8 metric)
 //! and a hash of the full state.
 
-use vertebra_kernels::residual::ResidualPass;
+use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::residual::{Residual, ResidualPass};
+use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyStore, Slots};
@@ -18,8 +20,10 @@ pub struct JointResidual<H> {
     pub joint: H,
     /// Linear error (cm): a joint's anchor separation, a rod's `|C_len|`.
     pub linear_cm: f32,
-    /// Angular error (rad): limit overshoot, plus a rod's curve error (the
-    /// angle between `t_b` and the reflection of `t_a`).
+    /// Angular error (rad): limit overshoot (a socket's swing, whatever
+    /// its shape, and twist; a hinge's range), plus a hinge's angle between
+    /// its axes, a fixed joint's angle between its frames, a rod's curve
+    /// error (the angle between `t_b` and the reflection of `t_a`).
     pub angular_rad: f32,
 }
 
@@ -38,15 +42,15 @@ pub struct Residuals {
     pub rods: Vec<JointResidual<RodHandle>>,
 }
 
-/// Per-lane residuals to per-joint ones, in slot order.
+/// Per-lane residuals of blocks (each `(lane_slot, per_lane)`) to
+/// per-joint ones, in slot order.
 fn collect<H>(
-    lane_slot: &[u32],
-    per_lane: &[[f32; 2]],
+    kinds: &[(&[u32], &[[f32; 2]])],
     handle: impl Fn(usize) -> Option<H>,
 ) -> Vec<JointResidual<H>> {
-    let mut joints: Vec<(u32, JointResidual<H>)> = lane_slot
+    let mut joints: Vec<(u32, JointResidual<H>)> = kinds
         .iter()
-        .zip(per_lane)
+        .flat_map(|(lane_slot, per_lane)| lane_slot.iter().zip(per_lane.iter()))
         .filter(|(slot, _)| **slot != EMPTY)
         .map(|(&slot, &[lin, ang])| {
             let joint = handle(slot as usize).expect("laid-out joints are live");
@@ -64,25 +68,34 @@ fn collect<H>(
     joints.into_iter().map(|j| j.1).collect()
 }
 
+/// Every lane's residual of `blocks`.
+fn measure<B: Residual>(backend: Backend, blocks: &[B], rows: &BodyRows) -> Vec<[f32; 2]> {
+    let mut out = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+    backend.dispatch(ResidualPass {
+        blocks,
+        rows,
+        out: &mut out,
+    });
+    out
+}
+
 pub(crate) fn residuals(world: &mut World) -> Residuals {
     let rows = &*world.rows.get();
-    let (sockets, rods) = (&world.layout.sockets, &world.layout.rods);
-    let mut socket_lanes = vec![[0.0f32; 2]; sockets.blocks.len() * BLOCK_LANES];
-    world.backend.dispatch(ResidualPass {
-        blocks: &sockets.blocks,
-        rows,
-        out: &mut socket_lanes,
-    });
-    let mut rod_lanes = vec![[0.0f32; 2]; rods.blocks.len() * BLOCK_LANES];
-    world.backend.dispatch(ResidualPass {
-        blocks: &rods.blocks,
-        rows,
-        out: &mut rod_lanes,
-    });
-    let joints = collect(&sockets.lane_slot, &socket_lanes, |s| {
-        world.joint_slots.handle_at(s)
-    });
-    let rods = collect(&rods.lane_slot, &rod_lanes, |s| {
+    let layout = &world.layout;
+    let backend = world.backend;
+    let sockets = measure(backend, &layout.sockets.blocks, rows);
+    let hinges = measure(backend, &layout.hinges.blocks, rows);
+    let fixed = measure(backend, &layout.fixed.blocks, rows);
+    let rods = measure(backend, &layout.rods.blocks, rows);
+    let joints = collect(
+        &[
+            (&layout.sockets.lane_slot, &sockets),
+            (&layout.hinges.lane_slot, &hinges),
+            (&layout.fixed.lane_slot, &fixed),
+        ],
+        |s| world.joint_slots.handle_at(s),
+    );
+    let rods = collect(&[(&layout.rods.lane_slot, &rods)], |s| {
         world.rod_slots.handle_at(s)
     });
     let lin = joints

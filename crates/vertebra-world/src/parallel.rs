@@ -123,7 +123,7 @@ mod tests {
         let bob = world.add_body(BodyDesc::dynamic(mass)).unwrap();
         let other = world.add_body(BodyDesc::dynamic(mass)).unwrap();
         for (a, b) in [(fixed, bob), (bob, other)] {
-            let desc = JointDesc::at_world_anchor(world.bodies(), a, b, Vec3::ZERO, Vec3::Y);
+            let desc = JointDesc::socket_at_world_anchor(world.bodies(), a, b, Vec3::ZERO, Vec3::Y);
             world.add_joint(desc.unwrap()).unwrap();
         }
         world.refresh_layout();

@@ -40,7 +40,7 @@
 //! `Err(IncompatibleSnapshot)` for another build) and the world is
 //! unchanged.
 //!
-//! Bytes: `"VTBSNAP2"` (the format), the build id (u64 LE: a hash of the
+//! Bytes: `"VTBSNAP4"` (the format), the build id (u64 LE: a hash of the
 //! crate version and the format), the xxh3 hash of the payload (u64 LE),
 //! then the payload (postcard).
 
@@ -54,7 +54,7 @@ use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
-const FORMAT: u8 = b'3';
+const FORMAT: u8 = b'4';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
@@ -287,7 +287,10 @@ mod tests {
     use glam::{Quat, Vec3};
 
     use super::*;
-    use crate::{AngularDrive, BodyDesc, RodStiffness, Shape, SolverConfig};
+    use crate::{
+        AngularDrive, BodyDesc, JointKind, LimitSoftness, RodStiffness, Shape, SolverConfig, Swing,
+        SwingTwist,
+    };
 
     #[test]
     fn lineages_differ() {
@@ -315,7 +318,7 @@ mod tests {
         world.remove_body(gone).unwrap();
         let bodies = world.bodies();
         let socket =
-            JointDesc::at_world_anchor(bodies, ground, links[0], -0.25 * Vec3::Y, -Vec3::Y)
+            JointDesc::socket_at_world_anchor(bodies, ground, links[0], -0.25 * Vec3::Y, -Vec3::Y)
                 .unwrap()
                 .with_swing_limit(1.0);
         let rod = RodDesc::from_pose(bodies, links[0], links[1], &[])
@@ -326,10 +329,15 @@ mod tests {
             compliance: 0.01,
             damping: 1.0,
         };
-        let driven =
-            JointDesc::at_world_anchor(bodies, links[1], links[2], -1.25 * Vec3::Y, -Vec3::Y)
-                .unwrap()
-                .with_drive(drive);
+        let driven = JointDesc::socket_at_world_anchor(
+            bodies,
+            links[1],
+            links[2],
+            -1.25 * Vec3::Y,
+            -Vec3::Y,
+        )
+        .unwrap()
+        .with_drive(drive);
         world.add_joint(socket).unwrap();
         world.add_rod(rod).unwrap();
         world.add_joint(driven).unwrap();
@@ -469,6 +477,34 @@ mod tests {
                     socket.drive.as_mut().unwrap().compliance = -1.0;
                 }),
                 "joint 1: drive compliance must be positive",
+            ),
+            (
+                Box::new(|s| s.joints[1].as_mut().unwrap().kind = JointKind::Fixed),
+                "joint 1: invalid joint: drive (a fixed joint has no rotation to drive)",
+            ),
+            (
+                Box::new(|s| {
+                    let swing = Swing::Ellipse { y: NAN, z: 0.5 };
+                    s.joints[0].as_mut().unwrap().kind =
+                        JointKind::Socket(SwingTwist::FREE.with_swing(swing));
+                }),
+                "joint 0: swing ellipse y is not finite",
+            ),
+            (
+                Box::new(|s| {
+                    s.joints[0].as_mut().unwrap().kind = JointKind::Hinge {
+                        range: Some([1.0, -1.0]),
+                        softness: LimitSoftness::Compliance(0.1),
+                    }
+                }),
+                "joint 0: invalid hinge range limit",
+            ),
+            (
+                Box::new(|s| {
+                    let soft = SwingTwist::FREE.with_softness(LimitSoftness::Compliance(-1.0));
+                    s.joints[0].as_mut().unwrap().kind = JointKind::Socket(soft);
+                }),
+                "joint 0: limit compliance must be positive",
             ),
             (
                 Box::new(|s| s.colouring = Colouring::new()),

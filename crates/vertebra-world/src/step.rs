@@ -5,6 +5,8 @@
 use glam::{Quat, Vec3};
 use vertebra_kernels::body::BodyRows;
 use vertebra_kernels::contact::{self, ContactBlock};
+use vertebra_kernels::fixed::{self, FixedBlock};
+use vertebra_kernels::hinge::{self, HingeBlock};
 use vertebra_kernels::rod::{self, RodBlock};
 use vertebra_kernels::socket::{PositionPass, SocketBlock, VelocityPass};
 use vertebra_math::Backend;
@@ -22,9 +24,18 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
     for _ in 0..world.config.substeps {
         predict(world, h);
-        for block in &mut world.layout.sockets.blocks {
-            block.drive_lambda = vertebra_math::block::Vec3Block::default();
-        }
+        world
+            .layout
+            .sockets
+            .blocks
+            .iter_mut()
+            .for_each(SocketBlock::reset_lambdas);
+        world
+            .layout
+            .hinges
+            .blocks
+            .iter_mut()
+            .for_each(HingeBlock::reset_lambdas);
         world
             .layout
             .rods
@@ -199,10 +210,27 @@ fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
     Vec3::from(turn.to_rotation_vector()) / h
 }
 
+/// Which socket blocks: with drives or not, plain or shaped path.
+#[derive(Clone, Copy)]
+struct SocketBlocks {
+    driven: bool,
+    shaped: bool,
+}
+
 /// One kind of pass over one group's blocks of one type.
 trait Pass: Sync {
-    /// Sockets (`driven` says which blocks).
-    fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend);
+    /// Sockets (`driven` and `shaped` say which blocks).
+    fn sockets(
+        &self,
+        blocks: &mut [SocketBlock],
+        kind: SocketBlocks,
+        rows: &BodyRows,
+        backend: Backend,
+    );
+    /// Hinges (`driven` says which blocks).
+    fn hinges(&self, blocks: &mut [HingeBlock], driven: bool, rows: &BodyRows, backend: Backend);
+    /// Fixed joints.
+    fn fixed(&self, blocks: &mut [FixedBlock], rows: &BodyRows, backend: Backend);
     /// Rods.
     fn rods(&self, blocks: &mut [RodBlock], rows: &BodyRows, backend: Backend);
     /// Contacts.
@@ -256,17 +284,38 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
         } else {
             threads
         };
-        for (range, driven) in [(&group.driven, true), (&group.plain, false)] {
+        for (range, driven, shaped) in group.socket_ranges() {
             let blocks = &mut layout.sockets.blocks[range.clone()];
+            let kind = SocketBlocks { driven, shaped };
             chunked(
                 parallel,
                 min_blocks,
                 layout.disjoint,
                 blocks,
                 rows,
-                |c, rows| pass.sockets(c, driven, rows, backend),
+                |c, rows| pass.sockets(c, kind, rows, backend),
             );
         }
+        for (range, driven) in group.hinge_ranges() {
+            let blocks = &mut layout.hinges.blocks[range.clone()];
+            chunked(
+                parallel,
+                min_blocks,
+                layout.disjoint,
+                blocks,
+                rows,
+                |c, rows| pass.hinges(c, driven, rows, backend),
+            );
+        }
+        let blocks = &mut layout.fixed.blocks[group.fixed.clone()];
+        chunked(
+            parallel,
+            min_blocks,
+            layout.disjoint,
+            blocks,
+            rows,
+            |c, rows| pass.fixed(c, rows, backend),
+        );
         let blocks = &mut layout.rods.blocks[group.rods.clone()];
         chunked(
             parallel,
@@ -285,21 +334,55 @@ struct Positions {
 }
 
 impl Pass for Positions {
-    fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
+    fn sockets(
+        &self,
+        blocks: &mut [SocketBlock],
+        kind: SocketBlocks,
+        rows: &BodyRows,
+        backend: Backend,
+    ) {
+        let inv_h2 = self.inv_h2;
+        match (kind.driven, kind.shaped) {
+            (true, false) => backend.dispatch(PositionPass::<true, false> {
+                blocks,
+                rows,
+                inv_h2,
+            }),
+            (false, false) => backend.dispatch(PositionPass::<false, false> {
+                blocks,
+                rows,
+                inv_h2,
+            }),
+            (true, true) => backend.dispatch(PositionPass::<true, true> {
+                blocks,
+                rows,
+                inv_h2,
+            }),
+            (false, true) => backend.dispatch(PositionPass::<false, true> {
+                blocks,
+                rows,
+                inv_h2,
+            }),
+        }
+    }
+    fn hinges(&self, blocks: &mut [HingeBlock], driven: bool, rows: &BodyRows, backend: Backend) {
         let inv_h2 = self.inv_h2;
         if driven {
-            backend.dispatch(PositionPass::<true> {
+            backend.dispatch(hinge::PositionPass::<true> {
                 blocks,
                 rows,
                 inv_h2,
             });
         } else {
-            backend.dispatch(PositionPass::<false> {
+            backend.dispatch(hinge::PositionPass::<false> {
                 blocks,
                 rows,
                 inv_h2,
             });
         }
+    }
+    fn fixed(&self, blocks: &mut [FixedBlock], rows: &BodyRows, backend: Backend) {
+        backend.dispatch(fixed::PositionPass { blocks, rows });
     }
     fn rods(&self, blocks: &mut [RodBlock], rows: &BodyRows, backend: Backend) {
         backend.dispatch(rod::PositionPass {
@@ -314,14 +397,29 @@ impl Pass for Positions {
 }
 
 /// The velocity pass (drive damping, contact friction and restitution;
-/// rods have none).
+/// rods and fixed joints have none).
 struct Velocities {
     h: f32,
     resting_speed: f32,
 }
 
 impl Pass for Velocities {
-    fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
+    fn sockets(
+        &self,
+        blocks: &mut [SocketBlock],
+        kind: SocketBlocks,
+        rows: &BodyRows,
+        backend: Backend,
+    ) {
+        if kind.driven {
+            backend.dispatch(VelocityPass {
+                blocks,
+                rows,
+                h: self.h,
+            });
+        }
+    }
+    fn hinges(&self, blocks: &mut [HingeBlock], driven: bool, rows: &BodyRows, backend: Backend) {
         if driven {
             backend.dispatch(VelocityPass {
                 blocks,
@@ -330,6 +428,7 @@ impl Pass for Velocities {
             });
         }
     }
+    fn fixed(&self, _: &mut [FixedBlock], _: &BodyRows, _: Backend) {}
     fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
         let (h, resting_speed) = (self.h, self.resting_speed);

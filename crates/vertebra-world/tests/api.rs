@@ -6,8 +6,8 @@ mod common;
 use common::capsule;
 use glam::{Mat3, Quat, Vec3};
 use vertebra_world::{
-    AngularDrive, BackendChoice, BodyDesc, Error, JointDesc, MassProperties, Shape, SolverConfig,
-    World,
+    AngularDrive, BackendChoice, BodyDesc, Error, JointDesc, JointKind, LimitSoftness,
+    MassProperties, Shape, SolverConfig, Swing, SwingTwist, World,
 };
 
 fn unit_mass() -> MassProperties {
@@ -27,7 +27,9 @@ fn world() -> (
     let a = w.add_body(BodyDesc::fixed()).unwrap();
     let b = capsule(&mut w, Vec3::ZERO, -Vec3::Y * 0.4, 1.0);
     let s = w
-        .add_joint(JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, -Vec3::Y).unwrap())
+        .add_joint(
+            JointDesc::socket_at_world_anchor(w.bodies(), a, b, Vec3::ZERO, -Vec3::Y).unwrap(),
+        )
         .unwrap();
     w.step(1.0 / 60.0).unwrap();
     (w, a, b, s)
@@ -147,7 +149,7 @@ fn bad_bodies_are_refused_with_the_field_named() {
 fn bad_joints_are_refused() {
     rejected(Error::SameBody, |w| {
         let b = w.bodies().handle_at(1).unwrap();
-        w.add_joint(JointDesc::at_world_anchor(
+        w.add_joint(JointDesc::socket_at_world_anchor(
             w.bodies(),
             b,
             b,
@@ -163,7 +165,7 @@ fn bad_joints_are_refused() {
     };
     rejected_after(kinematic, Error::NoDynamicBody, |w, k| {
         let a = w.bodies().handle_at(0).unwrap();
-        w.add_joint(JointDesc::at_world_anchor(
+        w.add_joint(JointDesc::socket_at_world_anchor(
             w.bodies(),
             a,
             k,
@@ -178,7 +180,7 @@ fn bad_joints_are_refused() {
             w.bodies().handle_at(1).unwrap(),
         );
         w.add_joint(
-            JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
+            JointDesc::socket_at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
                 .with_swing_limit(4.0),
         )
         .map(drop)
@@ -189,7 +191,7 @@ fn bad_joints_are_refused() {
             w.bodies().handle_at(1).unwrap(),
         );
         w.add_joint(
-            JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
+            JointDesc::socket_at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?
                 .with_twist_limit(0.5, -0.5),
         )
         .map(drop)
@@ -199,7 +201,7 @@ fn bad_joints_are_refused() {
             w.bodies().handle_at(0).unwrap(),
             w.bodies().handle_at(1).unwrap(),
         );
-        w.add_joint(JointDesc::at_world_anchor(
+        w.add_joint(JointDesc::socket_at_world_anchor(
             w.bodies(),
             a,
             b,
@@ -228,6 +230,87 @@ fn bad_joints_are_refused() {
     });
 }
 
+/// A joint of `kind` between the world's two bodies, as the API refuses it.
+fn add_kind(w: &mut World, kind: JointKind, drive: Option<AngularDrive>) -> Result<(), Error> {
+    let (a, b) = (
+        w.bodies().handle_at(0).unwrap(),
+        w.bodies().handle_at(1).unwrap(),
+    );
+    let mut desc =
+        JointDesc::socket_at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X)?.with_kind(kind);
+    desc.drive = drive;
+    w.add_joint(desc).map(drop)
+}
+
+#[test]
+fn bad_joint_kinds_are_refused_with_the_field_named() {
+    let soft = |c| SwingTwist::FREE.with_softness(LimitSoftness::Compliance(c));
+    let drive = AngularDrive {
+        target: Quat::IDENTITY,
+        compliance: 0.0,
+        damping: 0.0,
+    };
+    let cases = [
+        (
+            JointKind::Socket(SwingTwist::FREE.with_swing(Swing::Ellipse { y: 0.5, z: 4.0 })),
+            None,
+            Error::InvalidLimit("swing ellipse z"),
+        ),
+        (
+            JointKind::Socket(SwingTwist::FREE.with_swing(Swing::Ellipse {
+                y: f32::NAN,
+                z: 0.5,
+            })),
+            None,
+            Error::NonFinite("swing ellipse y"),
+        ),
+        (
+            JointKind::Socket(SwingTwist::FREE.with_swing(Swing::Pyramid {
+                y: [-0.5, 0.5],
+                z: [0.5, -0.5],
+            })),
+            None,
+            Error::InvalidLimit("swing pyramid z"),
+        ),
+        (
+            JointKind::Socket(soft(-1.0)),
+            None,
+            Error::NonPositive("limit compliance"),
+        ),
+        (
+            JointKind::Socket(soft(f32::INFINITY)),
+            None,
+            Error::NonFinite("limit compliance"),
+        ),
+        (
+            JointKind::Hinge {
+                range: Some([0.0, 4.0]),
+                softness: LimitSoftness::Hard,
+            },
+            None,
+            Error::InvalidLimit("hinge range"),
+        ),
+        (
+            JointKind::Fixed,
+            Some(drive),
+            Error::InvalidJoint("drive (a fixed joint has no rotation to drive)"),
+        ),
+    ];
+    for (kind, drive, expected) in cases {
+        rejected(expected, |w| add_kind(w, kind, drive));
+    }
+    // A drive set later on a fixed joint is refused too.
+    let fixed = |w: &mut World| {
+        add_kind(w, JointKind::Fixed, None).unwrap();
+        w.joints().last().unwrap().0
+    };
+    rejected_after(
+        fixed,
+        Error::InvalidJoint("drive (a fixed joint has no rotation to drive)"),
+        |w, j| w.set_joint_drive(j, Some(drive)),
+    );
+}
+
 #[test]
 fn stale_handles_are_refused() {
     let (mut w, a, b, s) = world();
@@ -246,7 +329,7 @@ fn stale_handles_are_refused() {
     assert_eq!(c.index(), b.index());
     assert_ne!(c, b);
     assert_eq!(w.body(b), Err(Error::StaleHandle("body")));
-    assert!(JointDesc::at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X).is_err());
+    assert!(JointDesc::socket_at_world_anchor(w.bodies(), a, b, Vec3::ZERO, Vec3::X).is_err());
     w.step(1.0 / 60.0).unwrap();
 }
 

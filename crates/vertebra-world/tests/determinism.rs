@@ -34,7 +34,8 @@ fn build(backend: Backend, threads: usize) -> World {
                     let bottom = top + dir * 0.3;
                     let body = capsule(&mut w, top + dir * 0.02, bottom, 1.0 + 0.5 * depth as f32);
                     let mut desc =
-                        JointDesc::at_world_anchor(w.bodies(), parent, body, top, dir).unwrap();
+                        JointDesc::socket_at_world_anchor(w.bodies(), parent, body, top, dir)
+                            .unwrap();
                     if (tree + depth) % 3 == 0 {
                         desc = desc.with_swing_limit(0.4).with_twist_limit(-0.2, 0.3);
                     }
@@ -92,7 +93,7 @@ fn build(backend: Backend, threads: usize) -> World {
         let dir = Vec3::new(angle.cos(), 0.0, angle.sin());
         let anchor = Vec3::new(-3.0, 1.9, 0.0) + dir * 0.1;
         let spoke = capsule(&mut w, anchor, anchor + dir * 0.3, 0.5);
-        let desc = JointDesc::at_world_anchor(w.bodies(), hub, spoke, anchor, dir).unwrap();
+        let desc = JointDesc::socket_at_world_anchor(w.bodies(), hub, spoke, anchor, dir).unwrap();
         w.add_joint(desc).unwrap();
     }
     w

@@ -209,8 +209,8 @@ fn a_far_anchor_on_a_static_body_holds() {
         let bob = common::capsule(&mut w, top, top - Vec3::Y * 0.5, 1.0);
         w.set_body_velocity(bob, Vec3::new(2.0, 0.0, 0.0), Vec3::ZERO)
             .expect("push");
-        let socket =
-            JointDesc::at_world_anchor(w.bodies(), ground, bob, top, -Vec3::Y).expect("socket");
+        let socket = JointDesc::socket_at_world_anchor(w.bodies(), ground, bob, top, -Vec3::Y)
+            .expect("socket");
         w.add_joint(socket).expect("valid socket");
         let mut worst = 0.0f32;
         for _ in 0..120 {

@@ -50,7 +50,7 @@ fn as_a_host_with_ftz_daz<T>(f: impl FnOnce() -> T) -> T {
 ///
 /// The descriptions are computed once, in the default mode
 /// ([`descriptions`]): this is about the step, not about helpers such as
-/// `JointDesc::at_world_anchor`, which compute in their caller's mode.
+/// `JointDesc::socket_at_world_anchor`, which compute in their caller's mode.
 fn subnormal_scene(threads: usize, (bodies, sockets): &(Vec<BodyDesc>, Vec<JointDesc>)) -> World {
     let mut world = World::new(SolverConfig {
         gravity: Vec3::ZERO,
@@ -95,7 +95,8 @@ fn descriptions() -> (Vec<BodyDesc>, Vec<JointDesc>) {
             .with_damping(5.0, 5.0);
         bodies.push(ball);
         let ball = world.add_body(ball).unwrap();
-        let socket = JointDesc::at_world_anchor(world.bodies(), anchor, ball, Vec3::ZERO, Vec3::Y);
+        let socket =
+            JointDesc::socket_at_world_anchor(world.bodies(), anchor, ball, Vec3::ZERO, Vec3::Y);
         sockets.push(socket.unwrap());
     }
     (bodies, sockets)

@@ -5,7 +5,9 @@ mod common;
 
 use common::{angle_between, capsule, hanging_chain, world};
 use glam::{Mat3, Quat, Vec3};
-use vertebra_world::{AngularDrive, BodyDesc, JointDesc, Shape, SolverConfig, World};
+use vertebra_world::{
+    AngularDrive, BodyDesc, JointDesc, JointKind, Shape, SolverConfig, SwingTwist, World,
+};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -34,8 +36,7 @@ fn compound_pendulum_period_matches_the_closed_form() {
         anchor_b: Vec3::new(0.0, d, 0.0),
         frame_a: Quat::IDENTITY,
         frame_b: Quat::IDENTITY,
-        swing_limit: None,
-        twist_limit: None,
+        kind: JointKind::Socket(SwingTwist::FREE),
         drive: None,
     };
     w.add_joint(socket).unwrap();
@@ -177,9 +178,14 @@ fn internal_corrections_conserve_linear_momentum() {
     }
     for k in 1..8 {
         let anchor = Vec3::new(0.0, -0.25 * k as f32 + 0.025, 0.0);
-        let desc =
-            JointDesc::at_world_anchor(w.bodies(), bodies[k - 1], bodies[k], anchor, -Vec3::Y)
-                .unwrap();
+        let desc = JointDesc::socket_at_world_anchor(
+            w.bodies(),
+            bodies[k - 1],
+            bodies[k],
+            anchor,
+            -Vec3::Y,
+        )
+        .unwrap();
         w.add_joint(desc).unwrap();
     }
     for (k, &b) in bodies.iter().enumerate() {
@@ -229,7 +235,8 @@ fn arm(
 ) {
     let parent = w.add_body(BodyDesc::fixed()).unwrap();
     let child = capsule(w, dir * 0.05, dir * 0.45, 2.0);
-    let desc = JointDesc::at_world_anchor(w.bodies(), parent, child, Vec3::ZERO, dir).unwrap();
+    let desc =
+        JointDesc::socket_at_world_anchor(w.bodies(), parent, child, Vec3::ZERO, dir).unwrap();
     (parent, child, desc)
 }
 
@@ -351,7 +358,8 @@ fn a_kinematic_body_carries_its_joints_and_ignores_them() {
         .add_body(BodyDesc::kinematic().with_velocity(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO))
         .unwrap();
     let bob = capsule(&mut w, Vec3::ZERO, -Vec3::Y * 0.4, 1.0);
-    let desc = JointDesc::at_world_anchor(w.bodies(), carrier, bob, Vec3::ZERO, -Vec3::Y).unwrap();
+    let desc =
+        JointDesc::socket_at_world_anchor(w.bodies(), carrier, bob, Vec3::ZERO, -Vec3::Y).unwrap();
     w.add_joint(desc).unwrap();
     for _ in 0..120 {
         w.step(DT).unwrap();

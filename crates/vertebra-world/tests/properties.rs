@@ -47,7 +47,7 @@ fn chain(
         let body = capsule(&mut world, start, start + Vec3::X * 0.3, mass);
         if let Some(p) = parent {
             let socket =
-                JointDesc::at_world_anchor(world.bodies(), p, body, start, Vec3::X).unwrap();
+                JointDesc::socket_at_world_anchor(world.bodies(), p, body, start, Vec3::X).unwrap();
             let socket = if free {
                 socket
             } else {

@@ -57,7 +57,7 @@ fn within_speed_limits(world: &World) {
 fn hard_corrections_report_within_the_speed_limits() {
     let mut world = World::new(SolverConfig::default()).expect("default config");
     let (a, b) = two_bodies(&mut world);
-    let socket = vertebra_world::JointDesc::at_world_anchor(
+    let socket = vertebra_world::JointDesc::socket_at_world_anchor(
         world.bodies(),
         a,
         b,
@@ -192,7 +192,7 @@ fn settings_at_their_limits_step_finite_and_bounded() {
         world
             .set_body_velocity(a, Vec3::splat(1e30), Vec3::splat(1e30))
             .unwrap();
-        let socket = vertebra_world::JointDesc::at_world_anchor(
+        let socket = vertebra_world::JointDesc::socket_at_world_anchor(
             world.bodies(),
             a,
             b,

@@ -30,7 +30,7 @@ fn scene(tweak: impl FnOnce(&mut BodyDesc)) -> Scene {
     let mut desc_b = BodyDesc::dynamic(mass).with_position(Vec3::new(0.0, -0.75, 0.0));
     tweak(&mut desc_b);
     let b = world.add_body(desc_b).unwrap();
-    let socket = JointDesc::at_world_anchor(world.bodies(), ground, a, Vec3::ZERO, -Vec3::Y);
+    let socket = JointDesc::socket_at_world_anchor(world.bodies(), ground, a, Vec3::ZERO, -Vec3::Y);
     let socket = world.add_joint(socket.unwrap()).unwrap();
     let rod = RodDesc::from_pose(world.bodies(), a, b, &[]).unwrap();
     let rod = world.add_rod(rod).unwrap();

@@ -9,14 +9,23 @@
 //! `alpha~ = 0` and need no `lambda`. Every part is branch-free: an
 //! inactive limit has `C = 0`, and a zero correction moves nothing.
 //!
-//! The socket uses `point`, `swing`, `twist` and `drive`; the rod its own
-//! `rod` parts (curve, length, bend, twist), built on `angle`.
+//! The socket uses `point`, `swing`, `twist` and `drive` (plain path) or
+//! `ellipse`, `pyramid` (both through `swing_direction`) and `twist` with
+//! `limit` (shaped path); the hinge `point`, `hinge_axis`, `twist` with
+//! `limit`, and `drive`; the fixed joint `point` and `lock`; the rod its
+//! own `rod` parts (curve, length, bend, twist), built on `angle`.
 
 pub mod angle;
 pub mod drive;
+pub mod ellipse;
+pub mod hinge_axis;
+pub mod limit;
+pub mod lock;
 pub mod point;
+pub mod pyramid;
 pub mod rod;
 pub mod swing;
+pub mod swing_direction;
 pub mod twist;
 
 use vertebra_math::{Lane, Quat, Vec3};

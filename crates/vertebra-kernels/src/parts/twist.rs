@@ -34,6 +34,22 @@ pub fn excess<L: Lane>(phi: L, lo: L, hi: L) -> L {
     phi - phi.max(lo).min(hi)
 }
 
+/// The violation `|e|` (rad) and the axis `sign(e) t_b` along which it
+/// grows.
+#[inline(always)]
+pub fn violation<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+    lo: L,
+    hi: L,
+) -> (Vec3<L>, L) {
+    let (axis, phi) = measure(a, b, frame_a, frame_b);
+    let e = excess(phi, lo, hi);
+    (axis.scale(L::splat(1.0).copysign(e)), e.abs())
+}
+
 /// Enforces the range; returns the |excess| before the correction (rad).
 #[inline(always)]
 pub fn solve<L: Lane>(

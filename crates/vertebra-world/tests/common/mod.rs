@@ -35,7 +35,7 @@ pub fn hanging_chain(
         let lower = upper - Vec3::Y * length;
         let body = capsule(world, upper, lower, 1.0);
         let parent = *bodies.last().expect("a parent");
-        let desc = JointDesc::at_world_anchor(world.bodies(), parent, body, upper, -Vec3::Y)
+        let desc = JointDesc::socket_at_world_anchor(world.bodies(), parent, body, upper, -Vec3::Y)
             .expect("socket");
         sockets.push(world.add_joint(desc).expect("valid socket"));
         bodies.push(body);

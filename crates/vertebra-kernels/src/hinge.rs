@@ -1,0 +1,246 @@
+//! The hinge joint: a point part, the hinge axis part (the two frames' +X
+//! axes held together), a range about that axis (the twist of the frames,
+//! hard or soft) and an angular drive, solved together in one lane-generic
+//! kernel.
+//!
+//! The range is the `twist` part's angle: the relative rotation's twist
+//! about +X, in [-pi, pi], which for a hinge (no swing) is the hinge angle
+//! itself; `[-pi, pi]` disables it. The drive is the socket's drive part,
+//! with the same settings and the same velocity pass.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Quat as GQuat, Vec3 as GVec3};
+use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::{Lane, LaneKernel};
+
+use crate::body::{BodyPairs, BodyRows};
+use crate::parts::{drive, hinge_axis, limit, point, swing, twist};
+use crate::residual::Residual;
+use crate::socket::Driven;
+
+/// Eight hinges, field by field.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C, align(32))]
+pub struct HingeBlock {
+    /// The two bodies of each lane.
+    pub bodies: BodyPairs,
+    /// Anchor on a, a's body frame (m).
+    pub anchor_a: Vec3Block,
+    /// Anchor on b, b's body frame (m).
+    pub anchor_b: Vec3Block,
+    /// Joint frame in a's body frame (its +X is the hinge axis).
+    pub frame_a: QuatBlock,
+    /// Joint frame in b's body frame.
+    pub frame_b: QuatBlock,
+    /// Lowest hinge angle (rad); -pi with `range_max = pi` disables it.
+    pub range_min: [f32; BLOCK_LANES],
+    /// Highest hinge angle (rad).
+    pub range_max: [f32; BLOCK_LANES],
+    /// The range's compliance (rad / (N m)); 0 is hard.
+    pub limit_compliance: [f32; BLOCK_LANES],
+    /// The range's accumulated multiplier (N m s^2), reset every substep.
+    pub limit_lambda: [f32; BLOCK_LANES],
+    /// Drive target: b's joint frame relative to a's.
+    pub drive_target: QuatBlock,
+    /// Drive compliance (rad / (N m)); 0 is infinitely stiff.
+    pub drive_compliance: [f32; BLOCK_LANES],
+    /// 1 where the drive is on, 0 where off.
+    pub drive_enabled: [f32; BLOCK_LANES],
+    /// Drive damping rate (1/s).
+    pub drive_damping: [f32; BLOCK_LANES],
+    /// The drive's accumulated XPBD multiplier (world vector), reset every
+    /// substep.
+    pub drive_lambda: Vec3Block,
+}
+
+/// One hinge's solver data (one lane of a block).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HingeLane {
+    /// Row of body a.
+    pub body_a: u32,
+    /// Row of body b.
+    pub body_b: u32,
+    /// Whether body a is dynamic (written).
+    pub dynamic_a: bool,
+    /// Whether body b is dynamic (written).
+    pub dynamic_b: bool,
+    /// Anchor on a (m, a's body frame).
+    pub anchor_a: GVec3,
+    /// Anchor on b (m, b's body frame).
+    pub anchor_b: GVec3,
+    /// Joint frame in a's body frame (+X the hinge axis).
+    pub frame_a: GQuat,
+    /// Joint frame in b's body frame.
+    pub frame_b: GQuat,
+    /// Hinge range (rad), `[-pi, pi]` when unlimited.
+    pub range: [f32; 2],
+    /// The range's compliance (rad / (N m)); 0 is hard.
+    pub compliance: f32,
+    /// Drive target, compliance (rad/(N m)) and damping (1/s), if driven.
+    pub drive: Option<(GQuat, f32, f32)>,
+}
+
+impl HingeBlock {
+    /// A block of padding lanes.
+    pub fn padding() -> Self {
+        let mut block = Self::zeroed();
+        for lane in 0..BLOCK_LANES {
+            block.clear(lane);
+        }
+        block
+    }
+
+    /// Makes `lane` a padding lane: null rows, no writes, nothing enabled.
+    pub fn clear(&mut self, lane: usize) {
+        self.set(
+            lane,
+            &HingeLane {
+                body_a: 0,
+                body_b: 0,
+                dynamic_a: false,
+                dynamic_b: false,
+                anchor_a: GVec3::ZERO,
+                anchor_b: GVec3::ZERO,
+                frame_a: GQuat::IDENTITY,
+                frame_b: GQuat::IDENTITY,
+                range: [-core::f32::consts::PI, core::f32::consts::PI],
+                compliance: 0.0,
+                drive: None,
+            },
+        );
+    }
+
+    /// Writes one hinge into `lane`.
+    pub fn set(&mut self, lane: usize, h: &HingeLane) {
+        self.bodies
+            .set(lane, h.body_a, h.body_b, h.dynamic_a, h.dynamic_b);
+        self.anchor_a.set(lane, h.anchor_a);
+        self.anchor_b.set(lane, h.anchor_b);
+        self.frame_a.set(lane, h.frame_a);
+        self.frame_b.set(lane, h.frame_b);
+        (self.range_min[lane], self.range_max[lane]) = (h.range[0], h.range[1]);
+        self.limit_compliance[lane] = h.compliance;
+        self.limit_lambda[lane] = 0.0;
+        let (target, compliance, damping) = h.drive.unwrap_or((GQuat::IDENTITY, 0.0, 0.0));
+        self.drive_target.set(lane, target);
+        self.drive_compliance[lane] = compliance;
+        self.drive_damping[lane] = damping;
+        self.drive_enabled[lane] = if h.drive.is_some() { 1.0 } else { 0.0 };
+        self.drive_lambda.set(lane, GVec3::ZERO);
+    }
+
+    /// Zeroes the accumulated multipliers, as each substep begins.
+    pub fn reset_lambdas(&mut self) {
+        self.drive_lambda = Vec3Block::default();
+        self.limit_lambda = [0.0; BLOCK_LANES];
+    }
+}
+
+impl Driven for HingeBlock {
+    fn bodies(&self) -> &BodyPairs {
+        &self.bodies
+    }
+    #[inline(always)]
+    fn damping_rate<L: Lane>(&self, start: usize) -> L {
+        L::load(&self.drive_damping[start..]) * L::load(&self.drive_enabled[start..])
+    }
+}
+
+/// One XPBD iteration over `blocks`: every hinge's parts, in the order
+/// drive, hinge axis, range, point (the point last, as for the socket).
+/// `DRIVE` says whether the blocks' hinges have drives (the layout keeps
+/// driven and plain hinges apart).
+pub struct PositionPass<'a, const DRIVE: bool> {
+    /// The blocks to solve (one colour's, or the overflow set).
+    pub blocks: &'a mut [HingeBlock],
+    /// Body rows, read and written.
+    pub rows: &'a BodyRows,
+    /// `1 / h^2` for the substep `h` (s^-2).
+    pub inv_h2: f32,
+}
+
+impl<const DRIVE: bool> LaneKernel for PositionPass<'_, DRIVE> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let inv_h2 = L::splat(self.inv_h2);
+        for block in self.blocks.iter_mut() {
+            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
+                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h2);
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn solve_positions<L: Lane, const DRIVE: bool>(
+    block: &mut HingeBlock,
+    start: usize,
+    rows: &BodyRows,
+    inv_h2: L,
+) {
+    let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
+    let frame_a = block.frame_a.load::<L>(start);
+    let frame_b = block.frame_b.load::<L>(start);
+
+    if DRIVE {
+        let lambda = block.drive_lambda.load::<L>(start);
+        let alpha_tilde = L::load(&block.drive_compliance[start..]) * inv_h2;
+        let enabled = L::load(&block.drive_enabled[start..]);
+        let target = block.drive_target.load::<L>(start);
+        let lambda = drive::solve(
+            &mut a,
+            &mut b,
+            frame_a,
+            frame_b,
+            target,
+            enabled,
+            alpha_tilde,
+            lambda,
+        );
+        block.drive_lambda.store(start, lambda);
+    }
+
+    hinge_axis::solve(&mut a, &mut b, frame_a, frame_b);
+    let (lo, hi) = (
+        L::load(&block.range_min[start..]),
+        L::load(&block.range_max[start..]),
+    );
+    let (n, c) = twist::violation(&a, &b, frame_a, frame_b, lo, hi);
+    let alpha_tilde = L::load(&block.limit_compliance[start..]) * inv_h2;
+    let lambda = L::load(&block.limit_lambda[start..]);
+    limit::solve(&mut a, &mut b, n, c, alpha_tilde, lambda).store(&mut block.limit_lambda[start..]);
+    point::solve(
+        &mut a,
+        &mut b,
+        block.anchor_a.load(start),
+        block.anchor_b.load(start),
+        &block.bodies.start(start),
+    );
+
+    block.bodies.scatter(rows, start, &a, &b);
+}
+
+/// A hinge's residual error: anchor separation (m), and the angle between
+/// the hinge axes plus the range overshoot (rad).
+impl Residual for HingeBlock {
+    #[inline(always)]
+    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
+        let (a, b) = self.bodies.gather::<L>(rows, start);
+        let (fa, fb) = (self.frame_a.load::<L>(start), self.frame_b.load::<L>(start));
+        let (_, _, d) = point::separation(
+            &a,
+            &b,
+            self.anchor_a.load(start),
+            self.anchor_b.load(start),
+            &self.bodies.start(start),
+        );
+        let (_, misalignment) = swing::measure(&a, &b, fa, fb);
+        let (lo, hi) = (
+            L::load(&self.range_min[start..]),
+            L::load(&self.range_max[start..]),
+        );
+        let (_, overshoot) = twist::violation(&a, &b, fa, fb, lo, hi);
+        (d.length(), misalignment + overshoot)
+    }
+}

@@ -1,0 +1,58 @@
+//! Swing direction: what the shaped swing limits (elliptical cone, pyramid)
+//! measure, and the chain rule from a limit on it to a rotation axis.
+//!
+//! The swing of the swing-twist decomposition (twist about +X) depends only
+//! on where b's twist axis points in a's joint frame:
+//! `d = (q_a F_a)* (q_b F_b) x`, a unit vector (the twist turns about +X
+//! and leaves it). The swing `s = (0, s_y, s_z, s_w)` is the shortest arc
+//! from `x` to `d`: with `k = sqrt(2 (1 + d_x))`,
+//! `s_w = cos(theta / 2) = k / 2` and `(s_y, s_z) = (-d_z, d_y) / k`,
+//! `theta` the swing angle.
+//!
+//! **Gradients.** Turning b by a small world rotation `v` turns `d` by
+//! `v_a = (q_a F_a)* v` (the same rotation seen in a's joint frame):
+//! `dd = v_a x d`. So for any limit function `C(d)` with gradient `g`
+//! (`dC = g . dd`, in a's joint frame), `dC = v_a . (d x g)`: turning b
+//! about the world axis `n = q_a F_a (d x g)` grows `C` by `|n|` per
+//! radian, i.e. `dC/dtheta_b = n`, and turning a gives `-n` (its frame
+//! carries `d` the other way). The angle part takes such axes as they are
+//! (not unit), so each limit supplies only `C` and `g` (derived in its
+//! own header; checked against finite differences in
+//! `tests/joint_gradients.rs`). At `d = -x` (a swing of exactly pi) the
+//! swing axis is undefined: the gradients are 0 there, by selects.
+
+use vertebra_math::{Lane, Quat, Vec3};
+
+use crate::body::BodyLanes;
+
+/// b's twist axis in a's joint frame, and a's joint frame in the world.
+#[derive(Clone, Copy, Debug)]
+pub struct Direction<L> {
+    /// `q_a F_a`: a's joint frame in the world.
+    pub frame_a: Quat<L>,
+    /// `d`, unit, in a's joint frame.
+    pub d: Vec3<L>,
+}
+
+/// Measures `d` at the bodies' current orientations.
+#[inline(always)]
+pub fn measure<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+) -> Direction<L> {
+    let fa = a.q * frame_a;
+    let x = Vec3::splat(crate::TWIST_AXIS);
+    Direction {
+        frame_a: fa,
+        d: fa.inverse_rotate((b.q * frame_b).rotate(x)),
+    }
+}
+
+/// The world axis `n = q_a F_a (d x g)` for a limit of gradient `g` (a's
+/// joint frame): `dC/dtheta_b = n`, `dC/dtheta_a = -n`.
+#[inline(always)]
+pub fn axis<L: Lane>(dir: &Direction<L>, g: Vec3<L>) -> Vec3<L> {
+    dir.frame_a.rotate(dir.d.cross(g))
+}

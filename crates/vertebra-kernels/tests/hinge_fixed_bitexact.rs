@@ -1,0 +1,235 @@
+//! The hinge and fixed kernels' passes give the scalar reference's bits on
+//! every backend, for random and adversarial joints.
+
+mod common;
+
+use common::{
+    RawRows, agree_over_seeds, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat, vec,
+};
+use glam::{Quat, Vec3};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
+use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
+use vertebra_kernels::residual::ResidualPass;
+use vertebra_kernels::socket::VelocityPass;
+use vertebra_math::Backend;
+use vertebra_math::block::BLOCK_LANES;
+
+const STATICS: usize = 4;
+
+/// One random joint's bodies, anchors and frames; `adversarial` mixes in
+/// anchors that coincide, frames equal or turned by exactly pi about +Y
+/// (antiparallel axes), and zero anchors.
+struct Joint {
+    body_a: u32,
+    body_b: u32,
+    anchor_a: Vec3,
+    anchor_b: Vec3,
+    frame_a: Quat,
+    frame_b: Quat,
+}
+
+fn joint(r: &mut StdRng, rows: &RawRows, lane: usize, adversarial: bool) -> Joint {
+    let (body_a, body_b) = lane_bodies(r, rows, lane, STATICS);
+    let mut j = Joint {
+        body_a,
+        body_b,
+        anchor_a: vec(r, 0.3),
+        anchor_b: vec(r, 0.3),
+        frame_a: unit_quat(r),
+        frame_b: unit_quat(r),
+    };
+    if adversarial && r.random_bool(0.3) {
+        let pose = |row: u32| rows[row as usize][0];
+        let (pa, qa) = (
+            Vec3::from_slice(&pose(body_a)[..3]),
+            Quat::from_slice(&pose(body_a)[4..]),
+        );
+        let (pb, qb) = (
+            Vec3::from_slice(&pose(body_b)[..3]),
+            Quat::from_slice(&pose(body_b)[4..]),
+        );
+        j.anchor_b = qb.inverse() * (pa + qa * j.anchor_a - pb);
+        let flip = if r.random_bool(0.5) {
+            Quat::from_rotation_y(core::f32::consts::PI)
+        } else {
+            Quat::IDENTITY
+        };
+        j.frame_b = qb.inverse() * qa * j.frame_a * flip;
+    }
+    if adversarial && r.random_bool(0.1) {
+        (j.anchor_a, j.anchor_b) = (Vec3::ZERO, Vec3::ZERO);
+    }
+    j
+}
+
+fn compliance(r: &mut StdRng) -> f32 {
+    match r.random_range(0..4) {
+        0 => 0.0,
+        1 => 1e-9,
+        2 => 1e9,
+        _ => r.random_range(0.0..0.1),
+    }
+}
+
+fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlock>) {
+    let mut r = StdRng::seed_from_u64(seed);
+    let rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
+    let mut out = Vec::new();
+    for block_index in 0..blocks {
+        let mut block = HingeBlock::padding();
+        for lane in 0..BLOCK_LANES {
+            if r.random_bool(0.1) {
+                continue; // a padding lane
+            }
+            let j = joint(&mut r, &rows, block_index * BLOCK_LANES + lane, adversarial);
+            let pi = core::f32::consts::PI;
+            let range = match r.random_range(0..3) {
+                0 => [-pi, pi],
+                1 if adversarial => [0.0, 0.0],
+                _ => {
+                    let lo = r.random_range(-3.0..0.5f32);
+                    [lo, r.random_range(lo..3.1)]
+                }
+            };
+            let limit = compliance(&mut r);
+            let drive = compliance(&mut r);
+            block.set(
+                lane,
+                &HingeLane {
+                    body_a: j.body_a,
+                    body_b: j.body_b,
+                    dynamic_a: dynamic(&rows, j.body_a),
+                    dynamic_b: dynamic(&rows, j.body_b),
+                    anchor_a: j.anchor_a,
+                    anchor_b: j.anchor_b,
+                    frame_a: j.frame_a,
+                    frame_b: j.frame_b,
+                    range,
+                    compliance: limit,
+                    drive: r
+                        .random_bool(0.6)
+                        .then(|| (unit_quat(&mut r), drive, r.random_range(0.0..20.0))),
+                },
+            );
+            block
+                .bodies
+                .set_start(lane, &common::start(&mut r, adversarial));
+        }
+        out.push(block);
+    }
+    (rows, out)
+}
+
+fn fixed_joints(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<FixedBlock>) {
+    let mut r = StdRng::seed_from_u64(seed);
+    let rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
+    let mut out = Vec::new();
+    for block_index in 0..blocks {
+        let mut block = FixedBlock::padding();
+        for lane in 0..BLOCK_LANES {
+            if r.random_bool(0.1) {
+                continue;
+            }
+            let j = joint(&mut r, &rows, block_index * BLOCK_LANES + lane, adversarial);
+            block.set(
+                lane,
+                &FixedLane {
+                    body_a: j.body_a,
+                    body_b: j.body_b,
+                    dynamic_a: dynamic(&rows, j.body_a),
+                    dynamic_b: dynamic(&rows, j.body_b),
+                    anchor_a: j.anchor_a,
+                    anchor_b: j.anchor_b,
+                    frame_a: j.frame_a,
+                    frame_b: j.frame_b,
+                },
+            );
+            block
+                .bodies
+                .set_start(lane, &common::start(&mut r, adversarial));
+        }
+        out.push(block);
+    }
+    (rows, out)
+}
+
+/// Every float the hinge passes produce: rows, multipliers, residuals.
+fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32> {
+    let rows = to_rows(raw);
+    let mut blocks = blocks.to_vec();
+    for _ in 0..2 {
+        backend.dispatch(hinge::PositionPass::<true> {
+            blocks: &mut blocks,
+            rows: &rows,
+            inv_h2: 3600.0,
+        });
+        backend.dispatch(hinge::PositionPass::<false> {
+            blocks: &mut blocks,
+            rows: &rows,
+            inv_h2: 3600.0,
+        });
+    }
+    backend.dispatch(VelocityPass {
+        blocks: &blocks,
+        rows: &rows,
+        h: 1.0 / 60.0,
+    });
+    let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+    backend.dispatch(ResidualPass {
+        blocks: &blocks,
+        rows: &rows,
+        out: &mut residual,
+    });
+    let mut out = flatten(&rows);
+    for b in &blocks {
+        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
+            &b.drive_lambda,
+        )));
+        out.extend(b.limit_lambda);
+    }
+    out.extend(residual.iter().flatten());
+    out
+}
+
+/// Every float the fixed joints' passes produce: rows and residuals.
+fn run_fixed(backend: Backend, raw: &RawRows, blocks: &[FixedBlock]) -> Vec<f32> {
+    let rows = to_rows(raw);
+    let mut blocks = blocks.to_vec();
+    for _ in 0..2 {
+        backend.dispatch(fixed::PositionPass {
+            blocks: &mut blocks,
+            rows: &rows,
+        });
+    }
+    let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+    backend.dispatch(ResidualPass {
+        blocks: &blocks,
+        rows: &rows,
+        out: &mut residual,
+    });
+    let mut out = flatten(&rows);
+    out.extend(residual.iter().flatten());
+    out
+}
+
+#[test]
+fn random_hinges_agree_on_every_backend() {
+    agree_over_seeds(0..40, false, hinges, run_hinges);
+}
+
+#[test]
+fn adversarial_hinges_agree_on_every_backend_and_stay_finite() {
+    agree_over_seeds(100..160, true, hinges, run_hinges);
+}
+
+#[test]
+fn random_fixed_joints_agree_on_every_backend() {
+    agree_over_seeds(0..40, false, fixed_joints, run_fixed);
+}
+
+#[test]
+fn adversarial_fixed_joints_agree_on_every_backend_and_stay_finite() {
+    agree_over_seeds(100..160, true, fixed_joints, run_fixed);
+}

@@ -1,0 +1,104 @@
+//! How a [`JointDesc`] is encoded (snapshots, the state hash).
+//!
+//! A socket with a hard circular cone (or none) and a hard twist range is
+//! encoded exactly as the sockets of snapshot format 3 were: the swing
+//! limit as an optional angle, then the twist range, then the drive. So a
+//! world of such sockets, the only joints there were before joint kinds,
+//! keeps its state hash bit for bit (the golden hashes of
+//! `crates/vertebra-scenes/tests/golden.rs`). Every other kind is
+//! encoded after a third tag. Postcard encodes an enum's variant as its
+//! index and an `Option` as 0 or 1 before the value, so variant 0 with the
+//! twist range is format 3's `None` swing limit, variant 1 its `Some`.
+
+use glam::{Quat, Vec3};
+use serde::{Deserialize, Serialize};
+use vertebra_store::BodyHandle;
+
+use crate::joint::{AngularDrive, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
+
+#[derive(Serialize, Deserialize)]
+pub(crate) struct JointWire {
+    body_a: BodyHandle,
+    body_b: BodyHandle,
+    anchor_a: Vec3,
+    anchor_b: Vec3,
+    frame_a: Quat,
+    frame_b: Quat,
+    kind: KindWire,
+    drive: Option<AngularDrive>,
+}
+
+#[derive(Serialize, Deserialize)]
+enum KindWire {
+    /// A plain socket without a swing limit, with its twist range.
+    FreeSocket(Option<[f32; 2]>),
+    /// A plain socket's cone half-angle and twist range.
+    ConeSocket(f32, Option<[f32; 2]>),
+    /// Any other kind.
+    Kind(JointKind),
+}
+
+impl From<JointKind> for KindWire {
+    fn from(kind: JointKind) -> Self {
+        match kind {
+            JointKind::Socket(SwingTwist {
+                swing: Swing::Free,
+                twist,
+                softness: LimitSoftness::Hard,
+            }) => Self::FreeSocket(twist),
+            JointKind::Socket(SwingTwist {
+                swing: Swing::Cone(half),
+                twist,
+                softness: LimitSoftness::Hard,
+            }) => Self::ConeSocket(half, twist),
+            other => Self::Kind(other),
+        }
+    }
+}
+
+impl From<KindWire> for JointKind {
+    fn from(wire: KindWire) -> Self {
+        let plain = |swing, twist| {
+            JointKind::Socket(SwingTwist {
+                swing,
+                twist,
+                softness: LimitSoftness::Hard,
+            })
+        };
+        match wire {
+            KindWire::FreeSocket(twist) => plain(Swing::Free, twist),
+            KindWire::ConeSocket(half, twist) => plain(Swing::Cone(half), twist),
+            KindWire::Kind(kind) => kind,
+        }
+    }
+}
+
+impl From<JointDesc> for JointWire {
+    fn from(d: JointDesc) -> Self {
+        Self {
+            body_a: d.body_a,
+            body_b: d.body_b,
+            anchor_a: d.anchor_a,
+            anchor_b: d.anchor_b,
+            frame_a: d.frame_a,
+            frame_b: d.frame_b,
+            kind: d.kind.into(),
+            drive: d.drive,
+        }
+    }
+}
+
+impl From<JointWire> for JointDesc {
+    fn from(w: JointWire) -> Self {
+        Self {
+            body_a: w.body_a,
+            body_b: w.body_b,
+            anchor_a: w.anchor_a,
+            anchor_b: w.anchor_b,
+            frame_a: w.frame_a,
+            frame_b: w.frame_b,
+            kind: w.kind.into(),
+            drive: w.drive,
+        }
+    }
+}
