@@ -1,5 +1,6 @@
 //! The ragdoll description format (`docs/ragdolls.md`): TOML with bodies as
-//! capsules, ball-and-socket joints with swing and twist limits, and an
+//! capsules, joints (sockets with swing and twist limits, hinges, fixed
+//! joints: `joint_def.rs`), and an
 //! optional `[spine]` chain that the simplified ragdoll replaces by a rod.
 //! Units in the file: metres, kilograms, degrees; here: metres, kilograms,
 //! radians.
@@ -8,16 +9,22 @@ use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 use vertebra_world::{Shape, check_coordinate};
 
 use crate::error::RagdollError;
+use crate::joint_def::{JointDef, RawJoint, joint};
 
 /// The reference humanoid, shipped with the crate: 13 bodies, 12 joints,
 /// a 4-body spine.
 pub const REFERENCE_HUMANOID: &str = include_str!("../models/humanoid.toml");
+
+/// The anatomical humanoid, shipped with the crate: the reference
+/// humanoid's 13 bodies with hinged knees and elbows, elliptical shoulders,
+/// hips and spine joints, and a neck (`models/anatomical.toml`).
+pub const ANATOMICAL_HUMANOID: &str = include_str!("../models/anatomical.toml");
 
 /// The largest ragdoll file [`RagdollDesc::from_file`] reads (bytes): the
 /// reference humanoid is 5 KB and a body or joint about 150 bytes, so
@@ -43,18 +50,6 @@ struct RawBody {
     segment: [[f32; 3]; 2],
     radius: f32,
     mass: f32,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawJoint {
-    name: String,
-    parent: String,
-    child: String,
-    anchor: [f32; 3],
-    axis: [f32; 3],
-    swing: f32,
-    twist: [f32; 2],
 }
 
 #[derive(Deserialize)]
@@ -98,25 +93,6 @@ impl BodyDef {
     }
 }
 
-/// A ball-and-socket joint between a parent and a child body.
-#[derive(Clone, Debug, PartialEq)]
-pub struct JointDef {
-    /// Unique name.
-    pub name: String,
-    /// Index of the parent body.
-    pub parent: usize,
-    /// Index of the child body.
-    pub child: usize,
-    /// The pivot at bind pose (m, world).
-    pub anchor: Vec3,
-    /// The twist axis at bind pose, from parent to child (unit, world).
-    pub axis: Vec3,
-    /// Swing cone half-angle (rad).
-    pub swing: f32,
-    /// Twist range (rad).
-    pub twist: [f32; 2],
-}
-
 /// The chain a rod replaces in the simplified ragdoll.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpineDef {
@@ -152,7 +128,11 @@ pub struct RagdollDesc {
     pub parent_joint: Vec<Option<usize>>,
 }
 
-fn finite(context: &str, field: &'static str, values: &[f32]) -> Result<(), RagdollError> {
+pub(crate) fn finite(
+    context: &str,
+    field: &'static str,
+    values: &[f32],
+) -> Result<(), RagdollError> {
     if values.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
@@ -163,7 +143,12 @@ fn finite(context: &str, field: &'static str, values: &[f32]) -> Result<(), Ragd
     }
 }
 
-fn range(context: &str, field: &'static str, ok: bool, reason: &str) -> Result<(), RagdollError> {
+pub(crate) fn range(
+    context: &str,
+    field: &'static str,
+    ok: bool,
+    reason: &str,
+) -> Result<(), RagdollError> {
     if ok {
         Ok(())
     } else {
@@ -179,6 +164,11 @@ impl RagdollDesc {
     /// The reference humanoid (`models/humanoid.toml`).
     pub fn reference_humanoid() -> Self {
         Self::from_toml(REFERENCE_HUMANOID).expect("the shipped reference humanoid is valid")
+    }
+
+    /// The anatomical humanoid (`models/anatomical.toml`).
+    pub fn anatomical_humanoid() -> Self {
+        Self::from_toml(ANATOMICAL_HUMANOID).expect("the shipped anatomical humanoid is valid")
     }
 
     /// Reads, parses and validates a description file of at most
@@ -340,61 +330,6 @@ fn body(b: &RawBody, line: usize) -> Result<BodyDef, RagdollError> {
         .mass_properties_with_mass(def.mass)
         .map_err(|e| RagdollError::world(&context, e))?;
     Ok(def)
-}
-
-fn joint(
-    j: &RawJoint,
-    line: usize,
-    index: &HashMap<String, usize>,
-) -> Result<JointDef, RagdollError> {
-    let context = format!("line {line}: joint `{}`", j.name);
-    let lookup = |field: &'static str, name: &str| {
-        index
-            .get(name)
-            .copied()
-            .ok_or_else(|| RagdollError::UnknownBody {
-                context: context.clone(),
-                field,
-                name: name.to_owned(),
-            })
-    };
-    let (parent, child) = (lookup("parent", &j.parent)?, lookup("child", &j.child)?);
-    finite(&context, "anchor", &j.anchor)?;
-    finite(&context, "axis", &j.axis)?;
-    finite(&context, "swing", &[j.swing])?;
-    finite(&context, "twist", &j.twist)?;
-    check_coordinate("anchor", Vec3::from(j.anchor))
-        .map_err(|e| RagdollError::world(&context, e))?;
-    // In f64: the length of [1e38, 1e38, 0] overflows f32, and the axis
-    // normalised in f32 became zero.
-    let axis = DVec3::from(j.axis.map(f64::from));
-    if axis.length() <= 1e-6 {
-        return Err(RagdollError::ZeroAxis {
-            joint: j.name.clone(),
-        });
-    }
-    range(
-        &context,
-        "swing",
-        (0.0..=180.0).contains(&j.swing),
-        "must be in [0, 180] degrees",
-    )?;
-    let [lo, hi] = j.twist;
-    range(
-        &context,
-        "twist",
-        -180.0 <= lo && lo <= hi && hi <= 180.0,
-        "must be [min, max] within [-180, 180] degrees",
-    )?;
-    Ok(JointDef {
-        name: j.name.clone(),
-        parent,
-        child,
-        anchor: Vec3::from(j.anchor),
-        axis: axis.normalize().as_vec3(),
-        swing: j.swing.to_radians(),
-        twist: [lo.to_radians(), hi.to_radians()],
-    })
 }
 
 /// Checks the joints form one tree over all bodies; returns the root and

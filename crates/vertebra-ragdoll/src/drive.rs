@@ -5,8 +5,8 @@
 //! shape: its rest bend and twist become the target pose's, and its
 //! bending and twisting take the drive's strength.
 
-use glam::{Quat, Vec3};
-use vertebra_world::{AngularDrive, RodStiffness, World};
+use glam::Vec3;
+use vertebra_world::{AngularDrive, JointKind, RodStiffness, World};
 
 use crate::error::RagdollError;
 use crate::pose::Pose;
@@ -91,8 +91,11 @@ impl Ragdoll {
         target.validate(&self.desc)?;
         settings.validate(self.desc.joints.len())?;
         for (k, (j, socket)) in self.desc.joints.iter().zip(&self.joints).enumerate() {
-            let Some(socket) = socket else { continue };
-            let frame = Quat::from_rotation_arc(Vec3::X, j.axis);
+            // A fixed joint has no rotation to drive.
+            let (Some(socket), false) = (socket, j.kind == JointKind::Fixed) else {
+                continue;
+            };
+            let frame = j.frame;
             let relative =
                 (target.bones[j.parent].1 * frame).inverse() * (target.bones[j.child].1 * frame);
             let compliance = match settings.strength(k) {

@@ -40,13 +40,15 @@
 mod description;
 mod drive;
 mod error;
+mod joint_def;
 mod mapping;
 mod pose;
 mod ragdoll;
 
-pub use description::{BodyDef, JointDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
+pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
+pub use joint_def::JointDef;
 pub use mapping::SpineMapping;
 pub use pose::Pose;
 pub use ragdoll::{BuildOptions, Ragdoll, SpineMode, body_masses};

@@ -5,8 +5,8 @@ use std::collections::{HashMap, HashSet};
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, BodyHandle, JointDesc, JointHandle, JointKind, LimitSoftness, MIN_TIME_STEP,
-    MassProperties, RodDesc, RodHandle, RodStiffness, Shape, Swing, SwingTwist, World,
+    BodyDesc, BodyHandle, JointDesc, JointHandle, MIN_TIME_STEP, MassProperties, RodDesc,
+    RodHandle, RodStiffness, Shape, World,
 };
 
 use crate::description::RagdollDesc;
@@ -213,21 +213,16 @@ impl Ragdoll {
                 self.bodies[j.parent].expect("built"),
                 self.bodies[j.child].expect("built"),
             );
-            // Joint frames from bind pose (bodies unrotated there): +X along
-            // the twist axis; limits are measured from bind pose.
-            let frame = Quat::from_rotation_arc(Vec3::X, j.axis);
+            // Joint frames from bind pose (bodies unrotated there): both are
+            // the described frame, so limits are measured from bind pose.
             let socket = JointDesc {
                 body_a: a,
                 body_b: b,
                 anchor_a: j.anchor - desc.bodies[j.parent].centre(),
                 anchor_b: j.anchor - desc.bodies[j.child].centre(),
-                frame_a: frame,
-                frame_b: frame,
-                kind: JointKind::Socket(SwingTwist {
-                    swing: Swing::Cone(j.swing),
-                    twist: Some(j.twist),
-                    softness: LimitSoftness::Hard,
-                }),
+                frame_a: j.frame,
+                frame_b: j.frame,
+                kind: j.kind,
                 drive: None,
             };
             self.joints[k] = Some(

@@ -8,7 +8,7 @@ use vertebra_ragdoll::{
     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMapping, SpineMode, Strength,
     body_masses,
 };
-use vertebra_world::{BodyDesc, JointDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, JointDesc, JointKind, SolverConfig, Swing, SwingTwist, World};
 
 fn world() -> World {
     World::new(SolverConfig::default()).unwrap()
@@ -21,11 +21,20 @@ fn random_pose(desc: &RagdollDesc, r: &mut StdRng) -> Pose {
         .joints
         .iter()
         .map(|j| {
-            let twist = r.random_range(j.twist[0]..=j.twist[1]) * 0.9;
-            let side = j.axis.any_orthonormal_vector();
-            let spin = Quat::from_axis_angle(j.axis, r.random_range(0.0..std::f32::consts::TAU));
-            let swing = Quat::from_axis_angle(spin * side, r.random_range(0.0..=j.swing) * 0.9);
-            swing * Quat::from_axis_angle(j.axis, twist)
+            let JointKind::Socket(SwingTwist {
+                swing: Swing::Cone(cone),
+                twist: Some([lo, hi]),
+                ..
+            }) = j.kind
+            else {
+                panic!("the reference humanoid's joints are sockets with cones");
+            };
+            let axis = j.axis();
+            let twist = r.random_range(lo..=hi) * 0.9;
+            let side = axis.any_orthonormal_vector();
+            let spin = Quat::from_axis_angle(axis, r.random_range(0.0..std::f32::consts::TAU));
+            let swing = Quat::from_axis_angle(spin * side, r.random_range(0.0..=cone) * 0.9);
+            swing * Quat::from_axis_angle(axis, twist)
         })
         .collect();
     let root = (

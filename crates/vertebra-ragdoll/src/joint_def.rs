@@ -1,0 +1,292 @@
+//! A described joint: its kind (socket, hinge, fixed), its frame at bind
+//! pose, and its limits, read from a `[[joint]]` table and checked field
+//! by field (`docs/ragdolls.md` gives the format).
+
+use std::collections::HashMap;
+
+use glam::{DVec3, Mat3, Quat, Vec3};
+use serde::Deserialize;
+use vertebra_world::{JointKind, LimitSoftness, Swing, SwingTwist, check_coordinate};
+
+use crate::description::{finite, range};
+use crate::error::RagdollError;
+
+/// A joint between a parent and a child body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointDef {
+    /// Unique name.
+    pub name: String,
+    /// Index of the parent body.
+    pub parent: usize,
+    /// Index of the child body.
+    pub child: usize,
+    /// The pivot at bind pose (m, world).
+    pub anchor: Vec3,
+    /// The joint frame at bind pose (world): its +X is a socket's twist
+    /// axis (from parent to child) or a hinge's rotation axis, its +Y the
+    /// file's `normal` (when given). Both bodies' joint frames are this
+    /// one at bind pose, so every joint starts at zero swing, twist and
+    /// hinge angle.
+    pub frame: Quat,
+    /// The kind and its limits (rad), as the world takes them.
+    pub kind: JointKind,
+}
+
+impl JointDef {
+    /// The joint frame's +X at bind pose (unit, world): a socket's twist
+    /// axis, a hinge's rotation axis.
+    pub fn axis(&self) -> Vec3 {
+        self.frame * Vec3::X
+    }
+}
+
+/// A `[[joint]]` table as written.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawJoint {
+    pub name: String,
+    parent: String,
+    child: String,
+    anchor: [f32; 3],
+    kind: Option<String>,
+    axis: Option<[f32; 3]>,
+    normal: Option<[f32; 3]>,
+    swing: Option<RawSwing>,
+    twist: Option<[f32; 2]>,
+    range: Option<[f32; 2]>,
+    softness: Option<f32>,
+}
+
+/// `swing = 40` (a cone), `swing = { y = 80, z = 35 }` (an ellipse) or
+/// `swing = { y = [-30, 90], z = [-10, 80] }` (a pyramid), in degrees.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawSwing {
+    Cone(f32),
+    Ellipse { y: f32, z: f32 },
+    Pyramid { y: [f32; 2], z: [f32; 2] },
+}
+
+/// Fields each kind takes besides name, parent, child and anchor.
+const SOCKET_FIELDS: [&str; 5] = ["axis", "normal", "swing", "twist", "softness"];
+const HINGE_FIELDS: [&str; 3] = ["axis", "range", "softness"];
+
+impl RawJoint {
+    /// The optional fields this joint has, by name.
+    fn present(&self) -> [(&'static str, bool); 6] {
+        [
+            ("axis", self.axis.is_some()),
+            ("normal", self.normal.is_some()),
+            ("swing", self.swing.is_some()),
+            ("twist", self.twist.is_some()),
+            ("range", self.range.is_some()),
+            ("softness", self.softness.is_some()),
+        ]
+    }
+}
+
+/// Reads and checks one joint defined at `line`.
+pub(crate) fn joint(
+    j: &RawJoint,
+    line: usize,
+    index: &HashMap<String, usize>,
+) -> Result<JointDef, RagdollError> {
+    let context = format!("line {line}: joint `{}`", j.name);
+    let lookup = |field: &'static str, name: &str| {
+        index
+            .get(name)
+            .copied()
+            .ok_or_else(|| RagdollError::UnknownBody {
+                context: context.clone(),
+                field,
+                name: name.to_owned(),
+            })
+    };
+    let (parent, child) = (lookup("parent", &j.parent)?, lookup("child", &j.child)?);
+    finite(&context, "anchor", &j.anchor)?;
+    check_coordinate("anchor", Vec3::from(j.anchor))
+        .map_err(|e| RagdollError::world(&context, e))?;
+    let kind = j.kind.as_deref().unwrap_or("socket");
+    let allowed: &[&str] = match kind {
+        "socket" => &SOCKET_FIELDS,
+        "hinge" => &HINGE_FIELDS,
+        "fixed" => &[],
+        other => {
+            return Err(RagdollError::OutOfRange {
+                context,
+                field: "kind",
+                reason: format!("is `{other}`; must be socket, hinge or fixed"),
+            });
+        }
+    };
+    for (field, present) in j.present() {
+        let owners = match field {
+            "range" => "hinges",
+            "normal" | "swing" | "twist" => "sockets",
+            _ => "sockets and hinges",
+        };
+        range(
+            &context,
+            field,
+            !present || allowed.contains(&field),
+            &format!("is for {owners} only; this joint is a {kind}"),
+        )?;
+    }
+    let softness = softness(&context, j.softness)?;
+    let (frame, kind) = match kind {
+        "socket" => {
+            let frame = frame(
+                &context,
+                &j.name,
+                required(&context, "axis", j.axis)?,
+                j.normal,
+            )?;
+            let swing = swing(&context, j.swing.as_ref(), j.normal.is_some())?;
+            let twist = j
+                .twist
+                .map(|t| angle_range(&context, "twist", t, -180.0, 180.0))
+                .transpose()?;
+            let limits = SwingTwist {
+                swing,
+                twist,
+                softness,
+            };
+            (frame, JointKind::Socket(limits))
+        }
+        "hinge" => {
+            let frame = frame(&context, &j.name, required(&context, "axis", j.axis)?, None)?;
+            let range = j
+                .range
+                .map(|r| angle_range(&context, "range", r, -180.0, 180.0))
+                .transpose()?;
+            (frame, JointKind::Hinge { range, softness })
+        }
+        _ => (Quat::IDENTITY, JointKind::Fixed),
+    };
+    Ok(JointDef {
+        name: j.name.clone(),
+        parent,
+        child,
+        anchor: Vec3::from(j.anchor),
+        frame,
+        kind,
+    })
+}
+
+fn required<T>(context: &str, field: &'static str, value: Option<T>) -> Result<T, RagdollError> {
+    value.ok_or_else(|| RagdollError::OutOfRange {
+        context: context.to_owned(),
+        field,
+        reason: "is missing".to_owned(),
+    })
+}
+
+/// The joint frame at bind pose: +X along `axis`, +Y along `normal` made
+/// exactly perpendicular, or (without a normal) the shortest turn from +X
+/// to `axis`, as every joint had before normals existed.
+fn frame(
+    context: &str,
+    name: &str,
+    axis: [f32; 3],
+    normal: Option<[f32; 3]>,
+) -> Result<Quat, RagdollError> {
+    finite(context, "axis", &axis)?;
+    // In f64: the length of [1e38, 1e38, 0] overflows f32, and the axis
+    // normalised in f32 became zero.
+    let x = DVec3::from(axis.map(f64::from));
+    if x.length() <= 1e-6 {
+        return Err(RagdollError::ZeroAxis {
+            joint: name.to_owned(),
+        });
+    }
+    let x = x.normalize();
+    let Some(normal) = normal else {
+        return Ok(Quat::from_rotation_arc(Vec3::X, x.as_vec3()));
+    };
+    finite(context, "normal", &normal)?;
+    let n = DVec3::from(normal.map(f64::from));
+    let length = n.length();
+    range(
+        context,
+        "normal",
+        length > 1e-6 && (n.dot(x) / length).abs() <= 1e-3,
+        "must be a direction perpendicular to the axis (within 0.06 degrees)",
+    )?;
+    let y = (n - x * n.dot(x)).normalize();
+    let z = x.cross(y);
+    Ok(Quat::from_mat3(&Mat3::from_cols(x.as_vec3(), y.as_vec3(), z.as_vec3())).normalize())
+}
+
+/// The swing limit: free without `swing`; a shaped one needs the frame's
+/// `normal` to say which way its axes lie.
+fn swing(context: &str, raw: Option<&RawSwing>, has_normal: bool) -> Result<Swing, RagdollError> {
+    let half_angle = |field, x: f32| -> Result<f32, RagdollError> {
+        finite(context, field, &[x])?;
+        range(
+            context,
+            field,
+            (0.0..=180.0).contains(&x),
+            "must be in [0, 180] degrees",
+        )?;
+        Ok(x.to_radians())
+    };
+    let shaped = |ok: bool| {
+        range(
+            context,
+            "normal",
+            ok,
+            "is missing: an elliptical or pyramid swing needs it to place its axes",
+        )
+    };
+    Ok(match raw {
+        None => Swing::Free,
+        Some(RawSwing::Cone(x)) => Swing::Cone(half_angle("swing", *x)?),
+        Some(RawSwing::Ellipse { y, z }) => {
+            shaped(has_normal)?;
+            Swing::Ellipse {
+                y: half_angle("swing.y", *y)?,
+                z: half_angle("swing.z", *z)?,
+            }
+        }
+        Some(RawSwing::Pyramid { y, z }) => {
+            shaped(has_normal)?;
+            Swing::Pyramid {
+                y: angle_range(context, "swing.y", *y, -180.0, 180.0)?,
+                z: angle_range(context, "swing.z", *z, -180.0, 180.0)?,
+            }
+        }
+    })
+}
+
+/// `[min, max]` in degrees within `[lo, hi]`, in radians.
+fn angle_range(
+    context: &str,
+    field: &'static str,
+    [min, max]: [f32; 2],
+    lo: f32,
+    hi: f32,
+) -> Result<[f32; 2], RagdollError> {
+    finite(context, field, &[min, max])?;
+    range(
+        context,
+        field,
+        lo <= min && min <= max && max <= hi,
+        &format!("must be [min, max] within [{lo}, {hi}] degrees"),
+    )?;
+    Ok([min.to_radians(), max.to_radians()])
+}
+
+/// `softness = C`: the limits' compliance (rad / (N m)); hard without it.
+fn softness(context: &str, compliance: Option<f32>) -> Result<LimitSoftness, RagdollError> {
+    let Some(c) = compliance else {
+        return Ok(LimitSoftness::Hard);
+    };
+    finite(context, "softness", &[c])?;
+    range(
+        context,
+        "softness",
+        c >= 0.0,
+        "must be a compliance (rad / (N m)) of 0 or more",
+    )?;
+    Ok(LimitSoftness::Compliance(c))
+}
