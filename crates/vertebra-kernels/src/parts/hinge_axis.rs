@@ -30,15 +30,15 @@ pub fn measure<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> ([L; 2], [Vec3<L>; 2]) {
-    let (one, zero) = (L::splat(1.0), L::splat(0.0));
     let fb = b.q * frame_b;
-    let ta = (a.q * frame_a).rotate(Vec3::new(one, zero, zero));
-    let yb = fb.rotate(Vec3::new(zero, one, zero));
-    let zb = fb.rotate(Vec3::new(zero, zero, one));
+    let ta = axis_x(a.q * frame_a);
+    let (yb, zb) = (axis_y(fb), axis_z(fb));
     ([ta.dot(yb), ta.dot(zb)], [yb.cross(ta), zb.cross(ta)])
 }
 
-/// Aligns the axes; returns `|C|` before the correction.
+/// Aligns the axes; returns `|C|` before the correction. `K` is formed in
+/// each body's own frame (`j^T I^-1 j = (R^T j)^T S (R^T j)`), which also
+/// gives each body's turn `R S (R^T j)` without a second rotation into it.
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
@@ -47,15 +47,51 @@ pub fn solve<L: Lane>(
     frame_b: Quat<L>,
 ) -> L {
     let ([c1, c2], [j1, j2]) = measure(a, b, frame_a, frame_b);
-    let w = a.world_inv_inertia() + b.world_inv_inertia();
-    let (wj1, wj2) = (w.mul_vec(j1), w.mul_vec(j2));
-    let (k11, k12, k22) = (j1.dot(wj1), j2.dot(wj1), j2.dot(wj2));
+    let (ja1, ja2) = (a.q.inverse_rotate(j1), a.q.inverse_rotate(j2));
+    let (jb1, jb2) = (b.q.inverse_rotate(j1), b.q.inverse_rotate(j2));
+    let (sa1, sa2) = (a.inv_inertia.mul_vec(ja1), a.inv_inertia.mul_vec(ja2));
+    let (sb1, sb2) = (b.inv_inertia.mul_vec(jb1), b.inv_inertia.mul_vec(jb2));
+    let k11 = ja1.dot(sa1) + jb1.dot(sb1);
+    let k12 = ja2.dot(sa1) + jb2.dot(sb1);
+    let k22 = ja2.dot(sa2) + jb2.dot(sb2);
     let det = k11 * k22 - k12 * k12;
     // dlambda = -K^-1 C, K^-1 = [k22 -k12; -k12 k11] / det.
     let l1 = safe_ratio(k12 * c2 - k22 * c1, det);
     let l2 = safe_ratio(k12 * c1 - k11 * c2, det);
-    let turn = j1.scale(l1) + j2.scale(l2);
-    b.rotate(b.inv_inertia_mul(turn));
-    a.rotate(a.inv_inertia_mul(-turn));
+    b.rotate(b.q.rotate(sb1.scale(l1) + sb2.scale(l2)));
+    a.rotate(-a.q.rotate(sa1.scale(l1) + sa2.scale(l2)));
     (c1 * c1 + c2 * c2).sqrt()
+}
+
+/// The unit quaternion's rotation of +X (its matrix's first column).
+#[inline(always)]
+fn axis_x<L: Lane>(q: Quat<L>) -> Vec3<L> {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    Vec3::new(
+        one - two * (q.y * q.y + q.z * q.z),
+        two * (q.x * q.y + q.w * q.z),
+        two * (q.x * q.z - q.w * q.y),
+    )
+}
+
+/// The rotation of +Y (second column).
+#[inline(always)]
+fn axis_y<L: Lane>(q: Quat<L>) -> Vec3<L> {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    Vec3::new(
+        two * (q.x * q.y - q.w * q.z),
+        one - two * (q.x * q.x + q.z * q.z),
+        two * (q.y * q.z + q.w * q.x),
+    )
+}
+
+/// The rotation of +Z (third column).
+#[inline(always)]
+fn axis_z<L: Lane>(q: Quat<L>) -> Vec3<L> {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    Vec3::new(
+        two * (q.x * q.z + q.w * q.y),
+        two * (q.y * q.z - q.w * q.x),
+        one - two * (q.x * q.x + q.y * q.y),
+    )
 }
