@@ -146,6 +146,9 @@ fn impulses_are_held_to_the_speed_limits() {
     assert!((spin - config.max_angular_speed).abs() <= 1e-3 * config.max_angular_speed);
 }
 
+/// A call on the world.
+type Call = dyn Fn(&mut World) -> Result<(), Error>;
+
 /// Each refused call gives its error and leaves the state hash as it was.
 #[test]
 fn refused_impulses_change_nothing() {
@@ -157,7 +160,7 @@ fn refused_impulses_change_nothing() {
     other.remove_body(gone).unwrap();
     let centre = w.body(body).unwrap().position;
     let nan = Vec3::new(0.0, f32::NAN, 0.0);
-    let cases: Vec<(Error, Box<dyn Fn(&mut World) -> Result<(), Error>>)> = vec![
+    let cases: Vec<(Error, Box<Call>)> = vec![
         (
             Error::NotDynamic("an impulse"),
             Box::new(move |w| w.apply_impulse(fixed, Vec3::X)),
