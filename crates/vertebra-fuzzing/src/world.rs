@@ -129,9 +129,20 @@ pub(crate) fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) ->
     world.set_contacts(&contacts)
 }
 
+/// An impulse of one of the three kinds, at a point near the body or
+/// anywhere (static and kinematic bodies refuse them all).
+fn impulse(world: &mut World, body: BodyHandle, input: &mut Input) -> Result<(), Error> {
+    let impulse = input.vec3(100.0);
+    match input.pick(3) {
+        0 => world.apply_impulse(body, impulse),
+        1 => world.apply_impulse_at(body, impulse, input.vec3(5.0)),
+        _ => world.apply_angular_impulse(body, impulse),
+    }
+}
+
 /// One call chosen by the input; `Err` is a refusal.
 fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Error> {
-    match input.pick(11) {
+    match input.pick(12) {
         0 => add_body(world, input).map(|h| seen.bodies.push(h)),
         1 => match seen.body(input) {
             Some(h) => world.remove_body(h),
@@ -156,6 +167,10 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
             Some(h) => world.add_force(h, input.vec3(1000.0)),
             None => Ok(()),
         },
+        10 => match seen.body(input) {
+            Some(h) => impulse(world, h, input),
+            None => Ok(()),
+        },
         _ => world.step(if input.flag() {
             1.0 / 60.0
         } else {
@@ -165,7 +180,7 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
 }
 
 /// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
-/// removed, poses, velocities and forces set, steps) with arbitrary floats
+/// removed, poses, velocities, forces and impulses set, steps) with arbitrary floats
 /// one time in eight: no panic; every refused call leaves the world as it
 /// was; every body stays finite; no pending contact names a removed body;
 /// and the step's last-line NaN guard never fires (accepted input must

@@ -41,6 +41,7 @@ mod description;
 mod drive;
 mod error;
 mod mapping;
+mod motion;
 mod pose;
 mod ragdoll;
 

@@ -148,7 +148,7 @@ pub(crate) fn hold_speeds(b: &mut BodyStore, max_linear: f32, max_angular: f32) 
 
 /// `v` shortened to at most `max` (`v` itself when it is no longer), and
 /// finite even when a component overflowed to infinity.
-fn limit(v: Vec3, max: f32) -> Vec3 {
+pub(crate) fn limit(v: Vec3, max: f32) -> Vec3 {
     if v.length_squared() <= max * max {
         return v;
     }
