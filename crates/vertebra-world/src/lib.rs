@@ -25,6 +25,7 @@
 mod checks;
 mod config;
 mod contact;
+mod drive;
 mod layout;
 mod metrics;
 mod parallel;
@@ -42,10 +43,11 @@ pub use config::{
     MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
 };
 pub use contact::Contact;
+pub use drive::AngularDrive;
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use snapshot::Snapshot;
-pub use socket::{AngularDrive, SocketDesc, SocketHandle};
+pub use socket::{SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
@@ -346,7 +348,7 @@ impl World {
         let _mode = DefaultFloatMode::enter();
         let mut desc = self.socket(handle)?;
         if let Some(d) = &drive {
-            socket::validate_drive(d)?;
+            drive::validate_drive(d)?;
         }
         let regroup = desc.drive.is_some() != drive.is_some();
         desc.drive = drive;
