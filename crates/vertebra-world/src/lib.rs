@@ -43,7 +43,10 @@ pub use config::{
     MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
 };
 pub use contact::Contact;
-pub use drive::AngularDrive;
+pub use drive::{
+    AngularDrive, DriveStrength, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
+    MIN_DRIVE_FREQUENCY,
+};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use snapshot::Snapshot;
