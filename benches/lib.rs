@@ -5,7 +5,7 @@ use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
-use vertebra_kernels::socket::{PositionPass, SocketBlock, SocketLane};
+use vertebra_kernels::socket::{DriveLane, PositionPass, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::map::{LaneMap, map_arrays};
 use vertebra_math::{Backend, BackendChoice, Lane, Quat, Vec3, poly};
@@ -209,7 +209,12 @@ impl SocketWorkload {
                 frame_b: GQuat::from_rotation_z(0.3),
                 swing_max: 0.2,
                 twist: [-0.1, 0.1],
-                drive: drive.then_some((GQuat::from_rotation_x(0.2), 0.001, 1.0)),
+                drive: drive.then_some(DriveLane {
+                    target: GQuat::from_rotation_x(0.2),
+                    compliance: 0.001,
+                    damping_time: 0.001,
+                    ..DriveLane::OFF
+                }),
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }
@@ -234,12 +239,14 @@ impl ConstraintWorkload for SocketWorkload {
             self.backend.dispatch(PositionPass::<true> {
                 blocks,
                 rows,
+                inv_h: 60.0,
                 inv_h2: 3600.0,
             });
         } else {
             self.backend.dispatch(PositionPass::<false> {
                 blocks,
                 rows,
+                inv_h: 60.0,
                 inv_h2: 3600.0,
             });
         }

@@ -6,7 +6,7 @@ use glam::{Mat3, Vec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
-use vertebra_kernels::socket::{self, SocketBlock, SocketLane};
+use vertebra_kernels::socket::{self, DriveLane, SocketBlock, SocketLane};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::check::same_bits;
@@ -94,12 +94,13 @@ fn socket_block(input: &mut Input, rows: &RawRows) -> SocketBlock {
             frame_b: input.quat(),
             swing_max: input.float(PI).abs().min(PI),
             twist: sorted_range(input),
-            drive: input.flag().then(|| {
-                (
-                    input.quat(),
-                    input.float(1.0).abs(),
-                    input.float(10.0).abs(),
-                )
+            drive: input.flag().then(|| DriveLane {
+                target: input.quat(),
+                velocity: input.vec3(20.0),
+                compliance: input.float(1.0).abs(),
+                period2: input.float(1.0).abs(),
+                damping_time: input.float(1.0).abs(),
+                max_torque: input.float(100.0).abs(),
             }),
         };
         block.set(k, &lane);
@@ -166,9 +167,15 @@ fn run(
 ) -> Vec<f32> {
     let rows = BodyRows::from_raw(raw);
     let (mut sockets, mut rods, mut contacts) = ([blocks.0], [blocks.1], [blocks.2]);
+    backend.dispatch(socket::StartPass {
+        blocks: &mut sockets,
+        rows: &rows,
+        h: 1.0 / inv_h2.sqrt(),
+    });
     backend.dispatch(socket::PositionPass::<true> {
         blocks: &mut sockets,
         rows: &rows,
+        inv_h: inv_h2.sqrt(),
         inv_h2,
     });
     backend.dispatch(rod::PositionPass {

@@ -7,7 +7,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use glam::{Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
-    BodyHandle, BodyKind, Contact, RodDesc, RodStiffness, Snapshot, SocketDesc, SolverConfig, World,
+    AngularDrive, BodyHandle, BodyKind, Contact, DriveStrength, RodDesc, RodStiffness, Snapshot,
+    SocketDesc, SolverConfig, World,
 };
 
 use crate::input::Input;
@@ -112,6 +113,28 @@ fn quat(input: &mut Input, q: &mut Quat) {
     *q = Quat::from_array(a);
 }
 
+/// One field of a drive, crafted.
+fn drive(input: &mut Input, d: &mut AngularDrive) {
+    match input.pick(4) {
+        0 => quat(input, &mut d.target),
+        1 => vec3(input, &mut d.target_velocity),
+        2 => d.max_torque = value(input),
+        _ => {
+            d.strength = if input.flag() {
+                DriveStrength::Compliance {
+                    compliance: value(input),
+                    damping: value(input),
+                }
+            } else {
+                DriveStrength::Spring {
+                    frequency: value(input),
+                    damping_ratio: value(input),
+                }
+            }
+        }
+    }
+}
+
 fn mat3(input: &mut Input, m: &mut Mat3) {
     let mut a = m.to_cols_array();
     a[input.pick(9)] = value(input);
@@ -210,8 +233,7 @@ fn socket(input: &mut Input, state: &mut State) {
         5 => s.twist_limit = Some([value(input), value(input)]),
         6 => {
             if let Some(d) = s.drive.as_mut() {
-                quat(input, &mut d.target);
-                d.compliance = value(input);
+                drive(input, d);
             }
         }
         7 => state.sockets[slot] = None,

@@ -79,13 +79,25 @@ pub(crate) fn add_socket(
         socket = socket.with_twist_limit(input.float(4.0), input.float(4.0));
     }
     if input.flag() {
-        socket = socket.with_drive(AngularDrive {
-            target: input.quat(),
-            compliance: input.float(1.0),
-            damping: input.float(10.0),
-        });
+        socket = socket.with_drive(drive(input));
     }
     world.add_socket(socket)
+}
+
+/// A drive of either strength, moving or not, limited or not.
+fn drive(input: &mut Input) -> AngularDrive {
+    let target = input.quat();
+    let drive = if input.flag() {
+        AngularDrive::compliant(target, input.float(1.0), input.float(10.0))
+    } else {
+        AngularDrive::spring(target, input.float(50.0), input.float(2.0))
+    };
+    let drive = drive.with_target_velocity(input.vec3(20.0));
+    if input.flag() {
+        drive.with_max_torque(input.float(100.0))
+    } else {
+        drive
+    }
 }
 
 pub(crate) fn add_rod(

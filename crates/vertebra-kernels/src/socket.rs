@@ -11,7 +11,7 @@ use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
 use vertebra_math::{Lane, LaneKernel};
 
-use crate::body::{BodyPairs, BodyRows, VelocityLanes};
+use crate::body::{BodyPairs, BodyRows};
 use crate::parts::{drive, point, swing, twist};
 use crate::residual::Residual;
 
@@ -35,17 +35,30 @@ pub struct SocketBlock {
     pub twist_min: [f32; BLOCK_LANES],
     /// Highest twist angle (rad).
     pub twist_max: [f32; BLOCK_LANES],
-    /// Drive target: b's joint frame relative to a's.
+    /// Drive target of the current substep: b's joint frame relative to
+    /// a's (advanced by [`StartPass`] every substep).
     pub drive_target: QuatBlock,
-    /// Drive compliance (rad / (N m)); 0 is infinitely stiff.
+    /// Drive target angular velocity (rad/s, a's joint frame).
+    pub drive_velocity: Vec3Block,
+    /// Drive compliance (rad / (N m)); 0 with `drive_period2 = 0` is
+    /// infinitely stiff.
     pub drive_compliance: [f32; BLOCK_LANES],
+    /// Drive compliance per unit effective inverse inertia, `1 / omega^2`
+    /// (s^2), for drives given by frequency.
+    pub drive_period2: [f32; BLOCK_LANES],
+    /// Drive damping `gamma h` (s): compliance times damping, or
+    /// `2 zeta / omega`.
+    pub drive_damping_time: [f32; BLOCK_LANES],
+    /// Drive torque limit (N m), infinity for none.
+    pub drive_max_torque: [f32; BLOCK_LANES],
     /// 1 where the drive is on, 0 where off.
     pub drive_enabled: [f32; BLOCK_LANES],
-    /// Drive damping rate (1/s).
-    pub drive_damping: [f32; BLOCK_LANES],
     /// The drive's accumulated XPBD multiplier (world vector), reset every
     /// substep.
     pub drive_lambda: Vec3Block,
+    /// The drive's error at the substep's start (rad, world), measured by
+    /// [`StartPass`].
+    pub drive_start: Vec3Block,
 }
 
 /// One socket's solver data (one lane of a block).
@@ -71,8 +84,37 @@ pub struct SocketLane {
     pub swing_max: f32,
     /// Twist range (rad), `[-pi, pi]` when unlimited.
     pub twist: [f32; 2],
-    /// Drive target, compliance (rad/(N m)) and damping (1/s), if driven.
-    pub drive: Option<(GQuat, f32, f32)>,
+    /// The drive, if driven.
+    pub drive: Option<DriveLane>,
+}
+
+/// One socket's drive as the kernel holds it (see `parts::drive`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DriveLane {
+    /// The target at the step's start: b's joint frame relative to a's.
+    pub target: GQuat,
+    /// The target's angular velocity (rad/s, a's joint frame).
+    pub velocity: GVec3,
+    /// Compliance (rad / (N m)).
+    pub compliance: f32,
+    /// `1 / omega^2` (s^2).
+    pub period2: f32,
+    /// `gamma h` (s).
+    pub damping_time: f32,
+    /// Torque limit (N m), infinity for none.
+    pub max_torque: f32,
+}
+
+impl DriveLane {
+    /// What a plain socket's lane holds: nothing that pulls.
+    pub const OFF: Self = Self {
+        target: GQuat::IDENTITY,
+        velocity: GVec3::ZERO,
+        compliance: 0.0,
+        period2: 0.0,
+        damping_time: 0.0,
+        max_torque: f32::INFINITY,
+    };
 }
 
 impl SocketBlock {
@@ -115,12 +157,16 @@ impl SocketBlock {
         self.frame_b.set(lane, s.frame_b);
         self.swing_max[lane] = s.swing_max;
         (self.twist_min[lane], self.twist_max[lane]) = (s.twist[0], s.twist[1]);
-        let (target, compliance, damping) = s.drive.unwrap_or((GQuat::IDENTITY, 0.0, 0.0));
-        self.drive_target.set(lane, target);
-        self.drive_compliance[lane] = compliance;
-        self.drive_damping[lane] = damping;
+        let d = s.drive.unwrap_or(DriveLane::OFF);
+        self.drive_target.set(lane, d.target);
+        self.drive_velocity.set(lane, d.velocity);
+        self.drive_compliance[lane] = d.compliance;
+        self.drive_period2[lane] = d.period2;
+        self.drive_damping_time[lane] = d.damping_time;
+        self.drive_max_torque[lane] = d.max_torque;
         self.drive_enabled[lane] = if s.drive.is_some() { 1.0 } else { 0.0 };
         self.drive_lambda.set(lane, GVec3::ZERO);
+        self.drive_start.set(lane, GVec3::ZERO);
     }
 }
 
@@ -135,7 +181,9 @@ pub struct PositionPass<'a, const DRIVE: bool> {
     pub blocks: &'a mut [SocketBlock],
     /// Body rows, read and written.
     pub rows: &'a BodyRows,
-    /// `1 / h^2` for the substep `h` (s^-2): `alpha~ = compliance / h^2`.
+    /// `1 / h` for the substep `h` (s^-1): the drive's `gamma`.
+    pub inv_h: f32,
+    /// `1 / h^2` (s^-2): `alpha~ = compliance / h^2`.
     pub inv_h2: f32,
 }
 
@@ -143,10 +191,10 @@ impl<const DRIVE: bool> LaneKernel for PositionPass<'_, DRIVE> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let inv_h2 = L::splat(self.inv_h2);
+        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
         for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h2);
+                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h, inv_h2);
             }
         }
     }
@@ -157,6 +205,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     block: &mut SocketBlock,
     start: usize,
     rows: &BodyRows,
+    inv_h: L,
     inv_h2: L,
 ) {
     let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
@@ -165,19 +214,8 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
 
     if DRIVE {
         let lambda = block.drive_lambda.load::<L>(start);
-        let alpha_tilde = L::load(&block.drive_compliance[start..]) * inv_h2;
-        let enabled = L::load(&block.drive_enabled[start..]);
-        let target = block.drive_target.load::<L>(start);
-        let lambda = drive::solve(
-            &mut a,
-            &mut b,
-            frame_a,
-            frame_b,
-            target,
-            enabled,
-            alpha_tilde,
-            lambda,
-        );
+        let d = drive_lanes(block, start);
+        let lambda = drive::solve(&mut a, &mut b, frame_a, frame_b, &d, inv_h, inv_h2, lambda);
         block.drive_lambda.store(start, lambda);
     }
 
@@ -204,34 +242,55 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     block.bodies.scatter(rows, start, &a, &b);
 }
 
-/// The velocity pass: drive damping, `min(damping h, 1)` of the relative
-/// angular velocity removed per substep of `h` seconds. Only driven blocks
-/// need it.
-pub struct VelocityPass<'a> {
+/// A driven lane's settings as the drive part reads them.
+#[inline(always)]
+fn drive_lanes<L: Lane>(block: &SocketBlock, start: usize) -> drive::Drive<L> {
+    drive::Drive {
+        target: block.drive_target.load(start),
+        compliance: L::load(&block.drive_compliance[start..]),
+        period2: L::load(&block.drive_period2[start..]),
+        damping_time: L::load(&block.drive_damping_time[start..]),
+        max_torque: L::load(&block.drive_max_torque[start..]),
+        enabled: L::load(&block.drive_enabled[start..]),
+        start: block.drive_start.load(start),
+    }
+}
+
+/// The drives' substep start (before the bodies are predicted): each
+/// error measured against the last substep's target, then the target
+/// advanced by `h` at its angular velocity (`parts::drive`). Only driven
+/// blocks need it.
+pub struct StartPass<'a> {
     /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a [SocketBlock],
-    /// Body rows: poses and inertia read, velocities read and written.
+    pub blocks: &'a mut [SocketBlock],
+    /// Body rows, read.
     pub rows: &'a BodyRows,
     /// The substep (s).
     pub h: f32,
 }
 
-impl LaneKernel for VelocityPass<'_> {
+impl LaneKernel for StartPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
         let h = L::splat(self.h);
-        for block in self.blocks {
+        for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
                 let (a, b) = block.bodies.gather::<L>(self.rows, start);
-                let mut va = VelocityLanes::<L>::gather(self.rows, &block.bodies.body_a[start..]);
-                let mut vb = VelocityLanes::<L>::gather(self.rows, &block.bodies.body_b[start..]);
-                let rate =
-                    L::load(&block.drive_damping[start..]) * L::load(&block.drive_enabled[start..]);
-                let fraction = (rate * h).min(L::splat(1.0));
-                drive::damp(&a, &b, &mut va, &mut vb, fraction);
-                va.scatter(self.rows, &block.bodies.write_a[start..]);
-                vb.scatter(self.rows, &block.bodies.write_b[start..]);
+                let target = block.drive_target.load::<L>(start);
+                let error = drive::start(
+                    &a,
+                    &b,
+                    block.frame_a.load(start),
+                    block.frame_b.load(start),
+                    target,
+                    L::load(&block.drive_enabled[start..]),
+                );
+                block.drive_start.store(start, error);
+                let velocity = block.drive_velocity.load(start);
+                block
+                    .drive_target
+                    .store(start, drive::advance(target, velocity, h));
             }
         }
     }

@@ -17,8 +17,17 @@ use crate::ragdoll::{Ragdoll, rod_name};
 pub enum Strength {
     /// Zero compliance: the target is a hard constraint.
     Infinite,
-    /// XPBD compliance (rad / (N m)): time-step and iteration independent.
+    /// XPBD compliance (rad / (N m)): time-step and iteration independent;
+    /// damped by [`DriveSettings::damping`].
     Compliance(f32),
+    /// A damped spring of natural frequency (Hz) and damping ratio (1 is
+    /// critical) on each joint's own effective inertia.
+    Spring {
+        /// Natural frequency (Hz).
+        frequency: f32,
+        /// Damping ratio.
+        damping_ratio: f32,
+    },
 }
 
 /// Drive settings for a whole ragdoll, with optional per-joint overrides.
@@ -26,46 +35,79 @@ pub enum Strength {
 pub struct DriveSettings {
     /// The strength of every joint without an override.
     pub strength: Strength,
-    /// Damping rate (1/s) of the sockets' drives.
+    /// Damping coefficient (N m s / rad) of joints driven by
+    /// [`Strength::Compliance`] (a spring's damping is its ratio).
     pub damping: f32,
+    /// The largest torque (N m) each joint's drive exerts; infinity is
+    /// unlimited.
+    pub max_torque: f32,
     /// Per described joint, an override (empty: none). A simplified
     /// ragdoll's rod takes the override of the spine's first joint.
     pub joints: Vec<Option<Strength>>,
 }
 
 impl DriveSettings {
-    /// Every joint at `strength`, no damping, no overrides.
+    /// Every joint at `strength`, no damping, no torque limit, no
+    /// overrides.
     pub fn uniform(strength: Strength) -> Self {
         Self {
             strength,
             damping: 0.0,
+            max_torque: f32::INFINITY,
             joints: Vec::new(),
         }
     }
 
+    /// With a damping coefficient (N m s / rad).
+    pub fn with_damping(mut self, damping: f32) -> Self {
+        self.damping = damping;
+        self
+    }
+
+    /// With a torque limit (N m).
+    pub fn with_max_torque(mut self, max_torque: f32) -> Self {
+        self.max_torque = max_torque;
+        self
+    }
+
+    /// The drive `strength` gives a socket aimed at `target`.
+    fn socket_drive(&self, strength: Strength, target: Quat) -> AngularDrive {
+        let drive = match strength {
+            Strength::Infinite => AngularDrive::rigid(target),
+            Strength::Compliance(c) => AngularDrive::compliant(target, c, self.damping),
+            Strength::Spring {
+                frequency,
+                damping_ratio,
+            } => AngularDrive::spring(target, frequency, damping_ratio),
+        };
+        drive.with_max_torque(self.max_torque)
+    }
+
     fn validate(&self, joints: usize) -> Result<(), RagdollError> {
-        let bad =
-            |s: &Strength| matches!(s, Strength::Compliance(c) if !(c.is_finite() && *c >= 0.0));
-        if bad(&self.strength) || self.joints.iter().flatten().any(bad) {
-            return Err(RagdollError::OutOfRange {
-                context: "drive".to_owned(),
-                field: "compliance",
-                reason: "must be finite and not negative".to_owned(),
-            });
-        }
+        let out = |field: &'static str, reason: &str| RagdollError::OutOfRange {
+            context: "drive".to_owned(),
+            field,
+            reason: reason.to_owned(),
+        };
         if !(self.damping.is_finite() && self.damping >= 0.0) {
-            return Err(RagdollError::OutOfRange {
-                context: "drive".to_owned(),
-                field: "damping",
-                reason: "must be finite and not negative".to_owned(),
-            });
+            return Err(out("damping", "must be finite and not negative"));
+        }
+        if self.max_torque.is_nan() || self.max_torque < 0.0 {
+            return Err(out("max_torque", "must be a number, not negative"));
+        }
+        for s in core::iter::once(&self.strength).chain(self.joints.iter().flatten()) {
+            // The world checks every range; a strength is tried on an
+            // identity drive so that a refusal names the settings' field.
+            if let Err(e) = self.socket_drive(*s, Quat::IDENTITY).validate() {
+                let field = match s {
+                    Strength::Spring { .. } => "strength (frequency, damping ratio)",
+                    _ => "strength (compliance, damping)",
+                };
+                return Err(out(field, &e.to_string()));
+            }
         }
         if !self.joints.is_empty() && self.joints.len() != joints {
-            return Err(RagdollError::OutOfRange {
-                context: "drive".to_owned(),
-                field: "joints",
-                reason: format!("needs {joints} entries or none"),
-            });
+            return Err(out("joints", &format!("needs {joints} entries or none")));
         }
         Ok(())
     }
@@ -76,6 +118,26 @@ impl DriveSettings {
             .copied()
             .flatten()
             .unwrap_or(self.strength)
+    }
+}
+
+/// The rod's bending and twisting stiffness for a drive strength, when it
+/// replaces `joints` sockets in series: each socket of compliance `c`
+/// turns by `c tau` under a torque `tau`, the chain by `joints c tau`, and
+/// a rod of Kirchhoff stiffness `k` by `(l0 / k) tau`; so
+/// `k = l0 / (joints c)`. A spring strength is refused: the rod's parts
+/// have no frequency form yet (`docs/ragdolls.md`, "Drives").
+fn rod_stiffness(
+    strength: Strength,
+    rest: &vertebra_world::RodDesc,
+    joints: usize,
+) -> Result<RodStiffness, &'static str> {
+    match strength {
+        Strength::Infinite => Ok(RodStiffness::Kirchhoff(f32::INFINITY)),
+        Strength::Compliance(c) => Ok(RodStiffness::Kirchhoff(
+            rest.rest_length / (joints.max(1) as f32 * c),
+        )),
+        Strength::Spring { .. } => Err("a rod spine takes compliance strengths only"),
     }
 }
 
@@ -95,15 +157,7 @@ impl Ragdoll {
             let frame = Quat::from_rotation_arc(Vec3::X, j.axis);
             let relative =
                 (target.bones[j.parent].1 * frame).inverse() * (target.bones[j.child].1 * frame);
-            let compliance = match settings.strength(k) {
-                Strength::Infinite => 0.0,
-                Strength::Compliance(c) => c,
-            };
-            let drive = AngularDrive {
-                target: relative.normalize(),
-                compliance,
-                damping: settings.damping,
-            };
+            let drive = settings.socket_drive(settings.strength(k), relative.normalize());
             world
                 .set_socket_drive(*socket, Some(drive))
                 .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
@@ -115,10 +169,16 @@ impl Ragdoll {
             );
             let (f0, f1) = (base * rest.frame_a, top * rest.frame_b);
             let tb = f1 * Vec3::X;
-            let stiffness = match settings.strength(spine.joints[0]) {
-                Strength::Infinite => RodStiffness::Kirchhoff(f32::INFINITY),
-                Strength::Compliance(c) => RodStiffness::Kirchhoff(rest.rest_length / c),
-            };
+            let stiffness = rod_stiffness(
+                settings.strength(spine.joints[0]),
+                &rest,
+                spine.joints.len(),
+            )
+            .map_err(|reason| RagdollError::OutOfRange {
+                context: rod_name(&self.desc),
+                field: "drive strength",
+                reason: reason.to_owned(),
+            })?;
             let mut driven = rest.with_stiffness(stiffness, stiffness);
             driven.bend_rest = (f0.inverse() * tb).normalize();
             driven.twist_rest = crate::mapping::rod_twist(f0, f1);

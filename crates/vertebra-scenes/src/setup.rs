@@ -263,13 +263,8 @@ fn fix(world: &mut World, body: BodyHandle) -> Result<(), RagdollError> {
             .with_position(at)
             .with_orientation(world.body(body)?.orientation),
     )?;
-    let pin = SocketDesc::at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?.with_drive(
-        AngularDrive {
-            target: Quat::IDENTITY,
-            compliance: 0.0,
-            damping: 0.0,
-        },
-    );
+    let pin = SocketDesc::at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?
+        .with_drive(AngularDrive::rigid(Quat::IDENTITY));
     world.add_socket(pin)?;
     Ok(())
 }

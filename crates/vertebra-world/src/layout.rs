@@ -228,9 +228,7 @@ pub(crate) fn socket_lane(desc: &SocketDesc, bodies: &BodyStore) -> SocketLane {
         frame_b: desc.frame_b.normalize(),
         swing_max: desc.swing_limit.unwrap_or(PI),
         twist: desc.twist_limit.unwrap_or([-PI, PI]),
-        drive: desc
-            .drive
-            .map(|d| (d.target.normalize(), d.compliance, d.damping)),
+        drive: desc.drive.map(|d| d.lane()),
     }
 }
 

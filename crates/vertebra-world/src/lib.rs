@@ -25,6 +25,7 @@
 mod checks;
 mod config;
 mod contact;
+mod drive;
 mod impulse;
 mod layout;
 mod metrics;
@@ -43,10 +44,14 @@ pub use config::{
     MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
 };
 pub use contact::Contact;
+pub use drive::{
+    AngularDrive, DriveStrength, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
+    MIN_DRIVE_FREQUENCY,
+};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use snapshot::Snapshot;
-pub use socket::{AngularDrive, SocketDesc, SocketHandle};
+pub use socket::{SocketDesc, SocketHandle};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
@@ -403,7 +408,7 @@ impl World {
         let _mode = DefaultFloatMode::enter();
         let mut desc = self.socket(handle)?;
         if let Some(d) = &drive {
-            socket::validate_drive(d)?;
+            drive::validate_drive(d)?;
         }
         let regroup = desc.drive.is_some() != drive.is_some();
         desc.drive = drive;

@@ -1,5 +1,6 @@
 //! The socket joint's public description and its validation.
 
+use crate::drive::{AngularDrive, validate_drive};
 use glam::{Quat, Vec3};
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
@@ -11,18 +12,6 @@ pub enum SocketTag {}
 
 /// A stable reference to a socket joint.
 pub type SocketHandle = Handle<SocketTag>;
-
-/// Drives a socket's body b toward an orientation relative to body a.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct AngularDrive {
-    /// b's joint frame relative to a's joint frame (unit quaternion).
-    pub target: Quat,
-    /// Compliance (rad / (N m)), the inverse of stiffness; 0 is infinitely
-    /// stiff. Independent of the time step and iteration count (XPBD).
-    pub compliance: f32,
-    /// Damping rate (1/s) of the relative angular velocity.
-    pub damping: f32,
-}
 
 /// A ball-and-socket joint between two bodies.
 ///
@@ -122,21 +111,4 @@ impl SocketDesc {
         self.validate()?;
         crate::checks::joint_bodies(bodies, self.body_a, self.body_b)
     }
-}
-
-/// Checks a drive's target, compliance and damping.
-pub(crate) fn validate_drive(d: &AngularDrive) -> Result<(), Error> {
-    check_unit_quat("drive target", d.target)?;
-    for (what, x) in [
-        ("drive compliance", d.compliance),
-        ("drive damping", d.damping),
-    ] {
-        if !x.is_finite() {
-            return Err(Error::NonFinite(what));
-        }
-        if x < 0.0 {
-            return Err(Error::NonPositive(what));
-        }
-    }
-    Ok(())
 }

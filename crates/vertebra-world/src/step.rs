@@ -6,7 +6,7 @@ use glam::{Quat, Vec3};
 use vertebra_kernels::body::BodyRows;
 use vertebra_kernels::contact::{self, ContactBlock};
 use vertebra_kernels::rod::{self, RodBlock};
-use vertebra_kernels::socket::{PositionPass, SocketBlock, VelocityPass};
+use vertebra_kernels::socket::{PositionPass, SocketBlock, StartPass};
 use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
 
@@ -21,6 +21,7 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         .previous
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
     for _ in 0..world.config.substeps {
+        start_drives(world, h);
         predict(world, h);
         for block in &mut world.layout.sockets.blocks {
             block.drive_lambda = vertebra_math::block::Vec3Block::default();
@@ -45,9 +46,42 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         world.repaired += repair(world);
     }
     commit(world);
+    keep_drive_targets(world);
     let bodies = &mut world.bodies;
     bodies.force.iter_mut().for_each(|f| *f = Vec3::ZERO);
     bodies.torque.iter_mut().for_each(|t| *t = Vec3::ZERO);
+}
+
+/// The drives' substep start, before the bodies move: each drive's error
+/// against the last substep's target, then the target advanced by `h`.
+/// Every driven block, one after another, on the world's backend (each
+/// lane reads and writes only its own block).
+fn start_drives(world: &mut World, h: f32) {
+    let rows = &*world.rows.get();
+    let layout = &mut world.layout;
+    for group in layout
+        .colours
+        .iter()
+        .chain(core::iter::once(&layout.overflow))
+    {
+        world.backend.dispatch(StartPass {
+            blocks: &mut layout.sockets.blocks[group.driven.clone()],
+            rows,
+            h,
+        });
+    }
+}
+
+/// Writes each driven socket's advanced target back to its description,
+/// so that the next step (and a snapshot, and a new layout) starts where
+/// this one ended.
+fn keep_drive_targets(world: &mut World) {
+    for (slot, desc) in world.sockets.iter_mut().enumerate() {
+        if let Some(drive) = desc.as_mut().and_then(|d| d.drive.as_mut()) {
+            let (block, lane) = world.layout.sockets.place[slot];
+            drive.target = world.layout.sockets.blocks[block].drive_target.get(lane);
+        }
+    }
 }
 
 /// Rows for every slot (stale slots hold harmless old data: no joint
@@ -281,22 +315,25 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
 
 /// The position iteration.
 struct Positions {
+    inv_h: f32,
     inv_h2: f32,
 }
 
 impl Pass for Positions {
     fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
-        let inv_h2 = self.inv_h2;
+        let (inv_h, inv_h2) = (self.inv_h, self.inv_h2);
         if driven {
             backend.dispatch(PositionPass::<true> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             });
         } else {
             backend.dispatch(PositionPass::<false> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             });
         }
@@ -313,23 +350,15 @@ impl Pass for Positions {
     }
 }
 
-/// The velocity pass (drive damping, contact friction and restitution;
-/// rods have none).
+/// The velocity pass (contact friction and restitution; joints have none:
+/// drives damp at the position level).
 struct Velocities {
     h: f32,
     resting_speed: f32,
 }
 
 impl Pass for Velocities {
-    fn sockets(&self, blocks: &mut [SocketBlock], driven: bool, rows: &BodyRows, backend: Backend) {
-        if driven {
-            backend.dispatch(VelocityPass {
-                blocks,
-                rows,
-                h: self.h,
-            });
-        }
-    }
+    fn sockets(&self, _: &mut [SocketBlock], _: bool, _: &BodyRows, _: Backend) {}
     fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
         let (h, resting_speed) = (self.h, self.resting_speed);
@@ -346,6 +375,7 @@ fn solve_positions(world: &mut World, h: f32) {
     for_each_colour(
         world,
         &Positions {
+            inv_h: 1.0 / h,
             inv_h2: 1.0 / (h * h),
         },
     );

@@ -210,20 +210,12 @@ fn bad_joints_are_refused() {
     });
     rejected(Error::NonPositive("drive compliance"), |w| {
         let s = w.residuals().sockets[0].joint;
-        let drive = AngularDrive {
-            target: Quat::IDENTITY,
-            compliance: -1.0,
-            damping: 0.0,
-        };
+        let drive = AngularDrive::compliant(Quat::IDENTITY, -1.0, 0.0);
         w.set_socket_drive(s, Some(drive))
     });
     rejected(Error::NotNormalized("drive target"), |w| {
         let s = w.residuals().sockets[0].joint;
-        let drive = AngularDrive {
-            target: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
-            compliance: 0.0,
-            damping: 0.0,
-        };
+        let drive = AngularDrive::rigid(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0));
         w.set_socket_drive(s, Some(drive))
     });
 }
