@@ -288,6 +288,7 @@ impl RodWorkload {
                 twist: RodSoftness::Compliance(0.06),
                 bend_max: 0.3,
                 twist_range: [-0.1, 0.1],
+                max_torque: f32::INFINITY,
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }
@@ -310,6 +311,7 @@ impl ConstraintWorkload for RodWorkload {
         self.backend.dispatch(rod::PositionPass {
             blocks,
             rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
     }

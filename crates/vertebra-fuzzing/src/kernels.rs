@@ -63,10 +63,17 @@ fn sorted_range(input: &mut Input) -> [f32; 2] {
 }
 
 fn softness(input: &mut Input) -> RodSoftness {
-    if input.flag() {
-        RodSoftness::Compliance(input.float(1.0).abs())
-    } else {
-        RodSoftness::Relaxation(input.float(1.0).abs().min(1.0))
+    match input.pick(4) {
+        0 => RodSoftness::Compliance(input.float(1.0).abs()),
+        1 => RodSoftness::Damped {
+            compliance: input.float(1.0).abs(),
+            damping_time: input.float(1.0).abs(),
+        },
+        2 => RodSoftness::Spring {
+            period2: input.float(1.0).abs(),
+            damping_time: input.float(1.0).abs(),
+        },
+        _ => RodSoftness::Relaxation(input.float(1.0).abs().min(1.0)),
     }
 }
 
@@ -127,6 +134,7 @@ fn rod_block(input: &mut Input, rows: &RawRows) -> RodBlock {
             twist: softness(input),
             bend_max: input.float(PI).abs().min(PI),
             twist_range: sorted_range(input),
+            max_torque: input.float(100.0).abs(),
         };
         block.set(k, &lane);
         block.bodies.set_start(k, &start(input));
@@ -178,9 +186,14 @@ fn run(
         inv_h: inv_h2.sqrt(),
         inv_h2,
     });
+    backend.dispatch(rod::StartPass {
+        blocks: &mut rods,
+        rows: &rows,
+    });
     backend.dispatch(rod::PositionPass {
         blocks: &mut rods,
         rows: &rows,
+        inv_h: inv_h2.sqrt(),
         inv_h2,
     });
     backend.dispatch(contact::PositionPass {

@@ -252,15 +252,28 @@ fn rod(input: &mut Input, state: &mut State) {
     let Some(r) = state.rods[slot].as_mut() else {
         return slots(input, &mut state.rod_slots);
     };
-    match input.pick(11) {
+    match input.pick(14) {
         0 => r.body_a = handle,
         1 => r.body_b = handle,
         2 => quat(input, &mut r.frame_a),
+        10 => r.max_torque = value(input),
+        12 => r.twisting = RodStiffness::Relaxation(value(input)),
+        11 => {
+            r.bending = RodStiffness::Spring {
+                frequency: value(input),
+                damping_ratio: value(input),
+            }
+        }
         3 => r.rest_length = value(input),
         4 => vec3(input, &mut r.bend_rest),
         5 => r.twist_rest = value(input),
         6 => r.bending = RodStiffness::Kirchhoff(value(input)),
-        7 => r.twisting = RodStiffness::Relaxation(value(input)),
+        7 => {
+            r.twisting = RodStiffness::Damped {
+                stiffness: value(input),
+                damping: value(input),
+            }
+        }
         8 => r.bend_limit = limit(input),
         9 => state.rods[slot] = None,
         _ => slots(input, &mut state.rod_slots),

@@ -109,10 +109,11 @@ pub(crate) fn add_rod(
         return Err(Error::SameBody);
     };
     let through: Vec<Vec3> = (0..input.pick(3)).map(|_| input.vec3(5.0)).collect();
-    let mut rod = RodDesc::from_pose(world.bodies(), a, b, &through)?.with_stiffness(
-        RodStiffness::Kirchhoff(input.float(100.0)),
-        RodStiffness::Kirchhoff(input.float(100.0)),
-    );
+    let mut rod = RodDesc::from_pose(world.bodies(), a, b, &through)?
+        .with_stiffness(rod_stiffness(input), rod_stiffness(input));
+    if input.flag() {
+        rod = rod.with_max_torque(input.float(100.0));
+    }
     if input.flag() {
         rod = rod.with_bend_limit(input.float(4.0));
     }
@@ -120,6 +121,22 @@ pub(crate) fn add_rod(
         rod = rod.with_twist_limit(input.float(4.0), input.float(4.0));
     }
     world.add_rod(rod)
+}
+
+/// Any of a rod's stiffness forms, with values the world may refuse.
+fn rod_stiffness(input: &mut Input) -> RodStiffness {
+    match input.pick(4) {
+        0 => RodStiffness::Damped {
+            stiffness: input.float(100.0),
+            damping: input.float(100.0),
+        },
+        1 => RodStiffness::Spring {
+            frequency: input.float(20.0),
+            damping_ratio: input.float(4.0),
+        },
+        2 => RodStiffness::Relaxation(input.float(1.0)),
+        _ => RodStiffness::Kirchhoff(input.float(100.0)),
+    }
 }
 
 pub(crate) fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) -> Result<(), Error> {

@@ -249,5 +249,6 @@ pub(crate) fn rod_lane(desc: &RodDesc, bodies: &BodyStore) -> RodLane {
         twist: desc.softness(desc.twisting),
         bend_max: desc.bend_limit.unwrap_or(PI),
         twist_range: desc.twist_limit.unwrap_or([-PI, PI]),
+        max_torque: desc.max_torque,
     }
 }

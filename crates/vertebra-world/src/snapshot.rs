@@ -54,7 +54,7 @@ use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 use crate::{Contact, RodDesc, SocketDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
-const FORMAT: u8 = b'4';
+const FORMAT: u8 = b'5';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
@@ -390,6 +390,19 @@ mod tests {
             (
                 Box::new(|s| s.rods[0].as_mut().unwrap().rest_length = -0.4),
                 "rod 0: rod rest length must be positive",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().max_torque = NAN),
+                "rod 0: rod max torque is not finite",
+            ),
+            (
+                Box::new(|s| {
+                    s.rods[0].as_mut().unwrap().bending = RodStiffness::Spring {
+                        frequency: 2.0,
+                        damping_ratio: 2e3,
+                    }
+                }),
+                "rod 0: rod damping ratio (at most 1e3) is out of range",
             ),
             (
                 Box::new(|s| s.bodies.inverse_mass[1] = NAN),

@@ -53,7 +53,8 @@ pub(crate) fn step(world: &mut World, dt: f32) {
 }
 
 /// The drives' substep start, before the bodies move: each drive's error
-/// against the last substep's target, then the target advanced by `h`.
+/// against the last substep's target, then the target advanced by `h`;
+/// each rod's bend and twist error (its soft parts damp against them).
 /// Every driven block, one after another, on the world's backend (each
 /// lane reads and writes only its own block).
 fn start_drives(world: &mut World, h: f32) {
@@ -68,6 +69,10 @@ fn start_drives(world: &mut World, h: f32) {
             blocks: &mut layout.sockets.blocks[group.driven.clone()],
             rows,
             h,
+        });
+        world.backend.dispatch(rod::StartPass {
+            blocks: &mut layout.rods.blocks[group.rods.clone()],
+            rows,
         });
     }
 }
@@ -342,6 +347,7 @@ impl Pass for Positions {
         backend.dispatch(rod::PositionPass {
             blocks,
             rows,
+            inv_h: self.inv_h,
             inv_h2: self.inv_h2,
         });
     }

@@ -364,6 +364,60 @@ fn bad_rods_are_refused() {
             .with_stiffness(RodStiffness::Kirchhoff(-2.0), RodStiffness::Kirchhoff(1.0));
         w.add_rod(r).map(drop)
     });
+    rejected_after(above, Error::NonPositive("rod max torque"), |w, ends| {
+        w.add_rod(rod(w, ends)?.with_max_torque(-1.0)).map(drop)
+    });
+    rejected_after(above, Error::NonFinite("rod max torque"), |w, ends| {
+        w.add_rod(rod(w, ends)?.with_max_torque(f32::NAN)).map(drop)
+    });
+    rejected_after(
+        above,
+        Error::NonFinite("rod twisting damping"),
+        |w, ends| {
+            let damped = RodStiffness::Damped {
+                stiffness: 1.0,
+                damping: f32::INFINITY,
+            };
+            let r = rod(w, ends)?.with_stiffness(RodStiffness::Kirchhoff(1.0), damped);
+            w.add_rod(r).map(drop)
+        },
+    );
+    rejected_after(
+        above,
+        Error::OutOfRange("rod damping (damping over stiffness at most 1e6 s)"),
+        |w, ends| {
+            let damped = RodStiffness::Damped {
+                stiffness: 1e-9,
+                damping: 1.0,
+            };
+            w.add_rod(rod(w, ends)?.with_stiffness(damped, damped))
+                .map(drop)
+        },
+    );
+    rejected_after(
+        above,
+        Error::OutOfRange("rod frequency (at least 1e-3 Hz)"),
+        |w, ends| {
+            let spring = RodStiffness::Spring {
+                frequency: 0.0,
+                damping_ratio: 1.0,
+            };
+            w.add_rod(rod(w, ends)?.with_stiffness(spring, spring))
+                .map(drop)
+        },
+    );
+    rejected_after(
+        above,
+        Error::NonPositive("rod bending damping ratio"),
+        |w, ends| {
+            let spring = RodStiffness::Spring {
+                frequency: 2.0,
+                damping_ratio: -1.0,
+            };
+            w.add_rod(rod(w, ends)?.with_stiffness(spring, spring))
+                .map(drop)
+        },
+    );
     rejected_after(above, Error::InvalidLimit("bend"), |w, ends| {
         let r = rod(w, ends)?.with_bend_limit(4.0);
         w.add_rod(r).map(drop)
