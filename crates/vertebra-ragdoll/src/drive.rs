@@ -3,7 +3,8 @@
 //!
 //! Sockets use their angular drive; the rod is driven through its rest
 //! shape: its rest bend and twist become the target pose's, and its
-//! bending and twisting take the drive's strength.
+//! bending and twisting take the drive's strength, damping and torque
+//! limit (mapped from the sockets it replaces: `rod_stiffness`).
 
 use glam::{Quat, Vec3};
 use vertebra_world::{AngularDrive, RodStiffness, World};
@@ -121,23 +122,36 @@ impl DriveSettings {
     }
 }
 
-/// The rod's bending and twisting stiffness for a drive strength, when it
-/// replaces `joints` sockets in series: each socket of compliance `c`
-/// turns by `c tau` under a torque `tau`, the chain by `joints c tau`, and
-/// a rod of Kirchhoff stiffness `k` by `(l0 / k) tau`; so
-/// `k = l0 / (joints c)`. A spring strength is refused: the rod's parts
-/// have no frequency form yet (`docs/ragdolls.md`, "Drives").
+/// The rod's bending and twisting for a drive strength, when it replaces
+/// `joints` sockets in series (each a spring-damper of compliance `c` and
+/// damping `D`). In series every socket carries the same torque `tau`, so
+/// each turns by the same `C_i` with `tau = C_i / c + D C_i'`, and the
+/// chain by `C = n C_i`: `tau = C / (n c) + (D / n) C'`. The rod's torque is
+/// `(k / l0) C + (d / l0) C'`, so `k = l0 / (n c)` and `d = l0 D / n` (its
+/// damping time `d / k = c D`, the socket's). A spring strength is the
+/// rod's own spring at that frequency and ratio (on its effective
+/// inertia); infinite strength is a rigid rod. `docs/ragdolls.md`,
+/// "Drives", measures the two spines against each other.
 fn rod_stiffness(
     strength: Strength,
-    rest: &vertebra_world::RodDesc,
+    damping: f32,
+    rest_length: f32,
     joints: usize,
-) -> Result<RodStiffness, &'static str> {
+) -> RodStiffness {
+    let n = joints.max(1) as f32;
     match strength {
-        Strength::Infinite => Ok(RodStiffness::Kirchhoff(f32::INFINITY)),
-        Strength::Compliance(c) => Ok(RodStiffness::Kirchhoff(
-            rest.rest_length / (joints.max(1) as f32 * c),
-        )),
-        Strength::Spring { .. } => Err("a rod spine takes compliance strengths only"),
+        Strength::Infinite => RodStiffness::Kirchhoff(f32::INFINITY),
+        Strength::Compliance(c) => RodStiffness::Damped {
+            stiffness: rest_length / (n * c),
+            damping: rest_length * damping / n,
+        },
+        Strength::Spring {
+            frequency,
+            damping_ratio,
+        } => RodStiffness::Spring {
+            frequency,
+            damping_ratio,
+        },
     }
 }
 
@@ -171,15 +185,13 @@ impl Ragdoll {
             let tb = f1 * Vec3::X;
             let stiffness = rod_stiffness(
                 settings.strength(spine.joints[0]),
-                &rest,
+                settings.damping,
+                rest.rest_length,
                 spine.joints.len(),
-            )
-            .map_err(|reason| RagdollError::OutOfRange {
-                context: rod_name(&self.desc),
-                field: "drive strength",
-                reason: reason.to_owned(),
-            })?;
-            let mut driven = rest.with_stiffness(stiffness, stiffness);
+            );
+            let mut driven = rest
+                .with_stiffness(stiffness, stiffness)
+                .with_max_torque(settings.max_torque);
             driven.bend_rest = (f0.inverse() * tb).normalize();
             driven.twist_rest = crate::mapping::rod_twist(f0, f1);
             world
