@@ -348,6 +348,7 @@ impl ContactWorkload {
                 friction: 0.6,
                 restitution: 0.2,
                 approach: -1.0,
+                overlap: 0.0,
                 start: StartLane::default(),
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);

@@ -157,6 +157,7 @@ fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
             friction: input.float(2.0).abs(),
             restitution: input.float(1.0).abs().min(1.0),
             approach: input.float(10.0),
+            overlap: input.float(0.1).abs(),
             start: start(input),
         };
         block.set(k, &lane);

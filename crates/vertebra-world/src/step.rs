@@ -20,7 +20,8 @@ pub(crate) fn step(world: &mut World, dt: f32) {
     world
         .previous
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
-    for _ in 0..world.config.substeps {
+    let substeps = world.config.substeps;
+    for substep in 0..substeps {
         start_drives(world, h);
         predict(world, h);
         for block in &mut world.layout.sockets.blocks {
@@ -32,11 +33,14 @@ pub(crate) fn step(world: &mut World, dt: f32) {
             .blocks
             .iter_mut()
             .for_each(RodBlock::reset_lambdas);
+        // An overlap found at detection comes out evenly over the step
+        // (docs/contacts.md, "The jammed pile").
+        let remaining = (substeps - 1 - substep) as f32 / substeps as f32;
         world
             .contact_layout
             .blocks
             .iter_mut()
-            .for_each(ContactBlock::reset_lambdas);
+            .for_each(|b| b.start_substep(remaining));
         for _ in 0..world.config.iterations {
             solve_positions(world, h);
         }
