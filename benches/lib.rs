@@ -4,6 +4,7 @@
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
+use vertebra_kernels::driven::DriveLane;
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
@@ -212,7 +213,12 @@ impl SocketWorkload {
                 frame_b: GQuat::from_rotation_z(0.3),
                 swing_max: 0.2,
                 twist: [-0.1, 0.1],
-                drive: drive.then_some((GQuat::from_rotation_x(0.2), 0.001, 1.0)),
+                drive: drive.then_some(DriveLane {
+                    target: GQuat::from_rotation_x(0.2),
+                    compliance: 0.001,
+                    damping_time: 0.001,
+                    ..DriveLane::OFF
+                }),
                 shaped: ShapedLimits::FREE,
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
@@ -262,21 +268,25 @@ impl ConstraintWorkload for SocketWorkload {
             (true, false) => self.backend.dispatch(PositionPass::<true, false> {
                 blocks,
                 rows,
+                inv_h: 60.0,
                 inv_h2: 3600.0,
             }),
             (false, false) => self.backend.dispatch(PositionPass::<false, false> {
                 blocks,
                 rows,
+                inv_h: 60.0,
                 inv_h2: 3600.0,
             }),
             (true, true) => self.backend.dispatch(PositionPass::<true, true> {
                 blocks,
                 rows,
+                inv_h: 60.0,
                 inv_h2: 3600.0,
             }),
             (false, true) => self.backend.dispatch(PositionPass::<false, true> {
                 blocks,
                 rows,
+                inv_h: 60.0,
                 inv_h2: 3600.0,
             }),
         }
@@ -331,6 +341,7 @@ impl ConstraintWorkload for HingeWorkload {
         self.backend.dispatch(hinge::PositionPass::<false> {
             blocks: &mut self.blocks,
             rows: &self.rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
     }
@@ -419,6 +430,7 @@ impl RodWorkload {
                 twist: RodSoftness::Compliance(0.06),
                 bend_max: 0.3,
                 twist_range: [-0.1, 0.1],
+                max_torque: f32::INFINITY,
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }
@@ -441,6 +453,7 @@ impl ConstraintWorkload for RodWorkload {
         self.backend.dispatch(rod::PositionPass {
             blocks,
             rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
     }
@@ -477,6 +490,7 @@ impl ContactWorkload {
                 friction: 0.6,
                 restitution: 0.2,
                 approach: -1.0,
+                overlap: 0.0,
                 start: StartLane::default(),
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);

@@ -1,9 +1,10 @@
 //! vertebra against rapier3d, side by side in one process, on the
 //! reference humanoid: the passive-bending and ragdoll-drop scenes.
 //!
-//! First a table of whole runs (every frame of each scene): mean wall time
-//! per step and mean residual joint error per frame, rapier's measured by
-//! our own metric on its body poses. Then criterion's time per frame of the
+//! First a table of whole runs (every frame of each scene, from ten seeded
+//! starts): mean wall time per step and mean residual joint error per
+//! frame, each as its median and spread over the seeds, rapier's measured
+//! by our own metric on its body poses. Then criterion's time per frame of the
 //! 30-ragdoll drop, one second in, for each engine and setting.
 //! `cargo bench -p vertebra-benches --bench peer`
 
@@ -12,47 +13,81 @@ use std::hint::black_box;
 use criterion::Criterion;
 use vertebra_peer::{RapierScene, RapierSettings};
 use vertebra_ragdoll::SpineMode;
-use vertebra_scenes::{Frame, Scene, SceneConfig, build, run};
+use vertebra_scenes::{Frame, Scene, SceneConfig, Spread, build, run};
 
 const DT: f32 = 1.0 / 60.0;
 
-fn means(frames: &[Frame]) -> (f32, f32) {
+/// Seeded starts each whole run is repeated from (`vertebra_scenes::seed`):
+/// ten, so that the 10th and 90th percentiles are samples, not guesses.
+const SEEDS: u64 = 10;
+
+/// Per seed: ms per step, mean eps_lin (cm), mean eps_ang (rad).
+type Figures = Vec<(f64, f32, f32)>;
+
+fn row(engine: &str, figures: &Figures) {
+    let spread = |k: usize| {
+        Spread::of(
+            figures
+                .iter()
+                .map(|f| [f.0, f64::from(f.1), f64::from(f.2)][k]),
+        )
+    };
+    println!(
+        "| {engine} | {:.3} | {} | {} |",
+        spread(0).median,
+        spread(1).display(4),
+        spread(2).display(5)
+    );
+}
+
+fn figures(ms: f64, frames: &[Frame]) -> (f64, f32, f32) {
     let n = frames.len().max(1) as f32;
     let lin = frames.iter().map(|f| f.eps_lin_cm).sum::<f32>() / n;
     let ang = frames.iter().map(|f| f.eps_ang_rad).sum::<f32>() / n;
-    (lin, ang)
+    (ms, lin, ang)
 }
 
-fn row(engine: &str, ms: f64, frames: &[Frame]) {
-    let (lin, ang) = means(frames);
-    println!("| {engine} | {ms:.3} | {lin:.4} | {ang:.5} |");
-}
-
-/// Whole runs of both scenes: time per step and residual error.
+/// Whole runs of both scenes from seeds 0 .. SEEDS, one at a time (so that
+/// the times are one run's): time per step and residual error, each as
+/// the median [10th, 90th percentile] over the seeds.
 fn whole_runs() {
     for scene in [Scene::PassiveBending, Scene::RagdollDrop] {
-        println!("\n{scene}, {} frames:\n", scene.default_frames());
-        println!("| engine | ms per step | mean eps_lin (cm) | mean eps_ang (rad) |");
+        println!(
+            "\n{scene}, {} frames, median [p10, p90] over seeds 0..{}:\n",
+            scene.default_frames(),
+            SEEDS - 1
+        );
+        println!("| engine | ms per step (median) | mean eps_lin (cm) | mean eps_ang (rad) |");
         println!("| --- | ---: | ---: | ---: |");
         // 20 iterations a frame: in one substep (the paper's setting) and
         // as 5 substeps of 4.
         for (substeps, iterations) in [(1, 20), (5, 4)] {
             for (name, spine) in [("rod", SpineMode::Rod), ("socket", SpineMode::Sockets)] {
-                let mut config = SceneConfig::new(scene, spine);
-                (config.substeps, config.iterations) = (substeps, iterations);
-                let ours = run(&config, |_, _| {}).expect("our scene");
-                let engine = format!("vertebra {substeps}x{iterations}, {name} spine");
-                row(&engine, ours.ms_per_step, &ours.frames);
+                let ours: Figures = (0..SEEDS)
+                    .map(|seed| {
+                        let mut config = SceneConfig::new(scene, spine);
+                        (config.substeps, config.iterations) = (substeps, iterations);
+                        config.seed = seed;
+                        let run = run(&config, |_, _| {}).expect("our scene");
+                        figures(run.ms_per_step, &run.frames)
+                    })
+                    .collect();
+                row(
+                    &format!("vertebra {substeps}x{iterations}, {name} spine"),
+                    &ours,
+                );
             }
         }
         for settings in RapierSettings::COMPARED {
-            let config = SceneConfig::new(scene, SpineMode::Sockets);
-            let peer = vertebra_peer::run(&config, settings).expect("the rapier scene");
-            row(
-                &format!("{settings}, socket spine"),
-                peer.ms_per_step,
-                &peer.frames,
-            );
+            let peer: Figures = (0..SEEDS)
+                .map(|seed| {
+                    let mut config = SceneConfig::new(scene, SpineMode::Sockets);
+                    config.seed = seed;
+                    let run = vertebra_peer::run(&config, settings).expect("the rapier scene");
+                    figures(run.ms_per_step, &run.frames)
+                })
+                .collect();
+            row(&format!("{settings}, socket spine"), &peer);
         }
     }
 }

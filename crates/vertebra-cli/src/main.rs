@@ -2,6 +2,8 @@
 //! (`vertebra reproduce`), or run one scene (`vertebra scene NAME ...`).
 
 mod output;
+mod plots;
+mod reproduce;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -10,7 +12,7 @@ use clap::error::ErrorKind;
 use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
-use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, SceneRun};
+use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, Seeded};
 
 #[derive(Parser)]
 #[command(
@@ -31,6 +33,10 @@ enum Command {
         /// Where to write the results.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+        /// Seeded starts per scene and spine (0 .. K): every figure is
+        /// given as its median and spread over them.
+        #[arg(long, default_value_t = reproduce::DEFAULT_SEEDS)]
+        seeds: u64,
     },
     /// Runs one scene.
     Scene {
@@ -63,6 +69,10 @@ enum Command {
         /// each ragdoll by at most 1 mm and 0.1 degree.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Run from K seeds (--seed .. --seed + K - 1) and give every
+        /// figure's median and spread over them.
+        #[arg(long)]
+        seeds: Option<u64>,
         /// One JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -118,7 +128,7 @@ fn main() -> ExitCode {
 
 fn execute(command: Command) -> Result<(), String> {
     match command {
-        Command::Reproduce { out } => output::reproduce(&out),
+        Command::Reproduce { out, seeds } => reproduce::reproduce(&out, seeds),
         Command::Scene {
             name,
             spine,
@@ -129,6 +139,7 @@ fn execute(command: Command) -> Result<(), String> {
             threads,
             ragdoll,
             seed,
+            seeds,
             json,
         } => {
             let scene: Scene = name.parse()?;
@@ -153,29 +164,22 @@ fn execute(command: Command) -> Result<(), String> {
             config.threads = threads;
             config.ragdoll = ragdoll;
             config.seed = seed;
+            if let Some(count) = seeds {
+                let seeded = Seeded::run(&config, count, |_, _| {}).map_err(|e| e.to_string())?;
+                if json {
+                    println!("{}", output::seeded_json(&config, &seeded));
+                } else {
+                    output::print_seeded_summary(&config, &seeded);
+                }
+                return Ok(());
+            }
             let run = vertebra_scenes::run(&config, |_, _| {}).map_err(|e| e.to_string())?;
             if json {
                 println!("{}", output::run_json(&config, &run));
             } else {
-                print_summary(&config, &run);
+                output::print_summary(&config, &run);
             }
             Ok(())
         }
     }
-}
-
-fn print_summary(config: &SceneConfig, run: &SceneRun) {
-    let s = output::Summary::of(run);
-    println!(
-        "{} ({}): mean eps_lin {:.4} cm, max {:.4} cm; mean eps_ang {:.5} rad, max {:.5} rad; {:.3} ms/step on {}; state {:016x}",
-        config.scene,
-        output::spine_name(config.spine),
-        s.mean_lin,
-        s.max_lin,
-        s.mean_ang,
-        s.max_ang,
-        run.ms_per_step,
-        run.backend,
-        run.state_hash
-    );
 }

@@ -316,3 +316,79 @@ fn ragdoll_files_are_read_bounded_and_named_in_every_error() {
         ),
     );
 }
+
+#[test]
+fn seeds_give_every_figure_with_its_spread() {
+    let (code, stdout, stderr) = vertebra(&[
+        "scene",
+        "passive-bending",
+        "--spine",
+        "sockets",
+        "--frames",
+        "10",
+        "--seed",
+        "2",
+        "--seeds",
+        "3",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    assert_eq!(v["seeds"]["first"], 2);
+    assert_eq!(v["seeds"]["count"], 3);
+    assert_eq!(v["seeds"]["band"], "min-max");
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 3);
+    // Each seed's figures, and their spread: the median of three is the
+    // middle one, the band the smallest and largest.
+    let mut means: Vec<f64> = runs
+        .iter()
+        .map(|r| r["summary"]["mean_eps_lin_cm"].as_f64().unwrap())
+        .collect();
+    means.sort_by(f64::total_cmp);
+    let spread = &v["spread"]["mean_eps_lin_cm"];
+    assert_eq!(spread["median"].as_f64().unwrap(), means[1]);
+    assert_eq!(spread["min"].as_f64().unwrap(), means[0]);
+    assert_eq!(spread["max"].as_f64().unwrap(), means[2]);
+    // The seeded runs are the single runs of their seeds.
+    let (_, single, _) = vertebra(&[
+        "scene",
+        "passive-bending",
+        "--spine",
+        "sockets",
+        "--frames",
+        "10",
+        "--seed",
+        "3",
+        "--json",
+    ]);
+    let single: serde_json::Value = serde_json::from_str(single.trim()).unwrap();
+    assert_eq!(runs[1]["seed"], 3);
+    assert_eq!(runs[1]["state_hash"], single["state_hash"]);
+    assert_eq!(v["frames"].as_array().unwrap().len(), 10);
+    assert!(v["frames"][9]["eps_lin_cm"]["median"].is_number());
+    // Without --json: one line per figure, median [band].
+    let (code, text, _) = vertebra(&[
+        "scene",
+        "passive-bending",
+        "--spine",
+        "rod",
+        "--frames",
+        "5",
+        "--seeds",
+        "2",
+    ]);
+    assert_eq!(code, 0);
+    assert!(
+        text.contains("seeds 0..1: median [min-max] over 2 runs"),
+        "{text}"
+    );
+    assert!(text.contains("mean_eps_lin_cm"), "{text}");
+    fails_with(
+        &scene_with(&["--seeds", "0"])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+        "seeds",
+    );
+}

@@ -8,17 +8,22 @@
 //! Static geometry (ground, walls, boxes) is static bodies with colliders.
 //! Pairs of bodies that are never tested: the same body; two bodies that
 //! are both static or kinematic; pairs excluded by [`Collisions::exclude`]
-//! (a ragdoll's jointed pairs: `Ragdoll::non_colliding_pairs`); and pairs
-//! whose [`CollisionGroups`] do not match.
+//! (a ragdoll's jointed pairs: `Ragdoll::non_colliding_pairs`); pairs
+//! whose [`CollisionGroups`] do not match (set per collider, per body with
+//! [`Collisions::set_body_groups`], per ragdoll with
+//! [`Collisions::set_ragdoll_groups`]); and two bodies of one ragdoll whose
+//! self-collision is off ([`Collisions::set_ragdoll_self_collision`]).
 //!
-//! Removal is the set's business too: a body's colliders go with
-//! [`Collisions::remove_body`] (before or after `World::remove_body`), a
-//! ragdoll's bodies, joints and colliders with
-//! [`Collisions::remove_ragdoll`]. A collider whose body is gone makes
+//! A ragdoll comes in and goes out with its colliders in one call:
+//! [`Collisions::build_ragdoll`] builds it in the world and adds its
+//! capsules, [`Collisions::remove_ragdoll`] removes its bodies, joints and
+//! colliders. Removal is the set's business too: a body's colliders go
+//! with [`Collisions::remove_body`] (before or after `World::remove_body`). A collider whose body is gone makes
 //! [`Collisions::find_contacts`] refuse with [`Error::Collider`], naming the
 //! collider and its body. The set is saved and restored alongside the world
 //! with [`Collisions::snapshot`] and [`Collisions::restore`].
 
+mod groups;
 mod snapshot;
 
 use std::collections::{HashMap, HashSet};
@@ -28,13 +33,15 @@ use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::SharedShape;
-use vertebra_ragdoll::{Ragdoll, RagdollError};
+use vertebra_ragdoll::{BuildOptions, Ragdoll, RagdollDesc, RagdollError};
 use vertebra_world::{BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, World};
 
 pub use snapshot::CollisionSnapshot;
 
-/// Which colliders may touch: a pair is tested when each one's
-/// `membership` meets the other's `filter` (both bit sets).
+/// Which colliders may touch (Rapier's `InteractionGroups`): a pair is
+/// tested when each one's `membership` meets the other's `filter` (both
+/// bit sets): `a.membership & b.filter != 0 && b.membership & a.filter !=
+/// 0`. The default is every group, colliding with every group.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct CollisionGroups {
     /// The groups this collider is in.
@@ -96,18 +103,7 @@ impl Collider {
     /// normal, bad friction or restitution.
     fn geometry(&self) -> Result<SharedShape, Error> {
         let shape = match self.shape {
-            ColliderShape::Solid(s) => {
-                s.validate()?;
-                check_extent(&s)?;
-                match s {
-                    Shape::Sphere { radius } => SharedShape::ball(radius),
-                    Shape::Box { half_extents: h } => SharedShape::cuboid(h.x, h.y, h.z),
-                    Shape::Capsule {
-                        half_segment,
-                        radius,
-                    } => SharedShape::capsule(-half_segment, half_segment, radius),
-                }
-            }
+            ColliderShape::Solid(s) => solid(s)?,
             ColliderShape::Plane(n) => {
                 vertebra_world::check_unit_vec("plane normal", n)?;
                 SharedShape::halfspace(n.normalize())
@@ -130,6 +126,21 @@ impl Collider {
             reason: Box::new(reason),
         }
     }
+}
+
+/// The parry geometry of a solid (body frame), or why it is refused: a
+/// degenerate shape or one beyond [`MAX_COLLIDER_EXTENT`].
+fn solid(shape: Shape) -> Result<SharedShape, Error> {
+    shape.validate()?;
+    check_extent(&shape)?;
+    Ok(match shape {
+        Shape::Sphere { radius } => SharedShape::ball(radius),
+        Shape::Box { half_extents: h } => SharedShape::cuboid(h.x, h.y, h.z),
+        Shape::Capsule {
+            half_segment,
+            radius,
+        } => SharedShape::capsule(-half_segment, half_segment, radius),
+    })
 }
 
 /// The largest size (m) of a collider: a sphere's radius, a box's half
@@ -172,6 +183,11 @@ pub struct Collisions {
     colliders: Vec<(Collider, SharedShape)>,
     excluded: HashSet<(BodyHandle, BodyHandle)>,
     prediction: f32,
+    /// Bodies of ragdolls whose self-collision is off, each with its
+    /// ragdoll's group: two bodies of one group are never tested.
+    apart: HashMap<BodyHandle, u64>,
+    /// The group the next ragdoll whose self-collision goes off gets.
+    next_apart: u64,
 }
 
 fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {
@@ -256,9 +272,50 @@ impl Collisions {
         self.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())
     }
 
+    /// Builds a ragdoll in `world` (see `Ragdoll::build`) and adds its
+    /// capsules to this set (as [`Collisions::add_ragdoll`]: one per body,
+    /// default friction and groups, jointed pairs never tested), in one
+    /// call: how a ragdoll joins a world with collision detection. All or
+    /// nothing: every capsule is checked as a collider before the build,
+    /// and a refused build leaves the world as it was, so on error the
+    /// world and the set are unchanged (the error names the body). Its
+    /// inverse is [`Collisions::remove_ragdoll`].
+    pub fn build_ragdoll(
+        &mut self,
+        world: &mut World,
+        desc: &RagdollDesc,
+        options: BuildOptions,
+        pose: &vertebra_ragdoll::Pose,
+        previous: Option<(&vertebra_ragdoll::Pose, f32)>,
+    ) -> Result<Ragdoll, RagdollError> {
+        let geometries = desc
+            .bodies
+            .iter()
+            .map(|def| {
+                solid(def.shape()).map_err(|e| RagdollError::World {
+                    context: format!("body `{}` as a collider", def.name),
+                    error: e,
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let ragdoll = Ragdoll::build(world, desc, options, pose, previous)?;
+        for ((body, def), geometry) in ragdoll.bodies.iter().zip(&desc.bodies).zip(geometries) {
+            if let Some(body) = *body {
+                let collider = Collider::new(body, ColliderShape::Solid(def.shape()));
+                self.colliders.push((collider, geometry));
+            }
+        }
+        for (a, b) in ragdoll.non_colliding_pairs() {
+            self.exclude(a, b);
+        }
+        Ok(ragdoll)
+    }
+
     /// Removes a ragdoll from `world` (its joints and bodies, see
-    /// `Ragdoll::remove`) and its bodies' colliders and excluded pairs from
-    /// this set, in one call. All or nothing: when the ragdoll cannot be
+    /// `Ragdoll::remove`) and its bodies' colliders, excluded pairs and
+    /// self-collision setting from this set, in one call: the inverse of
+    /// [`Collisions::build_ragdoll`] (and of `Ragdoll::build` followed by
+    /// [`Collisions::add_ragdoll`]). All or nothing: when the ragdoll cannot be
     /// removed (a body or joint already gone, a body held by another
     /// joint) the world, the set and the ragdoll are unchanged.
     pub fn remove_ragdoll(
@@ -275,9 +332,10 @@ impl Collisions {
     }
 
     /// Re-creates a ragdoll at `pose` (see `Ragdoll::recreate`) and moves
-    /// its colliders and excluded pairs from the old bodies to the new ones
-    /// (friction, groups and any extra colliders kept, in their places in
-    /// the set). All or nothing, as `Ragdoll::recreate`.
+    /// its colliders, excluded pairs and self-collision setting from the
+    /// old bodies to the new ones (friction, groups and any extra
+    /// colliders kept, in their places in the set). All or nothing, as
+    /// `Ragdoll::recreate`.
     pub fn recreate_ragdoll(
         &mut self,
         world: &mut World,
@@ -301,6 +359,7 @@ impl Collisions {
             .iter()
             .map(|&(a, b)| ordered(to(a), to(b)))
             .collect();
+        self.apart = self.apart.iter().map(|(&b, &g)| (to(b), g)).collect();
         Ok(())
     }
 
@@ -325,12 +384,14 @@ impl Collisions {
         self.excluded.contains(&ordered(a, b))
     }
 
-    /// Forgets the colliders and excluded pairs of `body` (before or after
-    /// removing it from the world); the colliders after them move down in
-    /// [`Collisions::colliders`]. Nothing to forget is not an error.
+    /// Forgets the colliders, excluded pairs and self-collision setting of
+    /// `body` (before or after removing it from the world); the colliders
+    /// after them move down in [`Collisions::colliders`]. Nothing to forget
+    /// is not an error.
     pub fn remove_body(&mut self, body: BodyHandle) {
         self.colliders.retain(|c| c.0.body != body);
         self.excluded.retain(|&(a, b)| a != body && b != body);
+        self.apart.remove(&body);
     }
 
     /// Every contact between the colliders at the bodies' current poses, in
@@ -432,6 +493,7 @@ impl Collisions {
             && !self.excluded.contains(&ordered(ca.body, cb.body))
             && ca.groups.membership & cb.groups.filter != 0
             && cb.groups.membership & ca.groups.filter != 0
+            && !self.kept_apart(ca.body, cb.body)
     }
 }
 

@@ -4,9 +4,14 @@
 //! Bytes: `"VTBCOLLS"`, the format version (u32 LE), the xxh3 hash of the
 //! payload (u64 LE), then the payload (postcard): the prediction margin,
 //! every collider as it was added (body, shape, friction, restitution,
-//! groups) in the set's order, and the excluded pairs in a canonical order
-//! (so equal sets give equal bytes). The parry geometry is rebuilt from
-//! the shapes, exactly as [`Collisions::add`] builds it.
+//! groups) in the set's order, the excluded pairs in a canonical order
+//! (so equal sets give equal bytes), then the ragdolls' self-collision
+//! settings: every body whose self-collision is off with its ragdoll's
+//! group (u64), in a canonical order, and the next group to be given. The
+//! parry geometry is rebuilt from the shapes, exactly as
+//! [`Collisions::add`] builds it.
+//!
+//! Format versions: 1, without the self-collision settings; 2, with them.
 //!
 //! The bytes are untrusted input: the checksum only catches accidents (it
 //! is not keyed), so [`Collisions::restore`] checks every value as
@@ -18,7 +23,7 @@ use vertebra_world::{BodyHandle, Error, World};
 use crate::{Collider, Collisions, check_prediction, ordered};
 
 const MAGIC: &[u8; 8] = b"VTBCOLLS";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 const HEADER: usize = 20;
 
 /// A collision set's full state at one instant: [`Collisions::snapshot`]
@@ -45,6 +50,8 @@ struct State {
     prediction: f32,
     colliders: Vec<Collider>,
     excluded: Vec<(BodyHandle, BodyHandle)>,
+    apart: Vec<(BodyHandle, u64)>,
+    next_apart: u64,
 }
 
 impl Collisions {
@@ -52,10 +59,14 @@ impl Collisions {
     pub fn snapshot(&self) -> CollisionSnapshot {
         let mut excluded: Vec<_> = self.excluded.iter().copied().collect();
         excluded.sort_by_cached_key(encode);
+        let mut apart: Vec<_> = self.apart.iter().map(|(&b, &g)| (b, g)).collect();
+        apart.sort_by_cached_key(encode);
         let state = State {
             prediction: self.prediction,
             colliders: self.colliders().copied().collect(),
             excluded,
+            apart,
+            next_apart: self.next_apart,
         };
         let payload = encode(&state);
         let mut bytes = Vec::with_capacity(HEADER + payload.len());
@@ -73,8 +84,10 @@ impl Collisions {
     /// naming the collider and its body for a collider [`Collisions::add`]
     /// would refuse or whose body is not in `world`; `NonFinite` or
     /// `NonPositive` for a margin [`Collisions::set_prediction`] would
-    /// refuse. A set's own snapshot always restores into its world. The set is unchanged on
-    /// error.
+    /// refuse; `CorruptSnapshot` naming the entry for a self-collision
+    /// setting the API could not have made (a body twice, a body without a
+    /// collider, a group not yet given). A set's own snapshot always
+    /// restores into its world. The set is unchanged on error.
     pub fn restore(&mut self, snapshot: &CollisionSnapshot, world: &World) -> Result<(), Error> {
         let state = decode(&snapshot.bytes)?;
         check_prediction(state.prediction)?;
@@ -93,7 +106,32 @@ impl Collisions {
             .into_iter()
             .map(|(a, b)| ordered(a, b))
             .collect();
+        restored.next_apart = state.next_apart;
+        for (k, (body, group)) in state.apart.into_iter().enumerate() {
+            restored.check_apart(body, group).map_err(|why| {
+                Error::CorruptSnapshot(format!("self-collision entry {k}: {why}"))
+            })?;
+            restored.apart.insert(body, group);
+        }
         *self = restored;
+        Ok(())
+    }
+}
+
+impl Collisions {
+    /// Whether `body` may join `group` in a set being restored (its
+    /// colliders already in, and so checked against the world); the reason
+    /// if not.
+    fn check_apart(&self, body: BodyHandle, group: u64) -> Result<(), &'static str> {
+        if self.apart.contains_key(&body) {
+            return Err("a body listed twice");
+        }
+        if !self.colliders().any(|c| c.body == body) {
+            return Err("a body without a collider");
+        }
+        if group >= self.next_apart {
+            return Err("a group not given yet");
+        }
         Ok(())
     }
 }

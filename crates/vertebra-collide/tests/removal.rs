@@ -345,7 +345,7 @@ fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
         corrupt("not a collision-set snapshot"),
     );
     let mut newer = good.clone();
-    newer[8] = 2;
+    newer[8] = 3;
     assert_refused(
         &CollisionSnapshot::from_bytes(newer),
         Some(Error::IncompatibleSnapshot(

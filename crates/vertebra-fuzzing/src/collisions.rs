@@ -62,10 +62,7 @@ impl Scene {
             shape: ColliderShape::Solid(shape),
             friction: input.float(1.0),
             restitution: input.float(1.0),
-            groups: CollisionGroups {
-                membership: input.pick(4) as u32,
-                filter: input.pick(4) as u32,
-            },
+            groups: Self::groups(input),
         };
         let set = self.collisions.snapshot();
         if self.collisions.add(collider).is_err() {
@@ -83,20 +80,50 @@ impl Scene {
         Ok(())
     }
 
+    /// A ragdoll built and its colliders added, in two calls or in one.
     fn add_ragdoll(&mut self, input: &mut Input) -> Result<(), Error> {
-        let spine = [SpineMode::Rod, SpineMode::Sockets][input.pick(2)];
+        let options = BuildOptions::new([SpineMode::Rod, SpineMode::Sockets][input.pick(2)]);
         let pose = Pose::bind(&self.desc).moved(Vec3::ZERO, input.quat(), input.vec3(3.0));
-        let ragdoll = Ragdoll::build(
-            &mut self.world,
-            &self.desc,
-            BuildOptions::new(spine),
-            &pose,
-            None,
-        )
-        .map_err(|_| Error::InvalidConfig("ragdoll refused"))?;
-        self.collisions.add_ragdoll(&ragdoll)?;
+        let refused = |_| Error::InvalidConfig("ragdoll refused");
+        let ragdoll = if input.pick(2) == 0 {
+            let ragdoll = Ragdoll::build(&mut self.world, &self.desc, options, &pose, None)
+                .map_err(refused)?;
+            self.collisions.add_ragdoll(&ragdoll)?;
+            ragdoll
+        } else {
+            self.collisions
+                .build_ragdoll(&mut self.world, &self.desc, options, &pose, None)
+                .map_err(refused)?
+        };
         self.ragdolls.push(ragdoll);
         Ok(())
+    }
+
+    /// Groups from a few bits, so that some pairs match and some do not.
+    fn groups(input: &mut Input) -> CollisionGroups {
+        CollisionGroups {
+            membership: input.pick(4) as u32,
+            filter: input.pick(4) as u32,
+        }
+    }
+
+    /// Groups on a body's colliders, on a ragdoll's, or a ragdoll's
+    /// self-collision on or off (refused for a body or ragdoll whose
+    /// colliders are gone).
+    fn set_groups(&mut self, input: &mut Input) -> Result<(), Error> {
+        let groups = Self::groups(input);
+        match (input.pick(3), self.body(input), self.ragdoll(input)) {
+            (0, Some(body), _) => self.collisions.set_body_groups(body, groups),
+            (1, _, Some(k)) => self
+                .collisions
+                .set_ragdoll_groups(&self.ragdolls[k], groups),
+            (2, _, Some(k)) => {
+                let collide = input.pick(2) == 0;
+                self.collisions
+                    .set_ragdoll_self_collision(&self.ragdolls[k], collide)
+            }
+            _ => Ok(()),
+        }
     }
 
     /// A body out of the world and the set, the world's way first.
@@ -173,8 +200,9 @@ impl Scene {
 
 /// Up to 48 calls on a world with a ground plane, its collision set and
 /// ragdolls: bodies with arbitrary colliders added and removed, ragdolls
-/// added, removed, recreated (also after a joint of theirs was removed by
-/// hand), pairs excluded, the margin set, both snapshots taken and
+/// added (in one call or two), removed, recreated (also after a joint of
+/// theirs was removed by hand), pairs excluded, groups set on bodies and
+/// ragdolls, ragdolls' self-collision turned off and on, the margin set, both snapshots taken and
 /// restored, crafted collision snapshots restored, steps with detection.
 /// No panic; a refused call leaves the world, the set and the ragdolls as
 /// they were; no collider or contact outlives its body.
@@ -205,7 +233,7 @@ pub fn collisions(data: &[u8]) {
             break;
         }
         let before = scene.fingerprint();
-        let result = match input.pick(11) {
+        let result = match input.pick(13) {
             0 => scene.add_body(&mut input),
             1 => scene.add_ragdoll(&mut input),
             2 => scene.remove_body(&mut input),
@@ -260,6 +288,7 @@ pub fn collisions(data: &[u8]) {
                 Ok(())
             }
             10 => scene.collisions.set_prediction(input.float(0.1)),
+            11 => scene.set_groups(&mut input),
             _ => scene.step(),
         };
         if let Err(error) = result {

@@ -6,6 +6,7 @@ use core::f32::consts::PI;
 use glam::{Mat3, Vec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
+use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
@@ -66,10 +67,17 @@ fn sorted_range(input: &mut Input) -> [f32; 2] {
 }
 
 fn softness(input: &mut Input) -> RodSoftness {
-    if input.flag() {
-        RodSoftness::Compliance(input.float(1.0).abs())
-    } else {
-        RodSoftness::Relaxation(input.float(1.0).abs().min(1.0))
+    match input.pick(4) {
+        0 => RodSoftness::Compliance(input.float(1.0).abs()),
+        1 => RodSoftness::Damped {
+            compliance: input.float(1.0).abs(),
+            damping_time: input.float(1.0).abs(),
+        },
+        2 => RodSoftness::Spring {
+            period2: input.float(1.0).abs(),
+            damping_time: input.float(1.0).abs(),
+        },
+        _ => RodSoftness::Relaxation(input.float(1.0).abs().min(1.0)),
     }
 }
 
@@ -97,19 +105,25 @@ fn socket_block(input: &mut Input, rows: &RawRows) -> SocketBlock {
             frame_b: input.quat(),
             swing_max: input.float(PI).abs().min(PI),
             twist: sorted_range(input),
-            drive: input.flag().then(|| {
-                (
-                    input.quat(),
-                    input.float(1.0).abs(),
-                    input.float(10.0).abs(),
-                )
-            }),
+            drive: input.flag().then(|| drive_lane(input)),
             shaped: shaped(input),
         };
         block.set(k, &lane);
         block.bodies.set_start(k, &start(input));
     }
     block
+}
+
+/// A drive's lane: any target, velocity and settings of its ranges.
+fn drive_lane(input: &mut Input) -> DriveLane {
+    DriveLane {
+        target: input.quat(),
+        velocity: input.vec3(20.0),
+        compliance: input.float(1.0).abs(),
+        period2: input.float(1.0).abs(),
+        damping_time: input.float(1.0).abs(),
+        max_torque: input.float(100.0).abs(),
+    }
 }
 
 /// Shaped limits: semi-axes in (0, 1], angle ranges within [-pi, pi].
@@ -137,13 +151,7 @@ fn hinge_block(input: &mut Input, rows: &RawRows) -> HingeBlock {
             frame_b: input.quat(),
             range: sorted_range(input),
             compliance: input.float(1.0).abs(),
-            drive: input.flag().then(|| {
-                (
-                    input.quat(),
-                    input.float(1.0).abs(),
-                    input.float(10.0).abs(),
-                )
-            }),
+            drive: input.flag().then(|| drive_lane(input)),
         };
         block.set(k, &lane);
         block.bodies.set_start(k, &start(input));
@@ -189,6 +197,7 @@ fn rod_block(input: &mut Input, rows: &RawRows) -> RodBlock {
             twist: softness(input),
             bend_max: input.float(PI).abs().min(PI),
             twist_range: sorted_range(input),
+            max_torque: input.float(100.0).abs(),
         };
         block.set(k, &lane);
         block.bodies.set_start(k, &start(input));
@@ -211,6 +220,7 @@ fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
             friction: input.float(2.0).abs(),
             restitution: input.float(1.0).abs().min(1.0),
             approach: input.float(10.0),
+            overlap: input.float(0.1).abs(),
             start: start(input),
         };
         block.set(k, &lane);
@@ -228,28 +238,47 @@ fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32
     let rows = BodyRows::from_raw(raw);
     let (mut sockets, mut rods, mut contacts) = ([blocks.0], [blocks.1], [blocks.2]);
     let (mut hinges, mut fixed) = ([blocks.3], [blocks.4]);
+    let h = 1.0 / inv_h2.sqrt();
+    backend.dispatch(StartPass {
+        blocks: &mut sockets,
+        rows: &rows,
+        h,
+    });
+    backend.dispatch(StartPass {
+        blocks: &mut hinges,
+        rows: &rows,
+        h,
+    });
     backend.dispatch(socket::PositionPass::<true, false> {
         blocks: &mut sockets,
         rows: &rows,
+        inv_h: inv_h2.sqrt(),
         inv_h2,
     });
     backend.dispatch(socket::PositionPass::<true, true> {
         blocks: &mut sockets,
         rows: &rows,
+        inv_h: inv_h2.sqrt(),
         inv_h2,
     });
     backend.dispatch(hinge::PositionPass::<true> {
         blocks: &mut hinges,
         rows: &rows,
+        inv_h: inv_h2.sqrt(),
         inv_h2,
     });
     backend.dispatch(fixed::PositionPass {
         blocks: &mut fixed,
         rows: &rows,
     });
+    backend.dispatch(rod::StartPass {
+        blocks: &mut rods,
+        rows: &rows,
+    });
     backend.dispatch(rod::PositionPass {
         blocks: &mut rods,
         rows: &rows,
+        inv_h: inv_h2.sqrt(),
         inv_h2,
     });
     backend.dispatch(contact::PositionPass {

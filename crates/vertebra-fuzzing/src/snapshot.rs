@@ -7,8 +7,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use glam::{Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
-    BodyHandle, BodyKind, Contact, JointDesc, JointKind, LimitSoftness, RodDesc, RodStiffness,
-    Snapshot, SolverConfig, Swing, SwingTwist, World,
+    AngularDrive, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointKind,
+    LimitSoftness, RodDesc, RodStiffness, Snapshot, SolverConfig, Swing, SwingTwist, World,
 };
 
 use crate::input::Input;
@@ -111,6 +111,28 @@ fn quat(input: &mut Input, q: &mut Quat) {
     let mut a = q.to_array();
     a[input.pick(4)] = value(input);
     *q = Quat::from_array(a);
+}
+
+/// One field of a drive, crafted.
+fn drive(input: &mut Input, d: &mut AngularDrive) {
+    match input.pick(4) {
+        0 => quat(input, &mut d.target),
+        1 => vec3(input, &mut d.target_velocity),
+        2 => d.max_torque = value(input),
+        _ => {
+            d.strength = if input.flag() {
+                DriveStrength::Compliance {
+                    compliance: value(input),
+                    damping: value(input),
+                }
+            } else {
+                DriveStrength::Spring {
+                    frequency: value(input),
+                    damping_ratio: value(input),
+                }
+            }
+        }
+    }
 }
 
 fn mat3(input: &mut Input, m: &mut Mat3) {
@@ -252,8 +274,7 @@ fn socket(input: &mut Input, state: &mut State) {
         }
         6 => {
             if let Some(d) = s.drive.as_mut() {
-                quat(input, &mut d.target);
-                d.compliance = value(input);
+                drive(input, d);
             }
         }
         7 => state.joints[slot] = None,
@@ -272,15 +293,28 @@ fn rod(input: &mut Input, state: &mut State) {
     let Some(r) = state.rods[slot].as_mut() else {
         return slots(input, &mut state.rod_slots);
     };
-    match input.pick(11) {
+    match input.pick(14) {
         0 => r.body_a = handle,
         1 => r.body_b = handle,
         2 => quat(input, &mut r.frame_a),
+        10 => r.max_torque = value(input),
+        12 => r.twisting = RodStiffness::Relaxation(value(input)),
+        11 => {
+            r.bending = RodStiffness::Spring {
+                frequency: value(input),
+                damping_ratio: value(input),
+            }
+        }
         3 => r.rest_length = value(input),
         4 => vec3(input, &mut r.bend_rest),
         5 => r.twist_rest = value(input),
         6 => r.bending = RodStiffness::Kirchhoff(value(input)),
-        7 => r.twisting = RodStiffness::Relaxation(value(input)),
+        7 => {
+            r.twisting = RodStiffness::Damped {
+                stiffness: value(input),
+                damping: value(input),
+            }
+        }
         8 => r.bend_limit = limit(input),
         9 => state.rods[slot] = None,
         _ => slots(input, &mut state.rod_slots),

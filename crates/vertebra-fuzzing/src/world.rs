@@ -89,11 +89,7 @@ pub(crate) fn add_joint(
         }
     };
     if input.flag() {
-        joint = joint.with_drive(AngularDrive {
-            target: input.quat(),
-            compliance: input.float(1.0),
-            damping: input.float(10.0),
-        });
+        joint = joint.with_drive(drive(input));
     }
     world.add_joint(joint)
 }
@@ -123,6 +119,22 @@ fn limit_softness(input: &mut Input) -> LimitSoftness {
     }
 }
 
+/// A drive of either strength, moving or not, limited or not.
+fn drive(input: &mut Input) -> AngularDrive {
+    let target = input.quat();
+    let drive = if input.flag() {
+        AngularDrive::compliant(target, input.float(1.0), input.float(10.0))
+    } else {
+        AngularDrive::spring(target, input.float(50.0), input.float(2.0))
+    };
+    let drive = drive.with_target_velocity(input.vec3(20.0));
+    if input.flag() {
+        drive.with_max_torque(input.float(100.0))
+    } else {
+        drive
+    }
+}
+
 pub(crate) fn add_rod(
     world: &mut World,
     seen: &Seen,
@@ -132,10 +144,11 @@ pub(crate) fn add_rod(
         return Err(Error::SameBody);
     };
     let through: Vec<Vec3> = (0..input.pick(3)).map(|_| input.vec3(5.0)).collect();
-    let mut rod = RodDesc::from_pose(world.bodies(), a, b, &through)?.with_stiffness(
-        RodStiffness::Kirchhoff(input.float(100.0)),
-        RodStiffness::Kirchhoff(input.float(100.0)),
-    );
+    let mut rod = RodDesc::from_pose(world.bodies(), a, b, &through)?
+        .with_stiffness(rod_stiffness(input), rod_stiffness(input));
+    if input.flag() {
+        rod = rod.with_max_torque(input.float(100.0));
+    }
     if input.flag() {
         rod = rod.with_bend_limit(input.float(4.0));
     }
@@ -143,6 +156,22 @@ pub(crate) fn add_rod(
         rod = rod.with_twist_limit(input.float(4.0), input.float(4.0));
     }
     world.add_rod(rod)
+}
+
+/// Any of a rod's stiffness forms, with values the world may refuse.
+fn rod_stiffness(input: &mut Input) -> RodStiffness {
+    match input.pick(4) {
+        0 => RodStiffness::Damped {
+            stiffness: input.float(100.0),
+            damping: input.float(100.0),
+        },
+        1 => RodStiffness::Spring {
+            frequency: input.float(20.0),
+            damping_ratio: input.float(4.0),
+        },
+        2 => RodStiffness::Relaxation(input.float(1.0)),
+        _ => RodStiffness::Kirchhoff(input.float(100.0)),
+    }
 }
 
 pub(crate) fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) -> Result<(), Error> {
@@ -164,9 +193,20 @@ pub(crate) fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) ->
     world.set_contacts(&contacts)
 }
 
+/// An impulse of one of the three kinds, at a point near the body or
+/// anywhere (static and kinematic bodies refuse them all).
+fn impulse(world: &mut World, body: BodyHandle, input: &mut Input) -> Result<(), Error> {
+    let impulse = input.vec3(100.0);
+    match input.pick(3) {
+        0 => world.apply_impulse(body, impulse),
+        1 => world.apply_impulse_at(body, impulse, input.vec3(5.0)),
+        _ => world.apply_angular_impulse(body, impulse),
+    }
+}
+
 /// One call chosen by the input; `Err` is a refusal.
 fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Error> {
-    match input.pick(11) {
+    match input.pick(12) {
         0 => add_body(world, input).map(|h| seen.bodies.push(h)),
         1 => match seen.body(input) {
             Some(h) => world.remove_body(h),
@@ -191,6 +231,10 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
             Some(h) => world.add_force(h, input.vec3(1000.0)),
             None => Ok(()),
         },
+        10 => match seen.body(input) {
+            Some(h) => impulse(world, h, input),
+            None => Ok(()),
+        },
         _ => world.step(if input.flag() {
             1.0 / 60.0
         } else {
@@ -200,7 +244,7 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
 }
 
 /// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
-/// removed, poses, velocities and forces set, steps) with arbitrary floats
+/// removed, poses, velocities, forces and impulses set, steps) with arbitrary floats
 /// one time in eight: no panic; every refused call leaves the world as it
 /// was; every body stays finite; no pending contact names a removed body;
 /// and the step's last-line NaN guard never fires (accepted input must

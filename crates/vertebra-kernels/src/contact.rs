@@ -11,7 +11,12 @@
 //!   `s = ((p_b + r_b) - (p_a + r_a)) . n` must not be negative:
 //!   `C = min(s, 0)`, gradient `n` at `r_b` and `-n` at `r_a`, generalised
 //!   masses `1/m + (r x n)^T I^-1 (r x n)`. `lambda_n` accumulates over a
-//!   substep's iterations (the normal force is `lambda_n / h^2`).
+//!   substep's iterations (the normal force is `lambda_n / h^2`). An
+//!   overlap `o` the contact was made with is removed evenly over the
+//!   step's `S` substeps: substep `k` solves `C = min(s + o (S - 1 - k) / S,
+//!   0)`, so the bodies come out at `o / dt` whatever `S` (removed in the
+//!   first substep they came out at `o / h`, and a substepped pile of
+//!   ragdolls never came to rest).
 //! - **Static friction** (inside the cone): the points were one point when
 //!   the contact was made, so their tangential offset `d_t = d - (d . n) n`
 //!   (`d` their difference) is how far the bodies slid. It is removed along
@@ -60,6 +65,11 @@ pub struct ContactBlock {
     /// Normal relative velocity of b to a when the contact was made (m/s;
     /// negative when approaching).
     pub approach: [f32; BLOCK_LANES],
+    /// The overlap when the contact was made (m, >= 0; 0 for a gap).
+    pub overlap: [f32; BLOCK_LANES],
+    /// How much of `overlap` may remain at the end of this substep (m):
+    /// the overlap is removed evenly over the step's substeps.
+    pub allowance: [f32; BLOCK_LANES],
     /// Accumulated normal multiplier, reset every substep.
     pub lambda_n: [f32; BLOCK_LANES],
     /// Accumulated tangential multiplier (a world vector in the tangent
@@ -90,6 +100,8 @@ pub struct ContactLane {
     pub restitution: f32,
     /// Approach velocity along the normal (m/s).
     pub approach: f32,
+    /// The overlap when the contact was made (m, >= 0).
+    pub overlap: f32,
     /// The two points when the step began.
     pub start: StartLane,
 }
@@ -111,14 +123,20 @@ impl ContactBlock {
         self.friction[lane] = c.friction;
         self.restitution[lane] = c.restitution;
         self.approach[lane] = c.approach;
+        self.overlap[lane] = c.overlap;
+        self.allowance[lane] = c.overlap;
         self.lambda_n[lane] = 0.0;
         self.lambda_t.set(lane, GVec3::ZERO);
     }
 
-    /// Resets the multipliers (every substep).
-    pub fn reset_lambdas(&mut self) {
+    /// Starts a substep: the multipliers reset, and the overlap allowed at
+    /// its end set to `remaining` (in [0, 1]) of the contact's overlap.
+    pub fn start_substep(&mut self, remaining: f32) {
         self.lambda_n = [0.0; BLOCK_LANES];
         self.lambda_t = Vec3Block::default();
+        for (allowed, overlap) in self.allowance.iter_mut().zip(self.overlap) {
+            *allowed = overlap * remaining;
+        }
     }
 }
 
@@ -182,7 +200,8 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
     let zero = L::splat(0.0);
 
     let (ra, rb, d) = arms(block, start, &a, &b);
-    let c = d.dot(n).min(zero);
+    let allowance = L::load(&block.allowance[start..]);
+    let c = (d.dot(n) + allowance).min(zero);
     let w = a.positional_weight(ra, n) + b.positional_weight(rb, n);
     let dlambda_n = safe_ratio(-c, w);
     push(&mut a, &mut b, ra, rb, n.scale(dlambda_n));
@@ -296,7 +315,6 @@ fn solve_velocities<L: Lane>(
         zero,
     );
     let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
-    // One-sided: raise the normal velocity to the target, never pull.
     let change = L::select(touching, (target - relative.dot(n)).max(zero), zero);
     kick(
         &a,

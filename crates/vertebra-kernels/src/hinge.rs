@@ -5,18 +5,18 @@
 //!
 //! The range is the `twist` part's angle: the relative rotation's twist
 //! about +X, in [-pi, pi], which for a hinge (no swing) is the hinge angle
-//! itself; `[-pi, pi]` disables it. The drive is the socket's drive part,
-//! with the same settings and the same velocity pass.
+//! itself; `[-pi, pi]` disables it. The drive is the socket's drive part
+//! (`driven.rs`), with the same settings and the same substep start.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
-use vertebra_math::{Lane, LaneKernel};
+use vertebra_math::{Lane, LaneKernel, Quat};
 
 use crate::body::{BodyPairs, BodyRows};
-use crate::parts::{drive, hinge_axis, limit, point, swing, twist};
+use crate::driven::{DriveBlock, DriveLane, Driven};
+use crate::parts::{hinge_axis, limit, point, swing, twist};
 use crate::residual::Residual;
-use crate::socket::Driven;
 
 /// Eight hinges, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -40,17 +40,8 @@ pub struct HingeBlock {
     pub limit_compliance: [f32; BLOCK_LANES],
     /// The range's accumulated multiplier (N m s^2), reset every substep.
     pub limit_lambda: [f32; BLOCK_LANES],
-    /// Drive target: b's joint frame relative to a's.
-    pub drive_target: QuatBlock,
-    /// Drive compliance (rad / (N m)); 0 is infinitely stiff.
-    pub drive_compliance: [f32; BLOCK_LANES],
-    /// 1 where the drive is on, 0 where off.
-    pub drive_enabled: [f32; BLOCK_LANES],
-    /// Drive damping rate (1/s).
-    pub drive_damping: [f32; BLOCK_LANES],
-    /// The drive's accumulated XPBD multiplier (world vector), reset every
-    /// substep.
-    pub drive_lambda: Vec3Block,
+    /// The angular drives.
+    pub drive: DriveBlock,
 }
 
 /// One hinge's solver data (one lane of a block).
@@ -76,8 +67,8 @@ pub struct HingeLane {
     pub range: [f32; 2],
     /// The range's compliance (rad / (N m)); 0 is hard.
     pub compliance: f32,
-    /// Drive target, compliance (rad/(N m)) and damping (1/s), if driven.
-    pub drive: Option<(GQuat, f32, f32)>,
+    /// The drive, if driven.
+    pub drive: Option<DriveLane>,
 }
 
 impl HingeBlock {
@@ -121,17 +112,12 @@ impl HingeBlock {
         (self.range_min[lane], self.range_max[lane]) = (h.range[0], h.range[1]);
         self.limit_compliance[lane] = h.compliance;
         self.limit_lambda[lane] = 0.0;
-        let (target, compliance, damping) = h.drive.unwrap_or((GQuat::IDENTITY, 0.0, 0.0));
-        self.drive_target.set(lane, target);
-        self.drive_compliance[lane] = compliance;
-        self.drive_damping[lane] = damping;
-        self.drive_enabled[lane] = if h.drive.is_some() { 1.0 } else { 0.0 };
-        self.drive_lambda.set(lane, GVec3::ZERO);
+        self.drive.set(lane, h.drive.as_ref());
     }
 
     /// Zeroes the accumulated multipliers, as each substep begins.
     pub fn reset_lambdas(&mut self) {
-        self.drive_lambda = Vec3Block::default();
+        self.drive.lambda = Vec3Block::default();
         self.limit_lambda = [0.0; BLOCK_LANES];
     }
 }
@@ -141,8 +127,11 @@ impl Driven for HingeBlock {
         &self.bodies
     }
     #[inline(always)]
-    fn damping_rate<L: Lane>(&self, start: usize) -> L {
-        L::load(&self.drive_damping[start..]) * L::load(&self.drive_enabled[start..])
+    fn frames<L: Lane>(&self, start: usize) -> (Quat<L>, Quat<L>) {
+        (self.frame_a.load(start), self.frame_b.load(start))
+    }
+    fn drive_mut(&mut self) -> &mut DriveBlock {
+        &mut self.drive
     }
 }
 
@@ -155,7 +144,9 @@ pub struct PositionPass<'a, const DRIVE: bool> {
     pub blocks: &'a mut [HingeBlock],
     /// Body rows, read and written.
     pub rows: &'a BodyRows,
-    /// `1 / h^2` for the substep `h` (s^-2).
+    /// `1 / h` for the substep `h` (s^-1): the drive's `gamma`.
+    pub inv_h: f32,
+    /// `1 / h^2` (s^-2).
     pub inv_h2: f32,
 }
 
@@ -163,10 +154,10 @@ impl<const DRIVE: bool> LaneKernel for PositionPass<'_, DRIVE> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let inv_h2 = L::splat(self.inv_h2);
+        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
         for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h2);
+                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h, inv_h2);
             }
         }
     }
@@ -177,6 +168,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     block: &mut HingeBlock,
     start: usize,
     rows: &BodyRows,
+    inv_h: L,
     inv_h2: L,
 ) {
     let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
@@ -184,21 +176,10 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     let frame_b = block.frame_b.load::<L>(start);
 
     if DRIVE {
-        let lambda = block.drive_lambda.load::<L>(start);
-        let alpha_tilde = L::load(&block.drive_compliance[start..]) * inv_h2;
-        let enabled = L::load(&block.drive_enabled[start..]);
-        let target = block.drive_target.load::<L>(start);
-        let lambda = drive::solve(
-            &mut a,
-            &mut b,
-            frame_a,
-            frame_b,
-            target,
-            enabled,
-            alpha_tilde,
-            lambda,
-        );
-        block.drive_lambda.store(start, lambda);
+        let (a, b) = (&mut a, &mut b);
+        block
+            .drive
+            .solve(start, a, b, frame_a, frame_b, inv_h, inv_h2);
     }
 
     hinge_axis::solve(&mut a, &mut b, frame_a, frame_b);

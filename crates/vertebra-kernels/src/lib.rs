@@ -23,6 +23,7 @@
 
 pub mod body;
 pub mod contact;
+pub mod driven;
 pub mod fixed;
 pub mod hinge;
 pub mod parts;

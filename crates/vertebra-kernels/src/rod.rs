@@ -4,6 +4,10 @@
 //! one lane-generic kernel that shares the frames' measurement between its
 //! parts (paper section 7).
 //!
+//! The soft bend and twist are drives (`parts::rod::drive`): damped
+//! against their error as the substep began ([`StartPass`]), optionally
+//! given by frequency, and capped at a torque.
+//!
 //! Part order per iteration: soft bend, soft twist, bend limit, twist
 //! limit, curve, length. The hard geometric parts come last so that the arc
 //! is closest to admissible at the end of an iteration; the length last of
@@ -16,6 +20,7 @@ use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
 use crate::parts::angle::Softness;
+use crate::parts::rod::drive::Drive;
 use crate::parts::rod::{bend, curve, frames, length, twist};
 use crate::residual::Residual;
 
@@ -39,6 +44,18 @@ pub struct RodBlock {
     pub bend_compliance: [f32; BLOCK_LANES],
     /// Twisting compliance `l0 / k_t` (rad / (N m)).
     pub twist_compliance: [f32; BLOCK_LANES],
+    /// Bending compliance per unit effective inverse inertia, `1 / omega^2`
+    /// (s^2), for bending given by frequency.
+    pub bend_period2: [f32; BLOCK_LANES],
+    /// Twisting's `1 / omega^2` (s^2).
+    pub twist_period2: [f32; BLOCK_LANES],
+    /// Bending damping `gamma h` (s).
+    pub bend_damping_time: [f32; BLOCK_LANES],
+    /// Twisting damping `gamma h` (s).
+    pub twist_damping_time: [f32; BLOCK_LANES],
+    /// The largest torque of bending and of twisting (N m), infinity for
+    /// none.
+    pub max_torque: [f32; BLOCK_LANES],
     /// Bending relaxation factor (1 for XPBD, 0 for none).
     pub bend_relaxation: [f32; BLOCK_LANES],
     /// Twisting relaxation factor (1 for XPBD, 0 for none).
@@ -53,6 +70,12 @@ pub struct RodBlock {
     pub bend_lambda: [f32; BLOCK_LANES],
     /// Twisting's accumulated multiplier, reset every substep.
     pub twist_lambda: [f32; BLOCK_LANES],
+    /// The bend error `C n` as the substep began (rad, world), measured
+    /// by [`StartPass`].
+    pub bend_start: Vec3Block,
+    /// The twist error as the substep began (rad), measured by
+    /// [`StartPass`].
+    pub twist_start: [f32; BLOCK_LANES],
 }
 
 /// How a soft part is set: XPBD compliance, or the paper's relaxation.
@@ -63,14 +86,39 @@ pub enum RodSoftness {
     /// The fraction of the error removed per iteration, in [0, 1] (the
     /// paper's relaxation factor); 0 turns the part off.
     Relaxation(f32),
+    /// XPBD compliance (rad / (N m)) with damping, `gamma h` (s): compliance
+    /// times the damping coefficient.
+    Damped {
+        /// Compliance (rad / (N m)).
+        compliance: f32,
+        /// `gamma h` (s).
+        damping_time: f32,
+    },
+    /// A damped spring on the part's effective inertia
+    /// (`parts::rod::drive`).
+    Spring {
+        /// `1 / omega^2` (s^2).
+        period2: f32,
+        /// `gamma h = 2 zeta / omega` (s).
+        damping_time: f32,
+    },
 }
 
 impl RodSoftness {
-    /// (compliance, relaxation) as the kernel reads them.
-    pub fn lanes(self) -> (f32, f32) {
+    /// (compliance, relaxation, period2, damping time) as the kernel reads
+    /// them.
+    pub fn lanes(self) -> [f32; 4] {
         match self {
-            RodSoftness::Compliance(c) => (c, 1.0),
-            RodSoftness::Relaxation(r) => (0.0, r),
+            RodSoftness::Compliance(c) => [c, 1.0, 0.0, 0.0],
+            RodSoftness::Relaxation(r) => [0.0, r, 0.0, 0.0],
+            RodSoftness::Damped {
+                compliance,
+                damping_time,
+            } => [compliance, 1.0, 0.0, damping_time],
+            RodSoftness::Spring {
+                period2,
+                damping_time,
+            } => [0.0, 1.0, period2, damping_time],
         }
     }
 }
@@ -104,6 +152,9 @@ pub struct RodLane {
     pub bend_max: f32,
     /// Twist range (rad), `[-pi, pi]` when unlimited.
     pub twist_range: [f32; 2],
+    /// The largest torque of bending and of twisting (N m), infinity for
+    /// none.
+    pub max_torque: f32,
 }
 
 impl RodBlock {
@@ -134,6 +185,7 @@ impl RodBlock {
                 twist: RodSoftness::Relaxation(0.0),
                 bend_max: core::f32::consts::PI,
                 twist_range: [-core::f32::consts::PI, core::f32::consts::PI],
+                max_torque: f32::INFINITY,
             },
         );
     }
@@ -147,12 +199,25 @@ impl RodBlock {
         self.bend_rest.set(lane, r.bend_rest);
         self.rest_length[lane] = r.rest_length;
         self.twist_rest[lane] = r.twist_rest;
-        (self.bend_compliance[lane], self.bend_relaxation[lane]) = r.bend.lanes();
-        (self.twist_compliance[lane], self.twist_relaxation[lane]) = r.twist.lanes();
+        [
+            self.bend_compliance[lane],
+            self.bend_relaxation[lane],
+            self.bend_period2[lane],
+            self.bend_damping_time[lane],
+        ] = r.bend.lanes();
+        [
+            self.twist_compliance[lane],
+            self.twist_relaxation[lane],
+            self.twist_period2[lane],
+            self.twist_damping_time[lane],
+        ] = r.twist.lanes();
+        self.max_torque[lane] = r.max_torque;
         self.bend_max[lane] = r.bend_max;
         (self.twist_min[lane], self.twist_max[lane]) = (r.twist_range[0], r.twist_range[1]);
         self.bend_lambda[lane] = 0.0;
         self.twist_lambda[lane] = 0.0;
+        self.bend_start.set(lane, GVec3::ZERO);
+        self.twist_start[lane] = 0.0;
     }
 
     /// Resets the soft parts' multipliers (every substep).
@@ -168,7 +233,9 @@ pub struct PositionPass<'a> {
     pub blocks: &'a mut [RodBlock],
     /// Body rows, read and written.
     pub rows: &'a BodyRows,
-    /// `1 / h^2` for the substep `h` (s^-2).
+    /// `1 / h` for the substep `h` (s^-1).
+    pub inv_h: f32,
+    /// `1 / h^2` (s^-2).
     pub inv_h2: f32,
 }
 
@@ -176,34 +243,80 @@ impl LaneKernel for PositionPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let inv_h2 = L::splat(self.inv_h2);
+        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
         for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions(block, start, self.rows, inv_h2);
+                solve_positions(block, start, self.rows, inv_h, inv_h2);
             }
         }
     }
 }
 
+/// The soft parts' errors as the substep begins, before the bodies move
+/// (every substep, for the damping's rate: `parts::rod::drive`).
+pub struct StartPass<'a> {
+    /// The blocks (one colour's, or the overflow set).
+    pub blocks: &'a mut [RodBlock],
+    /// Body rows, read.
+    pub rows: &'a BodyRows,
+}
+
+impl LaneKernel for StartPass<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        for block in self.blocks.iter_mut() {
+            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
+                let (a, b) = block.bodies.gather::<L>(self.rows, start);
+                let f = frames(&a, &b, block.frame_a.load(start), block.frame_b.load(start));
+                let bend = bend::start(&f, block.bend_rest.load(start));
+                block.bend_start.store(start, bend);
+                twist::error(&f, L::load(&block.twist_rest[start..]))
+                    .store(&mut block.twist_start[start..]);
+            }
+        }
+    }
+}
+
+/// One soft part's drive, per lane, for the substep `h`.
 #[inline(always)]
-fn soft<L: Lane>(compliance: &[f32], relaxation: &[f32], inv_h2: L) -> Softness<L> {
-    Softness {
-        alpha_tilde: L::load(compliance) * inv_h2,
-        relaxation: L::load(relaxation),
+fn soft<L: Lane>(lanes: [&[f32]; 5], inv_h: L, inv_h2: L) -> Drive<L> {
+    let [compliance, relaxation, period2, damping_time, max_torque] = lanes;
+    Drive {
+        soft: Softness {
+            alpha_tilde: L::load(compliance) * inv_h2,
+            relaxation: L::load(relaxation),
+        },
+        spring: L::load(period2) * inv_h2,
+        gamma: L::load(damping_time) * inv_h,
+        limit: L::load(max_torque) / inv_h2,
     }
 }
 
 #[inline(always)]
-fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows, inv_h2: L) {
+fn solve_positions<L: Lane>(
+    block: &mut RodBlock,
+    start: usize,
+    rows: &BodyRows,
+    inv_h: L,
+    inv_h2: L,
+) {
     let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
     let (frame_a, frame_b) = (
         block.frame_a.load::<L>(start),
         block.frame_b.load::<L>(start),
     );
 
-    let bend_soft = soft(
-        &block.bend_compliance[start..],
-        &block.bend_relaxation[start..],
+    let rest_length = L::load(&block.rest_length[start..]);
+    let bend_drive = soft(
+        [
+            &block.bend_compliance[start..],
+            &block.bend_relaxation[start..],
+            &block.bend_period2[start..],
+            &block.bend_damping_time[start..],
+            &block.max_torque[start..],
+        ],
+        inv_h,
         inv_h2,
     );
     let f = frames(&a, &b, frame_a, frame_b);
@@ -213,20 +326,29 @@ fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows,
         &mut b,
         &f,
         block.bend_rest.load(start),
-        bend_soft,
+        rest_length,
+        &bend_drive,
+        block.bend_start.load(start),
         lambda,
     );
     lambda.store(&mut block.bend_lambda[start..]);
 
-    let twist_soft = soft(
-        &block.twist_compliance[start..],
-        &block.twist_relaxation[start..],
+    let twist_drive = soft(
+        [
+            &block.twist_compliance[start..],
+            &block.twist_relaxation[start..],
+            &block.twist_period2[start..],
+            &block.twist_damping_time[start..],
+            &block.max_torque[start..],
+        ],
+        inv_h,
         inv_h2,
     );
     let f = frames(&a, &b, frame_a, frame_b);
     let lambda = L::load(&block.twist_lambda[start..]);
     let rest = L::load(&block.twist_rest[start..]);
-    let lambda = twist::solve(&mut a, &mut b, &f, rest, twist_soft, lambda);
+    let start_twist = L::load(&block.twist_start[start..]);
+    let lambda = twist::solve(&mut a, &mut b, &f, rest, &twist_drive, start_twist, lambda);
     lambda.store(&mut block.twist_lambda[start..]);
 
     let f = frames(&a, &b, frame_a, frame_b);
@@ -242,13 +364,7 @@ fn solve_positions<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows,
     let f = frames(&a, &b, frame_a, frame_b);
     curve::solve(&mut a, &mut b, &f, &chord);
     let f = frames(&a, &b, frame_a, frame_b);
-    length::solve(
-        &mut a,
-        &mut b,
-        &f,
-        L::load(&block.rest_length[start..]),
-        &chord,
-    );
+    length::solve(&mut a, &mut b, &f, rest_length, &chord);
 
     block.bodies.scatter(rows, start, &a, &b);
 }

@@ -16,10 +16,11 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
-use vertebra_math::{Lane, LaneKernel, Vec3};
+use vertebra_math::{Lane, LaneKernel, Quat, Vec3};
 
-use crate::body::{BodyLanes, BodyPairs, BodyRows, VelocityLanes};
-use crate::parts::{drive, ellipse, limit, point, pyramid, swing, swing_direction, twist};
+use crate::body::{BodyLanes, BodyPairs, BodyRows};
+use crate::driven::{DriveBlock, DriveLane, Driven};
+use crate::parts::{ellipse, limit, point, pyramid, swing, swing_direction, twist};
 use crate::residual::Residual;
 
 /// Eight sockets, field by field.
@@ -42,17 +43,8 @@ pub struct SocketBlock {
     pub twist_min: [f32; BLOCK_LANES],
     /// Highest twist angle (rad).
     pub twist_max: [f32; BLOCK_LANES],
-    /// Drive target: b's joint frame relative to a's.
-    pub drive_target: QuatBlock,
-    /// Drive compliance (rad / (N m)); 0 is infinitely stiff.
-    pub drive_compliance: [f32; BLOCK_LANES],
-    /// 1 where the drive is on, 0 where off.
-    pub drive_enabled: [f32; BLOCK_LANES],
-    /// Drive damping rate (1/s).
-    pub drive_damping: [f32; BLOCK_LANES],
-    /// The drive's accumulated XPBD multiplier (world vector), reset every
-    /// substep.
-    pub drive_lambda: Vec3Block,
+    /// The angular drives.
+    pub drive: DriveBlock,
     /// Shaped path: the elliptical cone's semi-axis about Y,
     /// `sin(theta_y / 2)` (1 disables).
     pub ellipse_y: [f32; BLOCK_LANES],
@@ -118,8 +110,8 @@ pub struct SocketLane {
     pub swing_max: f32,
     /// Twist range (rad), `[-pi, pi]` when unlimited.
     pub twist: [f32; 2],
-    /// Drive target, compliance (rad/(N m)) and damping (1/s), if driven.
-    pub drive: Option<(GQuat, f32, f32)>,
+    /// The drive, if driven.
+    pub drive: Option<DriveLane>,
     /// The shaped path's limits ([`ShapedLimits::FREE`] on the plain path).
     pub shaped: ShapedLimits,
 }
@@ -165,12 +157,7 @@ impl SocketBlock {
         self.frame_b.set(lane, s.frame_b);
         self.swing_max[lane] = s.swing_max;
         (self.twist_min[lane], self.twist_max[lane]) = (s.twist[0], s.twist[1]);
-        let (target, compliance, damping) = s.drive.unwrap_or((GQuat::IDENTITY, 0.0, 0.0));
-        self.drive_target.set(lane, target);
-        self.drive_compliance[lane] = compliance;
-        self.drive_damping[lane] = damping;
-        self.drive_enabled[lane] = if s.drive.is_some() { 1.0 } else { 0.0 };
-        self.drive_lambda.set(lane, GVec3::ZERO);
+        self.drive.set(lane, s.drive.as_ref());
         let shaped = &s.shaped;
         (self.ellipse_y[lane], self.ellipse_z[lane]) = (shaped.ellipse[0], shaped.ellipse[1]);
         for k in 0..2 {
@@ -186,7 +173,7 @@ impl SocketBlock {
     /// Zeroes every accumulated multiplier (the drive's and the shaped
     /// limits'), as each substep begins.
     pub fn reset_lambdas(&mut self) {
-        self.drive_lambda = Vec3Block::default();
+        self.drive.lambda = Vec3Block::default();
         self.limit_lambda = [[0.0; BLOCK_LANES]; 4];
     }
 }
@@ -203,6 +190,8 @@ pub struct PositionPass<'a, const DRIVE: bool, const SHAPED: bool> {
     pub blocks: &'a mut [SocketBlock],
     /// Body rows, read and written.
     pub rows: &'a BodyRows,
+    /// `1 / h` for the substep `h` (s^-1): the drive's `gamma`.
+    pub inv_h: f32,
     /// `1 / h^2` for the substep `h` (s^-2): `alpha~ = compliance / h^2`.
     pub inv_h2: f32,
 }
@@ -211,10 +200,10 @@ impl<const DRIVE: bool, const SHAPED: bool> LaneKernel for PositionPass<'_, DRIV
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let inv_h2 = L::splat(self.inv_h2);
+        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
         for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions::<L, DRIVE, SHAPED>(block, start, self.rows, inv_h2);
+                solve_positions::<L, DRIVE, SHAPED>(block, start, self.rows, inv_h, inv_h2);
             }
         }
     }
@@ -225,6 +214,7 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
     block: &mut SocketBlock,
     start: usize,
     rows: &BodyRows,
+    inv_h: L,
     inv_h2: L,
 ) {
     let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
@@ -232,21 +222,10 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
     let frame_b = block.frame_b.load::<L>(start);
 
     if DRIVE {
-        let lambda = block.drive_lambda.load::<L>(start);
-        let alpha_tilde = L::load(&block.drive_compliance[start..]) * inv_h2;
-        let enabled = L::load(&block.drive_enabled[start..]);
-        let target = block.drive_target.load::<L>(start);
-        let lambda = drive::solve(
-            &mut a,
-            &mut b,
-            frame_a,
-            frame_b,
-            target,
-            enabled,
-            alpha_tilde,
-            lambda,
-        );
-        block.drive_lambda.store(start, lambda);
+        let (a, b) = (&mut a, &mut b);
+        block
+            .drive
+            .solve(start, a, b, frame_a, frame_b, inv_h, inv_h2);
     }
 
     if SHAPED {
@@ -338,53 +317,16 @@ fn solve_limit<L: Lane>(
     limit::solve(a, b, n, c, alpha_tilde, lambda).store(&mut block.limit_lambda[k][start..]);
 }
 
-/// A block of joints with angular drives: what the velocity pass needs.
-pub trait Driven {
-    /// The lanes' bodies.
-    fn bodies(&self) -> &BodyPairs;
-    /// Each lane's drive damping rate (1/s), 0 where undriven.
-    fn damping_rate<L: Lane>(&self, start: usize) -> L;
-}
-
 impl Driven for SocketBlock {
     fn bodies(&self) -> &BodyPairs {
         &self.bodies
     }
     #[inline(always)]
-    fn damping_rate<L: Lane>(&self, start: usize) -> L {
-        L::load(&self.drive_damping[start..]) * L::load(&self.drive_enabled[start..])
+    fn frames<L: Lane>(&self, start: usize) -> (Quat<L>, Quat<L>) {
+        (self.frame_a.load(start), self.frame_b.load(start))
     }
-}
-
-/// The velocity pass: drive damping, `min(damping h, 1)` of the relative
-/// angular velocity removed per substep of `h` seconds. Only driven blocks
-/// (sockets or hinges) need it.
-pub struct VelocityPass<'a, B> {
-    /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a [B],
-    /// Body rows: poses and inertia read, velocities read and written.
-    pub rows: &'a BodyRows,
-    /// The substep (s).
-    pub h: f32,
-}
-
-impl<B: Driven> LaneKernel for VelocityPass<'_, B> {
-    type Output = ();
-    #[inline(always)]
-    fn run<L: Lane>(self) {
-        let h = L::splat(self.h);
-        for block in self.blocks {
-            let bodies = block.bodies();
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let (a, b) = bodies.gather::<L>(self.rows, start);
-                let mut va = VelocityLanes::<L>::gather(self.rows, &bodies.body_a[start..]);
-                let mut vb = VelocityLanes::<L>::gather(self.rows, &bodies.body_b[start..]);
-                let fraction = (block.damping_rate::<L>(start) * h).min(L::splat(1.0));
-                drive::damp(&a, &b, &mut va, &mut vb, fraction);
-                va.scatter(self.rows, &bodies.write_a[start..]);
-                vb.scatter(self.rows, &bodies.write_b[start..]);
-            }
-        }
+    fn drive_mut(&mut self) -> &mut DriveBlock {
+        &mut self.drive
     }
 }
 

@@ -50,6 +50,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<ContactBl
                     },
                     restitution: r.random_range(0.0..=1.0),
                     approach: r.random_range(-10.0..10.0),
+                    overlap: r.random_range(0.0..0.1),
                     start: common::start(&mut r, adversarial),
                 },
             );

@@ -9,10 +9,10 @@ use common::{
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
+use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
 use vertebra_kernels::residual::ResidualPass;
-use vertebra_kernels::socket::VelocityPass;
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
@@ -108,9 +108,18 @@ fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlo
                     frame_b: j.frame_b,
                     range,
                     compliance: limit,
-                    drive: r
-                        .random_bool(0.6)
-                        .then(|| (unit_quat(&mut r), drive, r.random_range(0.0..20.0))),
+                    drive: r.random_bool(0.6).then(|| DriveLane {
+                        target: unit_quat(&mut r),
+                        velocity: vec(&mut r, 20.0),
+                        compliance: drive,
+                        damping_time: r.random_range(0.0..1.0),
+                        max_torque: if r.random_bool(0.5) {
+                            r.random_range(0.0..50.0)
+                        } else {
+                            f32::INFINITY
+                        },
+                        ..DriveLane::OFF
+                    }),
                 },
             );
             block
@@ -159,23 +168,25 @@ fn fixed_joints(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<Fi
 fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
+    backend.dispatch(StartPass {
+        blocks: &mut blocks,
+        rows: &rows,
+        h: 1.0 / 60.0,
+    });
     for _ in 0..2 {
         backend.dispatch(hinge::PositionPass::<true> {
             blocks: &mut blocks,
             rows: &rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
         backend.dispatch(hinge::PositionPass::<false> {
             blocks: &mut blocks,
             rows: &rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
     }
-    backend.dispatch(VelocityPass {
-        blocks: &blocks,
-        rows: &rows,
-        h: 1.0 / 60.0,
-    });
     let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
         blocks: &blocks,
@@ -184,9 +195,9 @@ fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32
     });
     let mut out = flatten(&rows);
     for b in &blocks {
-        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
-            &b.drive_lambda,
-        )));
+        for v in [&b.drive.lambda, &b.drive.start] {
+            out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(v)));
+        }
         out.extend(b.limit_lambda);
     }
     out.extend(residual.iter().flatten());

@@ -1,6 +1,7 @@
 //! The rod kernel gives the scalar reference's bits on every backend, for
 //! random and adversarial rods: straight, folded back, coincident ends,
-//! huge and tiny stiffness, relaxation and compliance.
+//! huge and tiny stiffness, relaxation and compliance, damped and sprung
+//! parts, torque caps that bind and that do not.
 
 mod common;
 
@@ -9,19 +10,44 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::residual::ResidualPass;
-use vertebra_kernels::rod::{PositionPass, RodBlock, RodLane, RodSoftness};
+use vertebra_kernels::rod::{PositionPass, RodBlock, RodLane, RodSoftness, StartPass};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
 const STATICS: usize = 4;
 
 fn softness(r: &mut StdRng) -> RodSoftness {
-    match r.random_range(0..5) {
+    match r.random_range(0..9) {
         0 => RodSoftness::Compliance(0.0),
         1 => RodSoftness::Compliance(1e-9),
         2 => RodSoftness::Compliance(1e9),
         3 => RodSoftness::Relaxation(r.random_range(0.0..1.0)),
+        4 => RodSoftness::Damped {
+            compliance: r.random_range(0.0..0.5),
+            damping_time: r.random_range(0.0..0.2),
+        },
+        5 => RodSoftness::Damped {
+            compliance: 1e-9,
+            damping_time: 1e6,
+        },
+        6 => RodSoftness::Spring {
+            period2: r.random_range(0.0..0.1),
+            damping_time: r.random_range(0.0..0.5),
+        },
+        7 => RodSoftness::Spring {
+            period2: 2.5e4,
+            damping_time: 0.0,
+        },
         _ => RodSoftness::Compliance(r.random_range(0.0..0.5)),
+    }
+}
+
+/// A torque cap: none, zero, or one that binds now and then (N m).
+fn max_torque(r: &mut StdRng) -> f32 {
+    match r.random_range(0..4) {
+        0 => 0.0,
+        1 => r.random_range(0.0..50.0),
+        _ => f32::INFINITY,
     }
 }
 
@@ -98,6 +124,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>
                     } else {
                         [-pi, pi]
                     },
+                    max_torque: max_torque(&mut r),
                 },
             );
             block
@@ -112,10 +139,15 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>
 fn run(backend: Backend, raw: &RawRows, blocks: &[RodBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
+    backend.dispatch(StartPass {
+        blocks: &mut blocks,
+        rows: &rows,
+    });
     for _ in 0..4 {
         backend.dispatch(PositionPass {
             blocks: &mut blocks,
             rows: &rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
     }
@@ -129,6 +161,10 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[RodBlock]) -> Vec<f32> {
     for b in &blocks {
         out.extend(b.bend_lambda);
         out.extend(b.twist_lambda);
+        out.extend(b.twist_start);
+        for lane in 0..BLOCK_LANES {
+            out.extend(b.bend_start.get(lane).to_array());
+        }
     }
     out.extend(residual.iter().flatten());
     out

@@ -10,8 +10,9 @@ use common::{
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
+use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::residual::ResidualPass;
-use vertebra_kernels::socket::{PositionPass, ShapedLimits, SocketBlock, SocketLane, VelocityPass};
+use vertebra_kernels::socket::{PositionPass, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
@@ -89,9 +90,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
                     } else {
                         [-pi, pi]
                     },
-                    drive: r
-                        .random_bool(0.6)
-                        .then(|| (unit_quat(&mut r), compliance, r.random_range(0.0..20.0))),
+                    drive: r.random_bool(0.6).then(|| drive(&mut r, compliance)),
                     shaped: shaped(&mut r, adversarial, compliance),
                 },
             );
@@ -128,39 +127,78 @@ fn shaped(r: &mut StdRng, adversarial: bool, compliance: f32) -> ShapedLimits {
     }
 }
 
+/// A drive of either strength (compliance, or `1 / omega^2` with
+/// compliance 0), moving or still, with or without a torque limit.
+fn drive(r: &mut StdRng, compliance: f32) -> DriveLane {
+    let spring = r.random_bool(0.5);
+    let omega = match r.random_range(0..3) {
+        0 => 1e-2,
+        1 => 1e4,
+        _ => r.random_range(1.0..200.0),
+    };
+    DriveLane {
+        target: unit_quat(r),
+        velocity: if r.random_bool(0.5) {
+            glam::Vec3::new(
+                r.random_range(-20.0..20.0),
+                r.random_range(-20.0..20.0),
+                r.random_range(-20.0..20.0),
+            )
+        } else {
+            glam::Vec3::ZERO
+        },
+        compliance: if spring { 0.0 } else { compliance },
+        period2: if spring { 1.0 / (omega * omega) } else { 0.0 },
+        damping_time: match r.random_range(0..3) {
+            0 => 0.0,
+            1 => 1e6,
+            _ => r.random_range(0.0..1.0),
+        },
+        max_torque: match r.random_range(0..4) {
+            0 => 0.0,
+            1 => r.random_range(0.0..50.0),
+            _ => f32::INFINITY,
+        },
+    }
+}
+
 /// Every float the passes produce: rows, multipliers, residuals.
 fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
     // Every kernel variant: with the drive part (disabled lanes multiply
     // it by zero) and without, plain and shaped path.
+    backend.dispatch(StartPass {
+        blocks: &mut blocks,
+        rows: &rows,
+        h: 1.0 / 60.0,
+    });
     for _ in 0..2 {
         backend.dispatch(PositionPass::<true, false> {
             blocks: &mut blocks,
             rows: &rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
         backend.dispatch(PositionPass::<false, false> {
             blocks: &mut blocks,
             rows: &rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
         backend.dispatch(PositionPass::<true, true> {
             blocks: &mut blocks,
             rows: &rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
         backend.dispatch(PositionPass::<false, true> {
             blocks: &mut blocks,
             rows: &rows,
+            inv_h: 60.0,
             inv_h2: 3600.0,
         });
     }
-    backend.dispatch(VelocityPass {
-        blocks: &blocks,
-        rows: &rows,
-        h: 1.0 / 60.0,
-    });
     let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
         blocks: &blocks,
@@ -169,8 +207,11 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
     });
     let mut out = flatten(&rows);
     for b in &blocks {
+        for v in [&b.drive.lambda, &b.drive.start] {
+            out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(v)));
+        }
         out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
-            &b.drive_lambda,
+            &b.drive.target,
         )));
         out.extend(b.limit_lambda.iter().flatten());
     }

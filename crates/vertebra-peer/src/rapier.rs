@@ -8,7 +8,8 @@ use parry3d::math::Pose;
 use rapier3d::prelude::*;
 use vertebra_scenes::SceneWorld;
 use vertebra_world::{
-    BodyHandle, BodyKind, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist, World,
+    AngularDrive, BodyHandle, BodyKind, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist,
+    World,
 };
 
 /// Rapier's solver budget per frame.
@@ -254,7 +255,8 @@ fn translate_socket(socket: &JointDesc) -> Result<GenericJoint, PeerError> {
     let frame_a = Pose::from_parts(socket.anchor_a, socket.frame_a);
     let frame_b = Pose::from_parts(socket.anchor_b, socket.frame_b);
     if let Some(drive) = socket.drive {
-        if drive.compliance != 0.0 || drive.damping != 0.0 {
+        let rigid = AngularDrive::rigid(drive.target);
+        if drive != rigid {
             return Err(PeerError::Unsupported("a soft angular drive"));
         }
         let target = Pose::from_parts(socket.anchor_a, socket.frame_a * drive.target);

@@ -3,9 +3,10 @@
 //!
 //! Sockets use their angular drive; the rod is driven through its rest
 //! shape: its rest bend and twist become the target pose's, and its
-//! bending and twisting take the drive's strength.
+//! bending and twisting take the drive's strength, damping and torque
+//! limit (mapped from the sockets it replaces: `rod_stiffness`).
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use vertebra_world::{AngularDrive, JointKind, RodStiffness, World};
 
 use crate::error::RagdollError;
@@ -17,8 +18,17 @@ use crate::ragdoll::{Ragdoll, rod_name};
 pub enum Strength {
     /// Zero compliance: the target is a hard constraint.
     Infinite,
-    /// XPBD compliance (rad / (N m)): time-step and iteration independent.
+    /// XPBD compliance (rad / (N m)): time-step and iteration independent;
+    /// damped by [`DriveSettings::damping`].
     Compliance(f32),
+    /// A damped spring of natural frequency (Hz) and damping ratio (1 is
+    /// critical) on each joint's own effective inertia.
+    Spring {
+        /// Natural frequency (Hz).
+        frequency: f32,
+        /// Damping ratio.
+        damping_ratio: f32,
+    },
 }
 
 /// Drive settings for a whole ragdoll, with optional per-joint overrides.
@@ -26,46 +36,79 @@ pub enum Strength {
 pub struct DriveSettings {
     /// The strength of every joint without an override.
     pub strength: Strength,
-    /// Damping rate (1/s) of the sockets' drives.
+    /// Damping coefficient (N m s / rad) of joints driven by
+    /// [`Strength::Compliance`] (a spring's damping is its ratio).
     pub damping: f32,
+    /// The largest torque (N m) each joint's drive exerts; infinity is
+    /// unlimited.
+    pub max_torque: f32,
     /// Per described joint, an override (empty: none). A simplified
     /// ragdoll's rod takes the override of the spine's first joint.
     pub joints: Vec<Option<Strength>>,
 }
 
 impl DriveSettings {
-    /// Every joint at `strength`, no damping, no overrides.
+    /// Every joint at `strength`, no damping, no torque limit, no
+    /// overrides.
     pub fn uniform(strength: Strength) -> Self {
         Self {
             strength,
             damping: 0.0,
+            max_torque: f32::INFINITY,
             joints: Vec::new(),
         }
     }
 
+    /// With a damping coefficient (N m s / rad).
+    pub fn with_damping(mut self, damping: f32) -> Self {
+        self.damping = damping;
+        self
+    }
+
+    /// With a torque limit (N m).
+    pub fn with_max_torque(mut self, max_torque: f32) -> Self {
+        self.max_torque = max_torque;
+        self
+    }
+
+    /// The drive `strength` gives a socket aimed at `target`.
+    fn socket_drive(&self, strength: Strength, target: Quat) -> AngularDrive {
+        let drive = match strength {
+            Strength::Infinite => AngularDrive::rigid(target),
+            Strength::Compliance(c) => AngularDrive::compliant(target, c, self.damping),
+            Strength::Spring {
+                frequency,
+                damping_ratio,
+            } => AngularDrive::spring(target, frequency, damping_ratio),
+        };
+        drive.with_max_torque(self.max_torque)
+    }
+
     fn validate(&self, joints: usize) -> Result<(), RagdollError> {
-        let bad =
-            |s: &Strength| matches!(s, Strength::Compliance(c) if !(c.is_finite() && *c >= 0.0));
-        if bad(&self.strength) || self.joints.iter().flatten().any(bad) {
-            return Err(RagdollError::OutOfRange {
-                context: "drive".to_owned(),
-                field: "compliance",
-                reason: "must be finite and not negative".to_owned(),
-            });
-        }
+        let out = |field: &'static str, reason: &str| RagdollError::OutOfRange {
+            context: "drive".to_owned(),
+            field,
+            reason: reason.to_owned(),
+        };
         if !(self.damping.is_finite() && self.damping >= 0.0) {
-            return Err(RagdollError::OutOfRange {
-                context: "drive".to_owned(),
-                field: "damping",
-                reason: "must be finite and not negative".to_owned(),
-            });
+            return Err(out("damping", "must be finite and not negative"));
+        }
+        if self.max_torque.is_nan() || self.max_torque < 0.0 {
+            return Err(out("max_torque", "must be a number, not negative"));
+        }
+        for s in core::iter::once(&self.strength).chain(self.joints.iter().flatten()) {
+            // The world checks every range; a strength is tried on an
+            // identity drive so that a refusal names the settings' field.
+            if let Err(e) = self.socket_drive(*s, Quat::IDENTITY).validate() {
+                let field = match s {
+                    Strength::Spring { .. } => "strength (frequency, damping ratio)",
+                    _ => "strength (compliance, damping)",
+                };
+                return Err(out(field, &e.to_string()));
+            }
         }
         if !self.joints.is_empty() && self.joints.len() != joints {
-            return Err(RagdollError::OutOfRange {
-                context: "drive".to_owned(),
-                field: "joints",
-                reason: format!("needs {joints} entries or none"),
-            });
+            return Err(out("joints", &format!("needs {joints} entries or none")));
         }
         Ok(())
     }
@@ -76,6 +119,39 @@ impl DriveSettings {
             .copied()
             .flatten()
             .unwrap_or(self.strength)
+    }
+}
+
+/// The rod's bending and twisting for a drive strength, when it replaces
+/// `joints` sockets in series (each a spring-damper of compliance `c` and
+/// damping `D`). In series every socket carries the same torque `tau`, so
+/// each turns by the same `C_i` with `tau = C_i / c + D C_i'`, and the
+/// chain by `C = n C_i`: `tau = C / (n c) + (D / n) C'`. The rod's torque is
+/// `(k / l0) C + (d / l0) C'`, so `k = l0 / (n c)` and `d = l0 D / n` (its
+/// damping time `d / k = c D`, the socket's). A spring strength is the
+/// rod's own spring at that frequency and ratio (on its effective
+/// inertia); infinite strength is a rigid rod. `docs/ragdolls.md`,
+/// "Drives", measures the two spines against each other.
+fn rod_stiffness(
+    strength: Strength,
+    damping: f32,
+    rest_length: f32,
+    joints: usize,
+) -> RodStiffness {
+    let n = joints.max(1) as f32;
+    match strength {
+        Strength::Infinite => RodStiffness::Kirchhoff(f32::INFINITY),
+        Strength::Compliance(c) => RodStiffness::Damped {
+            stiffness: rest_length / (n * c),
+            damping: rest_length * damping / n,
+        },
+        Strength::Spring {
+            frequency,
+            damping_ratio,
+        } => RodStiffness::Spring {
+            frequency,
+            damping_ratio,
+        },
     }
 }
 
@@ -98,15 +174,7 @@ impl Ragdoll {
             let frame = j.frame;
             let relative =
                 (target.bones[j.parent].1 * frame).inverse() * (target.bones[j.child].1 * frame);
-            let compliance = match settings.strength(k) {
-                Strength::Infinite => 0.0,
-                Strength::Compliance(c) => c,
-            };
-            let drive = AngularDrive {
-                target: relative.normalize(),
-                compliance,
-                damping: settings.damping,
-            };
+            let drive = settings.socket_drive(settings.strength(k), relative.normalize());
             world
                 .set_joint_drive(*socket, Some(drive))
                 .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
@@ -118,11 +186,15 @@ impl Ragdoll {
             );
             let (f0, f1) = (base * rest.frame_a, top * rest.frame_b);
             let tb = f1 * Vec3::X;
-            let stiffness = match settings.strength(spine.joints[0]) {
-                Strength::Infinite => RodStiffness::Kirchhoff(f32::INFINITY),
-                Strength::Compliance(c) => RodStiffness::Kirchhoff(rest.rest_length / c),
-            };
-            let mut driven = rest.with_stiffness(stiffness, stiffness);
+            let stiffness = rod_stiffness(
+                settings.strength(spine.joints[0]),
+                settings.damping,
+                rest.rest_length,
+                spine.joints.len(),
+            );
+            let mut driven = rest
+                .with_stiffness(stiffness, stiffness)
+                .with_max_torque(settings.max_torque);
             driven.bend_rest = (f0.inverse() * tb).normalize();
             driven.twist_rest = crate::mapping::rod_twist(f0, f1);
             world

@@ -42,6 +42,7 @@ mod drive;
 mod error;
 mod joint_def;
 mod mapping;
+mod motion;
 mod pose;
 mod ragdoll;
 

@@ -130,7 +130,9 @@ impl Ragdoll {
     /// pose and the spine bones between its ends. On error the world is
     /// put back as it was (its state, and so its state hash: the world
     /// restores a snapshot taken before the first body went in); only the
-    /// handles the refused build drew are never issued again.
+    /// handles the refused build drew are never issued again. With a
+    /// collision layer, `vertebra_collide::Collisions::build_ragdoll`
+    /// builds it and adds its colliders in one call.
     pub fn build(
         world: &mut World,
         desc: &RagdollDesc,

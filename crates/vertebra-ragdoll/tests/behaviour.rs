@@ -291,12 +291,8 @@ fn a_driven_ragdoll_with_fixed_hips_returns_to_its_pose_after_a_push() {
             Vec3::Y,
         )
         .unwrap();
-        w.add_joint(pin.with_drive(vertebra_world::AngularDrive {
-            target: Quat::IDENTITY,
-            compliance: 0.0,
-            damping: 0.0,
-        }))
-        .unwrap();
+        w.add_joint(pin.with_drive(vertebra_world::AngularDrive::rigid(Quat::IDENTITY)))
+            .unwrap();
         let mut settings = DriveSettings::uniform(Strength::Infinite);
         settings.damping = 10.0;
         ragdoll.drive_to(&mut w, &target, &settings).unwrap();

@@ -4,10 +4,16 @@
 //! (standard). Used by the `vertebra` command, the benches and the tests.
 
 mod kinematics;
+mod quantity;
 mod run;
 pub mod seed;
+mod seeds;
 mod setup;
+mod spread;
 
 pub use kinematics::{Locus, kinematics};
+pub use quantity::{Quantity, Stats};
 pub use run::{Frame, MAX_FRAMES, SceneRun, run};
+pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};
 pub use setup::{Scene, SceneConfig, SceneWorld, build, ragdoll_drop};
+pub use spread::Spread;

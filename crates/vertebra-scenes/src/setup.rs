@@ -264,11 +264,7 @@ fn fix(world: &mut World, body: BodyHandle) -> Result<(), RagdollError> {
             .with_orientation(world.body(body)?.orientation),
     )?;
     let pin = JointDesc::socket_at_world_anchor(world.bodies(), anchor, body, at, Vec3::Y)?
-        .with_drive(AngularDrive {
-            target: Quat::IDENTITY,
-            compliance: 0.0,
-            damping: 0.0,
-        });
+        .with_drive(AngularDrive::rigid(Quat::IDENTITY));
     world.add_joint(pin)?;
     Ok(())
 }

@@ -62,7 +62,16 @@ fn ragdoll_drop_rod() {
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision
 // coordinates, the rod's wrapped twist, the lineage-free state hash.
-const GOLDEN_BENDING_SOCKETS: u64 = 0x40d2_7cf5_71a4_7432;
-const GOLDEN_BENDING_ROD: u64 = 0xc330_bf11_d54b_3d63;
+// Passive bending's two updated 2026 by the drives (issue 15): the hips'
+// pin is a drive, and the hashed socket description gained the drive's
+// target velocity, strength and torque limit. Every body's state is the
+// same bits as before: hashing the old description's fields instead gave
+// the old values. The two rod hashes updated by the rod drives (issue 15):
+// the hashed rod description gained `max_torque` (and the stiffness two
+// variants). The bodies' bits are unchanged: with `max_torque` left out of
+// the serialisation the old hashes came back on every backend and thread
+// count (undriven rods take the old correction bit for bit).
+const GOLDEN_BENDING_SOCKETS: u64 = 0x72b8_cc15_033e_3505;
+const GOLDEN_BENDING_ROD: u64 = 0x91fc_ac92_3106_001f;
 const GOLDEN_DROP_SOCKETS: u64 = 0x554e_4f30_f575_bb42;
-const GOLDEN_DROP_ROD: u64 = 0x00b1_096d_8ec3_4b5d;
+const GOLDEN_DROP_ROD: u64 = 0x634e_2c17_abeb_9fa5;

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
-use vertebra_scenes::{Scene, SceneConfig, kinematics, run};
+use vertebra_scenes::{Comparison, Quantity, Scene, SceneConfig, Seeded, compare, kinematics, run};
 
 const BOTH: [SpineMode; 2] = [SpineMode::Sockets, SpineMode::Rod];
 
@@ -114,23 +114,32 @@ fn runs_are_deterministic_and_backend_independent() {
     }
 }
 
+/// Figure 8, right: smaller than passive bending, but consistent. The pile
+/// is chaotic, so the claim is checked over eight seeded starts, seed by
+/// seed: the rod's mean errors are lower in at least seven, and by 5% or
+/// more at the median (`docs/reproduction.md` gives the spread over 16).
 #[test]
 fn the_rod_ragdolls_drop_with_less_joint_error() {
-    // Figure 8, right: smaller than passive bending, but consistent.
-    let mean = |spine| {
-        let r = run(&SceneConfig::new(Scene::RagdollDrop, spine), |_, _| {}).unwrap();
-        let n = r.frames.len() as f32;
-        (
-            r.frames.iter().map(|f| f.eps_lin_cm).sum::<f32>() / n,
-            r.frames.iter().map(|f| f.eps_ang_rad).sum::<f32>() / n,
-        )
-    };
-    let (sockets, rod) = (mean(SpineMode::Sockets), mean(SpineMode::Rod));
-    eprintln!("drop: sockets {sockets:?}, rod {rod:?}");
-    assert!(
-        rod.0 < sockets.0 && rod.1 < sockets.1,
-        "sockets {sockets:?}, rod {rod:?}"
-    );
+    let seeded =
+        |spine| Seeded::run(&SceneConfig::new(Scene::RagdollDrop, spine), 8, |_, _| {}).unwrap();
+    let (sockets, rod) = (seeded(SpineMode::Sockets), seeded(SpineMode::Rod));
+    for quantity in [Quantity::EpsLin, Quantity::EpsAng] {
+        let each: Vec<f32> = sockets
+            .runs
+            .iter()
+            .zip(&rod.runs)
+            .map(|(s, r)| Comparison::of(s, r, quantity).ratio)
+            .collect();
+        eprintln!("drop, sockets over rod, {quantity}: {each:?}");
+        assert!(
+            each.iter().filter(|&&x| x > 1.0).count() >= 7,
+            "{quantity}: {each:?}"
+        );
+        assert!(
+            compare(&sockets, &rod, quantity).0.median > 1.05,
+            "{quantity}: {each:?}"
+        );
+    }
 }
 
 /// A seeded start is another start (every scene, both spines), the same on

@@ -33,6 +33,10 @@ pub enum Error {
     BodyInUse,
     /// A joint between two bodies neither of which is dynamic.
     NoDynamicBody,
+    /// A call that only a dynamic body takes (an impulse), made on a
+    /// static or kinematic one: their mass is infinite, so no impulse
+    /// moves them (a kinematic body's velocity is set, not pushed).
+    NotDynamic(&'static str),
     /// A limit range whose lower end is above its upper end, or outside
     /// the angle range it is measured in.
     InvalidLimit(&'static str),
@@ -79,6 +83,10 @@ impl fmt::Display for Error {
                 "the body is still used by a joint; remove the joint first"
             ),
             Error::NoDynamicBody => write!(f, "a joint needs at least one dynamic body"),
+            Error::NotDynamic(what) => write!(
+                f,
+                "{what} needs a dynamic body (static and kinematic bodies have infinite mass)"
+            ),
             Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
             Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
             Error::InvalidJoint(what) => write!(f, "invalid joint: {what}"),

@@ -109,6 +109,7 @@ impl Contact {
             friction: self.friction,
             restitution: self.restitution,
             approach: (velocity(ib, self.point) - velocity(ia, self.point)).dot(n),
+            overlap: depth.max(0.0),
             start,
         }
     }

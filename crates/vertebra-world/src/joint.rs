@@ -2,6 +2,8 @@
 //! validation. See `docs/joints.md` for each kind's parts and units.
 
 use glam::{Quat, Vec3};
+
+use crate::drive::{AngularDrive, validate_drive};
 use serde::{Deserialize, Serialize};
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
@@ -13,18 +15,6 @@ pub enum JointTag {}
 
 /// A stable reference to a joint.
 pub type JointHandle = Handle<JointTag>;
-
-/// Drives a joint's body b toward an orientation relative to body a.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct AngularDrive {
-    /// b's joint frame relative to a's joint frame (unit quaternion).
-    pub target: Quat,
-    /// Compliance (rad / (N m)), the inverse of stiffness; 0 is infinitely
-    /// stiff. Independent of the time step and iteration count (XPBD).
-    pub compliance: f32,
-    /// Damping rate (1/s) of the relative angular velocity.
-    pub damping: f32,
-}
 
 /// How a limit holds: hard, or as a spring on the excess.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -350,21 +340,4 @@ pub(crate) fn validate_drive_for(
         (_, Some(d)) => validate_drive(d),
         (_, None) => Ok(()),
     }
-}
-
-/// Checks a drive's target, compliance and damping.
-pub(crate) fn validate_drive(d: &AngularDrive) -> Result<(), Error> {
-    check_unit_quat("drive target", d.target)?;
-    for (what, x) in [
-        ("drive compliance", d.compliance),
-        ("drive damping", d.damping),
-    ] {
-        if !x.is_finite() {
-            return Err(Error::NonFinite(what));
-        }
-        if x < 0.0 {
-            return Err(Error::NonPositive(what));
-        }
-    }
-    Ok(())
 }

@@ -14,7 +14,8 @@ use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_store::BodyHandle;
 
-use crate::joint::{AngularDrive, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
+use crate::drive::AngularDrive;
+use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
 
 #[derive(Serialize, Deserialize)]
 pub(crate) struct JointWire {

@@ -189,16 +189,16 @@ impl Layout {
             JointKind::Socket(limits) => {
                 let (block, lane) = self.sockets.place[slot];
                 let block = &mut self.sockets.blocks[block];
-                let lambda = block.drive_lambda.get(lane);
+                let lambda = block.drive.lambda.get(lane);
                 block.set(lane, &socket_lane(desc, &limits, bodies));
-                block.drive_lambda.set(lane, lambda);
+                block.drive.lambda.set(lane, lambda);
             }
             JointKind::Hinge { range, softness } => {
                 let (block, lane) = self.hinges.place[slot];
                 let block = &mut self.hinges.blocks[block];
-                let lambda = block.drive_lambda.get(lane);
+                let lambda = block.drive.lambda.get(lane);
                 block.set(lane, &hinge_lane(desc, range, softness, bodies));
-                block.drive_lambda.set(lane, lambda);
+                block.drive.lambda.set(lane, lambda);
             }
             JointKind::Fixed => {
                 let (block, lane) = self.fixed.place[slot];
@@ -365,9 +365,7 @@ pub(crate) fn socket_lane(desc: &JointDesc, limits: &SwingTwist, bodies: &BodySt
         frame_b: desc.frame_b.normalize(),
         swing_max: plain_cone,
         twist: limits.twist.unwrap_or([-PI, PI]),
-        drive: desc
-            .drive
-            .map(|d| (d.target.normalize(), d.compliance, d.damping)),
+        drive: desc.drive.map(|d| d.lane()),
         shaped: if limits.is_plain() {
             ShapedLimits::FREE
         } else {
@@ -422,9 +420,7 @@ pub(crate) fn hinge_lane(
         frame_b: desc.frame_b.normalize(),
         range: range.unwrap_or([-PI, PI]),
         compliance: compliance(softness),
-        drive: desc
-            .drive
-            .map(|d| (d.target.normalize(), d.compliance, d.damping)),
+        drive: desc.drive.map(|d| d.lane()),
     }
 }
 
@@ -460,5 +456,6 @@ pub(crate) fn rod_lane(desc: &RodDesc, bodies: &BodyStore) -> RodLane {
         twist: desc.softness(desc.twisting),
         bend_max: desc.bend_limit.unwrap_or(PI),
         twist_range: desc.twist_limit.unwrap_or([-PI, PI]),
+        max_torque: desc.max_torque,
     }
 }

@@ -25,6 +25,8 @@
 mod checks;
 mod config;
 mod contact;
+mod drive;
+mod impulse;
 mod joint;
 mod joint_wire;
 mod layout;
@@ -43,9 +45,11 @@ pub use config::{
     MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
 };
 pub use contact::Contact;
-pub use joint::{
-    AngularDrive, JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist,
+pub use drive::{
+    AngularDrive, DriveStrength, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
+    MIN_DRIVE_FREQUENCY,
 };
+pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
 pub use snapshot::Snapshot;
@@ -59,7 +63,7 @@ pub use vertebra_store::{
 /// Bodies, joints and the solver that steps them.
 ///
 /// Every call that computes (adding bodies and joints, setting poses,
-/// forces, rods, drives and contacts, restoring, stepping) does so in the
+/// forces, impulses, rods, drives and contacts, restoring, stepping) does so in the
 /// default floating-point mode, whatever mode (FTZ, DAZ, rounding) the
 /// caller's thread runs in, and gives the caller its mode back: equal calls
 /// give equal worlds on every host ([`vertebra_math::float_mode`]).
@@ -214,6 +218,62 @@ impl World {
     pub fn add_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         self.bodies.add_torque(handle, torque)
+    }
+
+    /// Applies a linear impulse (N s, world) through a dynamic body's
+    /// centre of mass: its velocity changes by `impulse / mass` now, not
+    /// at the next step (Jolt's `AddImpulse`, Rapier's `apply_impulse`), and
+    /// is held to `max_linear_speed`. For a hit, a jump, an explosion: a
+    /// force `F` held for one step of `dt` is the impulse `F dt`, spread
+    /// over the step. Refused, with nothing changed: a static or kinematic
+    /// body (`NotDynamic`: infinite mass; set a kinematic body's velocity
+    /// instead), a non-finite impulse, one whose velocity change overflows
+    /// `f32`.
+    pub fn apply_impulse(&mut self, handle: BodyHandle, impulse: Vec3) -> Result<(), Error> {
+        self.apply_impulses(handle, impulse, Vec3::ZERO)
+    }
+
+    /// Applies a linear impulse (N s, world) at a world point (m, within
+    /// twice [`MAX_COORDINATE`] on every axis, as [`World::add_force_at`]
+    /// takes): the impulse through the centre of mass `x` and the angular
+    /// impulse `(point - x) x impulse` about it, so the velocity changes
+    /// by `impulse / mass` and the angular velocity by
+    /// `I_w^-1 ((point - x) x impulse)` (`I_w^-1`: the world inverse
+    /// inertia at the body's orientation), now; held to the speed limits.
+    /// Refused as [`World::apply_impulse`], and for a point out of range.
+    pub fn apply_impulse_at(
+        &mut self,
+        handle: BodyHandle,
+        impulse: Vec3,
+        point: Vec3,
+    ) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
+        let moment = impulse::moment_at(&self.bodies, handle, impulse, point)?;
+        self.apply_impulses(handle, impulse, moment)
+    }
+
+    /// Applies an angular impulse (N m s, world, about the centre of mass):
+    /// the angular velocity changes by `I_w^-1 angular_impulse` (the world
+    /// inverse inertia at the body's orientation) now, held to
+    /// `max_angular_speed`. Refused as [`World::apply_impulse`].
+    pub fn apply_angular_impulse(
+        &mut self,
+        handle: BodyHandle,
+        angular_impulse: Vec3,
+    ) -> Result<(), Error> {
+        self.apply_impulses(handle, Vec3::ZERO, angular_impulse)
+    }
+
+    /// The one path of the three impulse calls (see `impulse.rs`).
+    fn apply_impulses(
+        &mut self,
+        handle: BodyHandle,
+        linear: Vec3,
+        angular: Vec3,
+    ) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
+        let limits = (self.config.max_linear_speed, self.config.max_angular_speed);
+        impulse::apply(&mut self.bodies, handle, linear, angular, limits)
     }
 
     /// Adds a joint; `Err` (and no change) for invalid input.

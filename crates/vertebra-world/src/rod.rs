@@ -1,10 +1,12 @@
 //! The rod constraint's public description, and its instantiation from any
 //! pose of its two bodies (paper section 6).
 
-use core::f32::consts::PI;
+use core::f32::consts::{PI, TAU};
 
 use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
+
+use crate::drive::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, MAX_COORDINATE, check_coordinate, check_unit_quat,
     check_unit_vec,
@@ -37,6 +39,30 @@ pub enum RodStiffness {
     /// removed per iteration. How stiff the rod ends up depends on the
     /// iteration count (see `docs/rod-constraint.md`).
     Relaxation(f32),
+    /// Kirchhoff stiffness with damping: the torque is
+    /// `-(stiffness / l0) C - (damping / l0) dC/dt` on the bend or twist
+    /// error `C` (rad). Solved as XPBD with damping (compliance `l0 / k`,
+    /// damping time `damping / stiffness`; `vertebra_kernels::parts::rod::drive`).
+    Damped {
+        /// Kirchhoff stiffness `k` (N m^2); 0 is none (and then damping
+        /// does nothing: a damper needs a spring in XPBD), infinity rigid.
+        stiffness: f32,
+        /// Kirchhoff damping `d` (N m^2 s / rad), with `d / k` at most
+        /// [`MAX_DRIVE_DAMPING_TIME`] s.
+        damping: f32,
+    },
+    /// A damped spring at `frequency` with `damping_ratio` on the rod's
+    /// effective inertia in bending or twisting (bending counts the
+    /// bodies' centres carried round the arc; derivation in
+    /// `vertebra_kernels::parts::rod::drive`): a driven rod oscillates at
+    /// `frequency` whatever its bodies' masses.
+    Spring {
+        /// Natural frequency (Hz), at least [`MIN_DRIVE_FREQUENCY`];
+        /// infinity is rigid.
+        frequency: f32,
+        /// Damping ratio in [0, [`MAX_DRIVE_DAMPING_RATIO`]]; 1 is critical.
+        damping_ratio: f32,
+    },
 }
 
 /// A rod between the centres of mass of two bodies.
@@ -70,6 +96,11 @@ pub struct RodDesc {
     pub bend_limit: Option<f32>,
     /// Twist range (rad, within [-pi, pi]); `None` is unlimited.
     pub twist_limit: Option<[f32; 2]>,
+    /// The largest torque (N m, not negative) the soft bending and, apart,
+    /// the soft twisting exert; infinity is unlimited. A hit beyond it bends
+    /// or twists the rod away from its rest shape, which the rod recovers
+    /// afterwards. The limits are not capped.
+    pub max_torque: f32,
 }
 
 impl RodDesc {
@@ -134,6 +165,7 @@ impl RodDesc {
             twisting: RodStiffness::Kirchhoff(0.0),
             bend_limit: None,
             twist_limit: None,
+            max_torque: f32::INFINITY,
         })
     }
 
@@ -141,6 +173,12 @@ impl RodDesc {
     pub fn with_stiffness(mut self, bending: RodStiffness, twisting: RodStiffness) -> Self {
         self.bending = bending;
         self.twisting = twisting;
+        self
+    }
+
+    /// With a torque limit (N m) on the soft bending and twisting.
+    pub fn with_max_torque(mut self, max_torque: f32) -> Self {
+        self.max_torque = max_torque;
         self
     }
 
@@ -171,18 +209,13 @@ impl RodDesc {
         if !self.twist_rest.is_finite() {
             return Err(Error::NonFinite("rod rest twist"));
         }
-        for (what, s) in [
-            ("rod bending", self.bending),
-            ("rod twisting", self.twisting),
-        ] {
-            match s {
-                RodStiffness::Kirchhoff(k) if k.is_nan() => return Err(Error::NonFinite(what)),
-                RodStiffness::Kirchhoff(k) if k < 0.0 => return Err(Error::NonPositive(what)),
-                RodStiffness::Relaxation(r) if !(0.0..=1.0).contains(&r) => {
-                    return Err(Error::InvalidLimit("relaxation factor (must be in [0, 1])"));
-                }
-                _ => {}
-            }
+        check_stiffness(self.bending, STIFFNESS_FIELDS[0])?;
+        check_stiffness(self.twisting, STIFFNESS_FIELDS[1])?;
+        if self.max_torque.is_nan() {
+            return Err(Error::NonFinite("rod max torque"));
+        }
+        if self.max_torque < 0.0 {
+            return Err(Error::NonPositive("rod max torque"));
         }
         crate::checks::max_angle(self.bend_limit, "bend")?;
         crate::checks::twist_range(self.twist_limit)
@@ -197,10 +230,95 @@ impl RodDesc {
     pub(crate) fn softness(&self, s: RodStiffness) -> RodSoftness {
         match s {
             RodStiffness::Kirchhoff(k) if k > 0.0 => RodSoftness::Compliance(self.rest_length / k),
-            RodStiffness::Kirchhoff(_) => RodSoftness::Relaxation(0.0),
+            RodStiffness::Damped { stiffness, damping } if stiffness > 0.0 => RodSoftness::Damped {
+                compliance: self.rest_length / stiffness,
+                damping_time: damping / stiffness,
+            },
+            RodStiffness::Kirchhoff(_) | RodStiffness::Damped { .. } => {
+                RodSoftness::Relaxation(0.0)
+            }
             RodStiffness::Relaxation(r) => RodSoftness::Relaxation(r),
+            RodStiffness::Spring {
+                frequency,
+                damping_ratio,
+            } => {
+                let omega = TAU * frequency;
+                RodSoftness::Spring {
+                    period2: 1.0 / (omega * omega),
+                    damping_time: 2.0 * damping_ratio / omega,
+                }
+            }
         }
     }
+}
+
+/// The names a refusal gives each stiffness's fields, bending then
+/// twisting: (stiffness, damping, frequency, damping ratio).
+const STIFFNESS_FIELDS: [[&str; 4]; 2] = [
+    [
+        "rod bending",
+        "rod bending damping",
+        "rod bending frequency",
+        "rod bending damping ratio",
+    ],
+    [
+        "rod twisting",
+        "rod twisting damping",
+        "rod twisting frequency",
+        "rod twisting damping ratio",
+    ],
+];
+
+/// Checks one stiffness; `names` as in [`STIFFNESS_FIELDS`].
+fn check_stiffness(s: RodStiffness, names: [&'static str; 4]) -> Result<(), Error> {
+    let [what, damping_name, frequency_name, ratio_name] = names;
+    match s {
+        RodStiffness::Kirchhoff(k) => not_negative(what, k),
+        RodStiffness::Relaxation(r) if !(0.0..=1.0).contains(&r) => {
+            Err(Error::InvalidLimit("relaxation factor (must be in [0, 1])"))
+        }
+        RodStiffness::Relaxation(_) => Ok(()),
+        RodStiffness::Damped { stiffness, damping } => {
+            not_negative(what, stiffness)?;
+            not_negative(damping_name, damping)?;
+            if !damping.is_finite() {
+                return Err(Error::NonFinite(damping_name));
+            }
+            if stiffness > 0.0 && damping / stiffness > MAX_DRIVE_DAMPING_TIME {
+                return Err(Error::OutOfRange(
+                    "rod damping (damping over stiffness at most 1e6 s)",
+                ));
+            }
+            Ok(())
+        }
+        RodStiffness::Spring {
+            frequency,
+            damping_ratio,
+        } => {
+            if frequency.is_nan() {
+                return Err(Error::NonFinite(frequency_name));
+            }
+            if frequency < MIN_DRIVE_FREQUENCY {
+                return Err(Error::OutOfRange("rod frequency (at least 1e-3 Hz)"));
+            }
+            not_negative(ratio_name, damping_ratio)?;
+            if damping_ratio > MAX_DRIVE_DAMPING_RATIO {
+                return Err(Error::OutOfRange("rod damping ratio (at most 1e3)"));
+            }
+            Ok(())
+        }
+    }
+}
+
+/// A number, not negative (infinity allowed).
+fn not_negative(what: &'static str, x: f32) -> Result<(), Error> {
+    if x.is_nan() {
+        return Err(Error::NonFinite(what));
+    }
+    if x < 0.0 {
+        return Err(Error::NonPositive(what));
+    }
+    Ok(())
 }
 
 /// The unit tangent at `a` of the circle through `a`, `m`, `b`, pointing

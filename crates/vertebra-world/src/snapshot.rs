@@ -54,7 +54,7 @@ use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
-const FORMAT: u8 = b'4';
+const FORMAT: u8 = b'6';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
@@ -324,11 +324,9 @@ mod tests {
         let rod = RodDesc::from_pose(bodies, links[0], links[1], &[])
             .unwrap()
             .with_stiffness(RodStiffness::Kirchhoff(5.0), RodStiffness::Relaxation(0.5));
-        let drive = AngularDrive {
-            target: Quat::IDENTITY,
-            compliance: 0.01,
-            damping: 1.0,
-        };
+        let drive = AngularDrive::spring(Quat::IDENTITY, 4.0, 0.7)
+            .with_target_velocity(Vec3::new(0.0, 0.5, 0.0))
+            .with_max_torque(30.0);
         let driven = JointDesc::socket_at_world_anchor(
             bodies,
             links[1],
@@ -400,6 +398,19 @@ mod tests {
             (
                 Box::new(|s| s.rods[0].as_mut().unwrap().rest_length = -0.4),
                 "rod 0: rod rest length must be positive",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().max_torque = NAN),
+                "rod 0: rod max torque is not finite",
+            ),
+            (
+                Box::new(|s| {
+                    s.rods[0].as_mut().unwrap().bending = RodStiffness::Spring {
+                        frequency: 2.0,
+                        damping_ratio: 2e3,
+                    }
+                }),
+                "rod 0: rod damping ratio (at most 1e3) is out of range",
             ),
             (
                 Box::new(|s| s.bodies.inverse_mass[1] = NAN),
@@ -474,9 +485,26 @@ mod tests {
             (
                 Box::new(|s| {
                     let socket = s.joints[1].as_mut().unwrap();
-                    socket.drive.as_mut().unwrap().compliance = -1.0;
+                    socket.drive.as_mut().unwrap().max_torque = -1.0;
                 }),
-                "joint 1: drive compliance must be positive",
+                "joint 1: drive max torque must be positive",
+            ),
+            (
+                Box::new(|s| {
+                    let socket = s.joints[1].as_mut().unwrap();
+                    socket.drive.as_mut().unwrap().target_velocity.y = f32::NAN;
+                }),
+                "joint 1: drive target velocity is not finite",
+            ),
+            (
+                Box::new(|s| {
+                    let socket = s.joints[1].as_mut().unwrap();
+                    socket.drive.as_mut().unwrap().strength = crate::DriveStrength::Spring {
+                        frequency: 0.0,
+                        damping_ratio: 1.0,
+                    };
+                }),
+                "joint 1: drive frequency (at least 1e-3 Hz) is out of range",
             ),
             (
                 Box::new(|s| s.joints[1].as_mut().unwrap().kind = JointKind::Fixed),

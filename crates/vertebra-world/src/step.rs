@@ -5,14 +5,16 @@
 use glam::{Quat, Vec3};
 use vertebra_kernels::body::BodyRows;
 use vertebra_kernels::contact::{self, ContactBlock};
+use vertebra_kernels::driven::StartPass;
 use vertebra_kernels::fixed::{self, FixedBlock};
 use vertebra_kernels::hinge::{self, HingeBlock};
 use vertebra_kernels::rod::{self, RodBlock};
-use vertebra_kernels::socket::{PositionPass, SocketBlock, VelocityPass};
+use vertebra_kernels::socket::{PositionPass, SocketBlock};
 use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
 
 use crate::World;
+use crate::joint::JointKind;
 use crate::parallel::chunked;
 
 pub(crate) fn step(world: &mut World, dt: f32) {
@@ -22,7 +24,9 @@ pub(crate) fn step(world: &mut World, dt: f32) {
     world
         .previous
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));
-    for _ in 0..world.config.substeps {
+    let substeps = world.config.substeps;
+    for substep in 0..substeps {
+        start_drives(world, h);
         predict(world, h);
         world
             .layout
@@ -42,11 +46,14 @@ pub(crate) fn step(world: &mut World, dt: f32) {
             .blocks
             .iter_mut()
             .for_each(RodBlock::reset_lambdas);
+        // An overlap found at detection comes out evenly over the step
+        // (docs/contacts.md, "The jammed pile").
+        let remaining = (substeps - 1 - substep) as f32 / substeps as f32;
         world
             .contact_layout
             .blocks
             .iter_mut()
-            .for_each(ContactBlock::reset_lambdas);
+            .for_each(|b| b.start_substep(remaining));
         for _ in 0..world.config.iterations {
             solve_positions(world, h);
         }
@@ -56,9 +63,66 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         world.repaired += repair(world);
     }
     commit(world);
+    keep_drive_targets(world);
     let bodies = &mut world.bodies;
     bodies.force.iter_mut().for_each(|f| *f = Vec3::ZERO);
     bodies.torque.iter_mut().for_each(|t| *t = Vec3::ZERO);
+}
+
+/// The drives' substep start, before the bodies move: each drive's error
+/// against the last substep's target, then the target advanced by `h`;
+/// each rod's bend and twist error (its soft parts damp against them).
+/// Every driven block, one after another, on the world's backend (each
+/// lane reads and writes only its own block).
+fn start_drives(world: &mut World, h: f32) {
+    let rows = &*world.rows.get();
+    let layout = &mut world.layout;
+    for group in layout
+        .colours
+        .iter()
+        .chain(core::iter::once(&layout.overflow))
+    {
+        for range in [&group.driven, &group.shaped_driven] {
+            world.backend.dispatch(StartPass {
+                blocks: &mut layout.sockets.blocks[range.clone()],
+                rows,
+                h,
+            });
+        }
+        world.backend.dispatch(StartPass {
+            blocks: &mut layout.hinges.blocks[group.hinges_driven.clone()],
+            rows,
+            h,
+        });
+        world.backend.dispatch(rod::StartPass {
+            blocks: &mut layout.rods.blocks[group.rods.clone()],
+            rows,
+        });
+    }
+}
+
+/// Writes each driven joint's advanced target back to its description,
+/// so that the next step (and a snapshot, and a new layout) starts where
+/// this one ended.
+fn keep_drive_targets(world: &mut World) {
+    let layout = &world.layout;
+    for (slot, desc) in world.joints.iter_mut().enumerate() {
+        let Some(desc) = desc.as_mut() else { continue };
+        let Some(drive) = desc.drive.as_mut() else {
+            continue;
+        };
+        drive.target = match desc.kind {
+            JointKind::Socket(_) => {
+                let (block, lane) = layout.sockets.place[slot];
+                layout.sockets.blocks[block].drive.target.get(lane)
+            }
+            JointKind::Hinge { .. } => {
+                let (block, lane) = layout.hinges.place[slot];
+                layout.hinges.blocks[block].drive.target.get(lane)
+            }
+            JointKind::Fixed => continue,
+        };
+    }
 }
 
 /// Rows for every slot (stale slots hold harmless old data: no joint
@@ -159,7 +223,7 @@ pub(crate) fn hold_speeds(b: &mut BodyStore, max_linear: f32, max_angular: f32) 
 
 /// `v` shortened to at most `max` (`v` itself when it is no longer), and
 /// finite even when a component overflowed to infinity.
-fn limit(v: Vec3, max: f32) -> Vec3 {
+pub(crate) fn limit(v: Vec3, max: f32) -> Vec3 {
     if v.length_squared() <= max * max {
         return v;
     }
@@ -330,6 +394,7 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
 
 /// The position iteration.
 struct Positions {
+    inv_h: f32,
     inv_h2: f32,
 }
 
@@ -341,42 +406,48 @@ impl Pass for Positions {
         rows: &BodyRows,
         backend: Backend,
     ) {
-        let inv_h2 = self.inv_h2;
+        let (inv_h, inv_h2) = (self.inv_h, self.inv_h2);
         match (kind.driven, kind.shaped) {
             (true, false) => backend.dispatch(PositionPass::<true, false> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             }),
             (false, false) => backend.dispatch(PositionPass::<false, false> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             }),
             (true, true) => backend.dispatch(PositionPass::<true, true> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             }),
             (false, true) => backend.dispatch(PositionPass::<false, true> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             }),
         }
     }
     fn hinges(&self, blocks: &mut [HingeBlock], driven: bool, rows: &BodyRows, backend: Backend) {
-        let inv_h2 = self.inv_h2;
+        let (inv_h, inv_h2) = (self.inv_h, self.inv_h2);
         if driven {
             backend.dispatch(hinge::PositionPass::<true> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             });
         } else {
             backend.dispatch(hinge::PositionPass::<false> {
                 blocks,
                 rows,
+                inv_h,
                 inv_h2,
             });
         }
@@ -388,6 +459,7 @@ impl Pass for Positions {
         backend.dispatch(rod::PositionPass {
             blocks,
             rows,
+            inv_h: self.inv_h,
             inv_h2: self.inv_h2,
         });
     }
@@ -396,38 +468,16 @@ impl Pass for Positions {
     }
 }
 
-/// The velocity pass (drive damping, contact friction and restitution;
-/// rods and fixed joints have none).
+/// The velocity pass (contact friction and restitution; joints have none:
+/// drives damp at the position level).
 struct Velocities {
     h: f32,
     resting_speed: f32,
 }
 
 impl Pass for Velocities {
-    fn sockets(
-        &self,
-        blocks: &mut [SocketBlock],
-        kind: SocketBlocks,
-        rows: &BodyRows,
-        backend: Backend,
-    ) {
-        if kind.driven {
-            backend.dispatch(VelocityPass {
-                blocks,
-                rows,
-                h: self.h,
-            });
-        }
-    }
-    fn hinges(&self, blocks: &mut [HingeBlock], driven: bool, rows: &BodyRows, backend: Backend) {
-        if driven {
-            backend.dispatch(VelocityPass {
-                blocks,
-                rows,
-                h: self.h,
-            });
-        }
-    }
+    fn sockets(&self, _: &mut [SocketBlock], _: SocketBlocks, _: &BodyRows, _: Backend) {}
+    fn hinges(&self, _: &mut [HingeBlock], _: bool, _: &BodyRows, _: Backend) {}
     fn fixed(&self, _: &mut [FixedBlock], _: &BodyRows, _: Backend) {}
     fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
@@ -445,6 +495,7 @@ fn solve_positions(world: &mut World, h: f32) {
     for_each_colour(
         world,
         &Positions {
+            inv_h: 1.0 / h,
             inv_h2: 1.0 / (h * h),
         },
     );

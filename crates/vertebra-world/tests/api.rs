@@ -212,20 +212,12 @@ fn bad_joints_are_refused() {
     });
     rejected(Error::NonPositive("drive compliance"), |w| {
         let s = w.residuals().joints[0].joint;
-        let drive = AngularDrive {
-            target: Quat::IDENTITY,
-            compliance: -1.0,
-            damping: 0.0,
-        };
+        let drive = AngularDrive::compliant(Quat::IDENTITY, -1.0, 0.0);
         w.set_joint_drive(s, Some(drive))
     });
     rejected(Error::NotNormalized("drive target"), |w| {
         let s = w.residuals().joints[0].joint;
-        let drive = AngularDrive {
-            target: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
-            compliance: 0.0,
-            damping: 0.0,
-        };
+        let drive = AngularDrive::rigid(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0));
         w.set_joint_drive(s, Some(drive))
     });
 }
@@ -245,11 +237,7 @@ fn add_kind(w: &mut World, kind: JointKind, drive: Option<AngularDrive>) -> Resu
 #[test]
 fn bad_joint_kinds_are_refused_with_the_field_named() {
     let soft = |c| SwingTwist::FREE.with_softness(LimitSoftness::Compliance(c));
-    let drive = AngularDrive {
-        target: Quat::IDENTITY,
-        compliance: 0.0,
-        damping: 0.0,
-    };
+    let drive = AngularDrive::rigid(Quat::IDENTITY);
     let cases = [
         (
             JointKind::Socket(SwingTwist::FREE.with_swing(Swing::Ellipse { y: 0.5, z: 4.0 })),
@@ -455,6 +443,60 @@ fn bad_rods_are_refused() {
             .with_stiffness(RodStiffness::Kirchhoff(-2.0), RodStiffness::Kirchhoff(1.0));
         w.add_rod(r).map(drop)
     });
+    rejected_after(above, Error::NonPositive("rod max torque"), |w, ends| {
+        w.add_rod(rod(w, ends)?.with_max_torque(-1.0)).map(drop)
+    });
+    rejected_after(above, Error::NonFinite("rod max torque"), |w, ends| {
+        w.add_rod(rod(w, ends)?.with_max_torque(f32::NAN)).map(drop)
+    });
+    rejected_after(
+        above,
+        Error::NonFinite("rod twisting damping"),
+        |w, ends| {
+            let damped = RodStiffness::Damped {
+                stiffness: 1.0,
+                damping: f32::INFINITY,
+            };
+            let r = rod(w, ends)?.with_stiffness(RodStiffness::Kirchhoff(1.0), damped);
+            w.add_rod(r).map(drop)
+        },
+    );
+    rejected_after(
+        above,
+        Error::OutOfRange("rod damping (damping over stiffness at most 1e6 s)"),
+        |w, ends| {
+            let damped = RodStiffness::Damped {
+                stiffness: 1e-9,
+                damping: 1.0,
+            };
+            w.add_rod(rod(w, ends)?.with_stiffness(damped, damped))
+                .map(drop)
+        },
+    );
+    rejected_after(
+        above,
+        Error::OutOfRange("rod frequency (at least 1e-3 Hz)"),
+        |w, ends| {
+            let spring = RodStiffness::Spring {
+                frequency: 0.0,
+                damping_ratio: 1.0,
+            };
+            w.add_rod(rod(w, ends)?.with_stiffness(spring, spring))
+                .map(drop)
+        },
+    );
+    rejected_after(
+        above,
+        Error::NonPositive("rod bending damping ratio"),
+        |w, ends| {
+            let spring = RodStiffness::Spring {
+                frequency: 2.0,
+                damping_ratio: -1.0,
+            };
+            w.add_rod(rod(w, ends)?.with_stiffness(spring, spring))
+                .map(drop)
+        },
+    );
     rejected_after(above, Error::InvalidLimit("bend"), |w, ends| {
         let r = rod(w, ends)?.with_bend_limit(4.0);
         w.add_rod(r).map(drop)

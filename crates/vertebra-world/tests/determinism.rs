@@ -40,11 +40,11 @@ fn build(backend: Backend, threads: usize) -> World {
                         desc = desc.with_swing_limit(0.4).with_twist_limit(-0.2, 0.3);
                     }
                     if (tree + depth) % 4 == 1 {
-                        desc = desc.with_drive(AngularDrive {
-                            target: Quat::from_rotation_x(0.3),
-                            compliance: 0.01,
-                            damping: 2.0,
-                        });
+                        desc = desc.with_drive(
+                            AngularDrive::spring(Quat::from_rotation_x(0.3), 3.0, 0.5)
+                                .with_target_velocity(Vec3::new(0.0, 0.4, 0.0))
+                                .with_max_torque(20.0),
+                        );
                     }
                     w.add_joint(desc).unwrap();
                     next.push((body, bottom));

@@ -295,11 +295,7 @@ fn push_driven_arm(compliance: f32) -> (f32, f32, f32) {
     let mut w = world(1, 20);
     let (_, child, desc) = arm(&mut w, -Vec3::Y);
     let target = Quat::from_rotation_z(0.6);
-    let drive = AngularDrive {
-        target,
-        compliance,
-        damping: 5.0,
-    };
+    let drive = AngularDrive::compliant(target, compliance, 0.5);
     w.add_joint(desc.with_drive(drive)).unwrap();
     let error = |w: &World| {
         angle_between(

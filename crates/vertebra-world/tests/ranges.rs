@@ -8,8 +8,9 @@ use common::capsule;
 use glam::{Quat, Vec3};
 use vertebra_world::{
     AngularDrive, BodyHandle, Contact, Error, MAX_ANGULAR_SPEED_LIMIT, MAX_COORDINATE,
-    MAX_LINEAR_SPEED_LIMIT, MAX_ROD_LENGTH, MAX_SOLVER_SWEEPS, MAX_THREADS, RodDesc, RodStiffness,
-    SolverConfig, World,
+    MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MAX_LINEAR_SPEED_LIMIT, MAX_ROD_LENGTH,
+    MAX_SOLVER_SWEEPS, MAX_THREADS, MIN_DRIVE_FREQUENCY, RodDesc, RodStiffness, SolverConfig,
+    World,
 };
 
 /// Steps `world` a second at 60 Hz; every body stays finite, within
@@ -200,12 +201,34 @@ fn settings_at_their_limits_step_finite_and_bounded() {
             -Vec3::Y,
         )
         .unwrap();
-        let drive = AngularDrive {
-            target: Quat::from_rotation_z(1.0),
-            compliance: f32::MAX,
-            damping: f32::MAX,
-        };
+        let drive = AngularDrive::compliant(Quat::from_rotation_z(1.0), f32::MAX, 0.0)
+            .with_target_velocity(Vec3::X * MAX_ANGULAR_SPEED_LIMIT);
+        let slow = AngularDrive::spring(
+            Quat::from_rotation_z(1.0),
+            MIN_DRIVE_FREQUENCY,
+            MAX_DRIVE_DAMPING_RATIO,
+        );
+        let sticky = AngularDrive::compliant(Quat::IDENTITY, 1e-30, MAX_DRIVE_DAMPING_TIME / 1e-30)
+            .with_max_torque(f32::MAX);
         world.add_joint(socket.with_drive(drive)).unwrap();
+        for d in [slow, sticky] {
+            let extra = world
+                .add_body(vertebra_world::BodyDesc::dynamic(
+                    vertebra_world::Shape::Sphere { radius: 0.1 }
+                        .mass_properties_with_mass(1.0)
+                        .unwrap(),
+                ))
+                .unwrap();
+            let s = vertebra_world::JointDesc::socket_at_world_anchor(
+                world.bodies(),
+                a,
+                extra,
+                Vec3::ZERO,
+                Vec3::X,
+            )
+            .unwrap();
+            world.add_joint(s.with_drive(d)).unwrap();
+        }
         // 60 steps of at most MAX_LINEAR_SPEED_LIMIT / 60 m each.
         steps_clean(&mut world, MAX_LINEAR_SPEED_LIMIT * 1.01);
     }

@@ -85,11 +85,7 @@ fn every_piece_of_state_a_step_reads_changes_the_hash() {
             s.world.add_torque(s.a, Vec3::X).unwrap()
         }),
         ("socket drive", |s| {
-            let drive = AngularDrive {
-                target: Quat::from_rotation_x(0.2),
-                compliance: 0.0,
-                damping: 0.0,
-            };
+            let drive = AngularDrive::rigid(Quat::from_rotation_x(0.2));
             s.world.set_joint_drive(s.socket, Some(drive)).unwrap();
         }),
         ("socket removed", |s| {

@@ -12,11 +12,15 @@
 //! `1/2 k_b kappa^2 l0` with `kappa = C / l0` is `1/2 (k_b / l0) C^2`: the
 //! compliance is `l0 / k_b`.
 //!
+//! As a drive it is damped, sprung and capped by `super::drive`, whose
+//! header derives the bend's effective inertia.
+//!
 //! The limit keeps `psi <= psi_max`: `C = max(psi - psi_max, 0)` about the
 //! bend axis `t_a x t_b`, hard.
 
 use vertebra_math::{Lane, Vec3, poly};
 
+use super::drive::{self, Drive, bend_weight};
 use super::{Frames, bend_angle};
 use crate::body::BodyLanes;
 use crate::parts::angle::{self, Softness};
@@ -29,18 +33,31 @@ pub fn measure<L: Lane>(f: &Frames<L>, rest_direction: Vec3<L>) -> (Vec3<L>, L) 
     (n, poly::atan2(sin, d.dot(f.tb)))
 }
 
-/// One soft bending correction; returns the new accumulated `lambda`.
+/// The error as a rotation vector `C n` (rad, world): the bend's state at
+/// the substep's start, read along the axis of the moment by [`solve`].
 #[inline(always)]
+pub fn start<L: Lane>(f: &Frames<L>, rest_direction: Vec3<L>) -> Vec3<L> {
+    let (n, c) = measure(f, rest_direction);
+    n.scale(c)
+}
+
+/// One soft bending correction, damped against the error `start` had as
+/// the substep began; returns the new accumulated `lambda`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
     f: &Frames<L>,
     rest_direction: Vec3<L>,
-    soft: Softness<L>,
+    rest_length: L,
+    d: &Drive<L>,
+    start: Vec3<L>,
     lambda: L,
 ) -> L {
     let (n, c) = measure(f, rest_direction);
-    lambda + angle::correct_axes(a, b, n, n, c, soft, lambda)
+    let w = bend_weight(a, b, n, rest_length);
+    drive::correct(a, b, n, n, c, c - start.dot(n), w, d, lambda)
 }
 
 /// How far `psi` exceeds the limit (rad, >= 0), and the bend axis.

@@ -11,6 +11,7 @@
 
 pub mod bend;
 pub mod curve;
+pub mod drive;
 pub mod length;
 pub mod twist;
 

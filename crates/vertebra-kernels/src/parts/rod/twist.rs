@@ -19,11 +19,13 @@
 //! `dtau/dtheta_a = -(t_a - t_a x k)` and `dtau/dtheta_b = t_b + t_b x k`
 //! (derivation in `docs/rod-constraint.md`; checked against finite
 //! differences in `tests/rod_gradients.rs`). The energy
-//! `1/2 k_t (tau/l0)^2 l0` gives the compliance `l0 / k_t`, as for bending.
+//! `1/2 k_t (tau/l0)^2 l0` gives the compliance `l0 / k_t`, as for bending;
+//! damping, the spring form and the torque cap are `super::drive`'s.
 
 use vertebra_math::{Lane, Quat, Vec3, poly};
 
 use super::Frames;
+use super::drive::{self, Drive};
 use crate::body::{BodyLanes, safe_ratio};
 use crate::parts::angle::{self, Softness};
 use crate::parts::twist::excess;
@@ -54,21 +56,32 @@ pub fn measure<L: Lane>(f: &Frames<L>) -> L {
     relative.twist_angle(Vec3::splat(crate::TWIST_AXIS))
 }
 
-/// One soft twisting correction toward `rest`; returns the new `lambda`.
-/// The error `tau - rest` is wrapped to [-pi, pi]: a rod twisted past pi
+/// The error `tau - rest`, wrapped to [-pi, pi]: a rod twisted past pi
 /// from its rest twist turns back the short way, not the long way round.
+#[inline(always)]
+pub fn error<L: Lane>(f: &Frames<L>, rest: L) -> L {
+    poly::wrap_angle(measure(f) - rest)
+}
+
+/// One soft twisting correction toward `rest`, damped against the error
+/// `start` as the substep began (the rate wraps too); returns the new
+/// `lambda`. Twisting moves no centre: its effective inverse inertia is
+/// the angle part's `w` (`super::drive`).
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
     f: &Frames<L>,
     rest: L,
-    soft: Softness<L>,
+    d: &Drive<L>,
+    start: L,
     lambda: L,
 ) -> L {
-    let c = poly::wrap_angle(measure(f) - rest);
+    let c = error(f, rest);
     let (n_a, n_b) = axes(f);
-    lambda + angle::correct_axes(a, b, n_a, n_b, c, soft, lambda)
+    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
+    let rate = poly::wrap_angle(c - start);
+    drive::correct(a, b, n_a, n_b, c, rate, w, d, lambda)
 }
 
 /// Enforces `lo <= tau <= hi`; returns |excess| before the correction.

@@ -1,0 +1,185 @@
+//! `vertebra reproduce`: every scene both ways over seeded starts; a table
+//! of each figure's median and spread, the rod's advantage with its spread,
+//! CSV, plots, pictures and `summary.json`.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use serde_json::{Value, json};
+use vertebra_ragdoll::SpineMode;
+use vertebra_scenes::{
+    Comparison, Quantity, Scene, SceneConfig, Seeded, Spread, compare, kinematics,
+};
+
+use crate::output::{io, spine_name, spreads, write_csv};
+use crate::plots::{font_options, picture, plot, plot_locus, to_png};
+
+/// Seeds `reproduce` runs each scene from unless told: enough for the 10th
+/// and 90th percentiles, and the whole command in well under a minute on
+/// two cores (`docs/reproduction.md`).
+pub const DEFAULT_SEEDS: u64 = 16;
+
+/// Runs every scene both ways from seeds `0 .. seeds` and writes everything
+/// under `out`.
+pub fn reproduce(out: &Path, seeds: u64) -> Result<(), String> {
+    std::fs::create_dir_all(out).map_err(|e| io(format!("{}: {e}", out.display())))?;
+    let fonts = font_options();
+    let mut document = Vec::new();
+    let mut table = String::new();
+    for scene in Scene::ALL {
+        let mut runs = Vec::new();
+        for spine in [SpineMode::Sockets, SpineMode::Rod] {
+            let config = SceneConfig::new(scene, spine);
+            let label = format!("{scene} ({})", spine_name(spine));
+            let seeded = Seeded::run(&config, seeds, |done, count| progress(&label, done, count))
+                .map_err(|e| e.to_string())?;
+            eprintln!();
+            write_csv(
+                &out.join(format!("{scene}-{}.csv", spine_name(spine))),
+                &seeded,
+            )?;
+            runs.push((spine, seeded));
+        }
+        write_table(&mut table, scene, &runs);
+        document.push(scene_json(scene, &runs));
+        let (chart, poses) = (
+            out.join(format!("{scene}.svg")),
+            out.join(format!("{scene}-poses.svg")),
+        );
+        plot(&chart, scene, &runs)?;
+        picture(&poses, scene, &runs)?;
+        to_png(&chart, &fonts)?;
+        to_png(&poses, &fonts)?;
+    }
+    let locus = kinematics(0.45, 60f32.to_radians(), 61);
+    plot_locus(&out.join("kinematics.svg"), &locus)?;
+    to_png(&out.join("kinematics.svg"), &fonts)?;
+    let mut csv = String::from("chain,largest_gap_m\n");
+    for (name, _, gap) in &locus.chains {
+        writeln!(csv, "{name},{gap}").ok();
+    }
+    std::fs::write(out.join("kinematics.csv"), csv).map_err(io)?;
+    let document = json!({
+        "seeds": { "first": 0, "count": seeds, "band": Spread::band_name(seeds as usize) },
+        "scenes": document,
+        "kinematics": locus.chains.iter().map(|(n, _, g)| json!({"chain": n, "largest_gap_m": g})).collect::<Vec<_>>(),
+    });
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&document).map_err(io)?,
+    )
+    .map_err(io)?;
+    print!("{table}");
+    for (name, _, gap) in &locus.chains {
+        println!(
+            "kinematics: {name:<20} largest gap to the rod's end {:.2} mm",
+            gap * 1e3
+        );
+    }
+    println!("results in {}", out.display());
+    Ok(())
+}
+
+/// One scene's block of the table: each figure's median [band] per spine,
+/// then the rod against the sockets seed by seed.
+fn write_table(table: &mut String, scene: Scene, runs: &[(SpineMode, Seeded)]) {
+    let seeds = runs[0].1.runs.len();
+    let band = Spread::band_name(seeds);
+    writeln!(
+        table,
+        "{scene}: median [{band}] over {seeds} seeds\n{:<22} {:>28} {:>28}",
+        "",
+        spine_name(runs[0].0),
+        spine_name(runs[1].0)
+    )
+    .ok();
+    let (sockets, rod) = (spreads(&runs[0].1), spreads(&runs[1].1));
+    let shown = |name: &str| {
+        Quantity::compared(scene)
+            .iter()
+            .chain(&[Quantity::EpsLin, Quantity::EpsAng])
+            .any(|q| name.ends_with(q.key()))
+            || name == "ms_per_step"
+    };
+    for ((name, s), (_, r)) in sockets.iter().zip(&rod).filter(|(s, _)| shown(&s.0)) {
+        writeln!(
+            table,
+            "{name:<22} {:>28} {:>28}",
+            s.display(4),
+            r.display(4)
+        )
+        .ok();
+    }
+    for quantity in Quantity::compared(scene) {
+        let (ratio, lower) = compare(&runs[0].1, &runs[1].1, quantity);
+        writeln!(
+            table,
+            "rod vs sockets, {quantity}: {} times lower, lower in {} of the frames",
+            ratio.display(2),
+            percent(&lower)
+        )
+        .ok();
+    }
+    table.push('\n');
+}
+
+/// A spread of fractions as percentages: `74% [60%, 85%]`.
+fn percent(s: &Spread) -> String {
+    let (low, high) = s.range();
+    format!(
+        "{:.0}% [{:.0}%, {:.0}%]",
+        s.median * 100.0,
+        low * 100.0,
+        high * 100.0
+    )
+}
+
+fn scene_json(scene: Scene, runs: &[(SpineMode, Seeded)]) -> Value {
+    let spines: Vec<Value> = runs
+        .iter()
+        .map(|(spine, seeded)| {
+            json!({
+                "spine": spine_name(*spine),
+                "state_hashes": seeded.runs.iter().map(|r| format!("{:016x}", r.state_hash)).collect::<Vec<_>>(),
+                "spread": spreads(seeded).into_iter().map(|(k, s)| (k, json!(s))).collect::<serde_json::Map<_, _>>(),
+            })
+        })
+        .collect();
+    let comparison: serde_json::Map<String, Value> = Quantity::compared(scene)
+        .into_iter()
+        .map(|q| {
+            let (ratio, lower) = compare(&runs[0].1, &runs[1].1, q);
+            let per_seed: Vec<Value> = runs[0]
+                .1
+                .runs
+                .iter()
+                .zip(&runs[1].1.runs)
+                .map(|(sockets, rod)| {
+                    let c = Comparison::of(sockets, rod, q);
+                    json!({ "sockets_over_rod": c.ratio, "fraction_of_frames_rod_lower": c.lower })
+                })
+                .collect();
+            (
+                q.key().to_owned(),
+                json!({
+                    "sockets_over_rod": ratio,
+                    "fraction_of_frames_rod_lower": lower,
+                    "per_seed": per_seed,
+                }),
+            )
+        })
+        .collect();
+    json!({ "scene": scene.name(), "spines": spines, "rod_vs_sockets": comparison })
+}
+
+fn progress(label: &str, done: usize, count: usize) {
+    let width = 30;
+    let bar = width * done / count.max(1);
+    eprint!(
+        "\r{label:<28} [{}{}] {done}/{count} seeds",
+        "#".repeat(bar),
+        ".".repeat(width - bar)
+    );
+    std::io::stderr().flush().ok();
+}

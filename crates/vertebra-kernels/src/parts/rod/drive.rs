@@ -1,0 +1,141 @@
+//! The soft bend and twist as drives: XPBD with damping, a spring form and
+//! a torque cap, for one angle (the rod's counterpart of `parts::drive`).
+//!
+//! Damping. The soft part is the damped spring `tau = -K C - D dC/dt` on
+//! its error `C` (the bend's angle to its rest direction, or the twist's
+//! difference from its rest twist), solved by XPBD with damping (Macklin et
+//! al. 2016, eq. 26), one angle at a time:
+//!
+//! `dlambda = -(C + alpha~ lambda + gamma (C - C_0)) / ((1 + gamma) w + alpha~)`
+//!
+//! with `w = n_a^T I_a^-1 n_a + n_b^T I_b^-1 n_b` (the angle part's),
+//! `alpha~ = K^-1 / h^2`, `gamma = K^-1 D / h`, and `C_0` the error as the
+//! substep began (measured by the rod's `StartPass`), so that
+//! `(C - C_0) / h` is the error's rate. The bend's `C` is an angle about an
+//! axis `n` that turns as the bend does (it flips when `t_b` passes through
+//! its rest direction), so its start is kept as the rotation vector
+//! `C_0 n_0` and read along the current axis: `C_0 = (C_0 n_0) . n`. The
+//! twist's start is its wrapped error, and the rate wraps too. A Kirchhoff
+//! rod with stiffness `k` and damping `d` (N m^2 s: the torque is
+//! `(d / l0) dC/dt`, as the stiffness gives `(k / l0) C`) has
+//! `K^-1 = l0 / k` and `gamma h = d / k`.
+//!
+//! Spring. A frequency `f` and damping ratio `zeta` on the part's effective
+//! inertia `J` (`omega = 2 pi f`): `K = J omega^2`, `D = 2 zeta omega J`, so
+//! `alpha = w_J / omega^2` with `w_J = 1 / J`, and `gamma h = 2 zeta /
+//! omega`, as the socket's drive. What `J` is:
+//!
+//! - Twisting turns each body about its own tangent, which moves no
+//!   centre of mass and bends nothing: `J = 1 / w`, the angle part's.
+//! - Bending does not only turn the bodies: the hard curve part keeps the
+//!   chord halfway between the tangents, so a bend carries the bodies'
+//!   centres round the arc. With the bodies turned by `theta_a`,
+//!   `theta_b` about `n` (`psi = theta_b - theta_a`), the chord turns by
+//!   `(theta_a + theta_b) / 2` and the centres move apart across it at
+//!   `l0 (theta_a' + theta_b') / 2` (`l0` the chord, to first order).
+//!   With the pair's momentum zero the kinetic energy is
+//!   `1/2 (I_a theta_a'^2 + I_b theta_b'^2 + mu l0^2 ((theta_a' +
+//!   theta_b')/2)^2)`, `mu` the reduced mass; its least value for a given
+//!   `psi'` (the free bending mode, the one an impulse excites) is
+//!   `1/2 J psi'^2` with
+//!   `J = (I_a I_b + (I_a + I_b) mu l0^2 / 4) / (I_a + I_b + mu l0^2)`,
+//!   in inverse quantities (`u = n^T I^-1 n`, `v = 1/m_a + 1/m_b`)
+//!   `w_J = ((u_a + u_b) v + u_a u_b l0^2) / (v + (u_a + u_b) l0^2 / 4)`
+//!   ([`bend_weight`]). A held base (`u_a = 0`, `m_a` infinite) gives
+//!   `J = I_b + m_b l0^2 / 4`, the chest turning about the rod's middle;
+//!   equal bodies give `J = I / 2` (the centres stay on the chord); no
+//!   length gives the angle part's `1 / (u_a + u_b)`.
+//!
+//! A driven rod is then an oscillator at `f` in bending and in twisting.
+//! The soft part's own step divides by `(1 + gamma) w + alpha~` with the
+//! rotational `w` (it only turns the bodies; the curve part moves them),
+//! so one iteration does not land on the implicit Euler step as the
+//! socket's drive does: the iterations converge to it.
+//!
+//! Torque cap. `lambda` accumulates the substep's angular impulse times
+//! `h` (N m s^2); where `|lambda + dlambda|` would exceed `max_torque h^2`
+//! it is held there (a select per lane) and only the part of `dlambda` that
+//! gets there is applied. Infinity caps nothing, bit for bit.
+//!
+//! A part with neither damping nor spring (`gamma = 0`, `alpha = alpha~`)
+//! takes the angle part's correction bit for bit (`parts::angle`): the
+//! undriven rods of the golden scenes are unchanged.
+
+use vertebra_math::{Lane, Vec3};
+
+use crate::body::{BodyLanes, safe_ratio};
+use crate::parts::angle::Softness;
+
+/// A soft part's drive settings for this substep, per lane.
+#[derive(Clone, Copy, Debug)]
+pub struct Drive<L> {
+    /// Compliance over `h^2`, or the relaxation factor.
+    pub soft: Softness<L>,
+    /// `1 / (omega h)^2`: compliance per unit effective inverse inertia
+    /// over `h^2` (0 unless given by frequency).
+    pub spring: L,
+    /// `gamma` (damping time over `h`).
+    pub gamma: L,
+    /// The largest accumulated `|lambda|`: `max_torque h^2` (N m s^2).
+    pub limit: L,
+}
+
+/// The effective inverse inertia of bending about `n` (1/(kg m^2)): `w_J`
+/// of the module documentation, for a rod of length `rest_length` (m).
+#[inline(always)]
+pub fn bend_weight<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, n: Vec3<L>, rest_length: L) -> L {
+    let (ua, ub) = (a.angular_weight(n), b.angular_weight(n));
+    let v = a.inv_mass + b.inv_mass;
+    let l2 = rest_length * rest_length;
+    safe_ratio(
+        (ua + ub) * v + ua * ub * l2,
+        v + (ua + ub) * l2 * L::splat(0.25),
+    )
+}
+
+/// One damped, sprung, capped correction of the angle `c` (axes as in
+/// `parts::angle`); `rate` is `C - C_0` (rad) and `w_spring` the part's
+/// effective inverse inertia. Returns the new accumulated `lambda`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn correct<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    n_a: Vec3<L>,
+    n_b: Vec3<L>,
+    c: L,
+    rate: L,
+    w_spring: L,
+    d: &Drive<L>,
+    lambda: L,
+) -> L {
+    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
+    let s = d.soft;
+    let plain = safe_ratio(
+        -s.relaxation * c - s.alpha_tilde * lambda,
+        w + s.alpha_tilde,
+    );
+    let alpha = s.alpha_tilde + d.spring * w_spring;
+    let damped = safe_ratio(
+        -s.relaxation * c - alpha * lambda - d.gamma * rate,
+        (L::splat(1.0) + d.gamma) * w + alpha,
+    );
+    let dlambda = L::select((d.spring + d.gamma).gt(L::splat(0.0)), damped, plain);
+    let (lambda, dlambda) = cap(lambda, dlambda, d.limit);
+    b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
+    a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
+    lambda
+}
+
+/// `lambda + dlambda` held to `[-limit, limit]`, and the step that gets
+/// there (`dlambda` itself, bit for bit, within the limit).
+#[inline(always)]
+fn cap<L: Lane>(lambda: L, dlambda: L, limit: L) -> (L, L) {
+    let total = lambda + dlambda;
+    let over = total.abs().gt(limit);
+    let held = limit.copysign(total);
+    (
+        L::select(over, held, total),
+        L::select(over, held - lambda, dlambda),
+    )
+}
