@@ -14,6 +14,8 @@ use serde::Deserialize;
 use toml::Spanned;
 use vertebra_world::{Shape, check_coordinate};
 
+use crate::drive::DriveSettings;
+use crate::drive_def::{RawDrive, drive_settings};
 use crate::error::RagdollError;
 use crate::joint_def::{JointDef, RawJoint, joint};
 
@@ -41,6 +43,7 @@ struct RawFile {
     #[serde(default)]
     joint: Vec<Spanned<RawJoint>>,
     spine: Option<Spanned<RawSpine>>,
+    drive: Option<Spanned<RawDrive>>,
 }
 
 #[derive(Deserialize)]
@@ -126,6 +129,9 @@ pub struct RagdollDesc {
     pub root: usize,
     /// For each body, the joint whose child it is (`None` for the root).
     pub parent_joint: Vec<Option<usize>>,
+    /// How the ragdoll is driven toward an animation pose (the file's
+    /// `[drive]` table, with each joint's own strength), if the file says.
+    pub drive: Option<DriveSettings>,
 }
 
 pub(crate) fn finite(
@@ -244,6 +250,7 @@ impl RagdollDesc {
                 &format!("is {total} but the bodies weigh {sum}"),
             )?;
         }
+        let drive = drive(raw.drive.as_ref(), &joints, |span| at(span))?;
         Ok(Self {
             name: raw.name,
             bodies,
@@ -251,6 +258,7 @@ impl RagdollDesc {
             spine,
             root,
             parent_joint,
+            drive,
         })
     }
 
@@ -478,4 +486,25 @@ fn spine(
         bend_stiffness: s.bend_stiffness,
         twist_stiffness: s.twist_stiffness,
     })
+}
+
+/// The `[drive]` table with the joints' own strengths; a joint's strength
+/// without a table to fall back on is refused at the joint.
+fn drive(
+    raw: Option<&Spanned<RawDrive>>,
+    joints: &[JointDef],
+    at: impl Fn(core::ops::Range<usize>) -> usize,
+) -> Result<Option<DriveSettings>, RagdollError> {
+    let own: Vec<_> = joints.iter().map(|j| j.drive).collect();
+    match raw {
+        Some(table) => drive_settings(table.get_ref(), at(table.span()), own).map(Some),
+        None => match joints.iter().find(|j| j.drive.is_some()) {
+            Some(j) => Err(RagdollError::OutOfRange {
+                context: format!("joint `{}`", j.name),
+                field: "drive",
+                reason: "needs a [drive] table for the ragdoll's other joints".to_owned(),
+            }),
+            None => Ok(None),
+        },
+    }
 }

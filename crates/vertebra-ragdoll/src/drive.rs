@@ -84,7 +84,7 @@ impl DriveSettings {
         drive.with_max_torque(self.max_torque)
     }
 
-    fn validate(&self, joints: usize) -> Result<(), RagdollError> {
+    pub(crate) fn validate(&self, joints: usize) -> Result<(), RagdollError> {
         let out = |field: &'static str, reason: &str| RagdollError::OutOfRange {
             context: "drive".to_owned(),
             field,

@@ -9,6 +9,8 @@ use serde::Deserialize;
 use vertebra_world::{JointKind, LimitSoftness, Swing, SwingTwist, check_coordinate};
 
 use crate::description::{finite, range};
+use crate::drive::Strength;
+use crate::drive_def::RawStrength;
 use crate::error::RagdollError;
 
 /// A joint between a parent and a child body.
@@ -30,6 +32,9 @@ pub struct JointDef {
     pub frame: Quat,
     /// The kind and its limits (rad), as the world takes them.
     pub kind: JointKind,
+    /// The joint's own drive strength (the file's `drive = { ... }`), over
+    /// the ragdoll's `[drive]` one; `None` takes the ragdoll's.
+    pub drive: Option<Strength>,
 }
 
 impl JointDef {
@@ -55,6 +60,7 @@ pub(crate) struct RawJoint {
     twist: Option<[f32; 2]>,
     range: Option<[f32; 2]>,
     softness: Option<f32>,
+    drive: Option<RawStrength>,
 }
 
 /// `swing = 40` (a cone), `swing = { y = 80, z = 35 }` (an ellipse) or
@@ -68,12 +74,12 @@ enum RawSwing {
 }
 
 /// Fields each kind takes besides name, parent, child and anchor.
-const SOCKET_FIELDS: [&str; 5] = ["axis", "normal", "swing", "twist", "softness"];
-const HINGE_FIELDS: [&str; 3] = ["axis", "range", "softness"];
+const SOCKET_FIELDS: [&str; 6] = ["axis", "normal", "swing", "twist", "softness", "drive"];
+const HINGE_FIELDS: [&str; 4] = ["axis", "range", "softness", "drive"];
 
 impl RawJoint {
     /// The optional fields this joint has, by name.
-    fn present(&self) -> [(&'static str, bool); 6] {
+    fn present(&self) -> [(&'static str, bool); 7] {
         [
             ("axis", self.axis.is_some()),
             ("normal", self.normal.is_some()),
@@ -81,6 +87,7 @@ impl RawJoint {
             ("twist", self.twist.is_some()),
             ("range", self.range.is_some()),
             ("softness", self.softness.is_some()),
+            ("drive", self.drive.is_some()),
         ]
     }
 }
@@ -133,6 +140,7 @@ pub(crate) fn joint(
         )?;
     }
     let softness = softness(&context, j.softness)?;
+    let drive = j.drive.map(|d| d.read(&context)).transpose()?;
     let (frame, kind) = match kind {
         "socket" => {
             let frame = frame(
@@ -170,6 +178,7 @@ pub(crate) fn joint(
         anchor: Vec3::from(j.anchor),
         frame,
         kind,
+        drive,
     })
 }
 

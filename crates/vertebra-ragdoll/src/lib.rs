@@ -39,6 +39,7 @@
 
 mod description;
 mod drive;
+mod drive_def;
 mod error;
 mod joint_def;
 mod mapping;

@@ -1,11 +1,14 @@
 //! Joint kinds in the description format: the anatomical humanoid's
 //! hinges and elliptical cones, read as written and held by the world; and
-//! every inconsistent combination refused by joint and field.
+//! every inconsistent combination refused by joint and field; drive
+//! settings read from the file.
 
 use core::f32::consts::PI;
 
 use glam::{Quat, Vec3};
-use vertebra_ragdoll::{ANATOMICAL_HUMANOID, BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
+use vertebra_ragdoll::{
+    ANATOMICAL_HUMANOID, BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode, Strength,
+};
 use vertebra_world::{
     BodyDesc, JointDesc, JointKind, LimitSoftness, SolverConfig, Swing, SwingTwist, World,
 };
@@ -235,4 +238,115 @@ fn knees_and_elbows_never_bend_backwards() {
             -worst.to_degrees()
         );
     }
+}
+
+#[test]
+fn drive_settings_are_read_from_the_file() {
+    let desc = RagdollDesc::anatomical_humanoid();
+    let drive = desc
+        .drive
+        .as_ref()
+        .expect("the anatomical humanoid has a [drive] table");
+    assert_eq!(
+        drive.strength,
+        Strength::Spring {
+            frequency: 4.0,
+            damping_ratio: 1.0
+        }
+    );
+    assert_eq!(drive.max_torque, 400.0);
+    let knee = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
+    let hip = desc.joints.iter().position(|j| j.name == "hip_l").unwrap();
+    let six = Strength::Spring {
+        frequency: 6.0,
+        damping_ratio: 1.0,
+    };
+    assert_eq!((drive.joints[knee], drive.joints[hip]), (Some(six), None));
+    // The reference humanoid's file says nothing of drives.
+    assert_eq!(RagdollDesc::reference_humanoid().drive, None);
+}
+
+#[test]
+fn drive_settings_that_make_no_drive_are_refused_by_field() {
+    let table = "[drive]\nfrequency = 4.0\ndamping_ratio = 1.0\nmax_torque = 400.0";
+    let knee = "range = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 1.0 }";
+    let cases = [
+        (
+            edited(table, "[drive]\nfrequency = 4.0\ncompliance = 0.1"),
+            "[drive]: drive takes one of: strength = \"infinite\", frequency with damping_ratio, or compliance",
+        ),
+        (
+            edited(
+                table,
+                "[drive]\nfrequency = 4.0\ndamping_ratio = 1.0\ndamping = 2.0",
+            ),
+            "[drive]: damping is for a compliance strength only",
+        ),
+        (
+            edited(table, "[drive]\nstrength = \"infinite\"\nmax_torque = -1.0"),
+            "[drive]: max_torque must be a number, not negative",
+        ),
+        (
+            edited(table, "[drive]\nfrequency = 0.0\ndamping_ratio = 1.0"),
+            "[drive]: strength (frequency, damping ratio)",
+        ),
+        (
+            edited(table, "[drive]\nfrequency = inf\ndamping_ratio = nan"),
+            "[drive]: drive is not finite",
+        ),
+        (
+            edited(knee, "range = [0.0, 150.0]\ndrive = { frequency = 6.0 }"),
+            "joint `knee_l`: drive takes one of",
+        ),
+        (
+            edited(table, "").replace("[drive]", ""),
+            "joint `knee_l`: drive needs a [drive] table",
+        ),
+    ];
+    for (text, expected) in cases {
+        let e = RagdollDesc::from_toml(&text).unwrap_err().to_string();
+        assert!(e.contains(expected), "expected `{expected}` in `{e}`");
+    }
+    // A fixed joint has nothing to drive.
+    let fixed = edited(
+        "kind = \"hinge\"\naxis = [1.0, 0.0, 0.0]\nrange = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 1.0 }",
+        "kind = \"fixed\"\ndrive = { frequency = 6.0, damping_ratio = 1.0 }",
+    );
+    let e = RagdollDesc::from_toml(&fixed).unwrap_err().to_string();
+    assert!(
+        e.contains("joint `knee_l`: drive is for sockets and hinges only; this joint is a fixed"),
+        "{e}"
+    );
+}
+
+/// The file's drive settings drive the ragdoll: hanging by its hips under
+/// gravity, held to its bind pose, the anatomical humanoid stays within a
+/// few centimetres of it (limp, its arms and legs would hang and swing).
+#[test]
+fn the_files_drive_holds_the_pose() {
+    let desc = RagdollDesc::anatomical_humanoid();
+    let drive = desc.drive.clone().unwrap();
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let pose = Pose::bind(&desc);
+    let ragdoll = Ragdoll::build(
+        &mut world,
+        &desc,
+        BuildOptions::new(SpineMode::Rod),
+        &pose,
+        None,
+    )
+    .unwrap();
+    let hips = ragdoll.bodies[desc.root].unwrap();
+    let at = world.body(hips).unwrap().position;
+    let anchor = world.add_body(BodyDesc::fixed().with_position(at)).unwrap();
+    let pin = JointDesc::fixed_at(world.bodies(), anchor, hips, at).unwrap();
+    world.add_joint(pin).unwrap();
+    ragdoll.drive_to(&mut world, &pose, &drive).unwrap();
+    let head = ragdoll.bodies[desc.body_index("head").unwrap()].unwrap();
+    let start = world.body(head).unwrap().position;
+    for _ in 0..120 {
+        world.step(1.0 / 60.0).unwrap();
+    }
+    let sag = (world.body(head).unwrap().position - start).length();
+    assert!(sag < 0.05, "the head sagged {sag} m");
 }
