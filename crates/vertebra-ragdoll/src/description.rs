@@ -250,7 +250,7 @@ impl RagdollDesc {
                 &format!("is {total} but the bodies weigh {sum}"),
             )?;
         }
-        let drive = drive(raw.drive.as_ref(), &joints, |span| at(span))?;
+        let drive = drive(raw.drive.as_ref(), &joints, at)?;
         Ok(Self {
             name: raw.name,
             bodies,
