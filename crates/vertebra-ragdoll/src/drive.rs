@@ -164,19 +164,67 @@ impl Ragdoll {
         target: &Pose,
         settings: &DriveSettings,
     ) -> Result<(), RagdollError> {
+        self.drive(world, target, None, settings)
+    }
+
+    /// Drives every joint along a moving animation: from `prev` (the pose
+    /// as this step begins) to `pose` (as it ends, `dt` seconds later), as
+    /// Jolt's `DriveToPoseUsingMotors(prev, pose, dt)`. Each joint's target
+    /// starts at `prev`'s relative rotation and turns at the angular
+    /// velocity that reaches `pose`'s at the step's end
+    /// (`AngularDrive::following`), so a drive follows the animation
+    /// without lagging a frame behind and its damping acts on the motion
+    /// relative to the animation's, not relative to rest. Call it every
+    /// frame with the animation's last two poses. The rod has no target
+    /// velocity: it takes `pose`'s shape (`docs/ragdolls.md`, "Drives").
+    pub fn drive_following(
+        &self,
+        world: &mut World,
+        prev: &Pose,
+        pose: &Pose,
+        dt: f32,
+        settings: &DriveSettings,
+    ) -> Result<(), RagdollError> {
+        prev.validate(&self.desc)?;
+        if !(dt.is_finite() && dt >= vertebra_world::MIN_TIME_STEP) {
+            return Err(RagdollError::OutOfRange {
+                context: "drive".to_owned(),
+                field: "dt",
+                reason: format!(
+                    "is {dt}; must be a time step of at least {} s",
+                    vertebra_world::MIN_TIME_STEP
+                ),
+            });
+        }
+        self.drive(world, pose, Some((prev, dt)), settings)
+    }
+
+    fn drive(
+        &self,
+        world: &mut World,
+        target: &Pose,
+        from: Option<(&Pose, f32)>,
+        settings: &DriveSettings,
+    ) -> Result<(), RagdollError> {
         target.validate(&self.desc)?;
         settings.validate(self.desc.joints.len())?;
-        for (k, (j, socket)) in self.desc.joints.iter().zip(&self.joints).enumerate() {
+        let relative = |pose: &Pose, j: &crate::JointDef| {
+            let frame = j.frame;
+            ((pose.bones[j.parent].1 * frame).inverse() * (pose.bones[j.child].1 * frame))
+                .normalize()
+        };
+        for (k, (j, joint)) in self.desc.joints.iter().zip(&self.joints).enumerate() {
             // A fixed joint has no rotation to drive.
-            let (Some(socket), false) = (socket, j.kind == JointKind::Fixed) else {
+            let (Some(joint), false) = (joint, j.kind == JointKind::Fixed) else {
                 continue;
             };
-            let frame = j.frame;
-            let relative =
-                (target.bones[j.parent].1 * frame).inverse() * (target.bones[j.child].1 * frame);
-            let drive = settings.socket_drive(settings.strength(k), relative.normalize());
+            let end = relative(target, j);
+            let mut drive = settings.socket_drive(settings.strength(k), end);
+            if let Some((prev, dt)) = from {
+                drive = drive.following(relative(prev, j), end, dt);
+            }
             world
-                .set_joint_drive(*socket, Some(drive))
+                .set_joint_drive(*joint, Some(drive))
                 .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
         }
         if let (Some(rod), Some(rest), Some(spine)) = (self.rod, self.rod_rest, &self.desc.spine) {
