@@ -4,8 +4,8 @@ use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
 use vertebra_world::{SolverConfig, World};
 
 /// Arbitrary bytes (as UTF-8, lossily) through the TOML loader: an error,
-/// or a description that builds both ways and steps to a finite state
-/// without the step's NaN guard.
+/// or a description that builds both ways, is driven by its own drive
+/// settings, and steps to a finite state without the step's NaN guard.
 pub fn ragdoll_loader(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let Ok(desc) = RagdollDesc::from_toml(&text) else {
@@ -20,13 +20,19 @@ pub fn ragdoll_loader(data: &[u8]) {
             &Pose::bind(&desc),
             None,
         );
-        if built.is_err() {
+        let Ok(ragdoll) = built else {
             assert_eq!(
                 world.bodies().len(),
                 0,
                 "a refused ragdoll left bodies behind"
             );
             continue;
+        };
+        // Drive settings the loader accepted drive the ragdoll.
+        if let Some(drive) = &desc.drive {
+            ragdoll
+                .drive_to(&mut world, &Pose::bind(&desc), drive)
+                .expect("accepted drive settings drive the ragdoll");
         }
         for _ in 0..4 {
             world.step(1.0 / 60.0).expect("a valid step");
