@@ -3,17 +3,27 @@
 //! told otherwise, each with a rod spine (simplified) or a socket spine
 //! (standard). Used by the `vertebra` command, the benches and the tests.
 
+mod builder;
+mod config;
+mod controllability;
 mod kinematics;
+mod passive_bending;
 mod quantity;
+mod ragdoll_drop;
 mod run;
+mod scene;
+mod scene_world;
 pub mod seed;
 mod seeds;
-mod setup;
 mod spread;
 
+pub use builder::build;
+pub use config::SceneConfig;
 pub use kinematics::{Locus, kinematics};
 pub use quantity::{Quantity, Stats};
+pub use ragdoll_drop::ragdoll_drop;
 pub use run::{Frame, MAX_FRAMES, SceneRun, run};
+pub use scene::Scene;
+pub use scene_world::SceneWorld;
 pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};
-pub use setup::{Scene, SceneConfig, SceneWorld, build, ragdoll_drop};
 pub use spread::Spread;

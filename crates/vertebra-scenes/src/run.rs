@@ -5,7 +5,7 @@ use std::time::Instant;
 use vertebra_math::Backend;
 use vertebra_ragdoll::{Pose, RagdollError, SpineMapping};
 
-use crate::setup::{Scene, SceneConfig, build};
+use crate::{Scene, SceneConfig, build};
 
 /// The most frames a run takes: 4.6 hours at 60 Hz. A run keeps a record
 /// per frame (16 bytes), reserved up front from the count, so the bound
