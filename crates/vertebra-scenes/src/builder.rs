@@ -5,16 +5,20 @@ use glam::{Quat, Vec3};
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
 use vertebra_world::{AngularDrive, BodyDesc, BodyHandle, JointDesc, World};
 
-use crate::{Scene, SceneConfig, SceneWorld, controllability, passive_bending, ragdoll_drop};
+use crate::{
+    Scene, SceneConfig, SceneWorld, controllability, hit_reaction, passive_bending, ragdoll_drop,
+};
 
 /// Builds `config`'s scene at its first frame.
 pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
     let desc = config.description();
+    let drive = config.drive()?;
     let world = config.world()?;
     match config.scene {
         Scene::PassiveBending => passive_bending::build(world, &desc, config),
         Scene::Controllability => controllability::build(world, &desc, config),
-        Scene::RagdollDrop => ragdoll_drop::build(world, &desc, config),
+        Scene::RagdollDrop | Scene::AnatomicalDrop => ragdoll_drop::build(world, &desc, config),
+        Scene::HitReaction => hit_reaction::build(world, &desc, config, &drive),
     }
 }
 

@@ -1,6 +1,6 @@
 //! How to run a scene: spine, solver settings, ragdoll, seed.
 
-use vertebra_ragdoll::{RagdollDesc, RagdollError, SpineMode};
+use vertebra_ragdoll::{DriveSettings, RagdollDesc, RagdollError, SpineMode, Strength};
 use vertebra_world::{BackendChoice, SolverConfig, World};
 
 use crate::Scene;
@@ -22,7 +22,8 @@ pub struct SceneConfig {
     pub backend: BackendChoice,
     /// Worker threads.
     pub threads: usize,
-    /// The ragdoll (the reference humanoid when `None`).
+    /// The ragdoll (when `None`, the reference humanoid in the paper's
+    /// scenes, the anatomical humanoid in the others).
     pub ragdoll: Option<RagdollDesc>,
     /// Ragdolls dropped in the ragdoll-drop scene (the paper's 30; see
     /// [`ragdoll_drop`](crate::ragdoll_drop) for more).
@@ -30,6 +31,14 @@ pub struct SceneConfig {
     /// The start: 0 is the paper's scene exactly; any other seed moves each
     /// ragdoll by at most 1 mm and 0.1 degree ([`crate::seed`]).
     pub seed: u64,
+    /// The hit-reaction drive's natural frequency (Hz, finite and above 0).
+    pub drive_frequency: f32,
+    /// The hit-reaction drive's damping ratio (1 is critical; finite, not
+    /// negative).
+    pub drive_damping_ratio: f32,
+    /// The hit-reaction drive's torque limit per joint (N m; infinity is
+    /// unlimited, not negative).
+    pub max_torque: f32,
 }
 
 impl SceneConfig {
@@ -46,7 +55,43 @@ impl SceneConfig {
             ragdoll: None,
             ragdolls: 30,
             seed: 0,
+            drive_frequency: 16.0,
+            drive_damping_ratio: 1.0,
+            max_torque: f32::INFINITY,
         }
+    }
+
+    /// The hit-reaction drive: a spring at [`Self::drive_frequency`] and
+    /// [`Self::drive_damping_ratio`], torque limited to
+    /// [`Self::max_torque`]. Refused, naming the field, when out of range
+    /// (whichever scene runs, so a bad setting is never silently ignored).
+    pub(crate) fn drive(&self) -> Result<DriveSettings, RagdollError> {
+        let out = |field: &'static str, value: f32, range: &str| RagdollError::OutOfRange {
+            context: "scene".to_owned(),
+            field,
+            reason: format!("is {value}; must be {range}"),
+        };
+        let f = self.drive_frequency;
+        if !(f.is_finite() && f > 0.0) {
+            return Err(out("drive_frequency", f, "finite and above 0 Hz"));
+        }
+        let r = self.drive_damping_ratio;
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(out("drive_damping_ratio", r, "finite and not negative"));
+        }
+        let t = self.max_torque;
+        if t.is_nan() || t < 0.0 {
+            return Err(out(
+                "max_torque",
+                t,
+                "a number, not negative (inf: unlimited)",
+            ));
+        }
+        let strength = Strength::Spring {
+            frequency: f,
+            damping_ratio: r,
+        };
+        Ok(DriveSettings::uniform(strength).with_max_torque(t))
     }
 
     pub(crate) fn world(&self) -> Result<World, RagdollError> {
@@ -61,8 +106,12 @@ impl SceneConfig {
     }
 
     pub(crate) fn description(&self) -> RagdollDesc {
-        self.ragdoll
-            .clone()
-            .unwrap_or_else(RagdollDesc::reference_humanoid)
+        self.ragdoll.clone().unwrap_or_else(|| {
+            if self.scene.is_paper() {
+                RagdollDesc::reference_humanoid()
+            } else {
+                RagdollDesc::anatomical_humanoid()
+            }
+        })
     }
 }

@@ -3,7 +3,7 @@
 use core::fmt;
 use core::str::FromStr;
 
-/// A scene of the paper.
+/// A scene: the paper's three, and two on the anatomical humanoid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Scene {
     /// Figures 2 and 8 (left): the hips fixed, the upper body slumps.
@@ -13,14 +13,29 @@ pub enum Scene {
     /// Figure 7: the hips fixed, every joint driven to the bind pose, the
     /// chest pushed.
     Controllability,
+    /// The anatomical humanoid, hips held, every joint driven to the bind
+    /// pose by a spring, hit on the chest and then on the head
+    /// ([`crate::HIT_FRAMES`]).
+    HitReaction,
+    /// The ragdoll drop with the anatomical humanoid.
+    AnatomicalDrop,
 }
 
 impl Scene {
-    /// Every simulated scene.
-    pub const ALL: [Scene; 3] = [
+    /// The paper's scenes (what `vertebra reproduce` runs).
+    pub const PAPER: [Scene; 3] = [
         Scene::PassiveBending,
         Scene::RagdollDrop,
         Scene::Controllability,
+    ];
+
+    /// Every simulated scene.
+    pub const ALL: [Scene; 5] = [
+        Scene::PassiveBending,
+        Scene::RagdollDrop,
+        Scene::Controllability,
+        Scene::HitReaction,
+        Scene::AnatomicalDrop,
     ];
 
     /// The name on the command line.
@@ -29,15 +44,25 @@ impl Scene {
             Scene::PassiveBending => "passive-bending",
             Scene::RagdollDrop => "ragdoll-drop",
             Scene::Controllability => "controllability",
+            Scene::HitReaction => "hit-reaction",
+            Scene::AnatomicalDrop => "anatomical-drop",
         }
     }
 
-    /// Frames the paper's figure runs.
+    /// Whether the scene is one of the paper's, on the reference humanoid
+    /// (the others are on the anatomical one).
+    pub fn is_paper(self) -> bool {
+        Scene::PAPER.contains(&self)
+    }
+
+    /// Frames the paper's figure runs (the new scenes: 4 s and 10 s).
     pub fn default_frames(self) -> usize {
         match self {
             Scene::PassiveBending => 300,
             Scene::RagdollDrop => 600,
             Scene::Controllability => 240,
+            Scene::HitReaction => 240,
+            Scene::AnatomicalDrop => 600,
         }
     }
 }
@@ -52,7 +77,7 @@ impl FromStr for Scene {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         Scene::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| {
-            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop or controllability)")
+            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability, hit-reaction or anatomical-drop)")
         })
     }
 }

@@ -25,6 +25,9 @@ pub struct SceneWorld {
     pub target: Option<Pose>,
     /// The body pushed, and the force (N) (controllability).
     pub push: Option<(BodyHandle, Vec3)>,
+    /// Impulses: (frame, body, impulse in N s through its centre of mass),
+    /// applied before that frame's step (the hit reaction).
+    pub hits: Vec<(usize, BodyHandle, Vec3)>,
     /// The ragdolls' joints: the residual error counts these (not the pins
     /// holding hips in place).
     joints: HashSet<JointHandle>,
@@ -50,9 +53,16 @@ impl SceneWorld {
             ragdolls,
             target,
             push,
+            hits: Vec::new(),
             joints,
             rods,
         }
+    }
+
+    /// With `hits` ([`Self::hits`]).
+    pub(crate) fn with_hits(mut self, hits: Vec<(usize, BodyHandle, Vec3)>) -> Self {
+        self.hits = hits;
+        self
     }
 
     /// Collision detection for a step of `dt` seconds: this scene's
@@ -67,7 +77,8 @@ impl SceneWorld {
     }
 
     /// Frame `frame` of the scene, `dt` seconds: collision detection, the
-    /// push of figure 7 (controllability, frames 30 to 90), the step.
+    /// push of figure 7 (controllability, frames 30 to 90), the hits due
+    /// this frame, the step.
     pub fn advance(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
         self.detect(dt)?;
         if let (Some((body, force)), Scene::Controllability, true) =
@@ -75,11 +86,15 @@ impl SceneWorld {
         {
             self.world.add_force(body, force)?;
         }
+        for &(_, body, impulse) in self.hits.iter().filter(|h| h.0 == frame) {
+            self.world.apply_impulse(body, impulse)?;
+        }
         Ok(self.world.step(dt)?)
     }
 
     /// The ragdolls' residual error (as of `world`'s last step or
-    /// [`World::measure_residuals`]) and deviation from the target, in
+    /// [`World::measure_residuals`]), its largest angular error of any one
+    /// joint, and deviation from the target, in
     /// `world`: this scene's own world, or one holding the same bodies and
     /// joints under the same handles (the peer comparison's mirror).
     pub fn measure(&self, world: &World) -> Frame {
@@ -95,8 +110,12 @@ impl SceneWorld {
             .filter(|j| self.rods.contains(&j.joint))
             .map(|j| (j.linear_cm, j.angular_rad));
         let (eps_lin_cm, eps_ang_rad) = joint_errors
-            .chain(rod_errors)
+            .clone()
+            .chain(rod_errors.clone())
             .fold((0.0, 0.0), |(l, a), (dl, da)| (l + dl, a + da));
+        let max_violation_rad = joint_errors
+            .chain(rod_errors)
+            .fold(0.0, |m: f32, (_, a)| m.max(a));
         let (mut deviation_cm, mut deviation_rad) = (0.0, 0.0);
         if let Some(target) = &self.target {
             for ragdoll in &self.ragdolls {
@@ -113,6 +132,7 @@ impl SceneWorld {
             eps_ang_rad,
             deviation_cm,
             deviation_rad,
+            max_violation_rad,
         }
     }
 }
