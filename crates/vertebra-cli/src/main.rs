@@ -1,5 +1,6 @@
 //! `vertebra`: reproduce the paper's results on the reference humanoid
-//! (`vertebra reproduce`), or run one scene (`vertebra scene NAME ...`).
+//! (`vertebra reproduce`), or run one scene, the paper's or one on the
+//! anatomical humanoid (`vertebra scene NAME ...`).
 
 mod output;
 mod plots;
@@ -40,7 +41,8 @@ enum Command {
     },
     /// Runs one scene.
     Scene {
-        /// passive-bending, ragdoll-drop or controllability.
+        /// passive-bending, ragdoll-drop, controllability (the paper's), or
+        /// hit-reaction, anatomical-drop (the anatomical humanoid).
         name: String,
         /// rod (simplified) or sockets (standard).
         #[arg(long)]
@@ -69,6 +71,16 @@ enum Command {
         /// each ragdoll by at most 1 mm and 0.1 degree.
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// hit-reaction: the drive's natural frequency (Hz, above 0).
+        #[arg(long, default_value_t = 16.0, allow_negative_numbers = true)]
+        drive_frequency: f32,
+        /// hit-reaction: the drive's damping ratio (1 is critical).
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        damping_ratio: f32,
+        /// hit-reaction: the drive's torque limit per joint (N m; inf is
+        /// unlimited).
+        #[arg(long, default_value_t = f32::INFINITY, allow_negative_numbers = true)]
+        max_torque: f32,
         /// Run from K seeds (--seed .. --seed + K - 1) and give every
         /// figure's median and spread over them.
         #[arg(long)]
@@ -139,6 +151,9 @@ fn execute(command: Command) -> Result<(), String> {
             threads,
             ragdoll,
             seed,
+            drive_frequency,
+            damping_ratio,
+            max_torque,
             seeds,
             json,
         } => {
@@ -164,6 +179,9 @@ fn execute(command: Command) -> Result<(), String> {
             config.threads = threads;
             config.ragdoll = ragdoll;
             config.seed = seed;
+            config.drive_frequency = drive_frequency;
+            config.drive_damping_ratio = damping_ratio;
+            config.max_torque = max_torque;
             if let Some(count) = seeds {
                 let seeded = Seeded::run(&config, count, |_, _| {}).map_err(|e| e.to_string())?;
                 if json {

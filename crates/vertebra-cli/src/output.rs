@@ -29,6 +29,13 @@ fn figures(run: &SceneRun) -> Vec<(String, f64)> {
             out.push((format!("{what}_{}", q.key()), f64::from(x)));
         }
     }
+    for (r, name) in run.recoveries().iter().zip(["chest", "head"]) {
+        out.push((format!("peak_deviation_cm_{name}"), f64::from(r.peak_cm)));
+        // Never back (within the window before the next hit): infinite,
+        // `null` in JSON.
+        let frames = r.frames.map_or(f64::INFINITY, |f| f as f64);
+        out.push((format!("recovery_frames_{name}"), frames));
+    }
     out.push(("ms_per_step".to_owned(), run.ms_per_step));
     out
 }
@@ -162,6 +169,21 @@ pub fn print_summary(config: &SceneConfig, run: &SceneRun) {
         run.backend,
         run.state_hash
     );
+    if !config.scene.is_paper() {
+        let v = run.stats(Quantity::MaxViolation).max.to_degrees();
+        println!("  largest limit violation of any joint: {v:.3} degrees");
+    }
+    for (r, name) in run.recoveries().iter().zip(["chest", "head"]) {
+        let back = r
+            .frames
+            .map_or("never".to_owned(), |f| format!("{f} frames"));
+        println!(
+            "  {name} hit at frame {}: peak deviation {:.2} cm, back within {}% in {back}",
+            r.hit,
+            r.peak_cm,
+            vertebra_scenes::RECOVERED * 100.0
+        );
+    }
 }
 
 /// The summary of `vertebra scene --seeds K`: each figure's median and

@@ -27,7 +27,7 @@ pub fn reproduce(out: &Path, seeds: u64) -> Result<(), String> {
     let fonts = font_options();
     let mut document = Vec::new();
     let mut table = String::new();
-    for scene in Scene::ALL {
+    for scene in Scene::PAPER {
         let mut runs = Vec::new();
         for spine in [SpineMode::Sockets, SpineMode::Rod] {
             let config = SceneConfig::new(scene, spine);

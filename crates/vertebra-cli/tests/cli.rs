@@ -392,3 +392,74 @@ fn seeds_give_every_figure_with_its_spread() {
         "seeds",
     );
 }
+
+fn hit_with(extra: &[&str]) -> Vec<String> {
+    ["scene", "hit-reaction", "--spine", "rod", "--frames", "40"]
+        .iter()
+        .chain(extra)
+        .map(|s| s.to_string())
+        .collect()
+}
+
+#[test]
+fn bad_drive_settings_end_with_one_clear_line() {
+    for (flag, value, field) in [
+        ("--drive-frequency", "0", "drive_frequency is 0"),
+        ("--drive-frequency", "inf", "drive_frequency is inf"),
+        ("--drive-frequency", "NaN", "drive_frequency is NaN"),
+        ("--damping-ratio", "-1", "drive_damping_ratio is -1"),
+        ("--max-torque", "-5", "max_torque is -5"),
+        ("--max-torque", "NaN", "max_torque is NaN"),
+        ("--max-torque", "strong", "strong"),
+    ] {
+        let args = hit_with(&[flag, value]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        fails_with(&args, field);
+    }
+    // Refused whichever scene runs: a bad setting is never silently
+    // ignored.
+    let args = scene_with(&["--drive-frequency", "-2"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    fails_with(&args, "drive_frequency is -2");
+}
+
+#[test]
+fn the_new_scenes_run_by_name_and_report_their_figures() {
+    let (code, stdout, stderr) = vertebra(&[
+        "scene",
+        "hit-reaction",
+        "--spine",
+        "sockets",
+        "--drive-frequency",
+        "8",
+        "--damping-ratio",
+        "0.5",
+        "--max-torque",
+        "50",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    assert_eq!(v["scene"], "hit-reaction");
+    assert_eq!(v["frames"].as_array().unwrap().len(), 240);
+    assert!(v["frames"][0]["max_violation_rad"].is_number());
+    for field in [
+        "max_max_violation_rad",
+        "peak_deviation_cm_chest",
+        "peak_deviation_cm_head",
+        "recovery_frames_chest",
+        "recovery_frames_head",
+    ] {
+        assert!(v["summary"].get(field).is_some(), "missing `{field}`");
+    }
+    let (code, stdout, stderr) = vertebra(&[
+        "scene",
+        "anatomical-drop",
+        "--spine",
+        "rod",
+        "--frames",
+        "5",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("largest limit violation"), "{stdout}");
+}

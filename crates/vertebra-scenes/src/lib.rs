@@ -1,19 +1,34 @@
 //! The paper's scenes (figures 1, 2, 6, 7, 8), on the reference humanoid,
-//! at 60 Hz with gravity (0, -9.81, 0), 1 substep and 20 iterations unless
-//! told otherwise, each with a rod spine (simplified) or a socket spine
+//! and two on the anatomical humanoid (a hit reaction, the drop), at 60 Hz
+//! with gravity (0, -9.81, 0), 1 substep and 20 iterations unless told
+//! otherwise, each with a rod spine (simplified) or a socket spine
 //! (standard). Used by the `vertebra` command, the benches and the tests.
 
+mod builder;
+mod config;
+mod controllability;
+mod hit_reaction;
 mod kinematics;
+mod passive_bending;
 mod quantity;
+mod ragdoll_drop;
+mod recovery;
 mod run;
+mod scene;
+mod scene_world;
 pub mod seed;
 mod seeds;
-mod setup;
 mod spread;
 
+pub use builder::build;
+pub use config::SceneConfig;
+pub use hit_reaction::HIT_FRAMES;
 pub use kinematics::{Locus, kinematics};
 pub use quantity::{Quantity, Stats};
+pub use ragdoll_drop::ragdoll_drop;
+pub use recovery::{RECOVERED, Recovery};
 pub use run::{Frame, MAX_FRAMES, SceneRun, run};
+pub use scene::Scene;
+pub use scene_world::SceneWorld;
 pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};
-pub use setup::{Scene, SceneConfig, SceneWorld, build, ragdoll_drop};
 pub use spread::Spread;

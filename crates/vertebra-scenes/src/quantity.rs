@@ -16,15 +16,19 @@ pub enum Quantity {
     DeviationCm,
     /// Summed angle of the bodies from the target pose (rad): figure 7.
     DeviationRad,
+    /// The largest angular error of any one joint (rad): its limit
+    /// overshoot.
+    MaxViolation,
 }
 
 impl Quantity {
     /// Every quantity, in the order of [`Frame`]'s fields.
-    pub const ALL: [Quantity; 4] = [
+    pub const ALL: [Quantity; 5] = [
         Quantity::EpsLin,
         Quantity::EpsAng,
         Quantity::DeviationCm,
         Quantity::DeviationRad,
+        Quantity::MaxViolation,
     ];
 
     /// The quantity's value in `frame`.
@@ -34,6 +38,7 @@ impl Quantity {
             Quantity::EpsAng => frame.eps_ang_rad,
             Quantity::DeviationCm => frame.deviation_cm,
             Quantity::DeviationRad => frame.deviation_rad,
+            Quantity::MaxViolation => frame.max_violation_rad,
         }
     }
 
@@ -45,6 +50,7 @@ impl Quantity {
             Quantity::EpsAng => "eps_ang_rad",
             Quantity::DeviationCm => "deviation_cm",
             Quantity::DeviationRad => "deviation_rad",
+            Quantity::MaxViolation => "max_violation_rad",
         }
     }
 
@@ -53,7 +59,9 @@ impl Quantity {
     /// pose (figure 7).
     pub fn compared(scene: Scene) -> [Quantity; 2] {
         match scene {
-            Scene::Controllability => [Quantity::DeviationCm, Quantity::DeviationRad],
+            Scene::Controllability | Scene::HitReaction => {
+                [Quantity::DeviationCm, Quantity::DeviationRad]
+            }
             _ => [Quantity::EpsLin, Quantity::EpsAng],
         }
     }

@@ -5,10 +5,10 @@ use std::time::Instant;
 use vertebra_math::Backend;
 use vertebra_ragdoll::{Pose, RagdollError, SpineMapping};
 
-use crate::setup::{Scene, SceneConfig, build};
+use crate::{Scene, SceneConfig, build};
 
 /// The most frames a run takes: 4.6 hours at 60 Hz. A run keeps a record
-/// per frame (16 bytes), reserved up front from the count, so the bound
+/// per frame (20 bytes), reserved up front from the count, so the bound
 /// keeps it (and the CLI's JSON, about 60 bytes a frame) under 100 MB;
 /// without it a count near `usize::MAX` overflowed the reservation and
 /// 1e12 frames aborted allocating 16 TB.
@@ -27,6 +27,11 @@ pub struct Frame {
     pub deviation_cm: f32,
     /// Controllability: summed angle of the bodies from the target (rad).
     pub deviation_rad: f32,
+    /// The largest angular error of any one of the ragdolls' joints (rad):
+    /// its limit overshoot (for a hinge, plus the angle between its axes;
+    /// for the rod, its curve error), as in
+    /// [`vertebra_world::JointResidual::angular_rad`].
+    pub max_violation_rad: f32,
 }
 
 /// A finished run.

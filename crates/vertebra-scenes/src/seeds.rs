@@ -12,7 +12,7 @@ use crate::{MAX_FRAMES, Quantity, SceneConfig, SceneRun, Spread, run};
 /// The most seeds a [`Seeded`] run takes.
 pub const MAX_SEEDS: u64 = 10_000;
 
-/// The most frames a [`Seeded`] run keeps over all its seeds (160 MB of
+/// The most frames a [`Seeded`] run keeps over all its seeds (200 MB of
 /// frame records): ten of the longest single runs.
 pub const MAX_SEEDED_FRAMES: usize = 10 * MAX_FRAMES;
 

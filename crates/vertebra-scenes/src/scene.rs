@@ -1,0 +1,83 @@
+//! The scenes: their names on the command line and their frame counts.
+
+use core::fmt;
+use core::str::FromStr;
+
+/// A scene: the paper's three, and two on the anatomical humanoid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Scene {
+    /// Figures 2 and 8 (left): the hips fixed, the upper body slumps.
+    PassiveBending,
+    /// Figures 1 and 8 (right): 30 ragdolls dropped into a pit.
+    RagdollDrop,
+    /// Figure 7: the hips fixed, every joint driven to the bind pose, the
+    /// chest pushed.
+    Controllability,
+    /// The anatomical humanoid, hips held, every joint driven to the bind
+    /// pose by a spring, hit on the chest and then on the head
+    /// ([`crate::HIT_FRAMES`]).
+    HitReaction,
+    /// The ragdoll drop with the anatomical humanoid.
+    AnatomicalDrop,
+}
+
+impl Scene {
+    /// The paper's scenes (what `vertebra reproduce` runs).
+    pub const PAPER: [Scene; 3] = [
+        Scene::PassiveBending,
+        Scene::RagdollDrop,
+        Scene::Controllability,
+    ];
+
+    /// Every simulated scene.
+    pub const ALL: [Scene; 5] = [
+        Scene::PassiveBending,
+        Scene::RagdollDrop,
+        Scene::Controllability,
+        Scene::HitReaction,
+        Scene::AnatomicalDrop,
+    ];
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scene::PassiveBending => "passive-bending",
+            Scene::RagdollDrop => "ragdoll-drop",
+            Scene::Controllability => "controllability",
+            Scene::HitReaction => "hit-reaction",
+            Scene::AnatomicalDrop => "anatomical-drop",
+        }
+    }
+
+    /// Whether the scene is one of the paper's, on the reference humanoid
+    /// (the others are on the anatomical one).
+    pub fn is_paper(self) -> bool {
+        Scene::PAPER.contains(&self)
+    }
+
+    /// Frames the paper's figure runs (the new scenes: 4 s and 10 s).
+    pub fn default_frames(self) -> usize {
+        match self {
+            Scene::PassiveBending => 300,
+            Scene::RagdollDrop => 600,
+            Scene::Controllability => 240,
+            Scene::HitReaction => 240,
+            Scene::AnatomicalDrop => 600,
+        }
+    }
+}
+
+impl fmt::Display for Scene {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Scene {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Scene::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| {
+            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability, hit-reaction or anatomical-drop)")
+        })
+    }
+}

@@ -1,0 +1,138 @@
+//! A built scene: its world, what drives it frame by frame, and the
+//! metric measured on it.
+
+use std::collections::HashSet;
+
+use glam::Vec3;
+use vertebra_collide::Collisions;
+use vertebra_ragdoll::{Pose, Ragdoll, RagdollError};
+use vertebra_world::{BodyHandle, JointHandle, RodHandle, World};
+
+use crate::{Frame, Scene};
+
+/// A built scene: its world, collisions and ragdolls, and what is
+/// measured. [`SceneWorld::advance`] runs one frame as [`run`](crate::run)
+/// does; [`SceneWorld::measure`] measures any world holding the same joints
+/// (the peer comparison measures a mirror of another engine's bodies).
+pub struct SceneWorld {
+    /// The world.
+    pub world: World,
+    /// The colliders (the ragdoll drop), or `None`.
+    pub collisions: Option<Collisions>,
+    /// The ragdolls.
+    pub ragdolls: Vec<Ragdoll>,
+    /// Target pose for the deviation metric (controllability).
+    pub target: Option<Pose>,
+    /// The body pushed, and the force (N) (controllability).
+    pub push: Option<(BodyHandle, Vec3)>,
+    /// Impulses: (frame, body, impulse in N s through its centre of mass),
+    /// applied before that frame's step (the hit reaction).
+    pub hits: Vec<(usize, BodyHandle, Vec3)>,
+    /// The ragdolls' joints: the residual error counts these (not the pins
+    /// holding hips in place).
+    joints: HashSet<JointHandle>,
+    rods: HashSet<RodHandle>,
+}
+
+impl SceneWorld {
+    pub(crate) fn new(
+        world: World,
+        collisions: Option<Collisions>,
+        ragdolls: Vec<Ragdoll>,
+        target: Option<Pose>,
+        push: Option<(BodyHandle, Vec3)>,
+    ) -> Self {
+        let joints = ragdolls
+            .iter()
+            .flat_map(|r| r.joints.iter().flatten().copied())
+            .collect();
+        let rods = ragdolls.iter().filter_map(|r| r.rod).collect();
+        Self {
+            world,
+            collisions,
+            ragdolls,
+            target,
+            push,
+            hits: Vec::new(),
+            joints,
+            rods,
+        }
+    }
+
+    /// With `hits` ([`Self::hits`]).
+    pub(crate) fn with_hits(mut self, hits: Vec<(usize, BodyHandle, Vec3)>) -> Self {
+        self.hits = hits;
+        self
+    }
+
+    /// Collision detection for a step of `dt` seconds: this scene's
+    /// contacts, handed to the world for its next step (nothing without
+    /// colliders).
+    pub fn detect(&mut self, dt: f32) -> Result<(), RagdollError> {
+        if let Some(collisions) = &self.collisions {
+            let contacts = collisions.find_contacts(&self.world, dt)?;
+            self.world.set_contacts(&contacts)?;
+        }
+        Ok(())
+    }
+
+    /// Frame `frame` of the scene, `dt` seconds: collision detection, the
+    /// push of figure 7 (controllability, frames 30 to 90), the hits due
+    /// this frame, the step.
+    pub fn advance(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
+        self.detect(dt)?;
+        if let (Some((body, force)), Scene::Controllability, true) =
+            (self.push, scene, (30..90).contains(&frame))
+        {
+            self.world.add_force(body, force)?;
+        }
+        for &(_, body, impulse) in self.hits.iter().filter(|h| h.0 == frame) {
+            self.world.apply_impulse(body, impulse)?;
+        }
+        Ok(self.world.step(dt)?)
+    }
+
+    /// The ragdolls' residual error (as of `world`'s last step or
+    /// [`World::measure_residuals`]), its largest angular error of any one
+    /// joint, and deviation from the target, in
+    /// `world`: this scene's own world, or one holding the same bodies and
+    /// joints under the same handles (the peer comparison's mirror).
+    pub fn measure(&self, world: &World) -> Frame {
+        let r = world.residuals();
+        let joint_errors = r
+            .joints
+            .iter()
+            .filter(|j| self.joints.contains(&j.joint))
+            .map(|j| (j.linear_cm, j.angular_rad));
+        let rod_errors = r
+            .rods
+            .iter()
+            .filter(|j| self.rods.contains(&j.joint))
+            .map(|j| (j.linear_cm, j.angular_rad));
+        let (eps_lin_cm, eps_ang_rad) = joint_errors
+            .clone()
+            .chain(rod_errors.clone())
+            .fold((0.0, 0.0), |(l, a), (dl, da)| (l + dl, a + da));
+        let max_violation_rad = joint_errors
+            .chain(rod_errors)
+            .fold(0.0, |m: f32, (_, a)| m.max(a));
+        let (mut deviation_cm, mut deviation_rad) = (0.0, 0.0);
+        if let Some(target) = &self.target {
+            for ragdoll in &self.ragdolls {
+                for (i, body) in ragdoll.bodies.iter().enumerate() {
+                    if let Some(state) = body.and_then(|b| world.body(b).ok()) {
+                        deviation_cm += (state.position - target.bones[i].0).length() * 100.0;
+                        deviation_rad += state.orientation.angle_between(target.bones[i].1);
+                    }
+                }
+            }
+        }
+        Frame {
+            eps_lin_cm,
+            eps_ang_rad,
+            deviation_cm,
+            deviation_rad,
+            max_violation_rad,
+        }
+    }
+}
