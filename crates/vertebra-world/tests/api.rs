@@ -236,7 +236,7 @@ fn add_kind(w: &mut World, kind: JointKind, drive: Option<AngularDrive>) -> Resu
 
 #[test]
 fn bad_joint_kinds_are_refused_with_the_field_named() {
-    let soft = |c| SwingTwist::FREE.with_softness(LimitSoftness::Compliance(c));
+    let soft = |c| SwingTwist::FREE.with_softness(LimitSoftness::compliant(c));
     let drive = AngularDrive::rigid(Quat::IDENTITY);
     let cases = [
         (
