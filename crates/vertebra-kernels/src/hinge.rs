@@ -213,8 +213,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     let soft = block.limit_softness.lanes(start, inv_h, inv_h2);
     let lambda = L::load(&block.limit_lambda[start..]);
     let c0 = L::load(&block.limit_start[start..]);
-    limit::solve(&mut a, &mut b, n, (c, c0), soft, lambda)
-        .store(&mut block.limit_lambda[start..]);
+    limit::solve(&mut a, &mut b, n, (c, c0), soft, lambda).store(&mut block.limit_lambda[start..]);
     point::solve(
         &mut a,
         &mut b,

@@ -317,24 +317,26 @@ fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, R
     let soft = match raw {
         None => return Ok(LimitSoftness::Hard),
         Some(RawSoftness::Compliance(c)) => LimitSoftness::compliant(*c),
-        Some(RawSoftness::Table(t)) => match (t.compliance, t.damping, t.frequency, t.damping_ratio) {
-            (Some(compliance), damping, None, None) => LimitSoftness::Compliance {
-                compliance,
-                damping: damping.unwrap_or(0.0),
-            },
-            (None, None, Some(frequency), Some(damping_ratio)) => LimitSoftness::Spring {
-                frequency,
-                damping_ratio,
-            },
-            _ => {
-                return Err(RagdollError::OutOfRange {
+        Some(RawSoftness::Table(t)) => {
+            match (t.compliance, t.damping, t.frequency, t.damping_ratio) {
+                (Some(compliance), damping, None, None) => LimitSoftness::Compliance {
+                    compliance,
+                    damping: damping.unwrap_or(0.0),
+                },
+                (None, None, Some(frequency), Some(damping_ratio)) => LimitSoftness::Spring {
+                    frequency,
+                    damping_ratio,
+                },
+                _ => {
+                    return Err(RagdollError::OutOfRange {
                     context: context.to_owned(),
                     field: "softness",
                     reason: "takes a compliance, { compliance, damping } or { frequency, damping_ratio }"
                         .to_owned(),
                 });
+                }
             }
-        },
+        }
     };
     let numbers = match soft {
         LimitSoftness::Hard => vec![],

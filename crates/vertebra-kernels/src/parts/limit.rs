@@ -86,7 +86,10 @@ pub fn solve<L: Lane>(
     let w = a.angular_weight(n) + b.angular_weight(n);
     // Hard and compliance-only lanes: the angle part's expression, bit for
     // bit.
-    let plain = (-L::splat(1.0) * c - soft.alpha_tilde * held, w + soft.alpha_tilde);
+    let plain = (
+        -L::splat(1.0) * c - soft.alpha_tilde * held,
+        w + soft.alpha_tilde,
+    );
     let alpha = soft.alpha_tilde + soft.spring * w;
     let damping = L::select(active, soft.gamma * (c - c0), zero);
     let sprung = (
