@@ -47,7 +47,7 @@ fn run(
 ) -> Run {
     let mut w = World::new(SolverConfig {
         gravity: Vec3::ZERO,
-        ..world(8, 20).config().clone()
+        ..*world(8, 20).config()
     })
     .unwrap();
     let ground = w.add_body(BodyDesc::fixed()).unwrap();
