@@ -248,7 +248,7 @@ impl SocketWorkload {
                     block.pyramid_z[k][lane] = bound;
                 }
                 block.swing_max[lane] = core::f32::consts::PI;
-                block.limit_compliance[lane] = 1e-4;
+                block.limit_softness.compliance[lane] = 1e-4;
             }
         }
         work.shaped = true;
@@ -323,7 +323,7 @@ impl HingeWorkload {
                 frame_a: GQuat::IDENTITY,
                 frame_b: GQuat::from_rotation_z(0.3),
                 range: [0.0, 0.05],
-                compliance: 0.0,
+                softness: vertebra_kernels::limited::LimitLane::HARD,
                 drive: None,
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);

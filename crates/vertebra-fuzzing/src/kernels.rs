@@ -9,6 +9,7 @@ use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
+use vertebra_kernels::limited::{self, LimitLane};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_kernels::socket::{self, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::Backend;
@@ -132,7 +133,16 @@ fn shaped(input: &mut Input) -> ShapedLimits {
     ShapedLimits {
         ellipse: [semi(input.float(1.0)), semi(input.float(1.0))],
         pyramid: [sorted_range(input), sorted_range(input)],
+        softness: limit_lane(input),
+    }
+}
+
+/// A limit's softness: any settings of its ranges (hard among them).
+fn limit_lane(input: &mut Input) -> LimitLane {
+    LimitLane {
         compliance: input.float(1.0).abs(),
+        period2: input.float(1.0).abs(),
+        damping_time: input.float(1.0).abs(),
     }
 }
 
@@ -150,7 +160,7 @@ fn hinge_block(input: &mut Input, rows: &RawRows) -> HingeBlock {
             frame_a: input.quat(),
             frame_b: input.quat(),
             range: sorted_range(input),
-            compliance: input.float(1.0).abs(),
+            softness: limit_lane(input),
             drive: input.flag().then(|| drive_lane(input)),
         };
         block.set(k, &lane);
@@ -248,6 +258,16 @@ fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32
         blocks: &mut hinges,
         rows: &rows,
         h,
+    });
+    // The limits' start before the plain pass moves the bodies: the shaped
+    // path's damping then sees a nonzero `C - C_0`.
+    backend.dispatch(limited::StartPass {
+        blocks: &mut sockets,
+        rows: &rows,
+    });
+    backend.dispatch(limited::StartPass {
+        blocks: &mut hinges,
+        rows: &rows,
     });
     backend.dispatch(socket::PositionPass::<true, false> {
         blocks: &mut sockets,

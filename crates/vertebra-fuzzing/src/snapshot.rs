@@ -221,7 +221,16 @@ fn range(input: &mut Input) -> Option<[f32; 2]> {
 /// Any kind, its limits and softness from the special values.
 fn kind(input: &mut Input) -> JointKind {
     let softness = if input.flag() {
-        LimitSoftness::Compliance(value(input))
+        match input.flag() {
+            true => LimitSoftness::Compliance {
+                compliance: value(input),
+                damping: value(input),
+            },
+            false => LimitSoftness::Spring {
+                frequency: value(input),
+                damping_ratio: value(input),
+            },
+        }
     } else {
         LimitSoftness::Hard
     };

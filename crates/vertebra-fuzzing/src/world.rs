@@ -113,7 +113,16 @@ fn swing(input: &mut Input) -> Swing {
 /// Hard, or any compliance.
 fn limit_softness(input: &mut Input) -> LimitSoftness {
     if input.flag() {
-        LimitSoftness::Compliance(input.float(1.0))
+        match input.pick(2) {
+            0 => LimitSoftness::Compliance {
+                compliance: input.float(1.0),
+                damping: input.float(100.0),
+            },
+            _ => LimitSoftness::Spring {
+                frequency: input.float(50.0),
+                damping_ratio: input.float(2.0),
+            },
+        }
     } else {
         LimitSoftness::Hard
     }

@@ -13,8 +13,9 @@ use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
 use vertebra_math::{Lane, LaneKernel, Quat};
 
-use crate::body::{BodyPairs, BodyRows};
+use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::driven::{DriveBlock, DriveLane, Driven};
+use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{hinge_axis, limit, point, swing, twist};
 use crate::residual::Residual;
 
@@ -36,10 +37,14 @@ pub struct HingeBlock {
     pub range_min: [f32; BLOCK_LANES],
     /// Highest hinge angle (rad).
     pub range_max: [f32; BLOCK_LANES],
-    /// The range's compliance (rad / (N m)); 0 is hard.
-    pub limit_compliance: [f32; BLOCK_LANES],
+    /// The range's softness (hard, compliance or spring, and damping;
+    /// `parts::limit`).
+    pub limit_softness: SoftnessBlock,
     /// The range's accumulated multiplier (N m s^2), reset every substep.
     pub limit_lambda: [f32; BLOCK_LANES],
+    /// The range's violation at the substep's start (rad; the damping's
+    /// `C_0`), measured by [`crate::limited::StartPass`].
+    pub limit_start: [f32; BLOCK_LANES],
     /// The angular drives.
     pub drive: DriveBlock,
 }
@@ -65,8 +70,8 @@ pub struct HingeLane {
     pub frame_b: GQuat,
     /// Hinge range (rad), `[-pi, pi]` when unlimited.
     pub range: [f32; 2],
-    /// The range's compliance (rad / (N m)); 0 is hard.
-    pub compliance: f32,
+    /// The range's softness ([`LimitLane::HARD`] is hard).
+    pub softness: LimitLane,
     /// The drive, if driven.
     pub drive: Option<DriveLane>,
 }
@@ -95,7 +100,7 @@ impl HingeBlock {
                 frame_a: GQuat::IDENTITY,
                 frame_b: GQuat::IDENTITY,
                 range: [-core::f32::consts::PI, core::f32::consts::PI],
-                compliance: 0.0,
+                softness: LimitLane::HARD,
                 drive: None,
             },
         );
@@ -110,8 +115,9 @@ impl HingeBlock {
         self.frame_a.set(lane, h.frame_a);
         self.frame_b.set(lane, h.frame_b);
         (self.range_min[lane], self.range_max[lane]) = (h.range[0], h.range[1]);
-        self.limit_compliance[lane] = h.compliance;
+        self.limit_softness.set(lane, &h.softness);
         self.limit_lambda[lane] = 0.0;
+        self.limit_start[lane] = 0.0;
         self.drive.set(lane, h.drive.as_ref());
     }
 
@@ -132,6 +138,22 @@ impl Driven for HingeBlock {
     }
     fn drive_mut(&mut self) -> &mut DriveBlock {
         &mut self.drive
+    }
+}
+
+impl Limited for HingeBlock {
+    fn bodies(&self) -> &BodyPairs {
+        &self.bodies
+    }
+    #[inline(always)]
+    fn start_limits<L: Lane>(&mut self, start: usize, a: &BodyLanes<L>, b: &BodyLanes<L>) {
+        let (fa, fb) = (self.frame_a.load::<L>(start), self.frame_b.load::<L>(start));
+        let (lo, hi) = (
+            L::load(&self.range_min[start..]),
+            L::load(&self.range_max[start..]),
+        );
+        let (_, c0) = twist::violation(a, b, fa, fb, lo, hi);
+        c0.store(&mut self.limit_start[start..]);
     }
 }
 
@@ -188,9 +210,10 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
         L::load(&block.range_max[start..]),
     );
     let (n, c) = twist::violation(&a, &b, frame_a, frame_b, lo, hi);
-    let alpha_tilde = L::load(&block.limit_compliance[start..]) * inv_h2;
+    let soft = block.limit_softness.lanes(start, inv_h, inv_h2);
     let lambda = L::load(&block.limit_lambda[start..]);
-    limit::solve(&mut a, &mut b, n, c, alpha_tilde, lambda).store(&mut block.limit_lambda[start..]);
+    let c0 = L::load(&block.limit_start[start..]);
+    limit::solve(&mut a, &mut b, n, (c, c0), soft, lambda).store(&mut block.limit_lambda[start..]);
     point::solve(
         &mut a,
         &mut b,

@@ -12,6 +12,7 @@
 //!   drives' velocity (damping) pass, and its residual.
 //! - [`hinge`]: the hinge: one rotation axis with a range.
 //! - [`fixed`]: the fixed joint: no relative motion.
+//! - [`limited`]: soft limits' settings and their substep start pass.
 //! - [`contact`]: contacts: non-penetration and static friction at the
 //!   position level, dynamic friction and restitution at the velocity level.
 //! - [`residual`]: one pass that measures any joint block's residual error.
@@ -26,6 +27,7 @@ pub mod contact;
 pub mod driven;
 pub mod fixed;
 pub mod hinge;
+pub mod limited;
 pub mod parts;
 pub mod residual;
 pub mod rod;

@@ -20,6 +20,7 @@ use vertebra_math::{Lane, LaneKernel, Quat, Vec3};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::driven::{DriveBlock, DriveLane, Driven};
+use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{ellipse, limit, point, pyramid, swing, swing_direction, twist};
 use crate::residual::Residual;
 
@@ -55,8 +56,13 @@ pub struct SocketBlock {
     pub pyramid_y: [[f32; BLOCK_LANES]; 2],
     /// Shaped path: the pyramid's range about Z (rad).
     pub pyramid_z: [[f32; BLOCK_LANES]; 2],
-    /// Shaped path: the limits' compliance (rad / (N m)); 0 is hard.
-    pub limit_compliance: [f32; BLOCK_LANES],
+    /// Shaped path: the limits' softness (hard, compliance or spring, and
+    /// damping; `parts::limit`).
+    pub limit_softness: SoftnessBlock,
+    /// Shaped path: the violations of the ellipse, the pyramid's two angles
+    /// and the twist range at the substep's start (the damping's `C_0`),
+    /// measured by [`crate::limited::StartPass`].
+    pub limit_start: [[f32; BLOCK_LANES]; 4],
     /// Shaped path: accumulated multipliers of the ellipse, the pyramid's
     /// two angles and the twist range, reset every substep.
     pub limit_lambda: [[f32; BLOCK_LANES]; 4],
@@ -71,8 +77,8 @@ pub struct ShapedLimits {
     /// The pyramid's ranges of the swing angles about Y and Z (rad);
     /// `[-pi, pi]` is free.
     pub pyramid: [[f32; 2]; 2],
-    /// The limits' compliance (rad / (N m)); 0 is hard.
-    pub compliance: f32,
+    /// The limits' softness ([`LimitLane::HARD`] is hard).
+    pub softness: LimitLane,
 }
 
 impl ShapedLimits {
@@ -83,7 +89,7 @@ impl ShapedLimits {
             [-core::f32::consts::PI, core::f32::consts::PI],
             [-core::f32::consts::PI, core::f32::consts::PI],
         ],
-        compliance: 0.0,
+        softness: LimitLane::HARD,
     };
 }
 
@@ -164,9 +170,12 @@ impl SocketBlock {
             self.pyramid_y[k][lane] = shaped.pyramid[0][k];
             self.pyramid_z[k][lane] = shaped.pyramid[1][k];
         }
-        self.limit_compliance[lane] = shaped.compliance;
+        self.limit_softness.set(lane, &shaped.softness);
         for lambda in &mut self.limit_lambda {
             lambda[lane] = 0.0;
+        }
+        for c0 in &mut self.limit_start {
+            c0[lane] = 0.0;
         }
     }
 
@@ -229,7 +238,7 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
     }
 
     if SHAPED {
-        solve_shaped(block, start, &mut a, &mut b, inv_h2);
+        solve_shaped(block, start, &mut a, &mut b, inv_h, inv_h2);
     } else {
         swing::solve(
             &mut a,
@@ -263,20 +272,25 @@ fn solve_shaped<L: Lane>(
     start: usize,
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
+    inv_h: L,
     inv_h2: L,
 ) {
     let frame_a = block.frame_a.load::<L>(start);
     let frame_b = block.frame_b.load::<L>(start);
-    let alpha_tilde = L::load(&block.limit_compliance[start..]) * inv_h2;
+    let soft = block.limit_softness.lanes(start, inv_h, inv_h2);
     let (semi_y, semi_z) = (
         L::load(&block.ellipse_y[start..]),
         L::load(&block.ellipse_z[start..]),
     );
     // The ellipse's error is in swing sines, half a radian per radian for
-    // small swings: a quarter of the compliance (see `ellipse`).
+    // small swings: a quarter of the compliance (see `ellipse`). A spring's
+    // `period2` and every `damping_time` are ratios, the same in any units.
     let dir = swing_direction::measure(a, b, frame_a, frame_b);
     let (n, c) = ellipse::violation(&dir, semi_y, semi_z);
-    let quarter = alpha_tilde * L::splat(0.25);
+    let quarter = limit::Softness {
+        alpha_tilde: soft.alpha_tilde * L::splat(0.25),
+        ..soft
+    };
     solve_limit(block, 0, start, a, b, (n, c), quarter);
 
     let dir = swing_direction::measure(a, b, frame_a, frame_b);
@@ -285,15 +299,58 @@ fn solve_shaped<L: Lane>(
         load_range(&block.pyramid_y, start),
         load_range(&block.pyramid_z, start),
     );
-    solve_limit(block, 1, start, a, b, y, alpha_tilde);
-    solve_limit(block, 2, start, a, b, z, alpha_tilde);
+    solve_limit(block, 1, start, a, b, y, soft);
+    solve_limit(block, 2, start, a, b, z, soft);
 
     let (lo, hi) = (
         L::load(&block.twist_min[start..]),
         L::load(&block.twist_max[start..]),
     );
     let twist = twist::violation(a, b, frame_a, frame_b, lo, hi);
-    solve_limit(block, 3, start, a, b, twist, alpha_tilde);
+    solve_limit(block, 3, start, a, b, twist, soft);
+}
+
+/// The shaped path's four violations (ellipse in swing sines, pyramid y
+/// and z, twist; rad), each 0 where its limit holds.
+#[inline(always)]
+fn shaped_violations<L: Lane>(
+    block: &SocketBlock,
+    start: usize,
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+) -> [L; 4] {
+    let frame_a = block.frame_a.load::<L>(start);
+    let frame_b = block.frame_b.load::<L>(start);
+    let dir = swing_direction::measure(a, b, frame_a, frame_b);
+    let (_, ellipse) = ellipse::violation(
+        &dir,
+        L::load(&block.ellipse_y[start..]),
+        L::load(&block.ellipse_z[start..]),
+    );
+    let [(_, y), (_, z)] = pyramid::violations(
+        &dir,
+        load_range(&block.pyramid_y, start),
+        load_range(&block.pyramid_z, start),
+    );
+    let (lo, hi) = (
+        L::load(&block.twist_min[start..]),
+        L::load(&block.twist_max[start..]),
+    );
+    let (_, twist) = twist::violation(a, b, frame_a, frame_b, lo, hi);
+    [ellipse, y, z, twist]
+}
+
+impl Limited for SocketBlock {
+    fn bodies(&self) -> &BodyPairs {
+        &self.bodies
+    }
+    #[inline(always)]
+    fn start_limits<L: Lane>(&mut self, start: usize, a: &BodyLanes<L>, b: &BodyLanes<L>) {
+        let c0 = shaped_violations(self, start, a, b);
+        for (k, c0) in c0.into_iter().enumerate() {
+            c0.store(&mut self.limit_start[k][start..]);
+        }
+    }
 }
 
 /// A `[min, max]` pair of arrays as lanes.
@@ -302,7 +359,7 @@ fn load_range<L: Lane>(range: &[[f32; BLOCK_LANES]; 2], start: usize) -> [L; 2] 
     [L::load(&range[0][start..]), L::load(&range[1][start..])]
 }
 
-/// One shaped limit (`k` its multiplier) through the limit part.
+/// One shaped limit (`k` its multiplier and start) through the limit part.
 #[inline(always)]
 fn solve_limit<L: Lane>(
     block: &mut SocketBlock,
@@ -311,10 +368,11 @@ fn solve_limit<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
     (n, c): (Vec3<L>, L),
-    alpha_tilde: L,
+    soft: limit::Softness<L>,
 ) {
     let lambda = L::load(&block.limit_lambda[k][start..]);
-    limit::solve(a, b, n, c, alpha_tilde, lambda).store(&mut block.limit_lambda[k][start..]);
+    let c0 = L::load(&block.limit_start[k][start..]);
+    limit::solve(a, b, n, (c, c0), soft, lambda).store(&mut block.limit_lambda[k][start..]);
 }
 
 impl Driven for SocketBlock {

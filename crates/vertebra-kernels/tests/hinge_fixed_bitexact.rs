@@ -12,6 +12,7 @@ use rand::{RngExt, SeedableRng};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
+use vertebra_kernels::limited;
 use vertebra_kernels::residual::ResidualPass;
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
@@ -107,7 +108,7 @@ fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlo
                     frame_a: j.frame_a,
                     frame_b: j.frame_b,
                     range,
-                    compliance: limit,
+                    softness: common::limit_softness(&mut r, limit),
                     drive: r.random_bool(0.6).then(|| DriveLane {
                         target: unit_quat(&mut r),
                         velocity: vec(&mut r, 20.0),
@@ -125,6 +126,7 @@ fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlo
             block
                 .bodies
                 .set_start(lane, &common::start(&mut r, adversarial));
+            block.limit_start[lane] = common::limit_start(&mut r);
         }
         out.push(block);
     }
@@ -173,7 +175,14 @@ fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32
         rows: &rows,
         h: 1.0 / 60.0,
     });
-    for _ in 0..2 {
+    for iteration in 0..2 {
+        if iteration == 1 {
+            // The range's start on moved bodies: a nonzero `C - C_0`.
+            backend.dispatch(limited::StartPass {
+                blocks: &mut blocks,
+                rows: &rows,
+            });
+        }
         backend.dispatch(hinge::PositionPass::<true> {
             blocks: &mut blocks,
             rows: &rows,
@@ -199,6 +208,7 @@ fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32
             out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(v)));
         }
         out.extend(b.limit_lambda);
+        out.extend(b.limit_start);
     }
     out.extend(residual.iter().flatten());
     out

@@ -11,6 +11,7 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::driven::{DriveLane, StartPass};
+use vertebra_kernels::limited;
 use vertebra_kernels::residual::ResidualPass;
 use vertebra_kernels::socket::{PositionPass, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::Backend;
@@ -97,14 +98,17 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
             block
                 .bodies
                 .set_start(lane, &common::start(&mut r, adversarial));
+            for c0 in &mut block.limit_start {
+                c0[lane] = common::limit_start(&mut r);
+            }
         }
         out.push(block);
     }
     (rows, out)
 }
 
-/// Random shaped limits: an ellipse, a pyramid (angle ranges) and
-/// a compliance; adversarial ones degenerate.
+/// Random shaped limits: an ellipse, a pyramid (angle ranges) and a
+/// softness of any kind; adversarial ones degenerate.
 fn shaped(r: &mut StdRng, adversarial: bool, compliance: f32) -> ShapedLimits {
     let semi = |r: &mut StdRng| match r.random_range(0..4) {
         0 if adversarial => 0.001,
@@ -123,7 +127,7 @@ fn shaped(r: &mut StdRng, adversarial: bool, compliance: f32) -> ShapedLimits {
     ShapedLimits {
         ellipse: [semi(r), semi(r)],
         pyramid: [range(r), range(r)],
-        compliance: if r.random_bool(0.5) { 0.0 } else { compliance },
+        softness: common::limit_softness(r, compliance),
     }
 }
 
@@ -173,7 +177,15 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
         rows: &rows,
         h: 1.0 / 60.0,
     });
-    for _ in 0..2 {
+    for iteration in 0..2 {
+        if iteration == 1 {
+            // The limits' start on moved bodies: the damping then acts on
+            // a nonzero `C - C_0`.
+            backend.dispatch(limited::StartPass {
+                blocks: &mut blocks,
+                rows: &rows,
+            });
+        }
         backend.dispatch(PositionPass::<true, false> {
             blocks: &mut blocks,
             rows: &rows,
@@ -214,6 +226,7 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
             &b.drive.target,
         )));
         out.extend(b.limit_lambda.iter().flatten());
+        out.extend(b.limit_start.iter().flatten());
     }
     out.extend(residual.iter().flatten());
     out

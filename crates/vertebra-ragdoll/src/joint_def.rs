@@ -6,7 +6,10 @@ use std::collections::HashMap;
 
 use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::Deserialize;
-use vertebra_world::{JointKind, LimitSoftness, Swing, SwingTwist, check_coordinate};
+use vertebra_world::{
+    JointKind, LimitSoftness, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY,
+    Swing, SwingTwist, check_coordinate,
+};
 
 use crate::description::{finite, range};
 use crate::drive::Strength;
@@ -59,8 +62,30 @@ pub(crate) struct RawJoint {
     swing: Option<RawSwing>,
     twist: Option<[f32; 2]>,
     range: Option<[f32; 2]>,
-    softness: Option<f32>,
+    softness: Option<RawSoftness>,
     drive: Option<RawStrength>,
+}
+
+/// `softness = 0.001` (a compliance), `softness = { compliance = 0.001,
+/// damping = 20 }` or `softness = { frequency = 8, damping_ratio = 1 }`.
+#[derive(Deserialize)]
+#[serde(untagged)]
+#[serde(
+    expecting = "softness: a compliance, { compliance, damping } or { frequency, damping_ratio }"
+)]
+enum RawSoftness {
+    Compliance(f32),
+    Table(RawSoftTable),
+}
+
+/// The table form of `softness`, its combinations checked by `softness`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSoftTable {
+    compliance: Option<f32>,
+    damping: Option<f32>,
+    frequency: Option<f32>,
+    damping_ratio: Option<f32>,
 }
 
 /// `swing = 40` (a cone), `swing = { y = 80, z = 35 }` (an ellipse) or
@@ -139,7 +164,7 @@ pub(crate) fn joint(
             &format!("is for {owners} only; this joint is a {kind}"),
         )?;
     }
-    let softness = softness(&context, j.softness)?;
+    let softness = softness(&context, j.softness.as_ref())?;
     let drive = j.drive.map(|d| d.read(&context)).transpose()?;
     let (frame, kind) = match kind {
         "socket" => {
@@ -285,17 +310,64 @@ fn angle_range(
     Ok([min.to_radians(), max.to_radians()])
 }
 
-/// `softness = C`: the limits' compliance (rad / (N m)); hard without it.
-fn softness(context: &str, compliance: Option<f32>) -> Result<LimitSoftness, RagdollError> {
-    let Some(c) = compliance else {
-        return Ok(LimitSoftness::Hard);
+/// `softness = C`, `{ compliance = C, damping = D }` or `{ frequency = F,
+/// damping_ratio = Z }`: the limits' softness (`LimitSoftness`); hard
+/// without it. Checked as the world will check it, by name.
+fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, RagdollError> {
+    let soft = match raw {
+        None => return Ok(LimitSoftness::Hard),
+        Some(RawSoftness::Compliance(c)) => LimitSoftness::compliant(*c),
+        Some(RawSoftness::Table(t)) => {
+            match (t.compliance, t.damping, t.frequency, t.damping_ratio) {
+                (Some(compliance), damping, None, None) => LimitSoftness::Compliance {
+                    compliance,
+                    damping: damping.unwrap_or(0.0),
+                },
+                (None, None, Some(frequency), Some(damping_ratio)) => LimitSoftness::Spring {
+                    frequency,
+                    damping_ratio,
+                },
+                _ => {
+                    return Err(RagdollError::OutOfRange {
+                    context: context.to_owned(),
+                    field: "softness",
+                    reason: "takes a compliance, { compliance, damping } or { frequency, damping_ratio }"
+                        .to_owned(),
+                });
+                }
+            }
+        }
     };
-    finite(context, "softness", &[c])?;
-    range(
-        context,
-        "softness",
-        c >= 0.0,
-        "must be a compliance (rad / (N m)) of 0 or more",
-    )?;
-    Ok(LimitSoftness::Compliance(c))
+    let numbers = match soft {
+        LimitSoftness::Hard => vec![],
+        LimitSoftness::Compliance {
+            compliance,
+            damping,
+        } => vec![compliance, damping],
+        LimitSoftness::Spring {
+            frequency,
+            damping_ratio,
+        } => vec![frequency, damping_ratio],
+    };
+    finite(context, "softness", &numbers)?;
+    let (ok, reason) = match soft {
+        LimitSoftness::Compliance {
+            compliance,
+            damping,
+        } => (
+            compliance >= 0.0 && damping >= 0.0 && compliance * damping <= MAX_DRIVE_DAMPING_TIME,
+            "must be a compliance (rad / (N m)) and damping (N m s / rad) of 0 or more, compliance times damping at most 1e6 s",
+        ),
+        LimitSoftness::Spring {
+            frequency,
+            damping_ratio,
+        } => (
+            frequency >= MIN_DRIVE_FREQUENCY
+                && (0.0..=MAX_DRIVE_DAMPING_RATIO).contains(&damping_ratio),
+            "must be a frequency of at least 1e-3 Hz and a damping ratio in [0, 1e3]",
+        ),
+        LimitSoftness::Hard => (true, ""),
+    };
+    range(context, "softness", ok, reason)?;
+    Ok(soft)
 }

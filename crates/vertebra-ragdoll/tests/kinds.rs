@@ -180,7 +180,7 @@ fn pyramids_and_soft_limits_are_read_in_radians() {
             z: [r(-10.0), r(80.0)]
         }
     );
-    assert_eq!(softness, LimitSoftness::Compliance(0.001));
+    assert_eq!(softness, LimitSoftness::compliant(0.001));
 }
 
 /// The anatomical humanoid hanging by its hips, a kick (4 m/s) on each shin

@@ -4,6 +4,7 @@ use core::f32::consts::PI;
 
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error};
 
+use crate::drive::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
 use crate::joint::LimitSoftness;
 
 /// A largest angle (rad) in [0, pi], if set.
@@ -34,12 +35,49 @@ pub(crate) fn angle_range(limit: Option<[f32; 2]>, what: &'static str) -> Result
     }
 }
 
-/// A limit's softness: a compliance finite and not negative.
+/// A limit's softness: the drive's ranges, each error naming the limit's
+/// field.
 pub(crate) fn softness(softness: LimitSoftness) -> Result<(), Error> {
+    let not_negative = |what, x: f32| {
+        if !x.is_finite() {
+            Err(Error::NonFinite(what))
+        } else if x < 0.0 {
+            Err(Error::NonPositive(what))
+        } else {
+            Ok(())
+        }
+    };
     match softness {
-        LimitSoftness::Compliance(c) if !c.is_finite() => Err(Error::NonFinite("limit compliance")),
-        LimitSoftness::Compliance(c) if c < 0.0 => Err(Error::NonPositive("limit compliance")),
-        _ => Ok(()),
+        LimitSoftness::Hard => Ok(()),
+        LimitSoftness::Compliance {
+            compliance,
+            damping,
+        } => {
+            not_negative("limit compliance", compliance)?;
+            not_negative("limit damping", damping)?;
+            if compliance * damping > MAX_DRIVE_DAMPING_TIME {
+                return Err(Error::OutOfRange(
+                    "limit damping (compliance times damping at most 1e6 s)",
+                ));
+            }
+            Ok(())
+        }
+        LimitSoftness::Spring {
+            frequency,
+            damping_ratio,
+        } => {
+            if frequency.is_nan() {
+                return Err(Error::NonFinite("limit frequency"));
+            }
+            if frequency < MIN_DRIVE_FREQUENCY {
+                return Err(Error::OutOfRange("limit frequency (at least 1e-3 Hz)"));
+            }
+            not_negative("limit damping ratio", damping_ratio)?;
+            if damping_ratio > MAX_DRIVE_DAMPING_RATIO {
+                return Err(Error::OutOfRange("limit damping ratio (at most 1e3)"));
+            }
+            Ok(())
+        }
     }
 }
 

@@ -5,6 +5,7 @@ use glam::{Quat, Vec3};
 
 use crate::drive::{AngularDrive, validate_drive};
 use serde::{Deserialize, Serialize};
+use vertebra_kernels::limited::LimitLane;
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
 };
@@ -16,17 +17,76 @@ pub enum JointTag {}
 /// A stable reference to a joint.
 pub type JointHandle = Handle<JointTag>;
 
-/// How a limit holds: hard, or as a spring on the excess.
+/// How a limit holds: hard, or as a damped spring on the excess beyond
+/// it, which acts only while the limit is exceeded and lets go inside
+/// (`crates/vertebra-kernels/src/parts/limit.rs` derives it; the settings
+/// and ranges are the drive's, [`crate::DriveStrength`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub enum LimitSoftness {
     /// Never exceeded (to the solver's convergence).
     #[default]
     Hard,
-    /// A spring on the excess beyond the limit, of compliance
-    /// (rad / (N m)) the inverse of its stiffness, which lets go inside the
-    /// limit; 0 is hard. Independent of the time step and iteration count
-    /// (XPBD).
-    Compliance(f32),
+    /// The torque `-C / compliance - damping dC/dt` on the excess `C`.
+    /// Independent of the time step and iteration count (XPBD); how fast
+    /// it moves a body depends on the body's inertia.
+    Compliance {
+        /// Compliance (rad / (N m), finite, not negative), the inverse of
+        /// the stiffness; 0 is hard (and then damping does nothing).
+        compliance: f32,
+        /// Damping coefficient (N m s / rad, finite, not negative), with
+        /// `compliance * damping` at most [`crate::MAX_DRIVE_DAMPING_TIME`].
+        damping: f32,
+    },
+    /// A damped spring at `frequency` with `damping_ratio` whatever the
+    /// bodies' inertia (as Jolt's `SpringSettings`): stiffness and damping
+    /// scaled by the limit's effective inertia, per lane and iteration.
+    Spring {
+        /// Natural frequency (Hz), at least [`crate::MIN_DRIVE_FREQUENCY`];
+        /// infinity is hard.
+        frequency: f32,
+        /// Damping ratio in [0, [`crate::MAX_DRIVE_DAMPING_RATIO`]]: 1 is
+        /// critical (the limb comes to rest against the limit without
+        /// rebounding), 0 undamped (it bounces back off it).
+        damping_ratio: f32,
+    },
+}
+
+impl LimitSoftness {
+    /// A spring of compliance `c` (rad / (N m)) without damping.
+    pub const fn compliant(c: f32) -> Self {
+        Self::Compliance {
+            compliance: c,
+            damping: 0.0,
+        }
+    }
+
+    /// The kernel's lane data (`parts::limit`: `alpha = compliance +
+    /// period2 w`, `gamma h = damping_time`), as the drive's; all 0 when
+    /// hard (and for an infinite frequency).
+    pub(crate) fn lane(&self) -> LimitLane {
+        match *self {
+            Self::Hard => LimitLane::HARD,
+            Self::Compliance {
+                compliance,
+                damping,
+            } => LimitLane {
+                compliance,
+                period2: 0.0,
+                damping_time: compliance * damping,
+            },
+            Self::Spring {
+                frequency,
+                damping_ratio,
+            } => {
+                let omega = core::f32::consts::TAU * frequency;
+                LimitLane {
+                    compliance: 0.0,
+                    period2: 1.0 / (omega * omega),
+                    damping_time: 2.0 * damping_ratio / omega,
+                }
+            }
+        }
+    }
 }
 
 /// A socket's swing limit: how far b's twist axis (its joint frame's +X)

@@ -389,16 +389,8 @@ fn shaped_limits(limits: &SwingTwist) -> ShapedLimits {
         Swing::Ellipse { y, z } => shaped.ellipse = [semi(y), semi(z)],
         Swing::Pyramid { y, z } => shaped.pyramid = [y, z],
     }
-    shaped.compliance = compliance(limits.softness);
+    shaped.softness = limits.softness.lane();
     shaped
-}
-
-/// A limit's compliance (rad / (N m)); 0 when hard.
-fn compliance(softness: LimitSoftness) -> f32 {
-    match softness {
-        LimitSoftness::Hard => 0.0,
-        LimitSoftness::Compliance(c) => c,
-    }
 }
 
 /// A hinge's lane data.
@@ -419,7 +411,7 @@ pub(crate) fn hinge_lane(
         frame_a: desc.frame_a.normalize(),
         frame_b: desc.frame_b.normalize(),
         range: range.unwrap_or([-PI, PI]),
-        compliance: compliance(softness),
+        softness: softness.lane(),
         drive: desc.drive.map(|d| d.lane()),
     }
 }

@@ -40,7 +40,7 @@
 //! `Err(IncompatibleSnapshot)` for another build) and the world is
 //! unchanged.
 //!
-//! Bytes: `"VTBSNAP4"` (the format), the build id (u64 LE: a hash of the
+//! Bytes: `"VTBSNAP7"` (the format), the build id (u64 LE: a hash of the
 //! crate version and the format), the xxh3 hash of the payload (u64 LE),
 //! then the payload (postcard).
 
@@ -54,7 +54,7 @@ use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
-const FORMAT: u8 = b'6';
+const FORMAT: u8 = b'7';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
@@ -522,17 +522,30 @@ mod tests {
                 Box::new(|s| {
                     s.joints[0].as_mut().unwrap().kind = JointKind::Hinge {
                         range: Some([1.0, -1.0]),
-                        softness: LimitSoftness::Compliance(0.1),
+                        softness: LimitSoftness::compliant(0.1),
                     }
                 }),
                 "joint 0: invalid hinge range limit",
             ),
             (
                 Box::new(|s| {
-                    let soft = SwingTwist::FREE.with_softness(LimitSoftness::Compliance(-1.0));
+                    let soft = SwingTwist::FREE.with_softness(LimitSoftness::compliant(-1.0));
                     s.joints[0].as_mut().unwrap().kind = JointKind::Socket(soft);
                 }),
                 "joint 0: limit compliance must be positive",
+            ),
+            (
+                Box::new(|s| {
+                    let spring = LimitSoftness::Spring {
+                        frequency: 5.0,
+                        damping_ratio: f32::NAN,
+                    };
+                    s.joints[0].as_mut().unwrap().kind = JointKind::Hinge {
+                        range: Some([-1.0, 1.0]),
+                        softness: spring,
+                    }
+                }),
+                "joint 0: limit damping ratio is not finite",
             ),
             (
                 Box::new(|s| s.colouring = Colouring::new()),

@@ -8,6 +8,7 @@ use vertebra_kernels::contact::{self, ContactBlock};
 use vertebra_kernels::driven::StartPass;
 use vertebra_kernels::fixed::{self, FixedBlock};
 use vertebra_kernels::hinge::{self, HingeBlock};
+use vertebra_kernels::limited;
 use vertebra_kernels::rod::{self, RodBlock};
 use vertebra_kernels::socket::{PositionPass, SocketBlock};
 use vertebra_math::Backend;
@@ -71,7 +72,9 @@ pub(crate) fn step(world: &mut World, dt: f32) {
 
 /// The drives' substep start, before the bodies move: each drive's error
 /// against the last substep's target, then the target advanced by `h`;
-/// each rod's bend and twist error (its soft parts damp against them).
+/// each rod's bend and twist error (its soft parts damp against them);
+/// each shaped socket's and hinge's limit violations (`limited.rs`: a
+/// damped limit's `C_0`).
 /// Every driven block, one after another, on the world's backend (each
 /// lane reads and writes only its own block).
 fn start_drives(world: &mut World, h: f32) {
@@ -94,6 +97,18 @@ fn start_drives(world: &mut World, h: f32) {
             rows,
             h,
         });
+        for range in [&group.shaped_driven, &group.shaped_plain] {
+            world.backend.dispatch(limited::StartPass {
+                blocks: &mut layout.sockets.blocks[range.clone()],
+                rows,
+            });
+        }
+        for range in [&group.hinges_driven, &group.hinges_plain] {
+            world.backend.dispatch(limited::StartPass {
+                blocks: &mut layout.hinges.blocks[range.clone()],
+                rows,
+            });
+        }
         world.backend.dispatch(rod::StartPass {
             blocks: &mut layout.rods.blocks[group.rods.clone()],
             rows,

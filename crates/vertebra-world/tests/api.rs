@@ -236,9 +236,56 @@ fn add_kind(w: &mut World, kind: JointKind, drive: Option<AngularDrive>) -> Resu
 
 #[test]
 fn bad_joint_kinds_are_refused_with_the_field_named() {
-    let soft = |c| SwingTwist::FREE.with_softness(LimitSoftness::Compliance(c));
+    let soft = |c| SwingTwist::FREE.with_softness(LimitSoftness::compliant(c));
     let drive = AngularDrive::rigid(Quat::IDENTITY);
+    let hinge = |softness| JointKind::Hinge {
+        range: Some([0.0, 1.0]),
+        softness,
+    };
+    let spring = |frequency, damping_ratio| LimitSoftness::Spring {
+        frequency,
+        damping_ratio,
+    };
+    let damped = |compliance, damping| LimitSoftness::Compliance {
+        compliance,
+        damping,
+    };
     let cases = [
+        (
+            hinge(damped(0.1, -1.0)),
+            None,
+            Error::NonPositive("limit damping"),
+        ),
+        (
+            hinge(damped(0.1, f32::INFINITY)),
+            None,
+            Error::NonFinite("limit damping"),
+        ),
+        (
+            hinge(damped(1e4, 1e3)),
+            None,
+            Error::OutOfRange("limit damping (compliance times damping at most 1e6 s)"),
+        ),
+        (
+            hinge(spring(f32::NAN, 1.0)),
+            None,
+            Error::NonFinite("limit frequency"),
+        ),
+        (
+            hinge(spring(0.0, 1.0)),
+            None,
+            Error::OutOfRange("limit frequency (at least 1e-3 Hz)"),
+        ),
+        (
+            hinge(spring(5.0, -0.5)),
+            None,
+            Error::NonPositive("limit damping ratio"),
+        ),
+        (
+            JointKind::Socket(SwingTwist::FREE.with_softness(spring(5.0, 2e3))),
+            None,
+            Error::OutOfRange("limit damping ratio (at most 1e3)"),
+        ),
         (
             JointKind::Socket(SwingTwist::FREE.with_swing(Swing::Ellipse { y: 0.5, z: 4.0 })),
             None,

@@ -271,7 +271,7 @@ fn soft_knee(c: f32) -> (f32, f32) {
         .unwrap()
         .with_kind(JointKind::Hinge {
             range: Some([0.0, 2.0]),
-            softness: LimitSoftness::Compliance(c),
+            softness: LimitSoftness::compliant(c),
         });
     w.add_joint(knee).unwrap();
     let rest = w.body(shin).unwrap().orientation;

@@ -73,7 +73,19 @@ pub fn correct_axes<L: Lane>(
         -soft.relaxation * c - soft.alpha_tilde * lambda,
         w + soft.alpha_tilde,
     );
+    apply(a, b, n_a, n_b, dlambda);
+    dlambda
+}
+
+/// Turns `b` by `I_b^-1 n_b dlambda` and `a` by `-I_a^-1 n_a dlambda`.
+#[inline(always)]
+pub fn apply<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    n_a: Vec3<L>,
+    n_b: Vec3<L>,
+    dlambda: L,
+) {
     b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
     a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
-    dlambda
 }

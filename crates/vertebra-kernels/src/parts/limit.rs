@@ -2,38 +2,105 @@
 //! limit (cone, ellipse, pyramid, twist range, hinge range).
 //!
 //! The caller measures the violation `C >= 0` (0 where the limit holds)
-//! and its axis `n` (turning b by `x` about `n` grows `C` by `x`). The
-//! correction is the angle part's XPBD step with the limit's compliance
-//! `alpha` (rad / (N m); 0 is hard):
-//! `dlambda = (-C - alpha~ lambda) / (w + alpha~)`, `alpha~ = alpha / h^2`,
-//! accumulated in `lambda` over the substep's iterations (Macklin et al.
-//! 2016). Where the limit holds it does nothing (`C = 0` and the
-//! accumulated `lambda` masked out): a soft limit pushes back while it is
-//! exceeded, as a spring of stiffness `1 / alpha` (N m / rad) on the
-//! excess, and lets go inside. With `alpha = 0` it is exactly the angle
-//! part's hard correction.
+//! and its axis `n` (turning b by `x` about `n` grows `C` by `x`), and the
+//! violation `C_0` at the substep's start (the limit start pass,
+//! `limited.rs`, before the bodies are predicted). With
+//! `w = n^T (I_a^-1 + I_b^-1) n` the correction is the angle part's
+//! XPBD step with damping (Macklin et al. 2016, eq. 26), as the drive's
+//! (`drive.rs`, whose header derives it), on one axis:
+//!
+//! `dlambda = -(C + alpha~ lambda + gamma (C - C_0)) / ((1 + gamma) w + alpha~)`
+//!
+//! `alpha~ = alpha / h^2`, `gamma = damping_time / h`, accumulated in
+//! `lambda` over the substep's iterations. The limit's settings, per lane,
+//! as the drive's: `alpha = compliance + period2 w` and `damping_time`:
+//!
+//! - hard: all three 0; then the step is exactly the angle part's hard
+//!   correction (`dlambda = -C / w`), bit for bit (the plain XPBD
+//!   expression is kept and selected wherever `period2 / h^2 + gamma` is 0).
+//! - compliance `c` (rad / (N m)) and damping `d` (N m s / rad): `alpha =
+//!   c`, `damping_time = c d`: the torque on the excess is `-C / c - d
+//!   dC/dt`.
+//! - frequency `f` (Hz) and damping ratio `zeta`, on the limit's own
+//!   effective inertia `1 / w`: `period2 = 1 / omega^2`, `damping_time =
+//!   2 zeta / omega` (`omega = 2 pi f`). The masses cancel and one
+//!   iteration is the implicit Euler step of `C'' = -omega^2 C - 2 zeta
+//!   omega C'` (the drive header's derivation with `W` a scalar): the
+//!   excess is an oscillator at `f` with ratio `zeta` whatever the bodies.
+//!
+//! Where the limit holds (`C = 0`) the part does nothing: the accumulated
+//! `lambda` and the damping term are masked out, so damping acts only
+//! while the limit is exceeded. While it is exceeded the spring-damper is
+//! two-sided (the damper may pull, the accumulated `lambda` is not clamped
+//! to push only, unlike Jolt's and Box2D's soft limits): a critically
+//! damped excess `C = v t e^(-omega t)` then returns to the limit without
+//! crossing it, whereas clamping the push would release the limb at
+//! `t = 2 / omega` moving outward at `e^-2 = 13.5%` of its impact speed: a
+//! rebound. The damping's `C - C_0` counts only the excess: a limit
+//! entered during the substep has `C_0 = 0`.
 
 use vertebra_math::{Lane, Vec3};
 
-use super::angle::{Softness, correct_axes};
-use crate::body::BodyLanes;
+use super::angle;
+use crate::body::{BodyLanes, safe_ratio};
 
-/// Corrects a violation `c` (rad, >= 0) about `n`; returns the new
-/// accumulated `lambda` (N m s^2).
+/// A limit's softness, per lane, scaled to the substep (see the module
+/// documentation).
+#[derive(Clone, Copy, Debug)]
+pub struct Softness<L> {
+    /// `compliance / h^2` (rad / (N m s^2)).
+    pub alpha_tilde: L,
+    /// `period2 / h^2` (dimensionless): compliance per unit `w`.
+    pub spring: L,
+    /// `gamma = damping_time / h` (dimensionless).
+    pub gamma: L,
+}
+
+impl<L: Lane> Softness<L> {
+    /// From per-lane `compliance` (rad / (N m)), `period2` (s^2) and
+    /// `damping_time` (s), with `1 / h` and `1 / h^2`.
+    #[inline(always)]
+    pub fn new(compliance: L, period2: L, damping_time: L, inv_h: L, inv_h2: L) -> Self {
+        Self {
+            alpha_tilde: compliance * inv_h2,
+            spring: period2 * inv_h2,
+            gamma: damping_time * inv_h,
+        }
+    }
+}
+
+/// Corrects a violation `c` (rad, >= 0) about `n`, `c0` the violation at
+/// the substep's start; returns the new accumulated `lambda` (N m s^2).
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
     n: Vec3<L>,
-    c: L,
-    alpha_tilde: L,
+    (c, c0): (L, L),
+    soft: Softness<L>,
     lambda: L,
 ) -> L {
-    let active = c.gt(L::splat(0.0));
-    let held = L::select(active, lambda, L::splat(0.0));
-    let soft = Softness {
-        alpha_tilde,
-        relaxation: L::splat(1.0),
-    };
-    lambda + correct_axes(a, b, n, n, c, soft, held)
+    let zero = L::splat(0.0);
+    let active = c.gt(zero);
+    let held = L::select(active, lambda, zero);
+    let w = a.angular_weight(n) + b.angular_weight(n);
+    // Hard and compliance-only lanes: the angle part's expression, bit for
+    // bit.
+    let plain = (
+        -L::splat(1.0) * c - soft.alpha_tilde * held,
+        w + soft.alpha_tilde,
+    );
+    let alpha = soft.alpha_tilde + soft.spring * w;
+    let damping = L::select(active, soft.gamma * (c - c0), zero);
+    let sprung = (
+        -(c + alpha * held + damping),
+        w * (L::splat(1.0) + soft.gamma) + alpha,
+    );
+    let damped = (soft.spring + soft.gamma).gt(zero);
+    let dlambda = safe_ratio(
+        L::select(damped, sprung.0, plain.0),
+        L::select(damped, sprung.1, plain.1),
+    );
+    angle::apply(a, b, n, n, dlambda);
+    lambda + dlambda
 }

@@ -5,6 +5,7 @@ use glam::{Mat3, Quat, Vec3};
 use rand::RngExt;
 use rand::rngs::StdRng;
 use vertebra_kernels::body::{BodyRows, StartLane};
+use vertebra_kernels::limited::LimitLane;
 use vertebra_math::Backend;
 use vertebra_math::check::same_bits;
 
@@ -146,5 +147,46 @@ pub fn start(r: &mut StdRng, adversarial: bool) -> StartLane {
         gap: vec(r, 0.5),
         arm_a: vec(r, 0.5),
         arm_b: vec(r, 0.5),
+    }
+}
+
+/// A limit's softness of every kind: hard, compliance (with damping or
+/// without), a spring at any frequency and damping ratio, and extremes.
+pub fn limit_softness(r: &mut StdRng, compliance: f32) -> LimitLane {
+    let omega = match r.random_range(0..3) {
+        0 => 1e-2,
+        1 => 1e4,
+        _ => r.random_range(1.0..200.0f32),
+    };
+    let damping_time = match r.random_range(0..4) {
+        0 => 0.0,
+        1 => 1e6,
+        _ => r.random_range(0.0..1.0),
+    };
+    match r.random_range(0..4) {
+        0 => LimitLane::HARD,
+        1 => LimitLane {
+            compliance,
+            ..LimitLane::HARD
+        },
+        2 => LimitLane {
+            compliance,
+            damping_time,
+            ..LimitLane::HARD
+        },
+        _ => LimitLane {
+            period2: 1.0 / (omega * omega),
+            damping_time,
+            ..LimitLane::HARD
+        },
+    }
+}
+
+/// A violation at the substep's start (rad): zero, small or large.
+pub fn limit_start(r: &mut StdRng) -> f32 {
+    match r.random_range(0..3) {
+        0 => 0.0,
+        1 => r.random_range(0.0..0.1),
+        _ => r.random_range(0.0..4.0),
     }
 }
