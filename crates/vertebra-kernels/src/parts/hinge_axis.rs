@@ -17,6 +17,25 @@
 //! error in one step whatever the inertia's anisotropy (one row along
 //! `t_a x t_b` would be an oblique projection; see the drive part). A
 //! singular `K` (no dynamic body) gives no correction.
+//!
+//! The linearisation only holds near alignment. With swing angle `theta`
+//! between `t_a` and `t_b`, `|C| = sin theta`, so past 90 degrees the step
+//! drives toward the antiparallel zero, and near 90 degrees `K` is nearly
+//! singular (`j_1 = y_b x t_a` vanishes when `t_a = y_b`) and the step
+//! huge. The hinge kernel therefore first applies the swing part
+//! (`swing.rs`: one row along `t_a x t_b`, angle by atan2, exact for any
+//! `theta` below 180 degrees) with the cone [`NEWTON_CONE`]: inside it the
+//! swing part does nothing (the small-angle behaviour is today's), outside
+//! it brings `theta` back to 45 degrees. There the step is well posed:
+//! with `t_a = (cos theta, s_1, s_2)` in b's frame (`s_k = C_k`), the
+//! rows' Gram matrix is `[1 - s_1^2, -s_1 s_2; -s_1 s_2, 1 - s_2^2]`,
+//! whose determinant is `cos^2 theta` (1/2 at 45 degrees, 0 at 90), and
+//! the Newton step heads for `t_b = t_a`. Only the exact antiparallel pose
+//! (`n` undefined) remains an equilibrium.
+
+/// The swing (rad) past which the hinge kernel turns the axes back with
+/// the swing part before this part's 2-row step: 45 degrees.
+pub const NEWTON_CONE: f32 = core::f32::consts::FRAC_PI_4;
 
 use vertebra_math::{Lane, Quat, Vec3};
 
