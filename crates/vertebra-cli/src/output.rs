@@ -171,7 +171,10 @@ pub fn print_summary(config: &SceneConfig, run: &SceneRun) {
     );
     if !config.scene.is_paper() {
         let v = run.stats(Quantity::MaxViolation).max.to_degrees();
-        println!("  largest limit violation of any joint: {v:.3} degrees");
+        let e = run.stats(Quantity::MaxAngularError).max.to_degrees();
+        println!(
+            "  largest limit violation of any joint: {v:.3} degrees; largest angular error (held rotations too): {e:.3} degrees"
+        );
     }
     for (r, name) in run.recoveries().iter().zip(["chest", "head"]) {
         let back = r

@@ -8,7 +8,7 @@ use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
 use crate::parts::{lock, point};
-use crate::residual::Residual;
+use crate::residual::{Measured, Residual};
 
 /// Eight fixed joints, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -126,7 +126,7 @@ fn solve_positions<L: Lane>(block: &FixedBlock, start: usize, rows: &BodyRows) {
 /// between the two joint frames (rad).
 impl Residual for FixedBlock {
     #[inline(always)]
-    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
+    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> Measured<L> {
         let (a, b) = self.bodies.gather::<L>(rows, start);
         let (fa, fb) = (self.frame_a.load::<L>(start), self.frame_b.load::<L>(start));
         let (_, _, d) = point::separation(
@@ -136,6 +136,10 @@ impl Residual for FixedBlock {
             self.anchor_b.load(start),
             &self.bodies.start(start),
         );
-        (d.length(), lock::measure(&a, &b, fa, fb).length())
+        Measured {
+            linear: d.length(),
+            angular: lock::measure(&a, &b, fa, fb).length(),
+            limit: L::splat(0.0),
+        }
     }
 }

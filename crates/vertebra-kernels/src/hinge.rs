@@ -17,7 +17,7 @@ use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{hinge_axis, limit, point, swing, twist};
-use crate::residual::Residual;
+use crate::residual::{Measured, Residual};
 
 /// Eight hinges, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -239,7 +239,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
 /// the hinge axes plus the range overshoot (rad).
 impl Residual for HingeBlock {
     #[inline(always)]
-    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
+    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> Measured<L> {
         let (a, b) = self.bodies.gather::<L>(rows, start);
         let (fa, fb) = (self.frame_a.load::<L>(start), self.frame_b.load::<L>(start));
         let (_, _, d) = point::separation(
@@ -255,6 +255,10 @@ impl Residual for HingeBlock {
             L::load(&self.range_max[start..]),
         );
         let (_, overshoot) = twist::violation(&a, &b, fa, fb, lo, hi);
-        (d.length(), misalignment + overshoot)
+        Measured {
+            linear: d.length(),
+            angular: misalignment + overshoot,
+            limit: overshoot,
+        }
     }
 }

@@ -22,7 +22,7 @@ use crate::body::{BodyPairs, BodyRows};
 use crate::parts::angle::Softness;
 use crate::parts::rod::drive::Drive;
 use crate::parts::rod::{bend, curve, frames, length, twist};
-use crate::residual::Residual;
+use crate::residual::{Measured, Residual};
 
 /// Eight rods, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -374,7 +374,7 @@ fn solve_positions<L: Lane>(
 /// reflection of `t_a`) plus limit overshoot (rad).
 impl Residual for RodBlock {
     #[inline(always)]
-    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
+    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> Measured<L> {
         let (a, b) = self.bodies.gather::<L>(rows, start);
         let f = frames(
             &a,
@@ -392,6 +392,10 @@ impl Residual for RodBlock {
             L::load(&self.twist_max[start..]),
         );
         let twist_over = crate::parts::twist::excess(twist::measure(&f), lo, hi).abs();
-        (c_len.abs(), c_curve + bend_over + twist_over)
+        Measured {
+            linear: c_len.abs(),
+            angular: c_curve + bend_over + twist_over,
+            limit: bend_over + twist_over,
+        }
     }
 }

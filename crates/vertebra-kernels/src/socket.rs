@@ -22,7 +22,7 @@ use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{ellipse, limit, point, pyramid, swing, swing_direction, twist};
-use crate::residual::Residual;
+use crate::residual::{Measured, Residual};
 
 /// Eight sockets, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -421,7 +421,7 @@ fn shaped_overshoot<L: Lane>(
 /// figure 8 counts them.
 impl Residual for SocketBlock {
     #[inline(always)]
-    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> (L, L) {
+    fn residual<L: Lane>(&self, rows: &BodyRows, start: usize) -> Measured<L> {
         let (a, b) = self.bodies.gather::<L>(rows, start);
         let (fa, fb) = (self.frame_a.load::<L>(start), self.frame_b.load::<L>(start));
         let (_, _, d) = point::separation(
@@ -440,6 +440,10 @@ impl Residual for SocketBlock {
         let overshoot = swing::overshoot(theta, L::load(&self.swing_max[start..]))
             + twist::excess(phi, lo, hi).abs()
             + shaped_overshoot(self, &a, &b, start);
-        (d.length(), overshoot)
+        Measured {
+            linear: d.length(),
+            angular: overshoot,
+            limit: overshoot,
+        }
     }
 }

@@ -196,7 +196,7 @@ fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32
             inv_h2: 3600.0,
         });
     }
-    let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+    let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
         blocks: &blocks,
         rows: &rows,
@@ -224,7 +224,7 @@ fn run_fixed(backend: Backend, raw: &RawRows, blocks: &[FixedBlock]) -> Vec<f32>
             rows: &rows,
         });
     }
-    let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+    let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
         blocks: &blocks,
         rows: &rows,

@@ -211,7 +211,7 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
             inv_h2: 3600.0,
         });
     }
-    let mut residual = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+    let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
         blocks: &blocks,
         rows: &rows,

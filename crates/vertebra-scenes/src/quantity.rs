@@ -16,19 +16,22 @@ pub enum Quantity {
     DeviationCm,
     /// Summed angle of the bodies from the target pose (rad): figure 7.
     DeviationRad,
-    /// The largest angular error of any one joint (rad): its limit
-    /// overshoot.
+    /// The largest limit violation of any one joint (rad).
     MaxViolation,
+    /// The largest angular error of any one joint (rad): limit violation
+    /// plus the held rotations' error.
+    MaxAngularError,
 }
 
 impl Quantity {
     /// Every quantity, in the order of [`Frame`]'s fields.
-    pub const ALL: [Quantity; 5] = [
+    pub const ALL: [Quantity; 6] = [
         Quantity::EpsLin,
         Quantity::EpsAng,
         Quantity::DeviationCm,
         Quantity::DeviationRad,
         Quantity::MaxViolation,
+        Quantity::MaxAngularError,
     ];
 
     /// The quantity's value in `frame`.
@@ -39,6 +42,7 @@ impl Quantity {
             Quantity::DeviationCm => frame.deviation_cm,
             Quantity::DeviationRad => frame.deviation_rad,
             Quantity::MaxViolation => frame.max_violation_rad,
+            Quantity::MaxAngularError => frame.max_angular_error_rad,
         }
     }
 
@@ -51,6 +55,7 @@ impl Quantity {
             Quantity::DeviationCm => "deviation_cm",
             Quantity::DeviationRad => "deviation_rad",
             Quantity::MaxViolation => "max_violation_rad",
+            Quantity::MaxAngularError => "max_angular_error_rad",
         }
     }
 

@@ -27,11 +27,16 @@ pub struct Frame {
     pub deviation_cm: f32,
     /// Controllability: summed angle of the bodies from the target (rad).
     pub deviation_rad: f32,
-    /// The largest angular error of any one of the ragdolls' joints (rad):
-    /// its limit overshoot (for a hinge, plus the angle between its axes;
-    /// for the rod, its curve error), as in
-    /// [`vertebra_world::JointResidual::angular_rad`].
+    /// The largest limit violation of any one of the ragdolls' joints
+    /// (rad): how far past its swing cone, twist or hinge range (the rod:
+    /// its bend or twist limit), as in
+    /// [`vertebra_world::JointResidual::limit_rad`].
     pub max_violation_rad: f32,
+    /// The largest angular error of any one of the ragdolls' joints (rad):
+    /// its limit violation plus the error of its held rotations (a
+    /// hinge's angle between its axes, a fixed joint's angle, the rod's
+    /// curve error), as in [`vertebra_world::JointResidual::angular_rad`].
+    pub max_angular_error_rad: f32,
 }
 
 /// A finished run.

@@ -103,19 +103,20 @@ impl SceneWorld {
             .joints
             .iter()
             .filter(|j| self.joints.contains(&j.joint))
-            .map(|j| (j.linear_cm, j.angular_rad));
+            .map(|j| (j.linear_cm, j.angular_rad, j.limit_rad));
         let rod_errors = r
             .rods
             .iter()
             .filter(|j| self.rods.contains(&j.joint))
-            .map(|j| (j.linear_cm, j.angular_rad));
-        let (eps_lin_cm, eps_ang_rad) = joint_errors
+            .map(|j| (j.linear_cm, j.angular_rad, j.limit_rad));
+        let errors = joint_errors.chain(rod_errors);
+        let (eps_lin_cm, eps_ang_rad) = errors
             .clone()
-            .chain(rod_errors.clone())
-            .fold((0.0, 0.0), |(l, a), (dl, da)| (l + dl, a + da));
-        let max_violation_rad = joint_errors
-            .chain(rod_errors)
-            .fold(0.0, |m: f32, (_, a)| m.max(a));
+            .fold((0.0, 0.0), |(l, a), (dl, da, _)| (l + dl, a + da));
+        let (max_angular_error_rad, max_violation_rad) = errors
+            .fold((0.0f32, 0.0f32), |(a, v), (_, da, dv)| {
+                (a.max(da), v.max(dv))
+            });
         let (mut deviation_cm, mut deviation_rad) = (0.0, 0.0);
         if let Some(target) = &self.target {
             for ragdoll in &self.ragdolls {
@@ -133,6 +134,7 @@ impl SceneWorld {
             deviation_cm,
             deviation_rad,
             max_violation_rad,
+            max_angular_error_rad,
         }
     }
 }

@@ -25,6 +25,10 @@ pub struct JointResidual<H> {
     /// its axes, a fixed joint's angle between its frames, a rod's curve
     /// error (the angle between `t_b` and the reflection of `t_a`).
     pub angular_rad: f32,
+    /// The part of `angular_rad` that is limit overshoot (rad): how far
+    /// past its swing cone, twist or hinge range (a rod: its bend or twist
+    /// limit) the joint is. Zero for a fixed joint.
+    pub limit_rad: f32,
 }
 
 /// Residual error at the end of a step, as the design brief defines it:
@@ -45,14 +49,14 @@ pub struct Residuals {
 /// Per-lane residuals of blocks (each `(lane_slot, per_lane)`) to
 /// per-joint ones, in slot order.
 fn collect<H>(
-    kinds: &[(&[u32], &[[f32; 2]])],
+    kinds: &[(&[u32], &[[f32; 3]])],
     handle: impl Fn(usize) -> Option<H>,
 ) -> Vec<JointResidual<H>> {
     let mut joints: Vec<(u32, JointResidual<H>)> = kinds
         .iter()
         .flat_map(|(lane_slot, per_lane)| lane_slot.iter().zip(per_lane.iter()))
         .filter(|(slot, _)| **slot != EMPTY)
-        .map(|(&slot, &[lin, ang])| {
+        .map(|(&slot, &[lin, ang, limit])| {
             let joint = handle(slot as usize).expect("laid-out joints are live");
             (
                 slot,
@@ -60,6 +64,7 @@ fn collect<H>(
                     joint,
                     linear_cm: lin * 100.0,
                     angular_rad: ang,
+                    limit_rad: limit,
                 },
             )
         })
@@ -69,8 +74,8 @@ fn collect<H>(
 }
 
 /// Every lane's residual of `blocks`.
-fn measure<B: Residual>(backend: Backend, blocks: &[B], rows: &BodyRows) -> Vec<[f32; 2]> {
-    let mut out = vec![[0.0f32; 2]; blocks.len() * BLOCK_LANES];
+fn measure<B: Residual>(backend: Backend, blocks: &[B], rows: &BodyRows) -> Vec<[f32; 3]> {
+    let mut out = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
         blocks,
         rows,
