@@ -46,6 +46,7 @@ mod mapping;
 mod motion;
 mod pose;
 mod ragdoll;
+mod skeleton;
 
 pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
 pub use drive::{DriveSettings, Strength};
@@ -54,3 +55,4 @@ pub use joint_def::JointDef;
 pub use mapping::SpineMapping;
 pub use pose::Pose;
 pub use ragdoll::{BuildOptions, Ragdoll, SpineMode, body_masses};
+pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};

@@ -1,0 +1,265 @@
+//! The animation skeleton in an engine's terms: bones with parents and
+//! names, a bind pose of parent-local transforms, and poses in local and in
+//! model space (as Jolt's `Skeleton` and `SkeletonPose`, ozz's local and
+//! model-space transforms).
+//!
+//! Conventions (`docs/ragdolls.md`, "Skeletons"): right-handed, +Y up,
+//! metres. A bone's local transform maps points from the bone's frame into
+//! its parent's; its model transform maps them into the model frame (the
+//! skeleton root's parent: the character's frame, which the engine places
+//! in the world). Parents come before their children, so one pass from the
+//! first bone converts a local pose to model space.
+
+use core::ops::Mul;
+
+use glam::{Quat, Vec3};
+use vertebra_world::{MAX_COORDINATE, check_unit_quat};
+
+use crate::error::RagdollError;
+
+/// The most bones a skeleton may have.
+pub const MAX_BONES: usize = 4096;
+
+/// A rigid transform: a rotation, then a translation (no scale).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Transform {
+    /// Translation (m).
+    pub translation: Vec3,
+    /// Rotation (unit quaternion).
+    pub rotation: Quat,
+}
+
+impl Transform {
+    /// No rotation, no translation.
+    pub const IDENTITY: Self = Self {
+        translation: Vec3::ZERO,
+        rotation: Quat::IDENTITY,
+    };
+
+    /// A transform of `translation` (m) and `rotation`.
+    pub fn new(translation: Vec3, rotation: Quat) -> Self {
+        Self {
+            translation,
+            rotation,
+        }
+    }
+
+    /// The transform that undoes this one.
+    pub fn inverse(self) -> Self {
+        let rotation = self.rotation.conjugate();
+        Self {
+            translation: rotation * -self.translation,
+            rotation,
+        }
+    }
+
+    /// `point` (m) mapped by this transform.
+    pub fn transform_point(self, point: Vec3) -> Vec3 {
+        self.translation + self.rotation * point
+    }
+
+    /// `vector` rotated by this transform (no translation).
+    pub fn transform_vector(self, vector: Vec3) -> Vec3 {
+        self.rotation * vector
+    }
+
+    /// Checks that the translation is finite and within
+    /// [`MAX_COORDINATE`] and the rotation a unit quaternion (within 1e-3);
+    /// the error names `context` and the field.
+    pub fn validate(self, context: &str) -> Result<(), RagdollError> {
+        let t = self.translation;
+        if !t.is_finite() {
+            return Err(RagdollError::NonFinite {
+                context: context.to_owned(),
+                field: "translation",
+            });
+        }
+        if t.abs().max_element() > MAX_COORDINATE {
+            return Err(RagdollError::OutOfRange {
+                context: context.to_owned(),
+                field: "translation",
+                reason: format!("is {t}; each coordinate must be within {MAX_COORDINATE} m"),
+            });
+        }
+        check_unit_quat("rotation", self.rotation).map_err(|e| RagdollError::OutOfRange {
+            context: context.to_owned(),
+            field: "rotation",
+            reason: e.to_string(),
+        })
+    }
+}
+
+/// `a * b` applies `b`, then `a`: a child's model transform is its
+/// parent's model transform times its local one.
+impl Mul for Transform {
+    type Output = Transform;
+    fn mul(self, b: Transform) -> Transform {
+        Transform {
+            translation: self.transform_point(b.translation),
+            rotation: (self.rotation * b.rotation).normalize(),
+        }
+    }
+}
+
+/// One bone of a [`Skeleton`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Bone {
+    /// Unique, non-empty name.
+    pub name: String,
+    /// The parent bone's index (before this bone's), or `None` for a root.
+    pub parent: Option<usize>,
+    /// The bind pose: this bone's transform relative to its parent (or to
+    /// the model frame, for a root).
+    pub bind: Transform,
+}
+
+/// A validated skeleton: at most [`MAX_BONES`] bones, names unique and
+/// non-empty, every parent before its child, bind transforms finite with
+/// unit rotations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Skeleton {
+    bones: Vec<Bone>,
+}
+
+impl Skeleton {
+    /// A skeleton of `bones`, checked; the error names the bone and field.
+    pub fn new(bones: Vec<Bone>) -> Result<Self, RagdollError> {
+        if bones.is_empty() || bones.len() > MAX_BONES {
+            return Err(RagdollError::OutOfRange {
+                context: "skeleton".to_owned(),
+                field: "bones",
+                reason: format!("has {}; must have 1 to {MAX_BONES}", bones.len()),
+            });
+        }
+        for (i, bone) in bones.iter().enumerate() {
+            let context = bone_context(i, &bone.name);
+            let out_of_range = |field, reason: String| RagdollError::OutOfRange {
+                context: context.clone(),
+                field,
+                reason,
+            };
+            if bone.name.is_empty() {
+                return Err(out_of_range("name", "is empty".to_owned()));
+            }
+            if let Some(first) = bones[..i].iter().position(|b| b.name == bone.name) {
+                return Err(out_of_range("name", format!("is bone {first}'s too")));
+            }
+            if let Some(parent) = bone.parent.filter(|&p| p >= i) {
+                return Err(out_of_range(
+                    "parent",
+                    format!("is {parent}; must be a bone before this one (below {i})"),
+                ));
+            }
+            bone.bind.validate(&context)?;
+        }
+        Ok(Self { bones })
+    }
+
+    /// The bones, parents first.
+    pub fn bones(&self) -> &[Bone] {
+        &self.bones
+    }
+
+    /// How many bones.
+    pub fn len(&self) -> usize {
+        self.bones.len()
+    }
+
+    /// Never: a skeleton has at least one bone.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The index of the bone called `name`.
+    pub fn bone_index(&self, name: &str) -> Option<usize> {
+        self.bones.iter().position(|b| b.name == name)
+    }
+
+    /// The bind pose, parent-local.
+    pub fn bind_pose(&self) -> LocalPose {
+        LocalPose {
+            bones: self.bones.iter().map(|b| b.bind).collect(),
+        }
+    }
+
+    /// Checks that `transforms` has one transform per bone, each finite
+    /// with a unit rotation; the error names the bone.
+    fn check(&self, transforms: &[Transform]) -> Result<(), RagdollError> {
+        if transforms.len() != self.bones.len() {
+            return Err(RagdollError::BadPose(format!(
+                "{} transforms for {} bones",
+                transforms.len(),
+                self.bones.len()
+            )));
+        }
+        for (i, (t, bone)) in transforms.iter().zip(&self.bones).enumerate() {
+            t.validate(&bone_context(i, &bone.name))
+                .map_err(|e| RagdollError::BadPose(e.to_string()))?;
+        }
+        Ok(())
+    }
+}
+
+fn bone_context(index: usize, name: &str) -> String {
+    format!("bone {index} `{name}`")
+}
+
+/// A pose of a skeleton in local space: each bone's transform relative to
+/// its parent (a root's relative to the model frame), in bone order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LocalPose {
+    /// Per bone, parent-local.
+    pub bones: Vec<Transform>,
+}
+
+/// A pose of a skeleton in model space: each bone's transform relative to
+/// the model frame, in bone order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelPose {
+    /// Per bone, in the model frame.
+    pub bones: Vec<Transform>,
+}
+
+impl LocalPose {
+    /// This pose in model space (parents first, one pass). Refused if it
+    /// does not fit `skeleton` (count, a non-finite transform or
+    /// non-unit rotation: the error names the bone).
+    pub fn to_model(&self, skeleton: &Skeleton) -> Result<ModelPose, RagdollError> {
+        skeleton.check(&self.bones)?;
+        let mut model: Vec<Transform> = Vec::with_capacity(self.bones.len());
+        for (local, bone) in self.bones.iter().zip(&skeleton.bones) {
+            let placed = match bone.parent {
+                Some(p) => model[p] * *local,
+                None => *local,
+            };
+            model.push(placed);
+        }
+        Ok(ModelPose { bones: model })
+    }
+}
+
+impl ModelPose {
+    /// This pose in local space: each bone relative to its parent. Refused
+    /// as [`LocalPose::to_model`] refuses.
+    pub fn to_local(&self, skeleton: &Skeleton) -> Result<LocalPose, RagdollError> {
+        skeleton.check(&self.bones)?;
+        let bones = self
+            .bones
+            .iter()
+            .zip(&skeleton.bones)
+            .map(|(model, bone)| match bone.parent {
+                Some(p) => self.bones[p].inverse() * *model,
+                None => *model,
+            })
+            .collect();
+        Ok(LocalPose { bones })
+    }
+
+    /// This pose placed in the world by the model frame's transform
+    /// `model_to_world` (the character's).
+    pub fn in_world(&self, model_to_world: Transform) -> ModelPose {
+        ModelPose {
+            bones: self.bones.iter().map(|&t| model_to_world * t).collect(),
+        }
+    }
+}
