@@ -444,6 +444,8 @@ pub(crate) fn rod_lane(desc: &RodDesc, bodies: &BodyStore) -> RodLane {
         rest_length: desc.rest_length,
         bend_rest: desc.bend_rest.normalize(),
         twist_rest: desc.twist_rest,
+        bend_rest_velocity: glam::Vec3::ZERO,
+        twist_rest_velocity: 0.0,
         bend: desc.softness(desc.bending),
         twist: desc.softness(desc.twisting),
         bend_max: desc.bend_limit.unwrap_or(PI),

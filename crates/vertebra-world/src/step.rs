@@ -112,6 +112,7 @@ fn start_drives(world: &mut World, h: f32) {
         world.backend.dispatch(rod::StartPass {
             blocks: &mut layout.rods.blocks[group.rods.clone()],
             rows,
+            h,
         });
     }
 }
