@@ -426,6 +426,8 @@ impl RodWorkload {
                 rest_length: 0.12,
                 bend_rest: GVec3::X,
                 twist_rest: 0.0,
+                bend_rest_velocity: GVec3::ZERO,
+                twist_rest_velocity: 0.0,
                 bend: RodSoftness::Compliance(0.06),
                 twist: RodSoftness::Compliance(0.06),
                 bend_max: 0.3,

@@ -203,6 +203,8 @@ fn rod_block(input: &mut Input, rows: &RawRows) -> RodBlock {
             rest_length: input.float(2.0).abs().max(1e-3),
             bend_rest: input.vec3(1.0).try_normalize().unwrap_or(Vec3::X),
             twist_rest: input.float(PI),
+            bend_rest_velocity: Vec3::ZERO,
+            twist_rest_velocity: 0.0,
             bend: softness(input),
             twist: softness(input),
             bend_max: input.float(PI).abs().min(PI),
@@ -213,6 +215,18 @@ fn rod_block(input: &mut Input, rows: &RawRows) -> RodBlock {
         block.bodies.set_start(k, &start(input));
     }
     block
+}
+
+/// The rods' rest rates (rad/s), zero or not lane by lane; read after
+/// everything else, so that older corpus files keep their meaning (their
+/// rods' rests stay still).
+fn rest_rates(input: &mut Input, block: &mut RodBlock) {
+    for k in 0..BLOCK_LANES {
+        if input.flag() {
+            block.bend_rest_velocity.set(k, input.vec3(10.0));
+            block.twist_rest_velocity[k] = input.float(10.0);
+        }
+    }
 }
 
 fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
@@ -294,6 +308,7 @@ fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32
     backend.dispatch(rod::StartPass {
         blocks: &mut rods,
         rows: &rows,
+        h,
     });
     backend.dispatch(rod::PositionPass {
         blocks: &mut rods,
@@ -317,7 +332,7 @@ fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32
 pub fn kernels(data: &[u8]) {
     let mut input = Input::new(data);
     let raw = raw_rows(&mut input);
-    let blocks = (
+    let mut blocks = (
         socket_block(&mut input, &raw),
         rod_block(&mut input, &raw),
         contact_block(&mut input, &raw),
@@ -325,6 +340,7 @@ pub fn kernels(data: &[u8]) {
         fixed_block(&mut input, &raw),
     );
     let inv_h2 = 1.0 / (input.positive(0.05) * input.positive(0.05));
+    rest_rates(&mut input, &mut blocks.1);
     let expected = run(Backend::Scalar, &raw, &blocks, inv_h2);
     for backend in Backend::available() {
         let actual = run(backend, &raw, &blocks, inv_h2);

@@ -8,7 +8,8 @@ use glam::{Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
     AngularDrive, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointKind,
-    LimitSoftness, RodDesc, RodStiffness, Snapshot, SolverConfig, Swing, SwingTwist, World,
+    LimitSoftness, RodDesc, RodHandle, RodStiffness, Snapshot, SolverConfig, Swing, SwingTwist,
+    World,
 };
 
 use crate::input::Input;
@@ -302,7 +303,7 @@ fn rod(input: &mut Input, state: &mut State) {
     let Some(r) = state.rods[slot].as_mut() else {
         return slots(input, &mut state.rod_slots);
     };
-    match input.pick(14) {
+    match input.pick(16) {
         0 => r.body_a = handle,
         1 => r.body_b = handle,
         2 => quat(input, &mut r.frame_a),
@@ -326,6 +327,8 @@ fn rod(input: &mut Input, state: &mut State) {
         }
         8 => r.bend_limit = limit(input),
         9 => state.rods[slot] = None,
+        13 => vec3(input, &mut r.bend_rest_velocity),
+        14 => r.twist_rest_velocity = value(input),
         _ => slots(input, &mut state.rod_slots),
     }
 }
@@ -399,8 +402,9 @@ fn change(input: &mut Input, state: &mut State) {
     }
 }
 
-/// A small valid world from the input: up to 6 bodies, sockets, rods,
-/// contacts, some steps and removals (refused calls skipped).
+/// A small valid world from the input: up to 6 bodies, sockets, rods (the
+/// first, third, ... with moving rest shapes), contacts, some steps and
+/// removals (refused calls skipped).
 fn build(input: &mut Input) -> World {
     let mut world = World::new(SolverConfig::default()).expect("a valid config");
     let mut seen = Seen::default();
@@ -412,7 +416,13 @@ fn build(input: &mut Input) -> World {
     for _ in 0..input.pick(6) {
         let _ = match input.pick(3) {
             0 => add_joint(&mut world, &seen, input).map(|h| seen.joints.push(h)),
-            1 => add_rod(&mut world, &seen, input).map(|h| seen.rods.push(h)),
+            1 => add_rod(&mut world, &seen, input).and_then(|h| {
+                seen.rods.push(h);
+                match seen.rods.len() % 2 {
+                    1 => moving(&mut world, h),
+                    _ => Ok(()),
+                }
+            }),
             _ => world.step(1.0 / 60.0),
         };
     }
@@ -424,6 +434,13 @@ fn build(input: &mut Input) -> World {
     }
     let _ = set_contacts(&mut world, &seen, input);
     world
+}
+
+/// The rod's rest shape set moving (fixed rates: reading them from the
+/// input would give older corpus files another meaning).
+fn moving(world: &mut World, rod: RodHandle) -> Result<(), vertebra_world::Error> {
+    let desc = world.rod(rod)?;
+    world.set_rod(rod, desc.with_rest_velocity(Vec3::new(0.4, -1.5, 0.9), 2.5))
 }
 
 /// `payload` under `header`'s format and build, with a correct checksum.

@@ -6,7 +6,9 @@
 //!
 //! The soft bend and twist are drives (`parts::rod::drive`): damped
 //! against their error as the substep began ([`StartPass`]), optionally
-//! given by frequency, and capped at a torque.
+//! given by frequency, and capped at a torque. Their rest shape may move:
+//! [`StartPass`] advances it every substep at its rates, as the drives'
+//! start pass advances their targets (`driven.rs`).
 //!
 //! Part order per iteration: soft bend, soft twist, bend limit, twist
 //! limit, curve, length. The hard geometric parts come last so that the arc
@@ -20,7 +22,7 @@ use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
 use crate::parts::angle::Softness;
-use crate::parts::rod::drive::Drive;
+use crate::parts::rod::drive::{self, Drive};
 use crate::parts::rod::{bend, curve, frames, length, twist};
 use crate::residual::{Measured, Residual};
 
@@ -34,12 +36,20 @@ pub struct RodBlock {
     pub frame_a: QuatBlock,
     /// `F_b`: the material frame at b, in b's body frame.
     pub frame_b: QuatBlock,
-    /// Rest bend direction of `t_b`, in a's material frame (unit).
+    /// Rest bend direction of `t_b`, in a's material frame (unit): the
+    /// current substep's ([`StartPass`] advances it).
     pub bend_rest: Vec3Block,
     /// Rest length `l0` (m).
     pub rest_length: [f32; BLOCK_LANES],
-    /// Rest twist (rad).
+    /// Rest twist (rad): the current substep's ([`StartPass`] advances
+    /// it).
     pub twist_rest: [f32; BLOCK_LANES],
+    /// The rest direction's angular velocity (rad/s, a's material frame):
+    /// [`StartPass`] turns `bend_rest` by it every substep.
+    pub bend_rest_velocity: Vec3Block,
+    /// The rest twist's rate (rad/s): [`StartPass`] advances `twist_rest`
+    /// by it every substep.
+    pub twist_rest_velocity: [f32; BLOCK_LANES],
     /// Bending compliance `l0 / k_b` (rad / (N m)).
     pub bend_compliance: [f32; BLOCK_LANES],
     /// Twisting compliance `l0 / k_t` (rad / (N m)).
@@ -144,6 +154,11 @@ pub struct RodLane {
     pub bend_rest: GVec3,
     /// Rest twist (rad).
     pub twist_rest: f32,
+    /// The rest direction's angular velocity (rad/s, a's material frame);
+    /// only its part perpendicular to `bend_rest` moves it.
+    pub bend_rest_velocity: GVec3,
+    /// The rest twist's rate (rad/s).
+    pub twist_rest_velocity: f32,
     /// Bending softness.
     pub bend: RodSoftness,
     /// Twisting softness.
@@ -181,6 +196,8 @@ impl RodBlock {
                 rest_length: 0.0,
                 bend_rest: GVec3::X,
                 twist_rest: 0.0,
+                bend_rest_velocity: GVec3::ZERO,
+                twist_rest_velocity: 0.0,
                 bend: RodSoftness::Relaxation(0.0),
                 twist: RodSoftness::Relaxation(0.0),
                 bend_max: core::f32::consts::PI,
@@ -199,6 +216,8 @@ impl RodBlock {
         self.bend_rest.set(lane, r.bend_rest);
         self.rest_length[lane] = r.rest_length;
         self.twist_rest[lane] = r.twist_rest;
+        self.bend_rest_velocity.set(lane, r.bend_rest_velocity);
+        self.twist_rest_velocity[lane] = r.twist_rest_velocity;
         [
             self.bend_compliance[lane],
             self.bend_relaxation[lane],
@@ -252,27 +271,38 @@ impl LaneKernel for PositionPass<'_> {
     }
 }
 
-/// The soft parts' errors as the substep begins, before the bodies move
-/// (every substep, for the damping's rate: `parts::rod::drive`).
+/// The soft parts' errors as the substep begins, before the bodies move,
+/// against the last substep's rest shape; then the rest shape advanced by
+/// `h` at its rates (every substep, for the damping's rate relative to the
+/// rest's: `parts::rod::drive`, "Moving rest").
 pub struct StartPass<'a> {
     /// The blocks (one colour's, or the overflow set).
     pub blocks: &'a mut [RodBlock],
     /// Body rows, read.
     pub rows: &'a BodyRows,
+    /// The substep (s).
+    pub h: f32,
 }
 
 impl LaneKernel for StartPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
+        let h = L::splat(self.h);
         for block in self.blocks.iter_mut() {
             for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
                 let (a, b) = block.bodies.gather::<L>(self.rows, start);
                 let f = frames(&a, &b, block.frame_a.load(start), block.frame_b.load(start));
-                let bend = bend::start(&f, block.bend_rest.load(start));
-                block.bend_start.store(start, bend);
-                twist::error(&f, L::load(&block.twist_rest[start..]))
-                    .store(&mut block.twist_start[start..]);
+                let bend_rest = block.bend_rest.load(start);
+                block.bend_start.store(start, bend::start(&f, bend_rest));
+                let twist_rest = L::load(&block.twist_rest[start..]);
+                twist::error(&f, twist_rest).store(&mut block.twist_start[start..]);
+                let velocity = block.bend_rest_velocity.load(start);
+                block
+                    .bend_rest
+                    .store(start, drive::advance_direction(bend_rest, velocity, h));
+                let rate = L::load(&block.twist_rest_velocity[start..]);
+                drive::advance_twist(twist_rest, rate, h).store(&mut block.twist_rest[start..]);
             }
         }
     }

@@ -1,7 +1,8 @@
 //! The rod kernel gives the scalar reference's bits on every backend, for
 //! random and adversarial rods: straight, folded back, coincident ends,
 //! huge and tiny stiffness, relaxation and compliance, damped and sprung
-//! parts, torque caps that bind and that do not.
+//! parts, torque caps that bind and that do not, rest shapes still and
+//! moving (slow, fast, along the rest direction, wrapping past pi).
 
 mod common;
 
@@ -51,6 +52,27 @@ fn max_torque(r: &mut StdRng) -> f32 {
     }
 }
 
+/// A rest shape's rates (rad/s): still, moving, or (adversarial) fast,
+/// along the rest direction itself, or a twist that wraps past pi within
+/// a substep.
+fn rest_rates(r: &mut StdRng, bend_rest: Vec3, adversarial: bool) -> (Vec3, f32) {
+    match r.random_range(0..if adversarial { 6 } else { 3 }) {
+        0 => (Vec3::ZERO, 0.0),
+        1 => (
+            Vec3::new(
+                r.random_range(-5.0..5.0),
+                r.random_range(-5.0..5.0),
+                r.random_range(-5.0..5.0),
+            ),
+            r.random_range(-5.0..5.0),
+        ),
+        2 => (Vec3::Z * r.random_range(-2.0..2.0), 0.0),
+        3 => (bend_rest * 3.0, -1e-30),
+        4 => (Vec3::new(0.0, 1e6, -1e6), 1e6),
+        _ => (Vec3::new(1e-30, 0.0, 0.0), 300.0),
+    }
+}
+
 fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>) {
     let mut r = StdRng::seed_from_u64(seed);
     let mut rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
@@ -94,6 +116,14 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>
                 }
             }
             let pi = core::f32::consts::PI;
+            let bend_rest = (Quat::from_rotation_z(r.random_range(0.0..2.0)) * Vec3::X).normalize();
+            let twist_rest = if adversarial && r.random_bool(0.2) {
+                pi - 1e-3
+            } else {
+                r.random_range(-0.5..0.5)
+            };
+            let (bend_rest_velocity, twist_rest_velocity) =
+                rest_rates(&mut r, bend_rest, adversarial);
             block.set(
                 lane,
                 &RodLane {
@@ -108,9 +138,10 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>
                     } else {
                         r.random_range(0.1..2.0)
                     },
-                    bend_rest: (Quat::from_rotation_z(r.random_range(0.0..2.0)) * Vec3::X)
-                        .normalize(),
-                    twist_rest: r.random_range(-0.5..0.5),
+                    bend_rest,
+                    twist_rest,
+                    bend_rest_velocity,
+                    twist_rest_velocity,
                     bend: softness(&mut r),
                     twist: softness(&mut r),
                     bend_max: if r.random_bool(0.7) {
@@ -139,17 +170,23 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>
 fn run(backend: Backend, raw: &RawRows, blocks: &[RodBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
-    backend.dispatch(StartPass {
-        blocks: &mut blocks,
-        rows: &rows,
-    });
-    for _ in 0..4 {
-        backend.dispatch(PositionPass {
+    // Two substeps: the second damps against a start taken after the first
+    // moved the bodies and the rest.
+    for _ in 0..2 {
+        backend.dispatch(StartPass {
             blocks: &mut blocks,
             rows: &rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
+            h: 1.0 / 60.0,
         });
+        blocks.iter_mut().for_each(RodBlock::reset_lambdas);
+        for _ in 0..4 {
+            backend.dispatch(PositionPass {
+                blocks: &mut blocks,
+                rows: &rows,
+                inv_h: 60.0,
+                inv_h2: 3600.0,
+            });
+        }
     }
     let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
@@ -162,8 +199,10 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[RodBlock]) -> Vec<f32> {
         out.extend(b.bend_lambda);
         out.extend(b.twist_lambda);
         out.extend(b.twist_start);
+        out.extend(b.twist_rest);
         for lane in 0..BLOCK_LANES {
             out.extend(b.bend_start.get(lane).to_array());
+            out.extend(b.bend_rest.get(lane).to_array());
         }
     }
     out.extend(residual.iter().flatten());

@@ -2,12 +2,14 @@
 //! (the paper's figure 7 drives "with infinite strength").
 //!
 //! Sockets use their angular drive; the rod is driven through its rest
-//! shape: its rest bend and twist become the target pose's, and its
-//! bending and twisting take the drive's strength, damping and torque
-//! limit (mapped from the sockets it replaces: `rod_stiffness`).
+//! shape: its rest bend and twist become the target pose's (and, following
+//! an animation, move at the rates that reach the next pose's, as a
+//! socket's target moves at its target velocity), and its bending and
+//! twisting take the drive's strength, damping and torque limit (mapped
+//! from the sockets it replaces: `rod_stiffness`).
 
 use glam::{Quat, Vec3};
-use vertebra_world::{AngularDrive, JointKind, RodStiffness, World};
+use vertebra_world::{AngularDrive, JointKind, RodDesc, RodStiffness, World};
 
 use crate::error::RagdollError;
 use crate::pose::Pose;
@@ -156,8 +158,10 @@ fn rod_stiffness(
 }
 
 impl Ragdoll {
-    /// Drives every joint toward `target`. Call it again with each new
-    /// animation pose; it changes drive settings in place.
+    /// Drives every joint toward `target`, held still (every socket's
+    /// target velocity and the rod's rest rates are zero). Call it again
+    /// with each new animation pose; it changes drive settings in place.
+    /// A moving animation is better followed by [`Ragdoll::drive_following`].
     pub fn drive_to(
         &self,
         world: &mut World,
@@ -172,11 +176,12 @@ impl Ragdoll {
     /// Jolt's `DriveToPoseUsingMotors(prev, pose, dt)`. Each joint's target
     /// starts at `prev`'s relative rotation and turns at the angular
     /// velocity that reaches `pose`'s at the step's end
-    /// (`AngularDrive::following`), so a drive follows the animation
-    /// without lagging a frame behind and its damping acts on the motion
-    /// relative to the animation's, not relative to rest. Call it every
-    /// frame with the animation's last two poses. The rod has no target
-    /// velocity: it takes `pose`'s shape (`docs/ragdolls.md`, "Drives").
+    /// (`AngularDrive::following`); the rod's rest shape likewise starts at
+    /// `prev`'s bend and twist and moves at the rates that reach `pose`'s
+    /// (`RodDesc::following`). So every drive follows the animation without
+    /// lagging a frame behind and its damping acts on the motion relative
+    /// to the animation's, not relative to rest. Call it every frame with
+    /// the animation's last two poses (`docs/ragdolls.md`, "Drives").
     pub fn drive_following(
         &self,
         world: &mut World,
@@ -228,23 +233,40 @@ impl Ragdoll {
                 .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
         }
         if let (Some(rod), Some(rest), Some(spine)) = (self.rod, self.rod_rest, &self.desc.spine) {
-            let (base, top) = (
-                target.bones[spine.bodies[0]].1,
-                target.bones[*spine.bodies.last().expect("a chain")].1,
-            );
-            let (f0, f1) = (base * rest.frame_a, top * rest.frame_b);
-            let tb = f1 * Vec3::X;
+            // A pose's rod shape: `t_b` in a's material frame, and the
+            // twist.
+            let shape = |pose: &Pose| {
+                let (base, top) = (
+                    pose.bones[spine.bodies[0]].1,
+                    pose.bones[*spine.bodies.last().expect("a chain")].1,
+                );
+                let (f0, f1) = (base * rest.frame_a, top * rest.frame_b);
+                let tb = f1 * Vec3::X;
+                (
+                    (f0.inverse() * tb).normalize(),
+                    crate::mapping::rod_twist(f0, f1),
+                )
+            };
             let stiffness = rod_stiffness(
                 settings.strength(spine.joints[0]),
                 settings.damping,
                 rest.rest_length,
                 spine.joints.len(),
             );
-            let mut driven = rest
+            let driven = rest
                 .with_stiffness(stiffness, stiffness)
                 .with_max_torque(settings.max_torque);
-            driven.bend_rest = (f0.inverse() * tb).normalize();
-            driven.twist_rest = crate::mapping::rod_twist(f0, f1);
+            let driven = match from {
+                Some((prev, dt)) => driven.following(shape(prev), shape(target), dt),
+                None => {
+                    let (bend_rest, twist_rest) = shape(target);
+                    RodDesc {
+                        bend_rest,
+                        twist_rest,
+                        ..driven.with_rest_velocity(Vec3::ZERO, 0.0)
+                    }
+                }
+            };
             world
                 .set_rod(rod, driven)
                 .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;

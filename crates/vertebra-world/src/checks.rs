@@ -2,10 +2,30 @@
 
 use core::f32::consts::PI;
 
+use glam::Vec3;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error};
+
+use crate::MAX_ANGULAR_SPEED_LIMIT;
 
 use crate::drive::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
 use crate::joint::LimitSoftness;
+
+/// An angular velocity (rad/s): finite (`what` names it) and at most
+/// [`MAX_ANGULAR_SPEED_LIMIT`] long (`out_of_range` says so). Drives'
+/// target velocities and rods' rest velocities.
+pub(crate) fn angular_velocity(
+    v: Vec3,
+    what: &'static str,
+    out_of_range: &'static str,
+) -> Result<(), Error> {
+    if !v.is_finite() {
+        return Err(Error::NonFinite(what));
+    }
+    if v.length() > MAX_ANGULAR_SPEED_LIMIT {
+        return Err(Error::OutOfRange(out_of_range));
+    }
+    Ok(())
+}
 
 /// A largest angle (rad) in [0, pi], if set.
 pub(crate) fn max_angle(limit: Option<f32>, what: &'static str) -> Result<(), Error> {

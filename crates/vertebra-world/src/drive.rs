@@ -9,8 +9,6 @@ use glam::{Quat, Vec3};
 use vertebra_kernels::driven::DriveLane;
 use vertebra_store::{Error, check_unit_quat};
 
-use crate::MAX_ANGULAR_SPEED_LIMIT;
-
 /// The lowest drive frequency (Hz): a period of about 17 minutes. Lower
 /// ones are no drive at all, and `1 / omega^2` would leave `f32`.
 pub const MIN_DRIVE_FREQUENCY: f32 = 1e-3;
@@ -159,14 +157,11 @@ impl AngularDrive {
 /// Checks a drive's target, its velocity, strength and torque limit.
 pub(crate) fn validate_drive(d: &AngularDrive) -> Result<(), Error> {
     check_unit_quat("drive target", d.target)?;
-    if !d.target_velocity.is_finite() {
-        return Err(Error::NonFinite("drive target velocity"));
-    }
-    if d.target_velocity.length() > MAX_ANGULAR_SPEED_LIMIT {
-        return Err(Error::OutOfRange(
-            "drive target velocity (at most MAX_ANGULAR_SPEED_LIMIT)",
-        ));
-    }
+    crate::checks::angular_velocity(
+        d.target_velocity,
+        "drive target velocity",
+        "drive target velocity (at most MAX_ANGULAR_SPEED_LIMIT)",
+    )?;
     match d.strength {
         DriveStrength::Compliance {
             compliance,

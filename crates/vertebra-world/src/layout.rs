@@ -444,6 +444,8 @@ pub(crate) fn rod_lane(desc: &RodDesc, bodies: &BodyStore) -> RodLane {
         rest_length: desc.rest_length,
         bend_rest: desc.bend_rest.normalize(),
         twist_rest: desc.twist_rest,
+        bend_rest_velocity: desc.bend_rest_velocity,
+        twist_rest_velocity: desc.twist_rest_velocity,
         bend: desc.softness(desc.bending),
         twist: desc.softness(desc.twisting),
         bend_max: desc.bend_limit.unwrap_or(PI),

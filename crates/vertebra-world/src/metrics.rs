@@ -1,17 +1,18 @@
 //! What a step reports: residual joint error (the paper's figure 8 metric)
 //! and a hash of the full state.
 
+use glam::{Quat, Vec3};
 use vertebra_kernels::body::BodyRows;
 use vertebra_kernels::residual::{Residual, ResidualPass};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::Colouring;
-use vertebra_store::{BodyStore, Slots};
+use vertebra_store::{BodyHandle, BodyStore, Slots};
 
 use crate::joint::JointHandle;
 use crate::layout::EMPTY;
 use crate::rod::RodHandle;
-use crate::{Contact, JointDesc, RodDesc, World};
+use crate::{Contact, JointDesc, RodDesc, RodStiffness, World};
 
 /// One joint's residual error.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -133,11 +134,69 @@ struct Hashed<'a> {
     joint_slots: &'a Slots,
     joints: &'a [Option<JointDesc>],
     rod_slots: &'a Slots,
-    rods: &'a [Option<RodDesc>],
+    rods: Vec<HashedRod<'a>>,
     /// The solve order.
     colouring: &'a Colouring,
     /// The contacts set for the next step.
     contacts: &'a [Contact],
+}
+
+/// A rod slot as the state hash encodes it. A rod whose rest shape is still
+/// is hashed exactly as before rest shapes could move, so worlds of such
+/// rods keep their state hashes (the golden hashes of
+/// `crates/vertebra-scenes/tests/golden.rs`): postcard encodes an `Option`
+/// as 0 or 1 before the value and an enum as its variant index, so `Free`
+/// and `Still` are the old `None` and `Some(desc)` byte for byte. A moving
+/// rest follows a third tag, with its rates. (Snapshots, whose format
+/// changed, store the description as it is.)
+#[derive(serde::Serialize)]
+enum HashedRod<'a> {
+    Free,
+    Still(StillRod<'a>),
+    Moving(StillRod<'a>, Vec3, f32),
+}
+
+/// A rod's description without its rest shape's rates, field for field in
+/// [`RodDesc`]'s order.
+#[derive(serde::Serialize)]
+struct StillRod<'a> {
+    body_a: BodyHandle,
+    body_b: BodyHandle,
+    frame_a: Quat,
+    frame_b: Quat,
+    rest_length: f32,
+    bend_rest: Vec3,
+    twist_rest: f32,
+    bending: &'a RodStiffness,
+    twisting: &'a RodStiffness,
+    bend_limit: Option<f32>,
+    twist_limit: Option<[f32; 2]>,
+    max_torque: f32,
+}
+
+impl<'a> From<&'a Option<RodDesc>> for HashedRod<'a> {
+    fn from(slot: &'a Option<RodDesc>) -> Self {
+        let Some(d) = slot else { return Self::Free };
+        let still = StillRod {
+            body_a: d.body_a,
+            body_b: d.body_b,
+            frame_a: d.frame_a,
+            frame_b: d.frame_b,
+            rest_length: d.rest_length,
+            bend_rest: d.bend_rest,
+            twist_rest: d.twist_rest,
+            bending: &d.bending,
+            twisting: &d.twisting,
+            bend_limit: d.bend_limit,
+            twist_limit: d.twist_limit,
+            max_torque: d.max_torque,
+        };
+        if d.bend_rest_velocity == Vec3::ZERO && d.twist_rest_velocity == 0.0 {
+            Self::Still(still)
+        } else {
+            Self::Moving(still, d.bend_rest_velocity, d.twist_rest_velocity)
+        }
+    }
 }
 
 /// xxh3 over the bits of [`Hashed`] (postcard: floats as their bits).
@@ -148,7 +207,7 @@ pub(crate) fn state_hash(world: &World) -> u64 {
         joint_slots: &world.joint_slots,
         joints: &world.joints,
         rod_slots: &world.rod_slots,
-        rods: &world.rods,
+        rods: world.rods.iter().map(HashedRod::from).collect(),
         colouring: &world.colouring,
         contacts: &world.contacts,
     };

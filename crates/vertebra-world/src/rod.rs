@@ -70,6 +70,14 @@ pub enum RodStiffness {
 /// The material frames `F_a`, `F_b` are given in the bodies' frames; their
 /// +X axes are the tangents. [`RodDesc::from_pose`] sets everything so that
 /// the rod holds exactly at the bodies' current poses.
+///
+/// The rest shape (`bend_rest`, `twist_rest`) may move at
+/// `bend_rest_velocity` and `twist_rest_velocity`, as a drive's target
+/// moves at its `target_velocity` ([`crate::AngularDrive`]): the world
+/// advances it every substep and writes it back after each step, so
+/// [`World::rod`](crate::World::rod) returns the rest shape as the next
+/// step begins. [`RodDesc::following`] sets both from two animation
+/// shapes.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RodDesc {
     /// The first body (the paper's `x_a`; the hips of a spine).
@@ -86,8 +94,23 @@ pub struct RodDesc {
     /// straight). Its angle from `+X` is the rest bend, its direction the
     /// bend plane.
     pub bend_rest: Vec3,
-    /// Rest twist (rad).
+    /// Rest twist (rad): the twist the soft twisting turns the rod toward,
+    /// as the next step begins.
     pub twist_rest: f32,
+    /// The rest direction's angular velocity (rad/s, in a's material frame,
+    /// as `bend_rest`): substep `k` of a step aims at `bend_rest` turned by
+    /// `k h` at this velocity (about its fixed axis), and the bend's damping
+    /// acts on the bend's rate relative to the rest's. Only its part
+    /// perpendicular to `bend_rest` moves the rest (the part along it turns
+    /// the direction about itself). Zero is a still rest; its length is at
+    /// most [`MAX_ANGULAR_SPEED_LIMIT`](crate::MAX_ANGULAR_SPEED_LIMIT).
+    pub bend_rest_velocity: Vec3,
+    /// The rest twist's rate (rad/s): substep `k` aims at `twist_rest + k h
+    /// twist_rest_velocity` (wrapped to [-pi, pi]), and the twist's damping
+    /// acts on the twist's rate relative to it. Zero is a still rest; at
+    /// most [`MAX_ANGULAR_SPEED_LIMIT`](crate::MAX_ANGULAR_SPEED_LIMIT) in
+    /// size.
+    pub twist_rest_velocity: f32,
     /// Bending stiffness.
     pub bending: RodStiffness,
     /// Twisting stiffness.
@@ -161,6 +184,8 @@ impl RodDesc {
             rest_length,
             bend_rest: (material_a.inverse() * tb).normalize(),
             twist_rest: 0.0,
+            bend_rest_velocity: Vec3::ZERO,
+            twist_rest_velocity: 0.0,
             bending: RodStiffness::Kirchhoff(0.0),
             twisting: RodStiffness::Kirchhoff(0.0),
             bend_limit: None,
@@ -179,6 +204,32 @@ impl RodDesc {
     /// With a torque limit (N m) on the soft bending and twisting.
     pub fn with_max_torque(mut self, max_torque: f32) -> Self {
         self.max_torque = max_torque;
+        self
+    }
+
+    /// With the rest shape moving: the rest direction at `bend` (rad/s, a's
+    /// material frame), the rest twist at `twist` (rad/s).
+    pub fn with_rest_velocity(mut self, bend: Vec3, twist: f32) -> Self {
+        self.bend_rest_velocity = bend;
+        self.twist_rest_velocity = twist;
+        self
+    }
+
+    /// Following an animation (as [`crate::AngularDrive::following`]): the
+    /// rest shape is `prev` (rest direction, unit in a's material frame, and
+    /// rest twist in rad) as the next step begins and moves at constant
+    /// rates to reach `pose` when it ends, `dt` seconds later (the step's
+    /// `dt`): the rest direction along the shortest arc, the twist the short
+    /// way round. Call it every frame with the animation's last two shapes.
+    /// A `dt` of zero or not finite gives rates the world refuses (check it
+    /// first, as `Ragdoll::drive_following` does).
+    pub fn following(mut self, prev: (Vec3, f32), pose: (Vec3, f32), dt: f32) -> Self {
+        let (bend, twist) = prev;
+        let turn = vertebra_math::Quat::<f32>::from(Quat::from_rotation_arc(bend, pose.0));
+        self.bend_rest = bend;
+        self.twist_rest = twist;
+        self.bend_rest_velocity = Vec3::from(turn.to_rotation_vector()) / dt;
+        self.twist_rest_velocity = vertebra_math::poly::wrap_angle(pose.1 - twist) / dt;
         self
     }
 
@@ -209,6 +260,16 @@ impl RodDesc {
         if !self.twist_rest.is_finite() {
             return Err(Error::NonFinite("rod rest twist"));
         }
+        crate::checks::angular_velocity(
+            self.bend_rest_velocity,
+            "rod rest bend velocity",
+            "rod rest bend velocity (at most MAX_ANGULAR_SPEED_LIMIT)",
+        )?;
+        crate::checks::angular_velocity(
+            Vec3::new(self.twist_rest_velocity, 0.0, 0.0),
+            "rod rest twist velocity",
+            "rod rest twist velocity (at most MAX_ANGULAR_SPEED_LIMIT)",
+        )?;
         check_stiffness(self.bending, STIFFNESS_FIELDS[0])?;
         check_stiffness(self.twisting, STIFFNESS_FIELDS[1])?;
         if self.max_torque.is_nan() {

@@ -40,7 +40,7 @@
 //! `Err(IncompatibleSnapshot)` for another build) and the world is
 //! unchanged.
 //!
-//! Bytes: `"VTBSNAP7"` (the format), the build id (u64 LE: a hash of the
+//! Bytes: `"VTBSNAP8"` (the format), the build id (u64 LE: a hash of the
 //! crate version and the format), the xxh3 hash of the payload (u64 LE),
 //! then the payload (postcard).
 
@@ -54,7 +54,9 @@ use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
-const FORMAT: u8 = b'7';
+/// 8: rods' rest shapes gained their rates (`bend_rest_velocity`,
+/// `twist_rest_velocity`).
+const FORMAT: u8 = b'8';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
@@ -323,7 +325,8 @@ mod tests {
                 .with_swing_limit(1.0);
         let rod = RodDesc::from_pose(bodies, links[0], links[1], &[])
             .unwrap()
-            .with_stiffness(RodStiffness::Kirchhoff(5.0), RodStiffness::Relaxation(0.5));
+            .with_stiffness(RodStiffness::Kirchhoff(5.0), RodStiffness::Relaxation(0.5))
+            .with_rest_velocity(Vec3::new(0.0, 0.0, 0.3), -0.2);
         let drive = AngularDrive::spring(Quat::IDENTITY, 4.0, 0.7)
             .with_target_velocity(Vec3::new(0.0, 0.5, 0.0))
             .with_max_torque(30.0);
@@ -402,6 +405,22 @@ mod tests {
             (
                 Box::new(|s| s.rods[0].as_mut().unwrap().max_torque = NAN),
                 "rod 0: rod max torque is not finite",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().bend_rest_velocity.z = NAN),
+                "rod 0: rod rest bend velocity is not finite",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().bend_rest_velocity.x = 2e6),
+                "rod 0: rod rest bend velocity (at most MAX_ANGULAR_SPEED_LIMIT) is out of range",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().twist_rest_velocity = f32::INFINITY),
+                "rod 0: rod rest twist velocity is not finite",
+            ),
+            (
+                Box::new(|s| s.rods[0].as_mut().unwrap().twist_rest_velocity = -2e6),
+                "rod 0: rod rest twist velocity (at most MAX_ANGULAR_SPEED_LIMIT) is out of range",
             ),
             (
                 Box::new(|s| {
@@ -608,6 +627,9 @@ mod tests {
         let good = world.snapshot().as_bytes().to_vec();
         let mut other_format = good.clone();
         other_format[7] = b'1';
+        // The format before rods' rest rates: its rods lack two fields.
+        let mut previous_format = good.clone();
+        previous_format[7] = b'7';
         let mut other_build = good.clone();
         other_build[8] ^= 1;
         let mut trailing = State::decode(&good).unwrap().encode();
@@ -617,6 +639,10 @@ mod tests {
         let cases = [
             (
                 other_format,
+                "incompatible snapshot: another snapshot format",
+            ),
+            (
+                previous_format,
                 "incompatible snapshot: another snapshot format",
             ),
             (

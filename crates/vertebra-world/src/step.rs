@@ -65,6 +65,7 @@ pub(crate) fn step(world: &mut World, dt: f32) {
     }
     commit(world);
     keep_drive_targets(world);
+    keep_rod_rests(world);
     let bodies = &mut world.bodies;
     bodies.force.iter_mut().for_each(|f| *f = Vec3::ZERO);
     bodies.torque.iter_mut().for_each(|t| *t = Vec3::ZERO);
@@ -72,7 +73,8 @@ pub(crate) fn step(world: &mut World, dt: f32) {
 
 /// The drives' substep start, before the bodies move: each drive's error
 /// against the last substep's target, then the target advanced by `h`;
-/// each rod's bend and twist error (its soft parts damp against them);
+/// each rod's bend and twist error (its soft parts damp against them)
+/// against the last substep's rest shape, then the rest advanced by `h`;
 /// each shaped socket's and hinge's limit violations (`limited.rs`: a
 /// damped limit's `C_0`).
 /// Every driven block, one after another, on the world's backend (each
@@ -112,6 +114,7 @@ fn start_drives(world: &mut World, h: f32) {
         world.backend.dispatch(rod::StartPass {
             blocks: &mut layout.rods.blocks[group.rods.clone()],
             rows,
+            h,
         });
     }
 }
@@ -137,6 +140,34 @@ fn keep_drive_targets(world: &mut World) {
             }
             JointKind::Fixed => continue,
         };
+    }
+}
+
+/// Writes each moving rod's advanced rest shape back to its description,
+/// as [`keep_drive_targets`] does for drives, and lays the description out
+/// again: the next step then starts from the description, bit for bit as a
+/// rebuilt layout (a restored snapshot) starts from it. A still rest is
+/// left alone (its description and lane are as they were).
+fn keep_rod_rests(world: &mut World) {
+    let layout = &mut world.layout;
+    for (slot, desc) in world.rods.iter_mut().enumerate() {
+        let Some(desc) = desc.as_mut() else { continue };
+        let (bend, twist) = (
+            desc.bend_rest_velocity != Vec3::ZERO,
+            desc.twist_rest_velocity != 0.0,
+        );
+        if !(bend || twist) {
+            continue;
+        }
+        let (block, lane) = layout.rods.place[slot];
+        let block = &mut layout.rods.blocks[block];
+        if bend {
+            desc.bend_rest = block.bend_rest.get(lane);
+        }
+        if twist {
+            desc.twist_rest = block.twist_rest[lane];
+        }
+        block.set(lane, &crate::layout::rod_lane(desc, &world.bodies));
     }
 }
 

@@ -555,6 +555,67 @@ fn bad_rods_are_refused() {
     );
 }
 
+/// A rod's rest rates: finite and at most `MAX_ANGULAR_SPEED_LIMIT`, each
+/// refusal (by `add_rod` and by `set_rod`) naming the field and leaving the
+/// world, a moving rod in it included, as it was.
+#[test]
+fn bad_rest_rates_are_refused_by_name_and_change_nothing() {
+    use vertebra_world::{MAX_ANGULAR_SPEED_LIMIT, RodDesc, RodStiffness};
+    let (mut w, _, b, _) = world();
+    let c = w
+        .add_body(BodyDesc::dynamic(unit_mass()).with_position(Vec3::new(0.0, 0.5, 0.0)))
+        .unwrap();
+    let spring = RodStiffness::Spring {
+        frequency: 2.0,
+        damping_ratio: 1.0,
+    };
+    let rod = RodDesc::from_pose(w.bodies(), b, c, &[])
+        .unwrap()
+        .with_stiffness(spring, spring)
+        .with_rest_velocity(Vec3::Z, 0.5);
+    let handle = w.add_rod(rod).unwrap();
+    w.step(1.0 / 60.0).unwrap();
+    let fast = MAX_ANGULAR_SPEED_LIMIT * 1.01;
+    let bend = |v: Vec3| rod.with_rest_velocity(v, 0.0);
+    let twist = |v: f32| rod.with_rest_velocity(Vec3::ZERO, v);
+    let cases = [
+        (
+            bend(Vec3::new(0.0, f32::NAN, 0.0)),
+            Error::NonFinite("rod rest bend velocity"),
+        ),
+        (
+            bend(Vec3::new(f32::INFINITY, 0.0, 0.0)),
+            Error::NonFinite("rod rest bend velocity"),
+        ),
+        (
+            bend(Vec3::new(0.0, fast, 0.0)),
+            Error::OutOfRange("rod rest bend velocity (at most MAX_ANGULAR_SPEED_LIMIT)"),
+        ),
+        (twist(f32::NAN), Error::NonFinite("rod rest twist velocity")),
+        (
+            twist(f32::NEG_INFINITY),
+            Error::NonFinite("rod rest twist velocity"),
+        ),
+        (
+            twist(-fast),
+            Error::OutOfRange("rod rest twist velocity (at most MAX_ANGULAR_SPEED_LIMIT)"),
+        ),
+    ];
+    for (desc, error) in cases {
+        let before = (w.snapshot(), w.state_hash());
+        assert_eq!(w.set_rod(handle, desc), Err(error.clone()));
+        assert_eq!(w.add_rod(desc).err(), Some(error));
+        assert_eq!((w.snapshot(), w.state_hash()), before);
+    }
+    let limit = Vec3::new(0.6, 0.0, 0.8) * MAX_ANGULAR_SPEED_LIMIT;
+    w.set_rod(
+        handle,
+        rod.with_rest_velocity(limit, -MAX_ANGULAR_SPEED_LIMIT),
+    )
+    .unwrap();
+    w.step(1.0 / 60.0).unwrap();
+}
+
 #[test]
 fn a_body_with_a_rod_cannot_be_removed_until_the_rod_is() {
     use vertebra_world::RodDesc;

@@ -98,6 +98,16 @@ fn every_piece_of_state_a_step_reads_changes_the_hash() {
                 .set_rod(s.rod, rod.with_stiffness(stiff, stiff))
                 .unwrap();
         }),
+        ("rod rest bend velocity", |s| {
+            let rod = s.world.rod(s.rod).unwrap();
+            let moving = rod.with_rest_velocity(Vec3::Z * 0.1, 0.0);
+            s.world.set_rod(s.rod, moving).unwrap();
+        }),
+        ("rod rest twist velocity", |s| {
+            let rod = s.world.rod(s.rod).unwrap();
+            let moving = rod.with_rest_velocity(Vec3::ZERO, -0.1);
+            s.world.set_rod(s.rod, moving).unwrap();
+        }),
         ("pending contacts", |s| {
             let contact = Contact {
                 body_a: s.ground,

@@ -114,14 +114,26 @@ pub fn start<L: Lane>(
     measure(a, b, frame_a, frame_b, target).scale(enabled)
 }
 
+/// The turn `exp(velocity h)` that `h` seconds at `velocity` (rad/s) make,
+/// and where it moves anything at all (a nonzero speed): what every moving
+/// target advances by, the drives' here and the rod's rest shape
+/// (`parts::rod::drive::advance_direction`).
+#[inline(always)]
+pub fn turn<L: Lane>(velocity: Vec3<L>, h: L) -> (Quat<L>, L::Mask) {
+    let (axis, speed) = velocity.normalize_or_zero();
+    (
+        Quat::from_axis_angle(axis, speed * h),
+        speed.gt(L::splat(0.0)),
+    )
+}
+
 /// The target advanced by `h` seconds at `velocity` (rad/s, a's joint
 /// frame): `exp(velocity h) T`, renormalised. A still target is returned
 /// as it is, bit for bit.
 #[inline(always)]
 pub fn advance<L: Lane>(target: Quat<L>, velocity: Vec3<L>, h: L) -> Quat<L> {
-    let (axis, speed) = velocity.normalize_or_zero();
-    let turned = (Quat::from_axis_angle(axis, speed * h) * target).normalize();
-    Quat::select(speed.gt(L::splat(0.0)), turned, target)
+    let (turn, moving) = turn(velocity, h);
+    Quat::select(moving, (turn * target).normalize(), target)
 }
 
 /// One XPBD iteration of the drive; returns the new accumulated `lambda`

@@ -10,8 +10,9 @@
 //!
 //! with `w = n_a^T I_a^-1 n_a + n_b^T I_b^-1 n_b` (the angle part's),
 //! `alpha~ = K^-1 / h^2`, `gamma = K^-1 D / h`, and `C_0` the error as the
-//! substep began (measured by the rod's `StartPass`), so that
-//! `(C - C_0) / h` is the error's rate. The bend's `C` is an angle about an
+//! substep began (measured by the rod's `StartPass`, against the rest the
+//! previous substep aimed at: see "Moving rest"), so that `(C - C_0) / h`
+//! is the error's rate. The bend's `C` is an angle about an
 //! axis `n` that turns as the bend does (it flips when `t_b` passes through
 //! its rest direction), so its start is kept as the rotation vector
 //! `C_0 n_0` and read along the current axis: `C_0 = (C_0 n_0) . n`. The
@@ -19,6 +20,36 @@
 //! rod with stiffness `k` and damping `d` (N m^2 s: the torque is
 //! `(d / l0) dC/dt`, as the stiffness gives `(k / l0) C`) has
 //! `K^-1 = l0 / k` and `gamma h = d / k`.
+//!
+//! Moving rest. The rest shape may move (a rod following an animation):
+//! the rest direction turns at `w_r` (rad/s, a's material frame) and the
+//! rest twist advances at `v_t` (rad/s). The damping is then to act on the
+//! error's rate relative to the rest's, so that a rod moving with its rest
+//! is not held back. With `C_0` the error at the substep's start measured
+//! against this substep's rest, the bodies change the error by `C - C_0`
+//! and the rest by `-h r`, `r` the rate at which the rest moves along the
+//! error: for the twist (`C = tau - tau_rest`) `r = v_t`; for the bend,
+//! turning `d` by `x` about `n` shrinks `C` by `x`, so `r = (F(0) w_r) . n`,
+//! the rest direction's angular velocity read along the current bend axis
+//! (its part along `d` turns `d` about itself, and its part along `n x d`
+//! moves `d` out of the bend plane: neither changes `C` to first order).
+//! The damping term is therefore
+//!
+//! `gamma (C - C_0 - h r)`.
+//!
+//! The rod's `StartPass` gives it without a rate in the iterations, as the
+//! socket's drive does for its moving target (`parts::drive`, "Moving
+//! target"): it measures the start error against the previous substep's
+//! rest, then advances the rest by `h` ([`advance_direction`],
+//! [`advance_twist`]). Against the previous rest the start error is
+//! `C_0^- = C_0 + h r`: exactly for the twist (`tau_0 - (tau_rest - h v_t)`,
+//! up to the wrap, which the rate's own wrap undoes), and to first order in
+//! `h` for the bend (`d` turned back by `h w_r` lengthens the angle by
+//! `h r`; the rest is in the bend's start rotation vector `C_0^- n_0`,
+//! which is read along the current axis). So the kernel's
+//! `gamma (C - C_0^-)` is `gamma (C - C_0 - h r)`. A still rest (zero
+//! rates) is not advanced (a select keeps its bits), `C_0^- = C_0`, and
+//! every rod computes as before, bit for bit.
 //!
 //! Spring. A frequency `f` and damping ratio `zeta` on the part's effective
 //! inertia `J` (`omega = 2 pi f`): `K = J omega^2`, `D = 2 zeta omega J`, so
@@ -61,7 +92,7 @@
 //! takes the angle part's correction bit for bit (`parts::angle`): the
 //! undriven rods of the golden scenes are unchanged.
 
-use vertebra_math::{Lane, Vec3};
+use vertebra_math::{Lane, Vec3, poly};
 
 use crate::body::{BodyLanes, safe_ratio};
 use crate::parts::angle::Softness;
@@ -91,6 +122,27 @@ pub fn bend_weight<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, n: Vec3<L>, rest
         (ua + ub) * v + ua * ub * l2,
         v + (ua + ub) * l2 * L::splat(0.25),
     )
+}
+
+/// The rest direction `rest` (unit, a's material frame) advanced by `h`
+/// seconds at `velocity` (rad/s, the same frame): turned by the drives'
+/// [`turn`](crate::parts::drive::turn) and renormalised. Only the part of
+/// `velocity` perpendicular to `rest` moves it. A still rest is returned
+/// as it is, bit for bit.
+#[inline(always)]
+pub fn advance_direction<L: Lane>(rest: Vec3<L>, velocity: Vec3<L>, h: L) -> Vec3<L> {
+    let (turn, moving) = crate::parts::drive::turn(velocity, h);
+    let (turned, _) = turn.rotate(rest).normalize_or_zero();
+    Vec3::select(moving, turned, rest)
+}
+
+/// The rest twist `rest` (rad) advanced by `h` seconds at `rate` (rad/s),
+/// wrapped to [-pi, pi]. A still rest is returned as it is, bit for bit
+/// (not wrapped).
+#[inline(always)]
+pub fn advance_twist<L: Lane>(rest: L, rate: L, h: L) -> L {
+    let advanced = poly::wrap_angle(rest + rate * h);
+    L::select(rate.ne(L::splat(0.0)), advanced, rest)
 }
 
 /// One damped, sprung, capped correction of the angle `c` (axes as in
