@@ -204,16 +204,6 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
             .solve(start, a, b, frame_a, frame_b, inv_h, inv_h2);
     }
 
-    // Far off (past 45 degrees) the axes are first turned back globally
-    // along `t_a x t_b`, so the 2-row step below only sees a well-posed `K`
-    // and the aligned zero (see `parts::hinge_axis`).
-    swing::solve(
-        &mut a,
-        &mut b,
-        frame_a,
-        frame_b,
-        L::splat(hinge_axis::NEWTON_CONE),
-    );
     hinge_axis::solve(&mut a, &mut b, frame_a, frame_b);
     let (lo, hi) = (
         L::load(&block.range_min[start..]),
