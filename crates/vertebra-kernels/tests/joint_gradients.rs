@@ -1,14 +1,16 @@
 //! Every gradient the joint kinds' parts use (the shaped swing limits, the
 //! hinge axis, the lock), against central finite differences of the part's
 //! own measurement at random configurations; the hinge axis part's
-//! one-step alignment; and the ellipse's nearest point against its
-//! defining conditions.
+//! one-step alignment and the hinge range measured in the bodies' frames;
+//! and the ellipse's nearest point against its defining conditions.
 
 use glam::{Quat as GQuat, Vec3 as GVec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::BodyLanes;
-use vertebra_kernels::parts::{ellipse, frames, hinge_axis, lock, pyramid, swing, swing_direction};
+use vertebra_kernels::parts::{
+    ellipse, frames, hinge_axis, lock, pyramid, swing, swing_direction, twist,
+};
 use vertebra_math::{Quat, Sym3, Vec3};
 
 fn body(q: GQuat) -> BodyLanes<f32> {
@@ -167,9 +169,19 @@ fn hinge_axis_rows_match_finite_differences() {
     let mut checked = 0;
     for _ in 0..300 {
         let (a, b, fa, fb) = configuration(&mut r, 3.1);
-        let ([n, m], sin, _) = hinge_axis::measure(&a, &b, fa, fb);
-        if sin < 0.05 {
+        let rows = hinge_axis::measure(&a, &b, fa, fb);
+        if rows.sin < 0.05 {
             continue; // theta = |u| has no gradient at 0
+        }
+        // The rows are measured in each body's frame: the same world vectors.
+        let [n, m] = rows.a.map(|row| a.q.rotate(row));
+        for (in_a, in_b) in [n, m].into_iter().zip(rows.b.map(|row| b.q.rotate(row))) {
+            check(
+                "hinge axis row in b's frame",
+                in_a.into(),
+                in_b.into(),
+                1e-5,
+            );
         }
         let theta = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| swing::measure(a, b, fa, fb).1;
         check(
@@ -205,6 +217,33 @@ fn hinge_axis_rows_match_finite_differences() {
         checked += 1;
     }
     assert!(checked > 250, "only {checked} configurations off alignment");
+}
+
+/// The hinge's range measured in the bodies' own frames is the twist
+/// part's angle, about the same axis `t_b`.
+#[test]
+fn the_twist_measured_in_the_bodies_frames_is_the_twist() {
+    let mut r = StdRng::seed_from_u64(18);
+    for _ in 0..300 {
+        let (a, b, fa, fb) = configuration(&mut r, 3.0);
+        let (tb, phi) = twist::measure(&a, &b, fa, fb);
+        let ([in_a, in_b], local) = twist::measure_local(&a, &b, fa, fb);
+        if phi.abs() < 3.1 {
+            assert!((local - phi).abs() < 1e-5, "twist {local} against {phi}");
+        }
+        check(
+            "twist axis in a's frame",
+            a.q.rotate(in_a).into(),
+            tb.into(),
+            1e-5,
+        );
+        check(
+            "twist axis in b's frame",
+            b.q.rotate(in_b).into(),
+            tb.into(),
+            1e-5,
+        );
+    }
 }
 
 /// The angle between the frames' +X axes (rad), in double precision.

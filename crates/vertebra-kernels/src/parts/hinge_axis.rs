@@ -54,31 +54,53 @@
 //! undefined: `u = 0` gives no correction (an unstable equilibrium no
 //! other pose heads for).
 //!
-//! `K` is formed in each body's own frame (`j^T I^-1 j = (R^T j)^T S
-//! (R^T j)`), which also gives each body's turn `R S (R^T j)` without a
-//! second rotation into it; `dlambda` comes from `k22 / det` and
-//! `k12 / det`, which stay bounded as `|m| = |s|` vanishes near 180
-//! degrees (`k22` and `det` shrink together). A singular `K` (no dynamic
-//! body) gives no correction.
+//! The rows are measured in each body's own frame: in a's, `t_a = F_a x`
+//! and `t_b = (q_a* q_b F_b) x` (b's orientation relative to a, one
+//! quaternion product), then `n` and `m` there, turned into b's frame by
+//! the same relative rotation. `K` is formed from them
+//! (`j^T I^-1 j = (R^T j)^T S (R^T j)`), which also gives each body's turn
+//! `R S (R^T j)` with one rotation out of it (`angle::apply_local`);
+//! `dlambda` comes from `k22 / det` and `k12 / det`, which stay bounded as
+//! `|m| = |s|` vanishes near 180 degrees (`k22` and `det` shrink
+//! together). A singular `K` (no dynamic body) gives no correction.
 
 use vertebra_math::{Lane, Quat, Vec3};
 
-use super::swing;
+use super::{angle, swing};
 use crate::body::{BodyLanes, safe_ratio};
 
-/// The rows `[n, m]` (the gradients for b), `sin theta = |t_a x t_b|` and
-/// `d = 1 + cos theta`.
+/// The part's measurement: its rows in each body's frame, and the angle.
+#[derive(Clone, Copy, Debug)]
+pub struct Rows<L> {
+    /// `[n, m]` in a's body frame (`R_a^T n`, `R_a^T m`).
+    pub a: [Vec3<L>; 2],
+    /// `[n, m]` in b's body frame.
+    pub b: [Vec3<L>; 2],
+    /// `sin theta = |t_a x t_b|`.
+    pub sin: L,
+    /// `d = 1 + cos theta = |t_a + t_b|^2 / 2`.
+    pub d: L,
+}
+
+/// The rows (the gradients for b, in each body's frame) and the angle.
 #[inline(always)]
 pub fn measure<L: Lane>(
     a: &BodyLanes<L>,
     b: &BodyLanes<L>,
     frame_a: Quat<L>,
     frame_b: Quat<L>,
-) -> ([Vec3<L>; 2], L, L) {
-    let f = super::frames(a, b, frame_a, frame_b);
-    let (n, sin) = swing::axis(&f);
-    let s = f.ta + f.tb;
-    ([n, n.cross(s)], sin, s.dot(s) * L::splat(0.5))
+) -> Rows<L> {
+    let relative = a.q.conjugate() * b.q;
+    let (ta, tb) = (super::axis_x(frame_a), super::axis_x(relative * frame_b));
+    let (n, sin) = swing::axis(ta, tb);
+    let s = ta + tb;
+    let m = n.cross(s);
+    Rows {
+        a: [n, m],
+        b: [relative.inverse_rotate(n), relative.inverse_rotate(m)],
+        sin,
+        d: s.dot(s) * L::splat(0.5),
+    }
 }
 
 /// Aligns the axes; returns `sin theta` before the correction.
@@ -89,9 +111,12 @@ pub fn solve<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> L {
-    let ([n, m], sin, d) = measure(a, b, frame_a, frame_b);
-    let (ja1, ja2) = (a.q.inverse_rotate(n), a.q.inverse_rotate(m));
-    let (jb1, jb2) = (b.q.inverse_rotate(n), b.q.inverse_rotate(m));
+    let Rows {
+        a: [ja1, ja2],
+        b: [jb1, jb2],
+        sin,
+        d,
+    } = measure(a, b, frame_a, frame_b);
     let (sa1, sa2) = (a.inv_inertia.mul_vec(ja1), a.inv_inertia.mul_vec(ja2));
     let (sb1, sb2) = (b.inv_inertia.mul_vec(jb1), b.inv_inertia.mul_vec(jb2));
     let (kb11, kb12) = (jb1.dot(sb1), jb2.dot(sb1));
@@ -107,7 +132,11 @@ pub fn solve<L: Lane>(
     let e = safe_ratio(four * sin, d + (d * d + four * p * (sin * sin)).sqrt());
     // dlambda = -K^-1 (E, 0).
     let (l1, l2) = (-e * r22, e * r12);
-    b.rotate(b.q.rotate(sb1.scale(l1) + sb2.scale(l2)));
-    a.rotate(-a.q.rotate(sa1.scale(l1) + sa2.scale(l2)));
+    angle::apply_local(
+        a,
+        b,
+        sa1.scale(l1) + sa2.scale(l2),
+        sb1.scale(l1) + sb2.scale(l2),
+    );
     sin
 }
