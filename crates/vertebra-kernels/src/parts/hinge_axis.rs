@@ -1,6 +1,6 @@
 //! Hinge axis part: the two joint frames' +X axes held together (2
-//! degrees of freedom, hard, solved together), globally: one step from any
-//! misalignment below 180 degrees, exact when one body is dynamic.
+//! degrees of freedom, hard, solved together), globally: from any
+//! misalignment below 180 degrees, in one step when one body is dynamic.
 //!
 //! With `t_a = q_a F_a x`, `t_b = q_b F_b x` (unit), `u = t_a x t_b`
 //! (`|u| = sin theta`) and `s = t_a + t_b` (`|s|^2 = 2 (1 + cos theta)`),
@@ -36,8 +36,8 @@
 //! in one step, whatever the inertia's anisotropy and the angle.
 //!
 //! Two dynamic bodies each turn by their own Gibbs vector, and Gibbs
-//! vectors do not add. When both turn about `n` (isotropic inertias, or
-//! any split symmetric about the plane), b by the share `f_b` of the
+//! vectors do not add. When both turn about `n` (`n` a principal axis of
+//! both inverse inertias: isotropic ones, say), b by the share `f_b` of the
 //! correction along `n` (`f_b = (K_b K^-1)_11`, `K_b = J I_b^-1 J^T`) and
 //! a by `f_a = 1 - f_b`, the Gibbs magnitudes `x_b = f_b E / 2`,
 //! `x_a = f_a E / 2` turn by `2 atan(x_a) + 2 atan(x_b) = theta` when
@@ -47,7 +47,7 @@
 //! `d = 1 + cos theta = |s|^2 / 2` (accurate at both ends, unlike
 //! `1 + t_a . t_b`), `E = 4 |u| / (d + sqrt(d^2 + 4 p |u|^2))`: `2 T` for
 //! one dynamic body (`p = 0`), `4 tan(theta / 4)` for equal shares, and
-//! `theta` to second order near alignment. Bodies turning about different
+//! `theta + O(theta^3)` near alignment. Bodies turning about different
 //! axes (anisotropic inertias on both sides) are not exact in one step
 //! but come back from any angle below 180 degrees in a few (where `f_b`
 //! leaves [0, 1], `p` is held at 0). Exactly antiparallel axes leave `n`
