@@ -20,8 +20,10 @@ use vertebra_math::block::BLOCK_LANES;
 const STATICS: usize = 4;
 
 /// One random joint's bodies, anchors and frames; `adversarial` mixes in
-/// anchors that coincide, frames equal or turned by exactly pi about +Y
-/// (antiparallel axes), and zero anchors.
+/// anchors that coincide, frames equal, turned about +Y by exactly pi
+/// (antiparallel axes: exactly so where the orientations and a's frame are
+/// the identity), by pi as `f32` rounds it, by 179.9 degrees, by 90
+/// degrees or within 0.1 degree of it, and zero anchors.
 struct Joint {
     body_a: u32,
     body_b: u32,
@@ -52,12 +54,18 @@ fn joint(r: &mut StdRng, rows: &RawRows, lane: usize, adversarial: bool) -> Join
             Quat::from_slice(&pose(body_b)[4..]),
         );
         j.anchor_b = qb.inverse() * (pa + qa * j.anchor_a - pb);
-        let flip = if r.random_bool(0.5) {
-            Quat::from_rotation_y(core::f32::consts::PI)
-        } else {
-            Quat::IDENTITY
+        let turn = match r.random_range(0..6) {
+            0 => Quat::IDENTITY,
+            1 => Quat::from_xyzw(0.0, 1.0, 0.0, 0.0),
+            2 => Quat::from_rotation_y(core::f32::consts::PI),
+            3 => Quat::from_rotation_y(179.9f32.to_radians()),
+            4 => Quat::from_rotation_y(core::f32::consts::FRAC_PI_2),
+            _ => Quat::from_rotation_y(r.random_range(89.9f32..90.1).to_radians()),
         };
-        j.frame_b = qb.inverse() * qa * j.frame_a * flip;
+        if r.random_bool(0.3) {
+            j.frame_a = Quat::IDENTITY;
+        }
+        j.frame_b = qb.inverse() * qa * j.frame_a * turn;
     }
     if adversarial && r.random_bool(0.1) {
         (j.anchor_a, j.anchor_b) = (Vec3::ZERO, Vec3::ZERO);
@@ -74,9 +82,29 @@ fn compliance(r: &mut StdRng) -> f32 {
     }
 }
 
+/// Adversarial inertia on dynamic bodies: none (a body that only
+/// translates) or about one axis only (a singular hinge axis `K` when both
+/// sides are so).
+fn degenerate_inertia(r: &mut StdRng, rows: &mut RawRows) {
+    for row in rows.iter_mut().skip(1) {
+        if row[0][3] > 0.0 && r.random_bool(0.15) {
+            let axis = vec(r, 1.0).normalize_or(Vec3::X);
+            let inertia = if r.random_bool(0.5) {
+                glam::Mat3::ZERO
+            } else {
+                glam::Mat3::from_cols(axis * axis.x, axis * axis.y, axis * axis.z) * 3.0
+            };
+            row[1] = vertebra_kernels::body::BodyRows::inertia_row(inertia);
+        }
+    }
+}
+
 fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlock>) {
     let mut r = StdRng::seed_from_u64(seed);
-    let rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
+    let mut rows = rows(&mut r, blocks * BLOCK_LANES, STATICS, adversarial);
+    if adversarial {
+        degenerate_inertia(&mut r, &mut rows);
+    }
     let mut out = Vec::new();
     for block_index in 0..blocks {
         let mut block = HingeBlock::padding();
@@ -84,7 +112,15 @@ fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlo
             if r.random_bool(0.1) {
                 continue; // a padding lane
             }
-            let j = joint(&mut r, &rows, block_index * BLOCK_LANES + lane, adversarial);
+            let mut j = joint(&mut r, &rows, block_index * BLOCK_LANES + lane, adversarial);
+            if adversarial && r.random_bool(0.05) {
+                // Exactly antiparallel axes: both bodies unturned, a's frame
+                // the identity, b's turned by exactly pi about +Y.
+                for body in [j.body_a, j.body_b] {
+                    rows[body as usize][0][4..].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
+                }
+                (j.frame_a, j.frame_b) = (Quat::IDENTITY, Quat::from_xyzw(0.0, 1.0, 0.0, 0.0));
+            }
             let pi = core::f32::consts::PI;
             let range = match r.random_range(0..3) {
                 0 => [-pi, pi],

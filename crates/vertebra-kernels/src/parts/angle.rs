@@ -89,3 +89,19 @@ pub fn apply<L: Lane>(
     b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
     a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
 }
+
+/// Turns `b` by `R_b turn_b` and `a` by `-R_a turn_a`, each turn given in
+/// its body's own frame (`turn = S n dlambda` with the body-frame inverse
+/// inertia `S` and axis `n = R^T n_world`: the parts that measure in the
+/// bodies' frames form `w = n^T S n` from the same `S n`, and need no
+/// rotation into the body).
+#[inline(always)]
+pub fn apply_local<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    turn_a: Vec3<L>,
+    turn_b: Vec3<L>,
+) {
+    b.rotate(b.q.rotate(turn_b));
+    a.rotate(-a.q.rotate(turn_a));
+}

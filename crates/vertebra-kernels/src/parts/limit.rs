@@ -80,10 +80,37 @@ pub fn solve<L: Lane>(
     soft: Softness<L>,
     lambda: L,
 ) -> L {
+    let w = a.angular_weight(n) + b.angular_weight(n);
+    let dlambda = step(w, (c, c0), soft, lambda);
+    angle::apply(a, b, n, n, dlambda);
+    lambda + dlambda
+}
+
+/// As [`solve`], with the axis given in each body's own frame, `[R_a^T n,
+/// R_b^T n]` (as the hinge measures its range): `w` and the turns come
+/// from the same body-frame `S n` ([`angle::apply_local`]).
+#[inline(always)]
+pub fn solve_local<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    [n_a, n_b]: [Vec3<L>; 2],
+    (c, c0): (L, L),
+    soft: Softness<L>,
+    lambda: L,
+) -> L {
+    let (s_a, s_b) = (a.inv_inertia.mul_vec(n_a), b.inv_inertia.mul_vec(n_b));
+    let dlambda = step(n_a.dot(s_a) + n_b.dot(s_b), (c, c0), soft, lambda);
+    angle::apply_local(a, b, s_a.scale(dlambda), s_b.scale(dlambda));
+    lambda + dlambda
+}
+
+/// `dlambda` for the generalised inverse mass `w` (the module
+/// documentation's step).
+#[inline(always)]
+fn step<L: Lane>(w: L, (c, c0): (L, L), soft: Softness<L>, lambda: L) -> L {
     let zero = L::splat(0.0);
     let active = c.gt(zero);
     let held = L::select(active, lambda, zero);
-    let w = a.angular_weight(n) + b.angular_weight(n);
     // Hard and compliance-only lanes: the angle part's expression, bit for
     // bit.
     let plain = (
@@ -97,10 +124,8 @@ pub fn solve<L: Lane>(
         w * (L::splat(1.0) + soft.gamma) + alpha,
     );
     let damped = (soft.spring + soft.gamma).gt(zero);
-    let dlambda = safe_ratio(
+    safe_ratio(
         L::select(damped, sprung.0, plain.0),
         L::select(damped, sprung.1, plain.1),
-    );
-    angle::apply(a, b, n, n, dlambda);
-    lambda + dlambda
+    )
 }

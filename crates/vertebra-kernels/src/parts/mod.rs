@@ -63,3 +63,16 @@ pub fn frames<L: Lane>(
         tb: fb.rotate(x),
     }
 }
+
+/// `q x`: the unit quaternion's rotation of +X, its matrix's first column
+/// (fewer operations than [`Quat::rotate`], and other roundings). The
+/// hinge's parts measure in the bodies' own frames with it.
+#[inline(always)]
+pub fn axis_x<L: Lane>(q: Quat<L>) -> Vec3<L> {
+    let (one, two) = (L::splat(1.0), L::splat(2.0));
+    Vec3::new(
+        one - two * (q.y * q.y + q.z * q.z),
+        two * (q.x * q.y + q.w * q.z),
+        two * (q.x * q.z - q.w * q.y),
+    )
+}

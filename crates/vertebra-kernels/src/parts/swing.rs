@@ -22,8 +22,17 @@ pub fn measure<L: Lane>(
     frame_b: Quat<L>,
 ) -> (Vec3<L>, L) {
     let f = super::frames(a, b, frame_a, frame_b);
-    let (n, sin) = f.ta.cross(f.tb).normalize_or_zero();
+    let (n, sin) = axis(f.ta, f.tb);
     (n, poly::atan2(sin, f.ta.dot(f.tb)))
+}
+
+/// The swing axis `n = (t_a x t_b) / |t_a x t_b|` (unit, or zero when the
+/// axes are parallel or antiparallel) and `|t_a x t_b| = sin theta`, in
+/// whatever frame `t_a` and `t_b` are given (the hinge axis part,
+/// `hinge_axis.rs`, turns about the same `n`, measured in a's frame).
+#[inline(always)]
+pub fn axis<L: Lane>(ta: Vec3<L>, tb: Vec3<L>) -> (Vec3<L>, L) {
+    ta.cross(tb).normalize_or_zero()
 }
 
 /// How far the swing exceeds `max_angle` (rad, >= 0).
