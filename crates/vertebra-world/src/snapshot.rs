@@ -167,14 +167,18 @@ impl State {
                 joints_at[h.index()] += 1;
             }
         };
+        // A joint's bodies may both be kinematic now (made so after it was
+        // added), never both static.
         let live = joints("joint", &self.joint_slots, &self.joints, |d| {
-            d.validate_with(bodies)
+            d.validate()?;
+            checks::joined_bodies(bodies, d.body_a, d.body_b).map(drop)
         })?;
         for (slot, d) in live {
             joint(slot as u64, d.body_a, d.body_b);
         }
         let rods = joints("rod", &self.rod_slots, &self.rods, |d| {
-            d.validate_with(bodies)
+            d.validate()?;
+            checks::joined_bodies(bodies, d.body_a, d.body_b).map(drop)
         })?;
         for (slot, d) in rods {
             joint(slot as u64 + ROD_KEY, d.body_a, d.body_b);
@@ -288,8 +292,8 @@ mod tests {
 
     use super::*;
     use crate::{
-        AngularDrive, BodyDesc, JointKind, LimitSoftness, RodStiffness, Shape, SolverConfig, Swing,
-        SwingTwist,
+        AngularDrive, BodyDesc, BodyKind, JointKind, LimitSoftness, RodStiffness, Shape,
+        SolverConfig, Swing, SwingTwist,
     };
 
     #[test]
@@ -414,19 +418,25 @@ mod tests {
             ),
             (
                 Box::new(|s| s.bodies.inverse_mass[1] = NAN),
-                "body 1: inverse mass is not 1/mass",
+                "body 1: inverse mass is not 1/mass (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.inverse_mass[2] *= 2.0),
-                "body 2: inverse mass is not 1/mass",
+                "body 2: inverse mass is not 1/mass (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.inverse_inertia[3].x_axis.x = 1e30),
-                "body 3: inverse inertia is not the inertia's inverse",
+                "body 3: inverse inertia is not the inertia's inverse (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.mass[0] = 1.0),
-                "body 0: mass of an infinite-mass body is not zero",
+                "body 0: mass of a static body is not zero",
+            ),
+            (
+                // Made kinematic without World::set_body_kind: its inverse
+                // mass is still a dynamic body's.
+                Box::new(|s| s.bodies.kind[2] = BodyKind::Kinematic),
+                "body 2: inverse mass is not 1/mass (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.position[3].y = 2e6),
