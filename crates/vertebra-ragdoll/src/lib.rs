@@ -44,6 +44,7 @@ mod error;
 mod joint_def;
 mod mapping;
 mod motion;
+mod partial;
 mod pose;
 mod ragdoll;
 mod skeleton;
