@@ -33,7 +33,9 @@
 //! payload that passes it. Restoring decodes and validates the whole state
 //! before anything is assigned, with the checks the API applies to the same
 //! values (bodies as [`BodyStore::validate`], joints and contacts by their
-//! `validate`, with their bodies live and the right lineage) and structural
+//! `validate`, with their bodies live and the right lineage; a joint's
+//! bodies may both be kinematic, after `World::set_body_kind`, never both
+//! static) and structural
 //! ones (slot tables, array lengths, each body's joint count, the colouring
 //! as [`Colouring::validate`]). A refused snapshot gets
 //! `Err(CorruptSnapshot)` naming the item and the reason (or
