@@ -33,9 +33,9 @@
 //! payload that passes it. Restoring decodes and validates the whole state
 //! before anything is assigned, with the checks the API applies to the same
 //! values (bodies as [`BodyStore::validate`], joints and contacts by their
-//! `validate`, with their bodies live and the right lineage; a joint's
-//! bodies may both be kinematic, after `World::set_body_kind`, never both
-//! static) and structural
+//! `validate`, with their bodies live and the right lineage; a joint's or
+//! a pending contact's bodies may both be kinematic, after
+//! `World::set_body_kind`, never both static) and structural
 //! ones (slot tables, array lengths, each body's joint count, the colouring
 //! as [`Colouring::validate`]). A refused snapshot gets
 //! `Err(CorruptSnapshot)` naming the item and the reason (or
@@ -194,8 +194,11 @@ impl State {
         self.colouring
             .validate(&edges, bodies.capacity())
             .map_err(|why| corrupt(format!("colouring: {why}")))?;
+        // A pending contact, too, may have lost its dynamic body to a kind
+        // change since it was set.
         for (k, c) in self.contacts.iter().enumerate() {
-            c.validate_with(bodies)
+            c.validate()
+                .and_then(|()| checks::joined_bodies(bodies, c.body_a, c.body_b).map(drop))
                 .map_err(|e| corrupt(format!("contact {k}: {e}")))?;
         }
         Ok(())
