@@ -296,3 +296,44 @@ fn refused_partial_calls_name_the_item_and_change_nothing() {
     assert!(ragdoll.kinematic(&w).is_err());
     assert_eq!(w.state_hash(), hash);
 }
+
+/// A simplified ragdoll with both rod ends kinematic (the spine animated
+/// through its ends): the rod then joins two kinematic bodies and moves
+/// neither, still takes drives (`drive_to` sets its rest shape), and the
+/// interior spine bones are placed between the animated ends.
+#[test]
+fn a_rod_spine_with_both_ends_kinematic_is_animated_through_its_ends() {
+    let desc = RagdollDesc::reference_humanoid();
+    let mut w = World::new(SolverConfig::default()).unwrap();
+    let (start, before) = (walking(&desc, 0.0), walking(&desc, -DT));
+    let options = BuildOptions::new(SpineMode::Rod);
+    let ragdoll = Ragdoll::build(&mut w, &desc, options, &start, Some((&before, DT))).unwrap();
+    ragdoll.set_body_kinematic(&mut w, "hips", true).unwrap();
+    ragdoll.set_body_kinematic(&mut w, "chest", true).unwrap();
+    let settings = vertebra_ragdoll::DriveSettings::uniform(vertebra_ragdoll::Strength::Infinite);
+    let (hips, chest) = (index(&desc, "hips"), index(&desc, "chest"));
+    let mut worst = 0.0f32;
+    for frame in 1..=60 {
+        let target = walking(&desc, frame as f32 * DT);
+        ragdoll.drive_to(&mut w, &target, &settings).unwrap();
+        ragdoll
+            .drive_to_pose_using_kinematics(&mut w, &target, DT)
+            .unwrap();
+        w.step(DT).unwrap();
+        let bones = ragdoll
+            .skeleton_pose(&w, vertebra_ragdoll::SpineMapping::Arc)
+            .unwrap();
+        for k in [hips, chest] {
+            worst = worst.max((bones.bones[k].0 - target.bones[k].0).length());
+        }
+        for name in ["spine_lower", "spine_upper"] {
+            let y = bones.bones[index(&desc, name)].0.y;
+            assert!(
+                bones.bones[hips].0.y < y && y < bones.bones[chest].0.y,
+                "{name}"
+            );
+        }
+    }
+    assert!(worst < 1e-5, "{worst}");
+    ragdoll.release_drives(&mut w).unwrap();
+}
