@@ -2,8 +2,8 @@
 
 use glam::Vec3;
 use vertebra_world::{
-    AngularDrive, BodyDesc, BodyHandle, Contact, Error, JointDesc, JointHandle, JointKind,
-    LimitSoftness, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle,
+    AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, Error, JointDesc, JointHandle,
+    JointKind, LimitSoftness, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle,
     RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
 };
 
@@ -51,6 +51,9 @@ pub(crate) fn shape(input: &mut Input) -> Shape {
 pub(crate) fn add_body(world: &mut World, input: &mut Input) -> Result<BodyHandle, Error> {
     let desc = match input.pick(3) {
         0 => BodyDesc::fixed(),
+        // With a mass or without (only the first can become dynamic).
+        1 if input.flag() => BodyDesc::kinematic()
+            .with_mass(shape(input).mass_properties_with_mass(input.float(100.0))?),
         1 => BodyDesc::kinematic(),
         _ => BodyDesc::dynamic(shape(input).mass_properties_with_mass(input.float(100.0))?),
     };
@@ -213,9 +216,25 @@ fn impulse(world: &mut World, body: BodyHandle, input: &mut Input) -> Result<(),
     }
 }
 
+/// A body's kind switched to any kind (to or from static is refused), or
+/// a kinematic move to any pose over any time step.
+fn kinematic(world: &mut World, body: BodyHandle, input: &mut Input) -> Result<(), Error> {
+    if input.flag() {
+        let kinds = [BodyKind::Dynamic, BodyKind::Kinematic, BodyKind::Static];
+        world.set_body_kind(body, kinds[input.pick(3)])
+    } else {
+        let dt = if input.flag() {
+            1.0 / 60.0
+        } else {
+            input.float(0.1)
+        };
+        world.move_kinematic(body, input.vec3(5.0), input.quat(), dt)
+    }
+}
+
 /// One call chosen by the input; `Err` is a refusal.
 fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Error> {
-    match input.pick(12) {
+    match input.pick(13) {
         0 => add_body(world, input).map(|h| seen.bodies.push(h)),
         1 => match seen.body(input) {
             Some(h) => world.remove_body(h),
@@ -244,6 +263,10 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
             Some(h) => impulse(world, h, input),
             None => Ok(()),
         },
+        11 => match seen.body(input) {
+            Some(h) => kinematic(world, h, input),
+            None => Ok(()),
+        },
         _ => world.step(if input.flag() {
             1.0 / 60.0
         } else {
@@ -253,7 +276,8 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
 }
 
 /// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
-/// removed, poses, velocities, forces and impulses set, steps) with arbitrary floats
+/// removed, poses, velocities, forces and impulses set, kinds switched,
+/// kinematic bodies moved, steps) with arbitrary floats
 /// one time in eight: no panic; every refused call leaves the world as it
 /// was; every body stays finite; no pending contact names a removed body;
 /// and the step's last-line NaN guard never fires (accepted input must

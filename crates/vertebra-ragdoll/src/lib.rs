@@ -37,6 +37,8 @@
 //! # }
 //! ```
 
+mod blend;
+mod blend_back;
 mod description;
 mod drive;
 mod drive_def;
@@ -44,10 +46,12 @@ mod error;
 mod joint_def;
 mod mapping;
 mod motion;
+mod partial;
 mod pose;
 mod ragdoll;
 mod skeleton;
 
+pub use blend_back::{Blend, BlendBack};
 pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;

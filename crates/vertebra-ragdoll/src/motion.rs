@@ -104,13 +104,7 @@ impl Ragdoll {
         impulse: Vec3,
         point: Option<Vec3>,
     ) -> Result<(), RagdollError> {
-        let k = self.body_index(body)?;
-        let handle = self.bodies[k].ok_or_else(|| RagdollError::UnknownBody {
-            context: "impulse (an interior spine bone of a simplified ragdoll has no body)"
-                .to_owned(),
-            field: "body",
-            name: body.to_owned(),
-        })?;
+        let (k, handle) = self.named_body(body, "impulse")?;
         let in_body = |e| RagdollError::world(&self.body_context(k), e);
         match point {
             Some(p) => world.apply_impulse_at(handle, impulse, p),
@@ -119,21 +113,36 @@ impl Ragdoll {
         .map_err(in_body)
     }
 
-    /// The index of the described body named `name`.
-    fn body_index(&self, name: &str) -> Result<usize, RagdollError> {
-        self.desc
+    /// The described index and the handle of the body named `name`, for
+    /// the call `call` (which errors name): refused for a name that is not
+    /// a described body, and for an interior spine bone of a simplified
+    /// ragdoll (it has no body).
+    pub(crate) fn named_body(
+        &self,
+        name: &str,
+        call: &str,
+    ) -> Result<(usize, BodyHandle), RagdollError> {
+        let unknown = |context: String| RagdollError::UnknownBody {
+            context,
+            field: "body",
+            name: name.to_owned(),
+        };
+        let k = self
+            .desc
             .bodies
             .iter()
             .position(|b| b.name == name)
-            .ok_or_else(|| RagdollError::UnknownBody {
-                context: "impulse".to_owned(),
-                field: "body",
-                name: name.to_owned(),
-            })
+            .ok_or_else(|| unknown(call.to_owned()))?;
+        let handle = self.bodies[k].ok_or_else(|| {
+            unknown(format!(
+                "{call} (an interior spine bone of a simplified ragdoll has no body)"
+            ))
+        })?;
+        Ok((k, handle))
     }
 
     /// The root body's handle; a removed ragdoll has none.
-    fn root(&self) -> Result<BodyHandle, RagdollError> {
+    pub(crate) fn root(&self) -> Result<BodyHandle, RagdollError> {
         self.bodies[self.desc.root].ok_or_else(|| {
             RagdollError::world(
                 &self.body_context(self.desc.root),
@@ -143,7 +152,7 @@ impl Ragdoll {
     }
 
     /// Every body the ragdoll has, with its described index.
-    fn live_bodies(&self) -> impl Iterator<Item = (usize, BodyHandle)> + '_ {
+    pub(crate) fn live_bodies(&self) -> impl Iterator<Item = (usize, BodyHandle)> + '_ {
         self.bodies
             .iter()
             .enumerate()
@@ -151,7 +160,7 @@ impl Ragdoll {
     }
 
     /// How errors name described body `k`.
-    fn body_context(&self, k: usize) -> String {
+    pub(crate) fn body_context(&self, k: usize) -> String {
         format!("body `{}`", self.desc.bodies[k].name)
     }
 }

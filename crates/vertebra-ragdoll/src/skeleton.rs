@@ -263,3 +263,41 @@ impl ModelPose {
         }
     }
 }
+
+impl LocalPose {
+    /// This pose blended bone by bone with `other`, in local space: bone
+    /// `k` at `weights[k]` (0: this pose's transform, 1: `other`'s,
+    /// exactly; in between, translations (m, parent frame) interpolated
+    /// linearly and rotations along the shorter arc), as Unreal's physics
+    /// blend weight blends an animation pose with the simulated one.
+    /// Refused, naming the bone and the field, when either pose does not
+    /// fit `skeleton` or a weight is not finite or outside [0, 1] (one
+    /// weight per bone).
+    pub fn blend(
+        &self,
+        skeleton: &Skeleton,
+        other: &LocalPose,
+        weights: &[f32],
+    ) -> Result<LocalPose, RagdollError> {
+        skeleton.check(&self.bones)?;
+        skeleton.check(&other.bones)?;
+        crate::blend::check_weights(weights, skeleton.len(), |k| {
+            bone_context(k, &skeleton.bones[k].name)
+        })?;
+        let bones = self
+            .bones
+            .iter()
+            .zip(&other.bones)
+            .zip(weights)
+            .map(|((a, b), &w)| {
+                let (translation, rotation) = crate::blend::blend_bone(
+                    (a.translation, a.rotation),
+                    (b.translation, b.rotation),
+                    w,
+                );
+                Transform::new(translation, rotation)
+            })
+            .collect();
+        Ok(LocalPose { bones })
+    }
+}

@@ -37,6 +37,10 @@ pub enum Error {
     /// static or kinematic one: their mass is infinite, so no impulse
     /// moves them (a kinematic body's velocity is set, not pushed).
     NotDynamic(&'static str),
+    /// A call a body's kind does not take: a kind change to or from static,
+    /// a kinematic body without mass made dynamic, a dynamic body moved as
+    /// a kinematic one. The message names the field or the call first.
+    WrongKind(&'static str),
     /// A limit range whose lower end is above its upper end, or outside
     /// the angle range it is measured in.
     InvalidLimit(&'static str),
@@ -87,6 +91,7 @@ impl fmt::Display for Error {
                 f,
                 "{what} needs a dynamic body (static and kinematic bodies have infinite mass)"
             ),
+            Error::WrongKind(what) => write!(f, "{what}"),
             Error::InvalidLimit(what) => write!(f, "invalid {what} limit"),
             Error::InvalidConfig(what) => write!(f, "invalid solver setting: {what}"),
             Error::InvalidJoint(what) => write!(f, "invalid joint: {what}"),

@@ -21,7 +21,9 @@ pub type BodyHandle = Handle<BodyTag>;
 pub enum BodyKind {
     /// Moved by gravity, forces and constraints.
     Dynamic,
-    /// Moved only by its own velocity, which the caller sets; infinite mass.
+    /// Moved only by its own velocity, which the caller sets
+    /// (`World::move_kinematic` sets the velocity that reaches a pose);
+    /// infinite mass to everything that touches it.
     Kinematic,
     /// Never moves; infinite mass.
     Static,
@@ -40,7 +42,9 @@ pub struct BodyDesc {
     pub linear_velocity: Vec3,
     /// Angular velocity, world frame (rad/s).
     pub angular_velocity: Vec3,
-    /// Mass and inertia; required for dynamic bodies, ignored otherwise.
+    /// Mass and inertia: required for a dynamic body; optional for a
+    /// kinematic one (the mass it moves with if it is made dynamic; it has
+    /// infinite mass while kinematic); ignored for a static one.
     pub mass: Option<MassProperties>,
     /// Linear damping rate (1/s): velocity scales by 1 / (1 + h c) per
     /// substep of h seconds.
@@ -58,7 +62,8 @@ impl BodyDesc {
         }
     }
 
-    /// A kinematic body at the origin, at rest.
+    /// A kinematic body at the origin, at rest, without mass properties
+    /// (see [`BodyDesc::with_mass`] for one that can become dynamic).
     pub fn kinematic() -> Self {
         Self::of_kind(BodyKind::Kinematic)
     }
@@ -84,6 +89,13 @@ impl BodyDesc {
     /// With the centre of mass at `position` (m, world).
     pub fn with_position(mut self, position: Vec3) -> Self {
         self.position = position;
+        self
+    }
+
+    /// With mass properties: a dynamic body's, or the mass a kinematic
+    /// body moves with once it is made dynamic (`World::set_body_kind`).
+    pub fn with_mass(mut self, mass: MassProperties) -> Self {
+        self.mass = Some(mass);
         self
     }
 
@@ -125,7 +137,7 @@ impl BodyDesc {
             }
         }
         match (self.kind, self.mass) {
-            (BodyKind::Dynamic, Some(m)) => m.validate(),
+            (BodyKind::Dynamic | BodyKind::Kinematic, Some(m)) => m.validate(),
             (BodyKind::Dynamic, None) => Err(Error::NonPositive("mass")),
             _ => Ok(()),
         }
@@ -167,13 +179,18 @@ pub struct BodyStore {
     pub linear_velocity: Vec<Vec3>,
     /// Angular velocities (rad/s, world).
     pub angular_velocity: Vec<Vec3>,
-    /// Masses (kg); 0 for kinematic and static bodies.
+    /// Masses (kg): a dynamic body's; a kinematic body's own, which it
+    /// moves with again once made dynamic (0 for one that has none); 0 for
+    /// static bodies. Only a dynamic body's mass acts: sum `m v` over
+    /// dynamic bodies for momentum.
     pub mass: Vec<f32>,
-    /// Inverse masses (1/kg); 0 for kinematic and static bodies.
+    /// Inverse masses (1/kg); 0 for kinematic and static bodies (infinite
+    /// mass).
     pub inverse_mass: Vec<f32>,
-    /// Inertia tensors (kg m^2, body frame); zero for infinite mass.
+    /// Inertia tensors (kg m^2, body frame), kept as the masses are.
     pub inertia: Vec<Mat3>,
-    /// Inverse inertia tensors (body frame); zero for infinite mass.
+    /// Inverse inertia tensors (body frame); zero for kinematic and static
+    /// bodies.
     pub inverse_inertia: Vec<Mat3>,
     /// Force accumulated for the next step (N, world), cleared by the step.
     pub force: Vec<Vec3>,
@@ -208,8 +225,9 @@ impl BodyStore {
     /// array, and every slot (live or freed: the step uploads them all)
     /// holding what `insert` makes of a valid [`BodyDesc`] and the step
     /// keeps: the description's checks, masses and inertia with their
-    /// inverses computed as `insert` computes them (zero for kinematic and
-    /// static bodies), a static body at rest, finite pending forces.
+    /// inverses computed as `insert` computes them (inverses zero for
+    /// kinematic and static bodies, masses zero for static ones), a static
+    /// body at rest, finite pending forces.
     /// The error (`CorruptSnapshot`) names the body's slot and the reason.
     pub fn validate(&self) -> Result<(), Error> {
         self.slots.validate("body")?;
@@ -249,22 +267,22 @@ impl BodyStore {
         let cols = |m: Mat3| m.to_cols_array().to_vec();
         let pairs = [
             (
-                "mass of an infinite-mass body is not zero",
+                "mass of a static body is not zero",
                 vec![self.mass[i]],
                 vec![derived.mass],
             ),
             (
-                "inertia of an infinite-mass body is not zero",
+                "inertia of a static body, or of a kinematic body without mass, is not zero",
                 cols(self.inertia[i]),
                 cols(derived.inertia),
             ),
             (
-                "inverse mass is not 1/mass",
+                "inverse mass is not 1/mass (0 for kinematic and static bodies)",
                 vec![self.inverse_mass[i]],
                 vec![derived.inverse_mass],
             ),
             (
-                "inverse inertia is not the inertia's inverse",
+                "inverse inertia is not the inertia's inverse (0 for kinematic and static bodies)",
                 cols(self.inverse_inertia[i]),
                 cols(derived.inverse_inertia),
             ),
@@ -307,7 +325,7 @@ impl BodyStore {
             orientation: self.orientation[i],
             linear_velocity: self.linear_velocity[i],
             angular_velocity: self.angular_velocity[i],
-            mass: (self.kind[i] == BodyKind::Dynamic).then_some(MassProperties {
+            mass: self.has_own_mass(i).then_some(MassProperties {
                 mass: self.mass[i],
                 inertia: self.inertia[i],
             }),
@@ -531,10 +549,59 @@ impl BodyStore {
     pub fn is_dynamic(&self, handle: BodyHandle) -> Result<bool, Error> {
         Ok(self.kind[self.index(handle)?] == BodyKind::Dynamic)
     }
+
+    /// Whether slot `i` holds mass properties: every dynamic body, and a
+    /// kinematic one created with them or made kinematic from dynamic.
+    fn has_own_mass(&self, i: usize) -> bool {
+        match self.kind[i] {
+            BodyKind::Dynamic => true,
+            BodyKind::Kinematic => self.mass[i] != 0.0,
+            BodyKind::Static => false,
+        }
+    }
+
+    /// Switches a body between dynamic and kinematic (as Jolt's
+    /// `SetMotionType`). Its mass and inertia stay, so a body made
+    /// kinematic goes back to dynamic with its own mass; its velocities
+    /// stay as they are (a body made kinematic moves on at its velocity
+    /// until the caller sets another; one made dynamic starts with its
+    /// current velocity); pending forces act if it is dynamic when the
+    /// next step runs. The same kind again changes nothing. Refused with
+    /// nothing changed ([`Error::WrongKind`]): a static body, a change to
+    /// static, and a kinematic body without mass properties made dynamic.
+    pub fn set_kind(&mut self, handle: BodyHandle, kind: BodyKind) -> Result<(), Error> {
+        let i = self.index(handle)?;
+        match (self.kind[i], kind) {
+            (BodyKind::Static, _) => {
+                return Err(Error::WrongKind(
+                    "kind: a static body stays static (only dynamic and kinematic bodies switch)",
+                ));
+            }
+            (_, BodyKind::Static) => {
+                return Err(Error::WrongKind(
+                    "kind: no body becomes static at run time (remove it and add a static body)",
+                ));
+            }
+            (BodyKind::Kinematic, BodyKind::Dynamic) if !self.has_own_mass(i) => {
+                return Err(Error::WrongKind(
+                    "kind: a kinematic body without mass cannot become dynamic \
+                     (create it with BodyDesc::with_mass)",
+                ));
+            }
+            _ => {}
+        }
+        self.kind[i] = kind;
+        let derived = Derived::of(&self.desc(i));
+        self.inverse_mass[i] = derived.inverse_mass;
+        self.inverse_inertia[i] = derived.inverse_inertia;
+        Ok(())
+    }
 }
 
 /// Mass, inertia and their inverses as `insert` stores them: the
-/// description's for a dynamic body, zero (infinite mass) otherwise.
+/// description's for a dynamic body; for a kinematic one its own mass and
+/// inertia (zero without) with zero inverses (infinite mass); all zero for
+/// a static one.
 struct Derived {
     mass: f32,
     inverse_mass: f32,
@@ -550,6 +617,12 @@ impl Derived {
                 inverse_mass: 1.0 / m.mass,
                 inertia: m.inertia,
                 inverse_inertia: m.inertia.inverse(),
+            },
+            (BodyKind::Kinematic, Some(m)) => Self {
+                mass: m.mass,
+                inverse_mass: 0.0,
+                inertia: m.inertia,
+                inverse_inertia: Mat3::ZERO,
             },
             _ => Self {
                 mass: 0.0,

@@ -101,17 +101,34 @@ pub(crate) fn softness(softness: LimitSoftness) -> Result<(), Error> {
     }
 }
 
-/// Two different live bodies, at least one dynamic.
+/// Two different live bodies, at least one dynamic: what a new joint or
+/// rod needs.
 pub(crate) fn joint_bodies(bodies: &BodyStore, a: BodyHandle, b: BodyHandle) -> Result<(), Error> {
-    if a == b {
-        return Err(Error::SameBody);
-    }
-    let ka = bodies.kind[bodies.index(a)?];
-    let kb = bodies.kind[bodies.index(b)?];
+    let [ka, kb] = joined_bodies(bodies, a, b)?;
     if ka != BodyKind::Dynamic && kb != BodyKind::Dynamic {
         return Err(Error::NoDynamicBody);
     }
     Ok(())
+}
+
+/// Two different live bodies, not both static (their kinds): what a joint
+/// already in the world keeps. Its bodies may both have been made
+/// kinematic since it was added (`World::set_body_kind`); it then moves
+/// neither (the kernels give a pair of infinite masses no correction, as
+/// they do padding lanes) until one is dynamic again.
+pub(crate) fn joined_bodies(
+    bodies: &BodyStore,
+    a: BodyHandle,
+    b: BodyHandle,
+) -> Result<[BodyKind; 2], Error> {
+    if a == b {
+        return Err(Error::SameBody);
+    }
+    let kinds = [bodies.kind[bodies.index(a)?], bodies.kind[bodies.index(b)?]];
+    if kinds == [BodyKind::Static; 2] {
+        return Err(Error::NoDynamicBody);
+    }
+    Ok(kinds)
 }
 
 /// A joint's or contact's bodies as the colouring sees them: the slot of

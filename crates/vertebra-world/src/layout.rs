@@ -1,6 +1,7 @@
 //! The solver's constraint layout: every joint in a lane of a block of its
 //! type, the blocks ordered by colour, then the overflow set. Rebuilt only
-//! when the colouring changes (a joint added or removed), never per step.
+//! when the colouring changes (a joint added or removed, a joined body's
+//! kind changed: lanes cache which bodies are dynamic), never per step.
 //!
 //! Colouring keys: a joint is its slot, a rod its slot plus [`ROD_KEY`].
 //! Each joint kind has its own blocks (sockets of the plain and the shaped

@@ -29,6 +29,7 @@ mod drive;
 mod impulse;
 mod joint;
 mod joint_wire;
+mod kinematic;
 mod layout;
 mod metrics;
 mod parallel;
@@ -334,14 +335,15 @@ impl World {
     }
 
     /// Changes a rod's rest shape, stiffness and limits in place (its bodies
-    /// must stay the same): how a powered ragdoll drives its spine.
+    /// must stay the same, and may both be kinematic by now): how a powered
+    /// ragdoll drives its spine.
     pub fn set_rod(&mut self, handle: RodHandle, desc: RodDesc) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         let old = self.rod(handle)?;
         if (old.body_a, old.body_b) != (desc.body_a, desc.body_b) {
             return Err(Error::InvalidConfig("set_rod cannot change a rod's bodies"));
         }
-        desc.validate_with(&self.bodies)?;
+        desc.validate()?;
         self.rods[handle.index()] = Some(desc);
         if !self.layout_dirty {
             let (block, lane) = self.layout.rods.place[handle.index()];

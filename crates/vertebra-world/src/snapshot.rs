@@ -33,7 +33,9 @@
 //! payload that passes it. Restoring decodes and validates the whole state
 //! before anything is assigned, with the checks the API applies to the same
 //! values (bodies as [`BodyStore::validate`], joints and contacts by their
-//! `validate`, with their bodies live and the right lineage) and structural
+//! `validate`, with their bodies live and the right lineage; a joint's or
+//! a pending contact's bodies may both be kinematic, after
+//! `World::set_body_kind`, never both static) and structural
 //! ones (slot tables, array lengths, each body's joint count, the colouring
 //! as [`Colouring::validate`]). A refused snapshot gets
 //! `Err(CorruptSnapshot)` naming the item and the reason (or
@@ -169,14 +171,18 @@ impl State {
                 joints_at[h.index()] += 1;
             }
         };
+        // A joint's bodies may both be kinematic now (made so after it was
+        // added), never both static.
         let live = joints("joint", &self.joint_slots, &self.joints, |d| {
-            d.validate_with(bodies)
+            d.validate()?;
+            checks::joined_bodies(bodies, d.body_a, d.body_b).map(drop)
         })?;
         for (slot, d) in live {
             joint(slot as u64, d.body_a, d.body_b);
         }
         let rods = joints("rod", &self.rod_slots, &self.rods, |d| {
-            d.validate_with(bodies)
+            d.validate()?;
+            checks::joined_bodies(bodies, d.body_a, d.body_b).map(drop)
         })?;
         for (slot, d) in rods {
             joint(slot as u64 + ROD_KEY, d.body_a, d.body_b);
@@ -190,8 +196,11 @@ impl State {
         self.colouring
             .validate(&edges, bodies.capacity())
             .map_err(|why| corrupt(format!("colouring: {why}")))?;
+        // A pending contact, too, may have lost its dynamic body to a kind
+        // change since it was set.
         for (k, c) in self.contacts.iter().enumerate() {
-            c.validate_with(bodies)
+            c.validate()
+                .and_then(|()| checks::joined_bodies(bodies, c.body_a, c.body_b).map(drop))
                 .map_err(|e| corrupt(format!("contact {k}: {e}")))?;
         }
         Ok(())
@@ -290,8 +299,8 @@ mod tests {
 
     use super::*;
     use crate::{
-        AngularDrive, BodyDesc, JointKind, LimitSoftness, RodStiffness, Shape, SolverConfig, Swing,
-        SwingTwist,
+        AngularDrive, BodyDesc, BodyKind, JointKind, LimitSoftness, RodStiffness, Shape,
+        SolverConfig, Swing, SwingTwist,
     };
 
     #[test]
@@ -433,19 +442,25 @@ mod tests {
             ),
             (
                 Box::new(|s| s.bodies.inverse_mass[1] = NAN),
-                "body 1: inverse mass is not 1/mass",
+                "body 1: inverse mass is not 1/mass (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.inverse_mass[2] *= 2.0),
-                "body 2: inverse mass is not 1/mass",
+                "body 2: inverse mass is not 1/mass (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.inverse_inertia[3].x_axis.x = 1e30),
-                "body 3: inverse inertia is not the inertia's inverse",
+                "body 3: inverse inertia is not the inertia's inverse (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.mass[0] = 1.0),
-                "body 0: mass of an infinite-mass body is not zero",
+                "body 0: mass of a static body is not zero",
+            ),
+            (
+                // Made kinematic without World::set_body_kind: its inverse
+                // mass is still a dynamic body's.
+                Box::new(|s| s.bodies.kind[2] = BodyKind::Kinematic),
+                "body 2: inverse mass is not 1/mass (0 for kinematic and static bodies)",
             ),
             (
                 Box::new(|s| s.bodies.position[3].y = 2e6),

@@ -315,7 +315,7 @@ fn integrate(q: Quat, w: Vec3, h: f32) -> Quat {
 
 /// The angular velocity that turns `q0` into `q` in `h` seconds, exactly
 /// (the inverse of [`integrate`]): `log(q q0*) / h`, shortest arc.
-fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
+pub(crate) fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
     let turn = vertebra_math::Quat::<f32>::from(q * q0.conjugate());
     Vec3::from(turn.to_rotation_vector()) / h
 }

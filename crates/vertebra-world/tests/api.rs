@@ -709,3 +709,104 @@ fn coordinates_and_time_steps_out_of_range_are_refused() {
     world.step(vertebra_world::MAX_TIME_STEP).unwrap();
     assert!(world.body(body).unwrap().position.is_finite());
 }
+
+/// Kind changes to or from static, a kinematic body without mass made
+/// dynamic, and `move_kinematic` on a body that is not kinematic or with
+/// a bad pose, time step or a move faster than the speed limits: each
+/// refused by name, the world as it was.
+#[test]
+fn bad_kind_changes_and_kinematic_moves_are_refused() {
+    use vertebra_world::BodyKind;
+    let ground = |w: &mut World| w.bodies().handle_at(0).unwrap();
+    let bob = |w: &mut World| w.bodies().handle_at(1).unwrap();
+    for kind in [BodyKind::Dynamic, BodyKind::Kinematic, BodyKind::Static] {
+        rejected_after(
+            ground,
+            Error::WrongKind(
+                "kind: a static body stays static (only dynamic and kinematic bodies switch)",
+            ),
+            |w, g| w.set_body_kind(g, kind),
+        );
+    }
+    rejected_after(
+        bob,
+        Error::WrongKind(
+            "kind: no body becomes static at run time (remove it and add a static body)",
+        ),
+        |w, b| w.set_body_kind(b, BodyKind::Static),
+    );
+    let massless = |w: &mut World| w.add_body(BodyDesc::kinematic()).unwrap();
+    rejected_after(
+        massless,
+        Error::WrongKind(
+            "kind: a kinematic body without mass cannot become dynamic \
+             (create it with BodyDesc::with_mass)",
+        ),
+        |w, k| w.set_body_kind(k, BodyKind::Dynamic),
+    );
+    rejected_after(
+        bob,
+        Error::WrongKind(
+            "move_kinematic needs a kinematic body (switch it with World::set_body_kind)",
+        ),
+        |w, b| w.move_kinematic(b, Vec3::ZERO, Quat::IDENTITY, 1.0 / 60.0),
+    );
+    let kinematic = |w: &mut World| {
+        let b = w.bodies().handle_at(1).unwrap();
+        w.set_body_kind(b, BodyKind::Kinematic).unwrap();
+        b
+    };
+    let (dt, q) = (1.0 / 60.0, Quat::IDENTITY);
+    let nan = f32::NAN;
+    let cases: [(Error, Vec3, Quat, f32); 9] = [
+        (
+            Error::NonFinite("position"),
+            Vec3::new(nan, 0.0, 0.0),
+            q,
+            dt,
+        ),
+        (
+            Error::OutOfRange("position"),
+            Vec3::new(2.0e6, 0.0, 0.0),
+            q,
+            dt,
+        ),
+        (
+            Error::NotNormalized("orientation"),
+            Vec3::ZERO,
+            Quat::from_xyzw(0.0, 0.0, 0.0, 2.0),
+            dt,
+        ),
+        (
+            Error::NonFinite("orientation"),
+            Vec3::ZERO,
+            Quat::from_xyzw(nan, 0.0, 0.0, 1.0),
+            dt,
+        ),
+        (Error::NonFinite("time step"), Vec3::ZERO, q, nan),
+        (Error::NonPositive("time step"), Vec3::ZERO, q, 0.0),
+        (
+            Error::OutOfRange("time step (1e-6 s to 1 s)"),
+            Vec3::ZERO,
+            q,
+            2.0,
+        ),
+        (
+            Error::OutOfRange("position (reaching it in dt needs more than max_linear_speed)"),
+            Vec3::new(100.0, 0.0, 0.0),
+            q,
+            dt,
+        ),
+        (
+            Error::OutOfRange("orientation (reaching it in dt needs more than max_angular_speed)"),
+            Vec3::new(0.0, -0.2, 0.0),
+            Quat::from_rotation_z(3.0),
+            1e-3,
+        ),
+    ];
+    for (expected, position, orientation, dt) in cases {
+        rejected_after(kinematic, expected, |w, b| {
+            w.move_kinematic(b, position, orientation, dt)
+        });
+    }
+}

@@ -7,7 +7,8 @@ use common::capsule;
 use glam::{Quat, Vec3};
 use vertebra_math::Backend;
 use vertebra_world::{
-    AngularDrive, BackendChoice, BodyDesc, JointDesc, RodDesc, RodStiffness, SolverConfig, World,
+    AngularDrive, BackendChoice, BodyDesc, BodyKind, JointDesc, RodDesc, RodStiffness,
+    SolverConfig, World,
 };
 
 /// 30 branching chains (hundreds of bodies and sockets, several colours),
@@ -148,4 +149,68 @@ fn every_backend_and_thread_count_gives_the_same_bits() {
 fn repeated_runs_give_the_same_bits() {
     let best = Backend::best();
     assert_eq!(hash_after(best, 2, 30), hash_after(best, 2, 30));
+}
+
+/// [`hash_after`]'s world with bodies switching kind mid-run: at frame 10
+/// every fifth dynamic body (the hub among them: its 30 spokes leave the
+/// overflow set) turns kinematic and is moved along a circle by
+/// `move_kinematic` from then on; at frame 35 every other one of those is
+/// dynamic again. Returns the hash and how many joints overflow with the
+/// hub kinematic.
+fn hash_after_switching(backend: Backend, threads: usize, frames: usize) -> (u64, usize) {
+    let mut w = build(backend, threads);
+    let dynamic: Vec<_> = (0..w.bodies().capacity())
+        .filter_map(|i| w.bodies().handle_at(i))
+        .filter(|&b| w.bodies().is_dynamic(b).unwrap())
+        .collect();
+    let hub = dynamic
+        .iter()
+        .copied()
+        .find(|&b| w.bodies().mass[b.index()] == 5.0)
+        .unwrap();
+    let mut switched: Vec<_> = dynamic.iter().copied().step_by(5).collect();
+    switched.push(hub);
+    let mut overflow = usize::MAX;
+    for frame in 0..frames {
+        if frame == 10 {
+            for &b in &switched {
+                w.set_body_kind(b, BodyKind::Kinematic).unwrap();
+            }
+        }
+        if frame == 35 {
+            for &b in switched.iter().step_by(2) {
+                w.set_body_kind(b, BodyKind::Dynamic).unwrap();
+            }
+        }
+        for &b in &switched {
+            if w.bodies().kind[b.index()] == BodyKind::Kinematic {
+                let s = w.body(b).unwrap();
+                let t = frame as f32 / 60.0;
+                let to = s.position + 0.01 * Vec3::new(t.cos(), 0.5, t.sin());
+                let turn = Quat::from_rotation_y(0.02) * s.orientation;
+                w.move_kinematic(b, to, turn, 1.0 / 60.0).unwrap();
+            }
+        }
+        w.step(1.0 / 60.0).unwrap();
+        if frame == 20 {
+            overflow = w.overflow_count();
+        }
+    }
+    (w.state_hash(), overflow)
+}
+
+#[test]
+fn worlds_switching_kinds_mid_run_give_the_same_bits_everywhere() {
+    let (reference, overflow) = hash_after_switching(Backend::Scalar, 1, 60);
+    assert_eq!(overflow, 0, "a kinematic hub's spokes need no overflow");
+    for backend in Backend::available() {
+        for threads in [1, 2] {
+            let (hash, _) = hash_after_switching(backend, threads, 60);
+            assert_eq!(
+                hash, reference,
+                "{backend} with {threads} thread(s) differs from scalar"
+            );
+        }
+    }
+    assert_ne!(reference, hash_after(Backend::Scalar, 1, 60).0);
 }
