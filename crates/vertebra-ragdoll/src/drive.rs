@@ -244,7 +244,7 @@ impl Ragdoll {
                 .with_stiffness(stiffness, stiffness)
                 .with_max_torque(settings.max_torque);
             driven.bend_rest = (f0.inverse() * tb).normalize();
-            driven.twist_rest = crate::mapping::rod_twist(f0, f1);
+            driven.twist_rest = vertebra_world::rod_twist(f0, f1);
             world
                 .set_rod(rod, driven)
                 .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;

@@ -146,7 +146,7 @@ fn on_arc(
     let psi = cross.length().atan2(ta.dot(tb));
     let n = cross.normalize_or_zero();
     let length = (b.0 - a.0).length() / (2.0 * h(psi));
-    let tau = rod_twist(f0, f1);
+    let tau = vertebra_world::rod_twist(f0, f1);
     let (ga, gb) = (frame_a.inverse(), frame_b.inverse());
     s.iter()
         .map(|&s| {
@@ -164,14 +164,4 @@ fn on_arc(
             )
         })
         .collect()
-}
-
-/// The rod's twist between material frames `f0` and `f1` (the kernel's
-/// definition): about `t_b`, against `f0` carried by the minimal rotation
-/// from `t_a` to `t_b` (the identity if they are opposite).
-pub(crate) fn rod_twist(f0: Quat, f1: Quat) -> f32 {
-    use vertebra_math::Quat as LaneQuat;
-    let (ta, tb) = (f0 * Vec3::X, f1 * Vec3::X);
-    let minimal = LaneQuat::<f32>::from_parts(ta.cross(tb).into(), 1.0 + ta.dot(tb)).normalize();
-    ((minimal * LaneQuat::from(f0)).conjugate() * LaneQuat::from(f1)).twist_angle(Vec3::X.into())
 }
