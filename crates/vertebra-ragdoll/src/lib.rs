@@ -42,6 +42,7 @@ mod drive;
 mod drive_def;
 mod error;
 mod joint_def;
+mod mapper;
 mod mapping;
 mod motion;
 mod pose;
@@ -52,6 +53,7 @@ pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollD
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
 pub use joint_def::JointDef;
+pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
 pub use pose::Pose;
 pub use ragdoll::{BuildOptions, Ragdoll, SpineMode, body_masses};
