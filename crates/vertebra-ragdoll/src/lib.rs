@@ -56,5 +56,5 @@ pub use joint_def::JointDef;
 pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
 pub use pose::Pose;
-pub use ragdoll::{BuildOptions, Ragdoll, SpineMode, body_masses};
+pub use ragdoll::{BuildOptions, Ragdoll, RodRest, SpineMode, body_masses};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
