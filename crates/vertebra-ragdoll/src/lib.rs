@@ -48,6 +48,7 @@ mod motion;
 mod pose;
 mod ragdoll;
 mod skeleton;
+mod transition;
 
 pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
 pub use drive::{DriveSettings, Strength};
@@ -58,3 +59,4 @@ pub use mapping::SpineMapping;
 pub use pose::Pose;
 pub use ragdoll::{BuildOptions, Ragdoll, RodRest, SpineMode, body_masses};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
+pub use transition::Transition;
