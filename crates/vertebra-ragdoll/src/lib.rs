@@ -3,8 +3,9 @@
 //! simplified ragdoll (one rod), switch a character from animation to
 //! physics at any pose, drive it toward an animation pose, and write the
 //! result back onto an animation skeleton that has more bones than the
-//! ragdoll has bodies. The format and the mapping modes are documented in
-//! `docs/ragdolls.md`.
+//! ragdoll has bodies ([`SkeletonMapper`]; [`Transition`] switches from
+//! animation without a pop, an example on its page). The format, the
+//! mapper and the mapping modes are documented in `docs/ragdolls.md`.
 //!
 //! How an engine wires it in, once per character:
 //!

@@ -272,8 +272,8 @@ impl Ragdoll {
     /// body, at its centre of mass, rotation relative to bind), from the
     /// bodies in `world`; a simplified ragdoll's interior spine bodies are
     /// placed by `mapping`. It is [`SkeletonMapper`] on a skeleton of one
-    /// bone per body ([`SkeletonMapper::bodies_as_bones`]); for an engine's
-    /// own skeleton use the mapper.
+    /// bone per body (each at its centre of mass, unrotated at bind); for
+    /// an engine's own skeleton use the mapper.
     pub fn skeleton_pose(
         &self,
         world: &World,

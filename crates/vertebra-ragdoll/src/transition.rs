@@ -25,6 +25,52 @@ use crate::ragdoll::Ragdoll;
 use crate::skeleton::{LocalPose, ModelPose, Transform};
 
 /// The chain bones' offsets from the mapping at the switch to ragdoll.
+///
+/// The switch, from an engine's skeleton (here one bone per body; a game's
+/// has more, and the mapper places them):
+///
+/// ```
+/// use glam::{Quat, Vec3};
+/// use vertebra_ragdoll::{
+///     Bone, BuildOptions, Ragdoll, RagdollDesc, Skeleton, SkeletonMapper, SpineMapping,
+///     SpineMode, Transform, Transition,
+/// };
+/// use vertebra_world::{SolverConfig, World};
+///
+/// # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
+/// let desc = RagdollDesc::reference_humanoid();
+/// let bones = (0..desc.bodies.len()).map(|b| {
+///     let parent = desc.parent_joint[b].map(|j| desc.joints[j].parent);
+///     let from = parent.map_or(Vec3::ZERO, |p| desc.bodies[p].centre());
+///     let bind = Transform::new(desc.bodies[b].centre() - from, Quat::IDENTITY);
+///     Bone { name: desc.bodies[b].name.clone(), parent, bind }
+/// });
+/// let skeleton = Skeleton::new(bones.collect())?;
+/// let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod)?;
+///
+/// // The animation's last two poses (local), and where the model stands.
+/// let current = skeleton.bind_pose();
+/// let mut previous = current.clone();
+/// previous.bones[0].translation.z -= 0.02; // it was walking forward
+/// let place = Transform::new(Vec3::new(3.0, 0.0, -1.0), Quat::from_rotation_y(0.5));
+///
+/// let now = mapper.map_to_ragdoll(&current.to_model(&skeleton)?, place)?;
+/// let before = mapper.map_to_ragdoll(&previous.to_model(&skeleton)?, place)?;
+/// let mut world = World::new(SolverConfig::default())?;
+/// let options = BuildOptions::new(SpineMode::Rod);
+/// let ragdoll = Ragdoll::build(&mut world, &desc, options, &now, Some((&before, 1.0 / 60.0)))?;
+/// let transition =
+///     Transition::new(&mapper, &ragdoll, &world, &current, place, SpineMapping::Arc, 0.3)?;
+///
+/// for frame in 1..=30 {
+///     world.step(1.0 / 60.0)?;
+///     let since = frame as f32 / 60.0;
+///     let pose = transition.skeleton_pose(&mapper, &ragdoll, &world, &current, place, since)?;
+///     assert_eq!(pose.bones.len(), skeleton.len());
+/// }
+/// # Ok(())
+/// # }
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transition {
     mapping: SpineMapping,

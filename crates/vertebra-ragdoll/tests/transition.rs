@@ -351,6 +351,19 @@ fn a_fade_ends_on_the_pure_mapping_and_a_held_transition_keeps_its_offsets() {
             if frame == 0 {
                 offsets_held = offsets;
                 assert!(gap > 1e-3, "{spine:?}: an offset to fade ({gap} m)");
+                // No bone hangs below a chain bone here: the largest
+                // offset is the pure mapping's largest jump.
+                let (largest, turn) = fading.largest_offset();
+                assert!((largest - gap).abs() < 1e-5, "{largest} against {gap}");
+                let turned = chain
+                    .iter()
+                    .map(|&j| {
+                        faded.bones[j]
+                            .rotation
+                            .angle_between(pure.bones[j].rotation)
+                    })
+                    .fold(0.0, f32::max);
+                assert!((turn - turned).abs() < 2e-3, "{turn} against {turned}");
             } else {
                 for (o, first) in offsets.iter().zip(&offsets_held) {
                     assert!(o.translation.distance(first.translation) < 1e-4);
