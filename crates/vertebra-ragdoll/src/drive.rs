@@ -244,7 +244,7 @@ impl Ragdoll {
                 let tb = f1 * Vec3::X;
                 (
                     (f0.inverse() * tb).normalize(),
-                    crate::mapping::rod_twist(f0, f1),
+                    vertebra_world::rod_twist(f0, f1),
                 )
             };
             let stiffness = rod_stiffness(

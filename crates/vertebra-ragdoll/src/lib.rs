@@ -3,8 +3,9 @@
 //! simplified ragdoll (one rod), switch a character from animation to
 //! physics at any pose, drive it toward an animation pose, and write the
 //! result back onto an animation skeleton that has more bones than the
-//! ragdoll has bodies. The format and the mapping modes are documented in
-//! `docs/ragdolls.md`.
+//! ragdoll has bodies ([`SkeletonMapper`]; [`Transition`] switches from
+//! animation without a pop, an example on its page). The format, the
+//! mapper and the mapping modes are documented in `docs/ragdolls.md`.
 //!
 //! How an engine wires it in, once per character:
 //!
@@ -44,19 +45,23 @@ mod drive;
 mod drive_def;
 mod error;
 mod joint_def;
+mod mapper;
 mod mapping;
 mod motion;
 mod partial;
 mod pose;
 mod ragdoll;
 mod skeleton;
+mod transition;
 
 pub use blend_back::{Blend, BlendBack};
 pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
 pub use joint_def::JointDef;
+pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
 pub use pose::Pose;
-pub use ragdoll::{BuildOptions, Ragdoll, SpineMode, body_masses};
+pub use ragdoll::{BuildOptions, Ragdoll, RodRest, SpineMode, body_masses};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
+pub use transition::Transition;

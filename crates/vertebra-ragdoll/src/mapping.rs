@@ -1,6 +1,7 @@
-//! Writing the simulation back onto the animation skeleton (paper section
-//! 6). Bones with a body follow it; in a simplified ragdoll the spine's
-//! interior bones have none and are placed by one of three modes.
+//! Placing a chain of bones that have no body between two bodies that have
+//! one (paper section 6): the simplified ragdoll's spine bones between the
+//! hips and the chest, a neck between the chest and the head. One of three
+//! modes:
 //!
 //! | mode | bone lengths | chain end on the top body | source |
 //! | --- | --- | --- | --- |
@@ -8,17 +9,23 @@
 //! | `PositionOrientation` | change | exact | the paper |
 //! | `Arc` | kept along the arc; straight-line length shrinks by the chord factor `sin(x/2)/(x/2)` of the bone's share `x` of the bend (0.5% at 20 degrees per bone) | exact (to the rod's residual) | beyond the paper |
 //!
-//! Fractions `s_k` along the spine are the bones' shares of the bind-pose
-//! polyline through the chain's centres.
+//! A chain runs from the base body's centre of mass through the interior
+//! bones' origins to the top body's centre of mass, all at bind pose; the
+//! fractions `s_k` are the points' shares of that polyline's length. The
+//! mapper (`mapper.rs`) decides which bones form chains;
+//! [`Ragdoll::skeleton_pose`] is the mapper on a skeleton of one bone per
+//! body.
 
 use glam::{Quat, Vec3};
-use vertebra_world::World;
+use vertebra_world::{World, arc_tangent, rod_twist};
 
 use crate::error::RagdollError;
+use crate::mapper::SkeletonMapper;
 use crate::pose::Pose;
-use crate::ragdoll::{Ragdoll, SpineMode, rod_name};
+use crate::ragdoll::Ragdoll;
+use crate::skeleton::Transform;
 
-/// How a simplified ragdoll's interior spine bones are placed.
+/// How a chain of bones without bodies is placed between its two bodies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SpineMapping {
     /// The bones turn by shares of the top body's rotation relative to the
@@ -28,59 +35,141 @@ pub enum SpineMapping {
     /// between the chain's end and the top body.
     PositionOrientation,
     /// The bones sit on the rod's arc at their fractions of its length,
-    /// turned by the arc's natural frame and their share of the twist.
+    /// turned by the arc's natural frame and their share of the twist,
+    /// each with the offset it has at bind pose from the arc a rod made at
+    /// bind would take (none for a chain straight at bind, as the
+    /// reference spine is: a bent one, such as a clavicle between the
+    /// chest and the upper arm, maps bind pose to bind pose). A
+    /// chain no rod holds (a neck, any chain of a standard ragdoll) takes
+    /// the arc of a rod made at bind pose between its two bodies, so its
+    /// end is exact only as far as the two bodies keep their chord halfway
+    /// between their tangents.
     Arc,
 }
 
-impl Ragdoll {
-    /// The pose of every animation bone, from the bodies in `world`.
-    pub fn skeleton_pose(
+/// A chain of bones between two bodies, at bind pose (model frame = the
+/// description's world frame, bodies unrotated).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Chain {
+    /// The base body (index in the description).
+    pub base: usize,
+    /// The top body.
+    pub top: usize,
+    /// The interior bones, base to top (skeleton indices).
+    pub bones: Vec<usize>,
+    /// The base body's centre, the interior bones' origins, the top body's
+    /// centre (m, bind pose).
+    pub points: Vec<Vec3>,
+    /// Each point's share of the polyline's length, 0 to 1.
+    pub fractions: Vec<f32>,
+    /// Each interior bone's rotation at bind pose (model frame).
+    pub bind_rotations: Vec<Quat>,
+    /// The material frames (in the bodies' frames) of a rod made at bind
+    /// pose between the two bodies through the interior bones: the arc of
+    /// a chain no rod holds.
+    pub bind_frames: (Quat, Quat),
+    /// Each interior bone's bind transform in the frame of the bind arc
+    /// (the arc of `bind_frames` at bind pose) at its fraction: the
+    /// identity for a chain straight at bind.
+    pub arc_offsets: Vec<Transform>,
+    /// Whether the simplified ragdoll's rod joins the two bodies (the arc
+    /// then takes the rod's own frames).
+    pub rod: bool,
+}
+
+impl Chain {
+    /// A chain from body `base` (bind centre `points[0]`) through `bones`
+    /// to body `top` (bind centre `points.last()`).
+    pub fn new(
+        base: usize,
+        top: usize,
+        bones: Vec<usize>,
+        points: Vec<Vec3>,
+        bind_rotations: Vec<Quat>,
+        rod: bool,
+    ) -> Self {
+        let fractions = fractions(&points);
+        let bind_frames = bind_frames(&points);
+        let last = points.len() - 1;
+        let bind_arc = Arc::new(
+            (points[0], Quat::IDENTITY),
+            (points[last], Quat::IDENTITY),
+            bind_frames.0,
+            bind_frames.1,
+        );
+        let arc_offsets = (1..last)
+            .map(|k| {
+                let (p, q) = bind_arc.at(fractions[k]);
+                Transform::new(p, q).inverse() * Transform::new(points[k], bind_rotations[k - 1])
+            })
+            .collect();
+        Self {
+            base,
+            top,
+            bones,
+            points,
+            fractions,
+            bind_rotations,
+            bind_frames,
+            arc_offsets,
+            rod,
+        }
+    }
+
+    /// Writes each interior bone's world transform into `out` (indexed by
+    /// bone) from the two bodies' world poses (centre of mass, rotation
+    /// relative to bind). `rod_frames` are the rod's material frames, for
+    /// the arc of a chain a rod holds.
+    pub fn place(
         &self,
-        world: &World,
-        mapping: SpineMapping,
-    ) -> Result<Pose, RagdollError> {
-        let mut bones = vec![(Vec3::ZERO, Quat::IDENTITY); self.desc.bodies.len()];
-        for ((bone, body), def) in bones.iter_mut().zip(&self.bodies).zip(&self.desc.bodies) {
-            if let Some(h) = body {
-                let s = world
-                    .body(*h)
-                    .map_err(|e| RagdollError::world(&format!("body `{}`", def.name), e))?;
-                *bone = (s.position, s.orientation);
-            }
-        }
-        if let (SpineMode::Rod, Some(spine)) = (self.options.spine, &self.desc.spine) {
-            let chain = &spine.bodies;
-            let centres: Vec<Vec3> = chain
-                .iter()
-                .map(|&b| self.desc.bodies[b].centre())
-                .collect();
-            let fractions = fractions(&centres);
-            let placed = match mapping {
-                SpineMapping::Orientation | SpineMapping::PositionOrientation => interpolated(
-                    &centres,
-                    &fractions,
-                    bones[chain[0]],
-                    bones[chain[chain.len() - 1]],
-                    mapping == SpineMapping::PositionOrientation,
-                ),
-                SpineMapping::Arc => {
-                    let rod = world
-                        .rod(self.rod.expect("a simplified ragdoll has its rod"))
-                        .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
-                    on_arc(
-                        &fractions,
-                        bones[chain[0]],
-                        bones[chain[chain.len() - 1]],
-                        rod.frame_a,
-                        rod.frame_b,
-                    )
+        mode: SpineMapping,
+        base: (Vec3, Quat),
+        top: (Vec3, Quat),
+        rod_frames: Option<(Quat, Quat)>,
+        out: &mut [Transform],
+    ) {
+        let last = self.points.len() - 1;
+        let mut put = |k: usize, (p, q): (Vec3, Quat)| {
+            out[self.bones[k - 1]] =
+                Transform::new(p, (q * self.bind_rotations[k - 1]).normalize());
+        };
+        match mode {
+            SpineMapping::Orientation | SpineMapping::PositionOrientation => {
+                let relative = base.1.inverse() * top.1;
+                let relative = if relative.w < 0.0 {
+                    -relative
+                } else {
+                    relative
+                };
+                let (mut p, mut q) = base;
+                for k in 1..=last {
+                    p += q * (self.points[k] - self.points[k - 1]);
+                    q = base.1 * Quat::IDENTITY.slerp(relative, self.fractions[k]);
+                    if k < last {
+                        put(k, (p, q));
+                    }
                 }
-            };
-            for (k, &b) in chain.iter().enumerate().skip(1).take(chain.len() - 2) {
-                bones[b] = placed[k];
+                if mode == SpineMapping::PositionOrientation {
+                    // p is now where the chain's end lands; the gap to the
+                    // top body is shared out by fraction.
+                    let gap = top.0 - p;
+                    for (k, &bone) in self.bones.iter().enumerate() {
+                        out[bone].translation += gap * self.fractions[k + 1];
+                    }
+                }
+            }
+            SpineMapping::Arc => {
+                let (frame_a, frame_b) = match (self.rod, rod_frames) {
+                    (true, Some(frames)) => frames,
+                    _ => self.bind_frames,
+                };
+                let arc = Arc::new(base, top, frame_a, frame_b);
+                for (k, offset) in self.arc_offsets.iter().enumerate() {
+                    let (p, q) = arc.at(self.fractions[k + 1]);
+                    out[self.bones[k]] = Transform::new(p, q) * *offset;
+                }
             }
         }
-        Ok(Pose { bones })
     }
 }
 
@@ -94,84 +183,118 @@ fn fractions(points: &[Vec3]) -> Vec<f32> {
     acc.iter().map(|a| a / total).collect()
 }
 
-/// The paper's two interpolation modes.
-fn interpolated(
-    centres: &[Vec3],
-    s: &[f32],
-    base: (Vec3, Quat),
-    top: (Vec3, Quat),
-    move_positions: bool,
-) -> Vec<(Vec3, Quat)> {
-    let relative = base.1.inverse() * top.1;
-    let relative = if relative.w < 0.0 {
-        -relative
-    } else {
-        relative
-    };
-    let mut placed = vec![base];
-    for k in 1..centres.len() {
-        let (p, q) = placed[k - 1];
-        placed.push((
-            p + q * (centres[k] - centres[k - 1]),
-            base.1 * Quat::IDENTITY.slerp(relative, s[k]),
-        ));
-    }
-    if move_positions {
-        let gap = top.0 - placed[centres.len() - 1].0;
-        for (k, bone) in placed.iter_mut().enumerate() {
-            bone.0 += gap * s[k];
-        }
-    }
-    placed
+/// The material frames `RodDesc::from_pose` gives a rod made at bind pose
+/// (bodies unrotated) from `points[0]` to `points.last()` through the
+/// points between: the tangent at the base along the circle through the
+/// ends and the middle point (the chord when they are in line), the top's
+/// tangent its reflection about the chord.
+fn bind_frames(points: &[Vec3]) -> (Quat, Quat) {
+    let (a, b) = (points[0], points[points.len() - 1]);
+    let o = (b - a).normalize_or(Vec3::X);
+    let interior = &points[1..points.len() - 1];
+    let ta = interior
+        .get(interior.len() / 2)
+        .and_then(|&m| arc_tangent(a, m, b))
+        .unwrap_or(o);
+    let tb = 2.0 * ta.dot(o) * o - ta;
+    let frame_a = Quat::from_rotation_arc(Vec3::X, ta);
+    (
+        frame_a,
+        (Quat::from_rotation_arc(ta, tb) * frame_a).normalize(),
+    )
 }
 
-/// Bones on the rod's arc. With `F(0) = q_a F_a`, tangents `t_a`, `t_b`,
-/// bend `psi` about `n`, the arc's length `L = |d| / (2 sin(psi/2)/psi)` and
-/// `m = n x t_a`: `gamma(s) = p_a + L s (2 h(x) cos(x/2) t_a + 2 x h(x)^2 m)`,
-/// `x = psi s`, `h(x) = sin(x/2)/x` (smooth at `psi = 0`). The frame at `s`
-/// is `R(t(s), tau s) M(s) F(0) G(s)`, with `M(s)` the turn by `psi s` about
+/// A rod's arc between two bodies. With `F(0) = q_a F_a`, tangents `t_a`,
+/// `t_b`, bend `psi` about `n`, the arc's length
+/// `L = |d| / (2 sin(psi/2)/psi)` and `m = n x t_a`:
+/// `gamma(s) = p_a + L s (2 h(x) cos(x/2) t_a + 2 x h(x)^2 m)`, `x = psi s`,
+/// `h(x) = sin(x/2)/x` (smooth at `psi = 0`). The frame at `s` is
+/// `R(t(s), tau s) M(s) F(0) G(s)`, with `M(s)` the turn by `psi s` about
 /// `n`, `tau` the rod's twist and `G(s)` from `F_a^-1` to `F_b^-1`: so the
 /// ends are exactly the two bodies' orientations.
-fn on_arc(
-    s: &[f32],
-    a: (Vec3, Quat),
-    b: (Vec3, Quat),
-    frame_a: Quat,
-    frame_b: Quat,
-) -> Vec<(Vec3, Quat)> {
-    let h = |x: f32| vertebra_math::poly::half_sinc(x);
-    let (f0, f1) = (a.1 * frame_a, b.1 * frame_b);
-    let (ta, tb) = (f0 * Vec3::X, f1 * Vec3::X);
-    let cross = ta.cross(tb);
-    let psi = cross.length().atan2(ta.dot(tb));
-    let n = cross.normalize_or_zero();
-    let length = (b.0 - a.0).length() / (2.0 * h(psi));
-    let tau = rod_twist(f0, f1);
-    let (ga, gb) = (frame_a.inverse(), frame_b.inverse());
-    s.iter()
-        .map(|&s| {
-            let x = psi * s;
-            let along = ta * (2.0 * h(x) * (x / 2.0).cos()) + n.cross(ta) * (2.0 * x * h(x) * h(x));
-            let turn = if n == Vec3::ZERO {
-                Quat::IDENTITY
-            } else {
-                Quat::from_axis_angle(n, x)
-            };
-            let twist = Quat::from_axis_angle(turn * ta, tau * s);
-            (
-                a.0 + along * (length * s),
-                (twist * turn * f0 * ga.slerp(gb, s)).normalize(),
-            )
-        })
-        .collect()
+struct Arc {
+    start: Vec3,
+    ta: Vec3,
+    n: Vec3,
+    psi: f32,
+    length: f32,
+    tau: f32,
+    f0: Quat,
+    ga: Quat,
+    gb: Quat,
 }
 
-/// The rod's twist between material frames `f0` and `f1` (the kernel's
-/// definition): about `t_b`, against `f0` carried by the minimal rotation
-/// from `t_a` to `t_b` (the identity if they are opposite).
-pub(crate) fn rod_twist(f0: Quat, f1: Quat) -> f32 {
-    use vertebra_math::Quat as LaneQuat;
-    let (ta, tb) = (f0 * Vec3::X, f1 * Vec3::X);
-    let minimal = LaneQuat::<f32>::from_parts(ta.cross(tb).into(), 1.0 + ta.dot(tb)).normalize();
-    ((minimal * LaneQuat::from(f0)).conjugate() * LaneQuat::from(f1)).twist_angle(Vec3::X.into())
+impl Arc {
+    fn new(a: (Vec3, Quat), b: (Vec3, Quat), frame_a: Quat, frame_b: Quat) -> Self {
+        let (f0, f1) = (a.1 * frame_a, b.1 * frame_b);
+        let (ta, tb) = (f0 * Vec3::X, f1 * Vec3::X);
+        let cross = ta.cross(tb);
+        let psi = cross.length().atan2(ta.dot(tb));
+        Self {
+            start: a.0,
+            ta,
+            n: cross.normalize_or_zero(),
+            psi,
+            length: (b.0 - a.0).length() / (2.0 * half_sinc(psi)),
+            tau: rod_twist(f0, f1),
+            f0,
+            ga: frame_a.inverse(),
+            gb: frame_b.inverse(),
+        }
+    }
+
+    /// The position and rotation (relative to bind) at fraction `s`.
+    fn at(&self, s: f32) -> (Vec3, Quat) {
+        let h = half_sinc;
+        let x = self.psi * s;
+        let along = self.ta * (2.0 * h(x) * (x / 2.0).cos())
+            + self.n.cross(self.ta) * (2.0 * x * h(x) * h(x));
+        let turn = if self.n == Vec3::ZERO {
+            Quat::IDENTITY
+        } else {
+            Quat::from_axis_angle(self.n, x)
+        };
+        let twist = Quat::from_axis_angle(turn * self.ta, self.tau * s);
+        (
+            self.start + along * (self.length * s),
+            (twist * turn * self.f0 * self.ga.slerp(self.gb, s)).normalize(),
+        )
+    }
+}
+
+/// `sin(x/2) / x`, through the math layer (the kernels' own definition).
+fn half_sinc(x: f32) -> f32 {
+    vertebra_math::poly::half_sinc(x)
+}
+
+impl Ragdoll {
+    /// The pose of every body as an animation bone (one bone per described
+    /// body, at its centre of mass, rotation relative to bind), from the
+    /// bodies in `world`; a simplified ragdoll's interior spine bodies are
+    /// placed by `mapping`. It is [`SkeletonMapper`] on a skeleton of one
+    /// bone per body (each at its centre of mass, unrotated at bind); for
+    /// an engine's own skeleton use the mapper.
+    pub fn skeleton_pose(
+        &self,
+        world: &World,
+        mapping: SpineMapping,
+    ) -> Result<Pose, RagdollError> {
+        let (skeleton, mapper) = SkeletonMapper::bodies_as_bones(&self.desc, self.options.spine)?;
+        let model = mapper.map_to_skeleton(
+            self,
+            world,
+            &skeleton.bind_pose(),
+            Transform::IDENTITY,
+            mapping,
+        )?;
+        let bones = mapper
+            .binding()
+            .iter()
+            .map(|&bone| {
+                let t = model.bones[bone];
+                (t.translation, t.rotation)
+            })
+            .collect();
+        Ok(Pose { bones })
+    }
 }

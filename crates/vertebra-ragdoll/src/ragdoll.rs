@@ -23,11 +23,39 @@ pub enum SpineMode {
     Rod,
 }
 
+/// What a simplified ragdoll's rod takes its rest shape and limits from.
+/// Either way the rod is made at the pose it is built at (its material
+/// frames and rest length: paper section 6), so it holds exactly there.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RodRest {
+    /// The paper's, and the default: the pose at the switch. The rod has
+    /// no bending or twisting energy there (its stiffness keeps the spine
+    /// in the shape the animation left it in), its twist range is centred
+    /// on the switch's twist, and its bend limit caps the bend from the
+    /// tangents made there. A spine twisted near its limit at the switch
+    /// can twist that much further.
+    #[default]
+    Transition,
+    /// As the sockets': measured from the bind pose, in the frames made at
+    /// the switch. The rest bend and twist are the bind pose's (the
+    /// stiffness pulls the spine back toward it), and the twist range is
+    /// centred on the bind pose's twist (clamped to [-pi, pi]). The bend
+    /// limit is a cone about the base's tangent (the kernel's), so it is
+    /// widened by `psi_0`, the bind pose's bend in those frames (small for
+    /// a spine bent evenly at the switch): every bend within the limit of
+    /// the bind shape stays allowed. A switch pose beyond these limits is
+    /// pulled inside them by the first step, as a socket's is.
+    Bind,
+}
+
 /// Options for [`Ragdoll::build`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BuildOptions {
     /// Standard or simplified.
     pub spine: SpineMode,
+    /// Where a simplified ragdoll's rod takes its rest shape and limits
+    /// from.
+    pub rod_rest: RodRest,
     /// Opt-in stabilisation (after Jolt's `Ragdoll::Stabilize`, which
     /// follows Strunk): the largest allowed mass ratio across a joint, and
     /// between a body's largest and smallest principal inertia: finite and
@@ -37,10 +65,12 @@ pub struct BuildOptions {
 }
 
 impl BuildOptions {
-    /// Standard or simplified, not stabilised.
+    /// Standard or simplified, the rod's rest from the switch, not
+    /// stabilised.
     pub fn new(spine: SpineMode) -> Self {
         Self {
             spine,
+            rod_rest: RodRest::Transition,
             stabilise: None,
         }
     }
@@ -253,6 +283,10 @@ impl Ragdoll {
             )
             .with_bend_limit(spine.bend_limit)
             .with_twist_limit(spine.twist_limit[0], spine.twist_limit[1]);
+            let rod = match self.options.rod_rest {
+                RodRest::Transition => rod,
+                RodRest::Bind => measured_from_bind(rod),
+            };
             self.rod = Some(world.add_rod(rod).map_err(in_rod)?);
             self.rod_rest = Some(rod);
         }
@@ -412,6 +446,25 @@ pub(crate) fn rod_name(desc: &RagdollDesc) -> String {
         ),
         None => "spine rod".to_owned(),
     }
+}
+
+/// `rod`'s rest shape and limits measured from the bind pose
+/// ([`RodRest::Bind`]), in its frames. At bind the bodies are unrotated, so
+/// the material frames are `F_a` and `F_b` themselves: the rest direction
+/// is `F_a^-1 t_b`, the rest twist theirs; the twist range moves onto it
+/// and the bend limit widens by their bend.
+fn measured_from_bind(mut rod: RodDesc) -> RodDesc {
+    use core::f32::consts::PI;
+    let (ta, tb) = (rod.frame_a * Vec3::X, rod.frame_b * Vec3::X);
+    let bend = ta.cross(tb).length().atan2(ta.dot(tb));
+    let twist = vertebra_world::rod_twist(rod.frame_a, rod.frame_b);
+    rod.bend_rest = (rod.frame_a.inverse() * tb).normalize();
+    rod.twist_rest = twist;
+    rod.bend_limit = rod.bend_limit.map(|max| (max + bend).min(PI));
+    rod.twist_limit = rod
+        .twist_limit
+        .map(|[lo, hi]| [(twist + lo).max(-PI), (twist + hi).min(PI)]);
+    rod
 }
 
 /// Velocities that carry `from` to `to` in `dt` seconds.

@@ -339,8 +339,8 @@ fn stabilisation_bounds_mass_ratios_and_keeps_the_total() {
     let desc = RagdollDesc::reference_humanoid();
     for spine in [SpineMode::Sockets, SpineMode::Rod] {
         let options = BuildOptions {
-            spine,
             stabilise: Some(2.0),
+            ..BuildOptions::new(spine)
         };
         let masses = body_masses(&desc, &options);
         assert!((masses.iter().sum::<f32>() - 69.0).abs() < 1e-3);

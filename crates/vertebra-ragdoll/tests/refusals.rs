@@ -36,8 +36,8 @@ fn stabilisation_ratios_that_are_no_ratio_are_refused() {
     for ratio in [1e-8, 0.0, f32::NAN, -1.0, 0.5, f32::INFINITY] {
         for spine in [SpineMode::Rod, SpineMode::Sockets] {
             let options = BuildOptions {
-                spine,
                 stabilise: Some(ratio),
+                ..BuildOptions::new(spine)
             };
             let (world, built) = build(&desc, options, &Pose::bind(&desc));
             let message = built.expect_err("refused").to_string();
@@ -50,8 +50,8 @@ fn stabilisation_ratios_that_are_no_ratio_are_refused() {
     }
     // The tightest ratio builds and steps finite.
     let options = BuildOptions {
-        spine: SpineMode::Rod,
         stabilise: Some(1.0),
+        ..BuildOptions::new(SpineMode::Rod)
     };
     let (mut world, built) = build(&desc, options, &Pose::bind(&desc));
     built.unwrap();

@@ -52,7 +52,7 @@ pub use drive::{
 };
 pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist};
 pub use metrics::{JointResidual, Residuals};
-pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent};
+pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
 pub use snapshot::Snapshot;
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{

@@ -398,6 +398,28 @@ pub fn arc_tangent(a: Vec3, m: Vec3, b: Vec3) -> Option<Vec3> {
     Some(if t.dot(u) >= 0.0 { t } else { -t })
 }
 
+/// The rod's twist (rad, in [-pi, pi]) between its material frames
+/// `f0 = q_a F_a` and `f1 = q_b F_b` (unit quaternions, world): the angle
+/// about `t_b` from `f0`, carried by the minimal rotation from `t_a` to
+/// `t_b`, to `f1`. It is the rod kernel's own measure
+/// (`vertebra_kernels::parts::rod::twist::measure`) run on one `f32` lane,
+/// so a rest twist or a mapping computed with it is the twist the solver
+/// sees, to the bit.
+pub fn rod_twist(f0: Quat, f1: Quat) -> f32 {
+    use vertebra_kernels::parts::rod::{Frames, twist};
+    let x = vertebra_math::Vec3::<f32>::from(vertebra_kernels::TWIST_AXIS);
+    let (fa, fb) = (
+        vertebra_math::Quat::<f32>::from(f0),
+        vertebra_math::Quat::<f32>::from(f1),
+    );
+    twist::measure(&Frames {
+        fa,
+        fb,
+        ta: fa.rotate(x),
+        tb: fb.rotate(x),
+    })
+}
+
 /// `sin(x/2) / x`, through the math layer (the kernels' own definition).
 fn half_sinc(x: f32) -> f32 {
     vertebra_math::poly::half_sinc(x)

@@ -1,0 +1,94 @@
+//! Mapping one ragdoll onto a dense (69-bone) animation skeleton against
+//! the step of that ragdoll: the ragdoll drop with one ragdoll at 20
+//! iterations and 1 substep, one thread, one second in. Target: mapping
+//! costs less than the step.
+//! `cargo bench -p vertebra-benches --bench mapper`
+
+#[path = "../crates/vertebra-ragdoll/tests/support/dense.rs"]
+mod dense;
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use vertebra_benches::{DT, drop_scene};
+use vertebra_ragdoll::{SkeletonMapper, SpineMapping, SpineMode, Transform, Transition};
+
+const SPINES: [(&str, SpineMode); 2] = [
+    ("simplified", SpineMode::Rod),
+    ("standard", SpineMode::Sockets),
+];
+
+fn mapping(c: &mut Criterion) {
+    let skeleton = dense::dense_skeleton();
+    let animation = skeleton.bind_pose();
+    let animated = animation.to_model(&skeleton).expect("the bind pose");
+    let mut group = c.benchmark_group("mapper");
+    group.sample_size(20);
+    for (name, spine) in SPINES {
+        let mut scene = drop_scene(spine, 1, 1);
+        let desc = scene.ragdolls[0].description().clone();
+        let mapper = SkeletonMapper::new(&skeleton, &desc, spine).expect("the humanoid's bones");
+        // The solver step alone (contacts found outside the timing).
+        group.bench_function(BenchmarkId::new("step", name), |b| {
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                for _ in 0..iters {
+                    scene.detect(DT).expect("contacts");
+                    let start = Instant::now();
+                    scene.world.step(DT).expect("a step");
+                    total += start.elapsed();
+                }
+                total
+            })
+        });
+        let (world, ragdoll) = (&scene.world, &scene.ragdolls[0]);
+        for (mode, mapping) in [
+            ("map_orientation", SpineMapping::Orientation),
+            ("map_arc", SpineMapping::Arc),
+        ] {
+            group.bench_function(BenchmarkId::new(mode, name), |b| {
+                b.iter(|| {
+                    mapper
+                        .map_to_skeleton(ragdoll, world, &animation, Transform::IDENTITY, mapping)
+                        .expect("mapped")
+                })
+            });
+        }
+        let transition = Transition::new(
+            &mapper,
+            ragdoll,
+            world,
+            &animation,
+            Transform::IDENTITY,
+            SpineMapping::Arc,
+            0.5,
+        )
+        .expect("measured");
+        group.bench_function(BenchmarkId::new("transition_arc", name), |b| {
+            b.iter(|| {
+                transition
+                    .skeleton_pose(
+                        &mapper,
+                        ragdoll,
+                        world,
+                        &animation,
+                        Transform::IDENTITY,
+                        0.1,
+                    )
+                    .expect("mapped")
+            })
+        });
+        group.bench_function(BenchmarkId::new("map_to_ragdoll", name), |b| {
+            b.iter(|| {
+                mapper
+                    .map_to_ragdoll(black_box(&animated), Transform::IDENTITY)
+                    .expect("mapped")
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, mapping);
+criterion_main!(benches);

@@ -1,0 +1,529 @@
+//! The skeleton mapper: a ragdoll's bodies onto an animation skeleton that
+//! has more bones than the ragdoll has bodies, and an animation pose of the
+//! skeleton back onto the bodies (as Jolt's `SkeletonMapper`, with the
+//! paper's section 6 for the bones between two bodies).
+//!
+//! Frames: the description's world frame at bind pose is the skeleton's
+//! model frame (both bind poses are in it, metres, +Y up). A body's pose is
+//! its centre of mass and its rotation relative to bind pose (bodies are
+//! unrotated at bind), in the world; a bone's output is its transform in
+//! the world, the model frame placed by the caller's `model_to_world`.
+//!
+//! Every bone gets one role, fixed when the mapper is made:
+//!
+//! - **body**: a body of the built ragdoll follows it. Its world transform
+//!   is the body's times the fixed offset the two bind poses give.
+//! - **chain**: it lies on the path from a body bone up to the nearest body
+//!   bone above it, with no body bone between (the simplified ragdoll's
+//!   spine bones between the hips and the chest, a neck between the chest
+//!   and the head). The chain is placed by a [`SpineMapping`] from its two
+//!   bodies. A bone on two such paths belongs to the first (by the lower
+//!   body bone's index); the second path is then no chain, and its bones
+//!   that the first does not hold follow their parents.
+//! - **follows**: no body, below a body or chain bone, and in no chain (a
+//!   finger, a twist bone, a toe): it keeps the animation's local
+//!   transform relative to its parent.
+//! - **free**: no body bone above it (a root or motion bone above the
+//!   hips): it keeps the animation's model transform, placed in the world
+//!   by `model_to_world`.
+//!
+//! With locked translations (Jolt's `LockTranslations`) every bone whose
+//! parent is not free takes its animation's local translation relative to
+//! its parent (keeping its rotation), which hides a joint's stretch and a
+//! chain's change of length.
+
+use glam::{Quat, Vec3};
+use vertebra_world::{MAX_COORDINATE, World};
+
+use crate::description::RagdollDesc;
+use crate::error::RagdollError;
+use crate::mapping::{Chain, SpineMapping};
+use crate::pose::Pose;
+use crate::ragdoll::{Ragdoll, SpineMode, rod_name};
+use crate::skeleton::{Bone, LocalPose, ModelPose, Skeleton, Transform};
+
+/// Per described body its world pose (centre of mass, rotation relative to
+/// bind; a simplified ragdoll's interior spine bodies unread), and a
+/// simplified ragdoll's rod's material frames.
+pub(crate) type Bodies = (Vec<(Vec3, Quat)>, Option<(Quat, Quat)>);
+
+/// What places a bone (see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BoneRole {
+    /// Follows this body (index in the description).
+    Body(usize),
+    /// Between body bones `base` and `top` (skeleton indices), placed by
+    /// the spine mapping.
+    Chain {
+        /// The body bone at the chain's base.
+        base: usize,
+        /// The body bone at its top.
+        top: usize,
+    },
+    /// Keeps the animation's local transform relative to its parent.
+    Follows,
+    /// Keeps the animation's model transform.
+    Free,
+}
+
+/// Maps between a ragdoll's bodies and an animation skeleton; made once
+/// per skeleton, description and spine mode.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SkeletonMapper {
+    desc: RagdollDesc,
+    spine: SpineMode,
+    skeleton: Skeleton,
+    /// Per body, its bone.
+    binding: Vec<usize>,
+    /// Per body, its bone's bind transform in the body's frame.
+    offsets: Vec<Transform>,
+    roles: Vec<BoneRole>,
+    chains: Vec<Chain>,
+    lock_translations: bool,
+}
+
+impl SkeletonMapper {
+    /// A mapper where each body follows the bone of its own name (the
+    /// shipped humanoids' bodies are `hips`, `spine_lower`, `spine_upper`,
+    /// `chest`, `head`, `upper_arm_l`, `forearm_l`, ...); refused, naming
+    /// the body, when the skeleton has no such bone.
+    pub fn new(
+        skeleton: &Skeleton,
+        desc: &RagdollDesc,
+        spine: SpineMode,
+    ) -> Result<Self, RagdollError> {
+        let binding: Vec<Option<usize>> = desc
+            .bodies
+            .iter()
+            .map(|b| skeleton.bone_index(&b.name))
+            .collect();
+        Self::with_binding(skeleton, desc, spine, &binding)
+    }
+
+    /// A mapper where body `i` follows bone `bones[i]` (skeleton index).
+    /// Every body needs a bone of its own (a simplified ragdoll's interior
+    /// spine bodies too: the rod is made through their bones); refused,
+    /// naming the body and field, when one has none, one names a bone the
+    /// skeleton lacks or two share a bone.
+    pub fn with_binding(
+        skeleton: &Skeleton,
+        desc: &RagdollDesc,
+        spine: SpineMode,
+        bones: &[Option<usize>],
+    ) -> Result<Self, RagdollError> {
+        let count = skeleton.len();
+        if bones.len() != desc.bodies.len() {
+            return Err(RagdollError::OutOfRange {
+                context: "skeleton mapper".to_owned(),
+                field: "binding",
+                reason: format!(
+                    "has {} entries for {} bodies",
+                    bones.len(),
+                    desc.bodies.len()
+                ),
+            });
+        }
+        let mut binding = Vec::with_capacity(bones.len());
+        let mut owner: Vec<Option<usize>> = vec![None; count];
+        for (b, (&bone, def)) in bones.iter().zip(&desc.bodies).enumerate() {
+            let refuse = |reason: String| RagdollError::OutOfRange {
+                context: format!("body `{}`", def.name),
+                field: "bone",
+                reason,
+            };
+            let bone = match bone {
+                None => {
+                    return Err(refuse(format!(
+                        "is missing: the skeleton has no bone `{}` and every body needs one",
+                        def.name
+                    )));
+                }
+                Some(bone) if bone >= count => {
+                    return Err(refuse(format!("is {bone}; the skeleton has {count} bones")));
+                }
+                Some(bone) => bone,
+            };
+            if let Some(other) = owner[bone] {
+                return Err(refuse(format!(
+                    "is bone {bone} `{}`, which body `{}` follows too",
+                    skeleton.bones()[bone].name,
+                    desc.bodies[other].name
+                )));
+            }
+            owner[bone] = Some(b);
+            binding.push(bone);
+        }
+        let bind = skeleton.bind_pose().to_model(skeleton)?;
+        let offsets = binding
+            .iter()
+            .zip(&desc.bodies)
+            .map(|(&bone, def)| {
+                let t = bind.bones[bone];
+                Transform::new(t.translation - def.centre(), t.rotation)
+            })
+            .collect();
+        // Bodies the built ragdoll has: a simplified ragdoll has no
+        // interior spine bodies, so their bones join the spine's chain.
+        let spine_def = desc.spine.as_ref().filter(|_| spine == SpineMode::Rod);
+        let built =
+            |b: usize| spine_def.is_none_or(|s| !s.bodies[1..s.bodies.len() - 1].contains(&b));
+        let body_of: Vec<Option<usize>> = owner.iter().map(|o| o.filter(|&b| built(b))).collect();
+        let parent = |j: usize| skeleton.bones()[j].parent;
+
+        let mut roles: Vec<Option<BoneRole>> =
+            body_of.iter().map(|b| b.map(BoneRole::Body)).collect();
+        let mut chains = Vec::new();
+        for top in 0..count {
+            let Some(top_body) = body_of[top] else {
+                continue;
+            };
+            let mut interior = Vec::new();
+            let mut at = parent(top);
+            while let Some(j) = at.filter(|&j| body_of[j].is_none()) {
+                interior.push(j);
+                at = parent(j);
+            }
+            let Some(base) = at else {
+                continue; // no body bone above: the bones passed are free
+            };
+            if interior.is_empty() || interior.iter().any(|&j| roles[j].is_some()) {
+                continue;
+            }
+            interior.reverse();
+            for &j in &interior {
+                roles[j] = Some(BoneRole::Chain { base, top });
+            }
+            let base_body = body_of[base].expect("a body bone");
+            let points = core::iter::once(desc.bodies[base_body].centre())
+                .chain(interior.iter().map(|&j| bind.bones[j].translation))
+                .chain(core::iter::once(desc.bodies[top_body].centre()))
+                .collect();
+            let rotations = interior.iter().map(|&j| bind.bones[j].rotation).collect();
+            let rod = spine_def.is_some_and(|s| {
+                s.bodies[0] == base_body && s.bodies[s.bodies.len() - 1] == top_body
+            });
+            chains.push(Chain::new(
+                base_body, top_body, interior, points, rotations, rod,
+            ));
+        }
+        let mut placed: Vec<BoneRole> = Vec::with_capacity(count);
+        for (j, role) in roles.into_iter().enumerate() {
+            let role = role.unwrap_or(match parent(j) {
+                Some(p) if placed[p] != BoneRole::Free => BoneRole::Follows,
+                _ => BoneRole::Free,
+            });
+            placed.push(role);
+        }
+        Ok(Self {
+            desc: desc.clone(),
+            spine,
+            skeleton: skeleton.clone(),
+            binding,
+            offsets,
+            roles: placed,
+            chains,
+            lock_translations: false,
+        })
+    }
+
+    /// A skeleton of one bone per body (at its centre of mass, unrotated
+    /// at bind, parented as the joints are) and the mapper onto it: the
+    /// bodies-as-bones view of [`Ragdoll::skeleton_pose`].
+    pub(crate) fn bodies_as_bones(
+        desc: &RagdollDesc,
+        spine: SpineMode,
+    ) -> Result<(Skeleton, Self), RagdollError> {
+        // Parents before children: the root, then each body once its
+        // parent is in (the joints form a tree over the bodies).
+        let parent_body = |b: usize| desc.parent_joint[b].map(|j| desc.joints[j].parent);
+        let mut order = vec![desc.root];
+        let mut index: Vec<Option<usize>> = vec![None; desc.bodies.len()];
+        index[desc.root] = Some(0);
+        while order.len() < desc.bodies.len() {
+            let before = order.len();
+            for b in 0..desc.bodies.len() {
+                if index[b].is_none() && parent_body(b).is_some_and(|p| index[p].is_some()) {
+                    index[b] = Some(order.len());
+                    order.push(b);
+                }
+            }
+            if order.len() == before {
+                return Err(RagdollError::NotATree(
+                    "a body is not reached from the root".to_owned(),
+                ));
+            }
+        }
+        let bones = order
+            .iter()
+            .map(|&b| {
+                let def = &desc.bodies[b];
+                let parent = parent_body(b);
+                let from = parent.map_or(Vec3::ZERO, |p| desc.bodies[p].centre());
+                Bone {
+                    name: def.name.clone(),
+                    parent: parent.and_then(|p| index[p]),
+                    bind: Transform::new(def.centre() - from, Quat::IDENTITY),
+                }
+            })
+            .collect();
+        let skeleton = Skeleton::new(bones)?;
+        let mapper = Self::with_binding(&skeleton, desc, spine, &index)?;
+        Ok((skeleton, mapper))
+    }
+
+    /// With every bone whose parent is not free keeping the animation's
+    /// local translation (rotations still mapped), as Jolt's
+    /// `LockTranslations`: hides joint stretch and a chain's change of
+    /// length; the body bones then sit where the animation's lengths put
+    /// them, off their bodies by the stretch.
+    pub fn with_locked_translations(mut self, lock: bool) -> Self {
+        self.lock_translations = lock;
+        self
+    }
+
+    /// The skeleton it maps onto.
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
+    }
+
+    /// Per described body, the bone it follows (skeleton index).
+    pub fn binding(&self) -> &[usize] {
+        &self.binding
+    }
+
+    /// Per bone, what places it.
+    pub fn roles(&self) -> &[BoneRole] {
+        &self.roles
+    }
+
+    /// Every body's world pose (centre of mass, rotation relative to bind)
+    /// from an animation pose in model space and the model frame's place
+    /// in the world: for [`Ragdoll::build`] (two of them, a frame apart,
+    /// give the bodies the animation's velocities) and for
+    /// [`Ragdoll::drive_to`] / [`Ragdoll::drive_following`]. Refused,
+    /// naming the bone and field, for a pose that does not fit the
+    /// skeleton.
+    pub fn map_to_ragdoll(
+        &self,
+        animation: &ModelPose,
+        model_to_world: Transform,
+    ) -> Result<Pose, RagdollError> {
+        self.check_bones("animation", &animation.bones)?;
+        model_to_world.validate("model_to_world")?;
+        let bones = self
+            .binding
+            .iter()
+            .zip(&self.offsets)
+            .map(|(&bone, offset)| {
+                let body = model_to_world * animation.bones[bone] * offset.inverse();
+                (body.translation, body.rotation)
+            })
+            .collect();
+        Ok(Pose { bones })
+    }
+
+    /// Every bone's world transform from the ragdoll's bodies in `world`
+    /// and the animation's current local pose (for the bones without a
+    /// body that follow their parents or the model frame). `ragdoll` must
+    /// be built from the mapper's description and spine mode.
+    pub fn map_to_skeleton(
+        &self,
+        ragdoll: &Ragdoll,
+        world: &World,
+        animation: &LocalPose,
+        model_to_world: Transform,
+        mapping: SpineMapping,
+    ) -> Result<ModelPose, RagdollError> {
+        let (bodies, rod_frames) = self.read(ragdoll, world)?;
+        self.map(
+            &bodies,
+            rod_frames,
+            animation,
+            model_to_world,
+            mapping,
+            None,
+        )
+    }
+
+    /// As [`SkeletonMapper::map_to_skeleton`], from bodies given as a pose
+    /// (one entry per described body; a simplified ragdoll's interior
+    /// spine bodies are not read) and, for a simplified ragdoll's arc, its
+    /// rod's material frames (`RodDesc::frame_a`, `frame_b`; without them
+    /// the arc is the one a rod made at bind pose would take).
+    pub fn map_pose_to_skeleton(
+        &self,
+        bodies: &Pose,
+        rod_frames: Option<(Quat, Quat)>,
+        animation: &LocalPose,
+        model_to_world: Transform,
+        mapping: SpineMapping,
+    ) -> Result<ModelPose, RagdollError> {
+        bodies.validate(&self.desc)?;
+        if let Some((a, b)) = rod_frames {
+            for (field, q) in [("rod frame_a", a), ("rod frame_b", b)] {
+                vertebra_world::check_unit_quat(field, q).map_err(|e| RagdollError::World {
+                    context: rod_name(&self.desc),
+                    error: e,
+                })?;
+            }
+        }
+        self.map(
+            &bodies.bones,
+            rod_frames,
+            animation,
+            model_to_world,
+            mapping,
+            None,
+        )
+    }
+
+    /// The bodies' world poses and the rod's frames, read from `world`.
+    pub(crate) fn read(&self, ragdoll: &Ragdoll, world: &World) -> Result<Bodies, RagdollError> {
+        if ragdoll.options.spine != self.spine
+            || ragdoll.desc.name != self.desc.name
+            || ragdoll.desc.bodies.len() != self.desc.bodies.len()
+        {
+            return Err(RagdollError::OutOfRange {
+                context: "skeleton mapper".to_owned(),
+                field: "ragdoll",
+                reason: format!(
+                    "is `{}` ({} bodies, {:?} spine); the mapper was made for `{}` ({} bodies, {:?} spine)",
+                    ragdoll.desc.name,
+                    ragdoll.desc.bodies.len(),
+                    ragdoll.options.spine,
+                    self.desc.name,
+                    self.desc.bodies.len(),
+                    self.spine
+                ),
+            });
+        }
+        let mut bodies = vec![(Vec3::ZERO, Quat::IDENTITY); ragdoll.bodies.len()];
+        for ((out, handle), def) in bodies
+            .iter_mut()
+            .zip(&ragdoll.bodies)
+            .zip(&ragdoll.desc.bodies)
+        {
+            if let Some(h) = handle {
+                let s = world
+                    .body(*h)
+                    .map_err(|e| RagdollError::world(&format!("body `{}`", def.name), e))?;
+                *out = (s.position, s.orientation);
+            }
+        }
+        let rod_frames = match ragdoll.rod {
+            Some(rod) => {
+                let rod = world
+                    .rod(rod)
+                    .map_err(|e| RagdollError::world(&rod_name(&ragdoll.desc), e))?;
+                Some((rod.frame_a, rod.frame_b))
+            }
+            None => None,
+        };
+        Ok((bodies, rod_frames))
+    }
+
+    /// Writes each chain bone's world transform as its chain places it
+    /// into `out` (one entry per bone; other entries untouched).
+    pub(crate) fn place_chains(
+        &self,
+        bodies: &[(Vec3, Quat)],
+        rod_frames: Option<(Quat, Quat)>,
+        mapping: SpineMapping,
+        out: &mut [Transform],
+    ) {
+        for chain in &self.chains {
+            chain.place(
+                mapping,
+                bodies[chain.base],
+                bodies[chain.top],
+                rod_frames,
+                out,
+            );
+        }
+    }
+
+    /// Every bone's world transform, each chain bone `k` moved by
+    /// `corrections.0[k]` scaled by `corrections.1` (in `[0, 1]`) in its
+    /// own frame, before the bones below it are placed.
+    pub(crate) fn map(
+        &self,
+        bodies: &[(Vec3, Quat)],
+        rod_frames: Option<(Quat, Quat)>,
+        animation: &LocalPose,
+        model_to_world: Transform,
+        mapping: SpineMapping,
+        corrections: Option<(&[Transform], f32)>,
+    ) -> Result<ModelPose, RagdollError> {
+        self.check_bones("animation", &animation.bones)?;
+        model_to_world.validate("model_to_world")?;
+        let local = &animation.bones;
+        let mut out = vec![Transform::IDENTITY; self.skeleton.len()];
+        self.place_chains(bodies, rod_frames, mapping, &mut out);
+        for (j, bone) in self.skeleton.bones().iter().enumerate() {
+            let parent = bone.parent.map(|p| out[p]);
+            let placed = match self.roles[j] {
+                BoneRole::Body(b) => {
+                    let (p, q) = bodies[b];
+                    Transform::new(p, q) * self.offsets[b]
+                }
+                BoneRole::Chain { .. } => match corrections {
+                    Some((c, weight)) => out[j] * scaled(c[j], weight),
+                    None => out[j],
+                },
+                BoneRole::Follows | BoneRole::Free => parent.unwrap_or(model_to_world) * local[j],
+            };
+            out[j] = match (parent, bone.parent.map(|p| self.roles[p])) {
+                (Some(parent), Some(role)) if self.lock_translations && role != BoneRole::Free => {
+                    Transform::new(
+                        parent.transform_point(local[j].translation),
+                        placed.rotation,
+                    )
+                }
+                _ => placed,
+            };
+        }
+        Ok(ModelPose { bones: out })
+    }
+
+    /// Checks one transform per bone, each finite, within
+    /// [`MAX_COORDINATE`], with a unit rotation; the error names the bone.
+    pub(crate) fn check_bones(
+        &self,
+        what: &str,
+        transforms: &[Transform],
+    ) -> Result<(), RagdollError> {
+        if transforms.len() != self.skeleton.len() {
+            return Err(RagdollError::BadPose(format!(
+                "{what}: {} transforms for {} bones",
+                transforms.len(),
+                self.skeleton.len()
+            )));
+        }
+        for (i, (t, bone)) in transforms.iter().zip(self.skeleton.bones()).enumerate() {
+            // The common case without formatting a name; the check that
+            // names the field on any doubt.
+            let fits = t.translation.is_finite()
+                && t.translation.abs().max_element() <= MAX_COORDINATE
+                && t.rotation.is_finite()
+                && (t.rotation.length() - 1.0).abs() <= 1e-3;
+            if !fits {
+                t.validate(&format!("{what}: bone {i} `{}`", bone.name))
+                    .map_err(|e| RagdollError::BadPose(e.to_string()))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `t` scaled by `weight` in `[0, 1]`: its translation times `weight`, its
+/// rotation that share of the way from the identity.
+fn scaled(t: Transform, weight: f32) -> Transform {
+    if weight >= 1.0 {
+        t
+    } else {
+        Transform::new(
+            t.translation * weight,
+            Quat::IDENTITY.slerp(t.rotation, weight),
+        )
+    }
+}
