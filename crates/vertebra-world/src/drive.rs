@@ -54,7 +54,10 @@ pub enum DriveStrength {
 pub struct AngularDrive {
     /// b's joint frame relative to a's joint frame (unit quaternion), as
     /// the next step begins. The world advances it by `target_velocity`
-    /// every substep, and writes it back after each step.
+    /// every substep and, while it moves (a nonzero `target_velocity`),
+    /// writes it back after each step; the solver then starts the next
+    /// step from this value (normalised), as a restored snapshot does. A
+    /// still target reads back as it was given.
     pub target: Quat,
     /// The target's angular velocity (rad/s, in a's joint frame); damping
     /// acts on the joint's angular velocity relative to it.

@@ -298,6 +298,86 @@ fn driven_joints_step_on_bit_for_bit_after_restoring() {
     );
 }
 
+/// Steps `a` and `b` `steps` times each: both must give the same hashes
+/// and body bits after every step.
+fn step_alike(a: &mut World, b: &mut World, steps: usize, what: &str) {
+    for k in 0..steps {
+        a.step(DT).unwrap();
+        b.step(DT).unwrap();
+        assert_eq!(a.state_hash(), b.state_hash(), "{what}: step {k}");
+        assert!(body_bits(a) == body_bits(b), "{what}: step {k}");
+    }
+}
+
+#[test]
+fn a_drive_set_back_as_read_changes_nothing_and_dirty_layouts_restore_alike() {
+    for steps in 1..=8 {
+        let mut original = driven_chain();
+        for _ in 0..steps {
+            original.step(DT).unwrap();
+        }
+        // Every drive set back to what `joint` reads: no bit changes.
+        let mut twin = common::world(4, 6);
+        twin.restore(&original.snapshot()).unwrap();
+        twin.step(DT).unwrap();
+        original.step(DT).unwrap();
+        let joints: Vec<_> = twin.joints().collect();
+        for (handle, desc) in joints {
+            twin.set_joint_drive(handle, desc.drive).unwrap();
+        }
+        step_alike(
+            &mut original,
+            &mut twin,
+            10,
+            &format!("set back after {steps}"),
+        );
+        // A joint removed (the layout dirty when the snapshot is taken):
+        // the original lays its drives out again from their descriptions,
+        // as the restored world does.
+        let still = original.joints().last().unwrap().0;
+        original.remove_joint(still).unwrap();
+        let mut copy = common::world(4, 6);
+        copy.restore(&original.snapshot()).unwrap();
+        step_alike(
+            &mut original,
+            &mut copy,
+            10,
+            &format!("removed after {steps}"),
+        );
+        // A joint added back, then a snapshot before any step.
+        let (handle, mut desc) = original.joints().nth(2).unwrap();
+        original.remove_joint(handle).unwrap();
+        desc.drive = desc
+            .drive
+            .map(|d| d.with_target_velocity(Vec3::new(0.0, -2.0, 0.5)));
+        original.add_joint(desc).unwrap();
+        copy.restore(&original.snapshot()).unwrap();
+        step_alike(
+            &mut original,
+            &mut copy,
+            10,
+            &format!("re-added after {steps}"),
+        );
+    }
+}
+
+#[test]
+fn a_still_target_reads_back_as_given() {
+    let mut world = driven_chain();
+    for _ in 0..5 {
+        world.step(DT).unwrap();
+    }
+    let targets: Vec<_> = world
+        .joints()
+        .filter_map(|(_, d)| d.drive)
+        .filter(|d| d.target_velocity == Vec3::ZERO)
+        .map(|d| d.target.to_array().map(f32::to_bits))
+        .collect();
+    let given = [Quat::IDENTITY, still_target(), Quat::from_rotation_x(0.7)]
+        .map(|q| q.to_array().map(f32::to_bits));
+    assert_eq!(targets, given);
+}
+
 /// The child half of the test below: restores the snapshot in the file the
 /// parent names into a fresh world and prints the hashes of 60 steps.
 fn child(path: &str) {
