@@ -259,8 +259,11 @@ impl Ragdoll {
             let driven = rest
                 .with_stiffness(stiffness, stiffness)
                 .with_max_torque(settings.max_torque);
+            let world_error = |e| RagdollError::world(&rod_name(&self.desc), e);
             let driven = match from {
-                Some((prev, dt)) => driven.following(shape(prev), shape(target), dt),
+                Some((prev, dt)) => driven
+                    .following(shape(prev), shape(target), dt)
+                    .map_err(world_error)?,
                 None => {
                     let (bend_rest, twist_rest) = shape(target);
                     RodDesc {
@@ -270,9 +273,7 @@ impl Ragdoll {
                     }
                 }
             };
-            world
-                .set_rod(rod, driven)
-                .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
+            world.set_rod(rod, driven).map_err(world_error)?;
         }
         Ok(())
     }
