@@ -7,7 +7,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use glam::{Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
-    AngularDrive, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointKind,
+    AngularDrive, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointHandle, JointKind,
     LimitSoftness, RodDesc, RodHandle, RodStiffness, Snapshot, SolverConfig, Swing, SwingTwist,
     World,
 };
@@ -402,9 +402,10 @@ fn change(input: &mut Input, state: &mut State) {
     }
 }
 
-/// A small valid world from the input: up to 6 bodies, sockets, rods (the
-/// first, third, ... with moving rest shapes), contacts, some steps and
-/// removals (refused calls skipped).
+/// A small valid world from the input: up to 6 bodies, joints (their
+/// drives' targets moving, but the second's, fourth's, ... still), rods
+/// (the first, third, ... with moving rest shapes), contacts, some steps
+/// and removals (refused calls skipped).
 fn build(input: &mut Input) -> World {
     let mut world = World::new(SolverConfig::default()).expect("a valid config");
     let mut seen = Seen::default();
@@ -415,7 +416,13 @@ fn build(input: &mut Input) -> World {
     }
     for _ in 0..input.pick(6) {
         let _ = match input.pick(3) {
-            0 => add_joint(&mut world, &seen, input).map(|h| seen.joints.push(h)),
+            0 => add_joint(&mut world, &seen, input).and_then(|h| {
+                seen.joints.push(h);
+                match seen.joints.len() % 2 {
+                    0 => still(&mut world, h),
+                    _ => Ok(()),
+                }
+            }),
             1 => add_rod(&mut world, &seen, input).and_then(|h| {
                 seen.rods.push(h);
                 match seen.rods.len() % 2 {
@@ -443,6 +450,48 @@ fn moving(world: &mut World, rod: RodHandle) -> Result<(), vertebra_world::Error
     world.set_rod(rod, desc.with_rest_velocity(Vec3::new(0.4, -1.5, 0.9), 2.5))
 }
 
+/// The joint's drive, if it has one, made still (the input's drives all
+/// move: a tame velocity is never zero).
+fn still(world: &mut World, joint: JointHandle) -> Result<(), vertebra_world::Error> {
+    let Some(drive) = world.joint(joint)?.drive else {
+        return Ok(());
+    };
+    world.set_joint_drive(joint, Some(drive.with_target_velocity(Vec3::ZERO)))
+}
+
+/// Restores `snapshot` (`world`'s own, untouched) into a fresh world, and
+/// after each of 3 steps the world's new snapshot into another: every copy
+/// must step on bit for bit as the world does (equal state hashes after
+/// every step), moving drives and rest shapes included, however many steps
+/// the world had taken. Then puts `world` back to `snapshot`.
+fn continues_bit_for_bit(world: &mut World, snapshot: &Snapshot) {
+    let mut copies: Vec<World> = Vec::new();
+    for k in 0..4 {
+        let mut copy = World::new(SolverConfig::default()).expect("a valid config");
+        let taken = if k == 0 {
+            snapshot.clone()
+        } else {
+            world.snapshot()
+        };
+        copy.restore(&taken)
+            .expect("a world's own snapshot restores");
+        copies.push(copy);
+        world.step(1.0 / 60.0).expect("a valid time step");
+        for (c, copy) in copies.iter_mut().enumerate() {
+            copy.step(1.0 / 60.0).expect("a valid time step");
+            assert_eq!(
+                copy.state_hash(),
+                world.state_hash(),
+                "restored after {c} steps, diverged {} steps later",
+                k - c + 1
+            );
+        }
+    }
+    world
+        .restore(snapshot)
+        .expect("a world's own snapshot restores");
+}
+
 /// `payload` under `header`'s format and build, with a correct checksum.
 fn sealed(header: &[u8], payload: &[u8]) -> Snapshot {
     let mut bytes = header[..16].to_vec();
@@ -451,17 +500,20 @@ fn sealed(header: &[u8], payload: &[u8]) -> Snapshot {
     Snapshot::from_bytes(bytes)
 }
 
-/// Builds a small world from the input, snapshots it, changes the decoded
-/// state (up to 4 field changes: floats to NaN, infinities, huge values;
-/// indices, generations, lineages, lengths, colours) or the payload's bytes
-/// (then re-checksummed), and restores the result into the world and into
-/// a fresh one. Each restore either refuses with a named error and leaves
+/// Builds a small world from the input, snapshots it, checks that fresh
+/// worlds restoring its snapshots step on bit for bit as it does
+/// ([`continues_bit_for_bit`]) and puts it back to the snapshot; then
+/// changes the decoded state (up to 4 field changes: floats to NaN,
+/// infinities, huge values; indices, generations, lineages, lengths,
+/// colours) or the payload's bytes (then re-checksummed), and restores the
+/// result into the world and into a fresh one. Each restore either refuses with a named error and leaves
 /// its world exactly as it was, or accepts, and then 3 steps keep every
 /// body finite without the step's NaN guard firing.
 pub fn snapshot(data: &[u8]) {
     let mut input = Input::new(data);
-    let world = build(&mut input);
+    let mut world = build(&mut input);
     let original = world.snapshot();
+    continues_bit_for_bit(&mut world, &original);
     let (header, payload) = original.as_bytes().split_at(HEADER);
     let mut state: State = postcard::from_bytes(payload).expect("a valid snapshot decodes");
     let encoded = postcard::to_allocvec(&state).expect("encodes");

@@ -224,13 +224,16 @@ impl Ragdoll {
                 continue;
             };
             let end = relative(target, j);
+            let world_error = |e| RagdollError::world(&format!("joint `{}`", j.name), e);
             let mut drive = settings.socket_drive(settings.strength(k), end);
             if let Some((prev, dt)) = from {
-                drive = drive.following(relative(prev, j), end, dt);
+                drive = drive
+                    .following(relative(prev, j), end, dt)
+                    .map_err(world_error)?;
             }
             world
                 .set_joint_drive(*joint, Some(drive))
-                .map_err(|e| RagdollError::world(&format!("joint `{}`", j.name), e))?;
+                .map_err(world_error)?;
         }
         if let (Some(rod), Some(rest), Some(spine)) = (self.rod, self.rod_rest, &self.desc.spine) {
             // A pose's rod shape: `t_b` in a's material frame, and the
@@ -256,8 +259,11 @@ impl Ragdoll {
             let driven = rest
                 .with_stiffness(stiffness, stiffness)
                 .with_max_torque(settings.max_torque);
+            let world_error = |e| RagdollError::world(&rod_name(&self.desc), e);
             let driven = match from {
-                Some((prev, dt)) => driven.following(shape(prev), shape(target), dt),
+                Some((prev, dt)) => driven
+                    .following(shape(prev), shape(target), dt)
+                    .map_err(world_error)?,
                 None => {
                     let (bend_rest, twist_rest) = shape(target);
                     RodDesc {
@@ -267,9 +273,7 @@ impl Ragdoll {
                     }
                 }
             };
-            world
-                .set_rod(rod, driven)
-                .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
+            world.set_rod(rod, driven).map_err(world_error)?;
         }
         Ok(())
     }

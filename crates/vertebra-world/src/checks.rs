@@ -10,6 +10,18 @@ use crate::MAX_ANGULAR_SPEED_LIMIT;
 use crate::drive::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
 use crate::joint::LimitSoftness;
 
+/// The time step a drive or a rod follows an animation over: finite and at
+/// least [`MIN_TIME_STEP`](vertebra_store::MIN_TIME_STEP). A negative one
+/// would turn the target away from the animation, a zero one divide by
+/// zero.
+pub(crate) fn following_time_step(dt: f32) -> Result<(), Error> {
+    vertebra_store::check_positive("following time step", dt)?;
+    if dt < vertebra_store::MIN_TIME_STEP {
+        return Err(Error::OutOfRange("following time step (at least 1e-6 s)"));
+    }
+    Ok(())
+}
+
 /// An angular velocity (rad/s): finite (`what` names it) and at most
 /// [`MAX_ANGULAR_SPEED_LIMIT`] long (`out_of_range` says so). Drives'
 /// target velocities and rods' rest velocities.

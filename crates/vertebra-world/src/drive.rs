@@ -54,7 +54,10 @@ pub enum DriveStrength {
 pub struct AngularDrive {
     /// b's joint frame relative to a's joint frame (unit quaternion), as
     /// the next step begins. The world advances it by `target_velocity`
-    /// every substep, and writes it back after each step.
+    /// every substep and, while it moves (a nonzero `target_velocity`),
+    /// writes it back after each step; the solver then starts the next
+    /// step from this value (normalised), as a restored snapshot does. A
+    /// still target reads back as it was given.
     pub target: Quat,
     /// The target's angular velocity (rad/s, in a's joint frame); damping
     /// acts on the joint's angular velocity relative to it.
@@ -112,13 +115,20 @@ impl AngularDrive {
     /// target is `prev` (b's joint frame relative to a's) as the next step
     /// begins and turns at constant angular velocity to reach `pose` when
     /// it ends, `dt` seconds later (the step's `dt`). Call it every frame
-    /// with the animation's last two poses. A `dt` that is not positive
-    /// and finite gives a velocity the world refuses.
-    pub fn following(mut self, prev: Quat, pose: Quat, dt: f32) -> Self {
+    /// with the animation's last two poses.
+    ///
+    /// `Err` (naming the `following time step`) for a `dt` that is not
+    /// finite or below [`MIN_TIME_STEP`](crate::MIN_TIME_STEP), zero and
+    /// negative ones included: a negative `dt` would turn the target away
+    /// from `pose`. A turn too fast for the world (beyond
+    /// [`MAX_ANGULAR_SPEED_LIMIT`](crate::MAX_ANGULAR_SPEED_LIMIT)) is
+    /// refused when the drive is added or set, as any drive's velocity.
+    pub fn following(mut self, prev: Quat, pose: Quat, dt: f32) -> Result<Self, Error> {
+        crate::checks::following_time_step(dt)?;
         let turn = vertebra_math::Quat::<f32>::from(pose * prev.conjugate());
         self.target = prev;
         self.target_velocity = Vec3::from(turn.to_rotation_vector()) / dt;
-        self
+        Ok(self)
     }
 
     /// Checks the target, its velocity, the strength and the torque limit;

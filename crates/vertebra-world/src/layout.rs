@@ -208,6 +208,16 @@ impl Layout {
         }
     }
 
+    /// Writes a rod's new settings into its lane in place (its bodies
+    /// unchanged), keeping its multipliers.
+    pub fn update_rod(&mut self, slot: usize, desc: &RodDesc, bodies: &BodyStore) {
+        let (block, lane) = self.rods.place[slot];
+        let block = &mut self.rods.blocks[block];
+        let lambdas = (block.bend_lambda[lane], block.twist_lambda[lane]);
+        block.set(lane, &rod_lane(desc, bodies));
+        (block.bend_lambda[lane], block.twist_lambda[lane]) = lambdas;
+    }
+
     /// Measures where every joint's bodies stand as the step begins (the
     /// rows then hold displacements from there): each socket's anchors,
     /// each rod's chord between centres of mass.

@@ -346,11 +346,7 @@ impl World {
         desc.validate()?;
         self.rods[handle.index()] = Some(desc);
         if !self.layout_dirty {
-            let (block, lane) = self.layout.rods.place[handle.index()];
-            let block = &mut self.layout.rods.blocks[block];
-            let lambdas = (block.bend_lambda[lane], block.twist_lambda[lane]);
-            block.set(lane, &layout::rod_lane(&desc, &self.bodies));
-            (block.bend_lambda[lane], block.twist_lambda[lane]) = lambdas;
+            self.layout.update_rod(handle.index(), &desc, &self.bodies);
         }
         Ok(())
     }

@@ -221,16 +221,22 @@ impl RodDesc {
     /// rates to reach `pose` when it ends, `dt` seconds later (the step's
     /// `dt`): the rest direction along the shortest arc, the twist the short
     /// way round. Call it every frame with the animation's last two shapes.
-    /// A `dt` of zero or not finite gives rates the world refuses (check it
-    /// first, as `Ragdoll::drive_following` does).
-    pub fn following(mut self, prev: (Vec3, f32), pose: (Vec3, f32), dt: f32) -> Self {
+    /// `Err` for a `dt` that is not a time step, as
+    /// [`AngularDrive::following`](crate::AngularDrive::following).
+    pub fn following(
+        mut self,
+        prev: (Vec3, f32),
+        pose: (Vec3, f32),
+        dt: f32,
+    ) -> Result<Self, Error> {
+        crate::checks::following_time_step(dt)?;
         let (bend, twist) = prev;
         let turn = vertebra_math::Quat::<f32>::from(Quat::from_rotation_arc(bend, pose.0));
         self.bend_rest = bend;
         self.twist_rest = twist;
         self.bend_rest_velocity = Vec3::from(turn.to_rotation_vector()) / dt;
         self.twist_rest_velocity = vertebra_math::poly::wrap_angle(pose.1 - twist) / dt;
-        self
+        Ok(self)
     }
 
     /// With a largest bend angle (rad).

@@ -6,7 +6,10 @@
 //! their slots, the colouring (its history decides the solve order, so it
 //! is saved, not rebuilt), and the contacts set for the next step. The
 //! block layout is rebuilt from those on the next step, exactly as it was
-//! built before.
+//! built before: between steps every lane holds what its description lays
+//! out (a moving drive target or rod rest is written back after each step
+//! and its lane laid out again from it: `keep_drive_targets` and
+//! `keep_rod_rests` in `step.rs`).
 //!
 //! **Portable.** A snapshot restores into any world of the same build: the
 //! world that took it, or a fresh one in another process or on another

@@ -119,16 +119,27 @@ fn start_drives(world: &mut World, h: f32) {
     }
 }
 
-/// Writes each driven joint's advanced target back to its description,
-/// so that the next step (and a snapshot, and a new layout) starts where
-/// this one ended.
+/// Writes each moving drive's advanced target (a nonzero
+/// `target_velocity`) back to its joint's description, and lays the joint
+/// out again from the description: the next step then starts from the
+/// description, bit for bit as a rebuilt layout (a restored snapshot, a
+/// joint added or removed) starts from it. The lane holds the target
+/// normalised (`AngularDrive::lane`), and normalising an advanced target
+/// again moves it by an ulp in some steps, so the lane kept as it was
+/// would differ from what the description lays out. A still target is
+/// left alone: its description is as given and its lane is the layout's
+/// (the kernel's advance returns it bit for bit). The same rule as
+/// [`keep_rod_rests`].
 fn keep_drive_targets(world: &mut World) {
-    let layout = &world.layout;
+    let layout = &mut world.layout;
     for (slot, desc) in world.joints.iter_mut().enumerate() {
         let Some(desc) = desc.as_mut() else { continue };
         let Some(drive) = desc.drive.as_mut() else {
             continue;
         };
+        if drive.target_velocity == Vec3::ZERO {
+            continue;
+        }
         drive.target = match desc.kind {
             JointKind::Socket(_) => {
                 let (block, lane) = layout.sockets.place[slot];
@@ -140,14 +151,15 @@ fn keep_drive_targets(world: &mut World) {
             }
             JointKind::Fixed => continue,
         };
+        layout.update_joint(slot, desc, &world.bodies);
     }
 }
 
-/// Writes each moving rod's advanced rest shape back to its description,
-/// as [`keep_drive_targets`] does for drives, and lays the description out
-/// again: the next step then starts from the description, bit for bit as a
-/// rebuilt layout (a restored snapshot) starts from it. A still rest is
-/// left alone (its description and lane are as they were).
+/// Writes each moving rod's advanced rest shape back to its description
+/// and lays the rod out again from it, as [`keep_drive_targets`] does for
+/// drives (and for the same reason: the lane holds the rest normalised).
+/// A still rest is left alone (its description and lane are as they
+/// were).
 fn keep_rod_rests(world: &mut World) {
     let layout = &mut world.layout;
     for (slot, desc) in world.rods.iter_mut().enumerate() {
@@ -160,14 +172,14 @@ fn keep_rod_rests(world: &mut World) {
             continue;
         }
         let (block, lane) = layout.rods.place[slot];
-        let block = &mut layout.rods.blocks[block];
+        let block = &layout.rods.blocks[block];
         if bend {
             desc.bend_rest = block.bend_rest.get(lane);
         }
         if twist {
             desc.twist_rest = block.twist_rest[lane];
         }
-        block.set(lane, &crate::layout::rod_lane(desc, &world.bodies));
+        layout.update_rod(slot, desc, &world.bodies);
     }
 }
 

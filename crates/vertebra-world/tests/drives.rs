@@ -11,7 +11,8 @@ use core::f32::consts::TAU;
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    AngularDrive, BodyDesc, BodyHandle, JointDesc, JointHandle, Shape, SolverConfig, World,
+    AngularDrive, BodyDesc, BodyHandle, Error, JointDesc, JointHandle, MIN_TIME_STEP, Shape,
+    SolverConfig, World,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -129,12 +130,37 @@ fn a_drive_tracks_a_rotating_target_without_lag() {
 #[test]
 fn following_two_poses_reaches_the_second_at_the_end_of_the_step() {
     let (prev, pose) = (Quat::from_rotation_z(0.1), Quat::from_rotation_z(0.15));
-    let drive = AngularDrive::rigid(prev).following(prev, pose, DT);
+    let drive = AngularDrive::rigid(prev).following(prev, pose, DT).unwrap();
     let (mut w, ball, socket) = rig(1.0, drive);
     w.step(DT).unwrap();
     let target = w.joint(socket).unwrap().drive.unwrap().target;
     assert!(target.angle_between(pose) < 1e-5);
     assert!((angle(&w, ball) - 0.15).abs() < 1e-5);
+}
+
+#[test]
+fn following_refuses_a_time_step_that_is_not_one() {
+    // A negative dt used to give the velocity that turns the target away
+    // from the pose, accepted by the world.
+    let (prev, pose) = (Quat::from_rotation_z(0.1), Quat::from_rotation_z(0.15));
+    let drive = AngularDrive::spring(prev, 4.0, 1.0);
+    let cases = [
+        (-DT, Error::NonPositive("following time step")),
+        (0.0, Error::NonPositive("following time step")),
+        (-0.0, Error::NonPositive("following time step")),
+        (f32::NAN, Error::NonFinite("following time step")),
+        (f32::INFINITY, Error::NonFinite("following time step")),
+        (
+            1e-7,
+            Error::OutOfRange("following time step (at least 1e-6 s)"),
+        ),
+    ];
+    for (dt, error) in cases {
+        assert_eq!(drive.following(prev, pose, dt), Err(error), "dt {dt}");
+    }
+    let followed = drive.following(prev, pose, MIN_TIME_STEP).unwrap();
+    let speed = 0.05 / MIN_TIME_STEP;
+    assert!((followed.target_velocity.z - speed).abs() < 1e-4 * speed);
 }
 
 /// The largest and the final error (rad) of a drive at rest on target,

@@ -15,7 +15,7 @@ use core::f32::consts::TAU;
 
 use glam::Vec3;
 use vertebra_world::{
-    BodyDesc, BodyHandle, RodDesc, RodHandle, RodStiffness, Shape, SolverConfig, World,
+    BodyDesc, BodyHandle, Error, RodDesc, RodHandle, RodStiffness, Shape, SolverConfig, World,
 };
 
 /// One step is one substep (s): the substep of 10 substeps at 60 Hz.
@@ -230,4 +230,26 @@ fn the_advanced_rest_is_written_back() {
     let twist = w.rod(handle).unwrap().twist_rest;
     let expected = 3.5 - TAU;
     assert!((twist - expected).abs() < 1e-3, "{twist} for {expected}");
+}
+
+#[test]
+fn following_refuses_a_time_step_that_is_not_one() {
+    // A negative dt used to give rates that move the rest away from the
+    // pose, accepted by the world.
+    let (w, _, handle) = rig(RodStiffness::Kirchhoff(1.0));
+    let rod = w.rod(handle).unwrap();
+    let (prev, pose) = ((Vec3::X, 0.0), (Vec3::new(0.8, 0.6, 0.0), 0.2));
+    for (dt, error) in [
+        (-H, Error::NonPositive("following time step")),
+        (0.0, Error::NonPositive("following time step")),
+        (f32::NAN, Error::NonFinite("following time step")),
+        (
+            1e-7,
+            Error::OutOfRange("following time step (at least 1e-6 s)"),
+        ),
+    ] {
+        assert_eq!(rod.following(prev, pose, dt), Err(error), "dt {dt}");
+    }
+    let followed = rod.following(prev, pose, 0.5).unwrap();
+    assert!((followed.twist_rest_velocity - 0.4).abs() < 1e-6);
 }

@@ -7,10 +7,11 @@ mod common;
 
 use std::process::Command;
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use vertebra_math::Backend;
 use vertebra_world::{
-    BackendChoice, BodyDesc, Contact, Error, RodDesc, RodStiffness, Snapshot, SolverConfig, World,
+    AngularDrive, BackendChoice, BodyDesc, Contact, Error, JointDesc, RodDesc, RodStiffness,
+    Snapshot, SolverConfig, World,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -158,6 +159,223 @@ fn another_world_restores_a_snapshot_takes_on_its_handles_and_steps_on_bit_for_b
         assert_eq!(copy.body(own), Err(Error::ForeignHandle("body")));
         assert_eq!(run(&mut copy, 60), run(&mut original, 60), "after {steps}");
     }
+}
+
+/// A unit quaternion whose normalised bits, normalised again, change.
+fn still_target() -> Quat {
+    Quat::from_rotation_y(1.085) * Quat::from_rotation_x(0.40145)
+}
+
+/// A chain of five capsules under a static anchor, driven: its top held by
+/// a rigid pin (a static body and a socket with a rigid drive, as passive
+/// bending holds the hips), then sockets and hinges whose drives' targets
+/// turn (spring and compliance drives, one torque-limited) and, between
+/// them, a socket and a hinge whose drives hold still targets that are not
+/// the identity.
+fn driven_chain() -> World {
+    let mut world = common::world(4, 6);
+    let (bodies, _) = common::hanging_chain(&mut world, Vec3::new(0.0, 4.0, 0.0), 5, 0.35);
+    let top = bodies[1];
+    let at = world.body(top).unwrap().position;
+    let pin_body = world.add_body(BodyDesc::fixed().with_position(at)).unwrap();
+    let pin = JointDesc::socket_at_world_anchor(world.bodies(), pin_body, top, at, Vec3::Y)
+        .unwrap()
+        .with_drive(AngularDrive::rigid(Quat::IDENTITY));
+    world.add_joint(pin).unwrap();
+    let joint = |world: &World, k: usize, hinge: bool| {
+        let upper = Vec3::new(0.0, 4.0 - 0.35 * k as f32, 0.0);
+        let (a, b) = (bodies[k], bodies[k + 1]);
+        match hinge {
+            true => JointDesc::hinge_at_world_anchor(world.bodies(), a, b, upper, Vec3::Z),
+            false => JointDesc::socket_at_world_anchor(world.bodies(), a, b, upper, -Vec3::Y),
+        }
+        .unwrap()
+    };
+    let drives = [
+        (
+            1,
+            false,
+            AngularDrive::spring(Quat::IDENTITY, 6.0, 0.8)
+                .with_target_velocity(Vec3::new(0.3, 1.1, -0.7)),
+        ),
+        (
+            2,
+            true,
+            AngularDrive::spring(Quat::from_rotation_x(0.2), 4.0, 1.0)
+                .with_target_velocity(Vec3::new(1.7, 0.0, 0.0))
+                .with_max_torque(2.0),
+        ),
+        (
+            3,
+            false,
+            // Its glam-normalised target, normalised again, is other bits.
+            AngularDrive::compliant(still_target(), 1e-3, 0.5),
+        ),
+        (
+            4,
+            true,
+            AngularDrive::compliant(Quat::from_rotation_x(-0.4), 2e-3, 0.2)
+                .with_target_velocity(Vec3::new(-0.9, 0.2, 0.0)),
+        ),
+    ];
+    for (k, hinge, drive) in drives {
+        let desc = joint(&world, k, hinge).with_drive(drive);
+        world.add_joint(desc).unwrap();
+    }
+    let still = JointDesc::hinge_at_world_anchor(
+        world.bodies(),
+        pin_body,
+        bodies[5],
+        Vec3::new(0.0, 4.0 - 0.35 * 4.5, 0.0),
+        Vec3::X,
+    )
+    .unwrap()
+    .with_drive(AngularDrive::spring(Quat::from_rotation_x(0.7), 2.0, 0.5));
+    world.add_joint(still).unwrap();
+    world
+        .set_body_velocity(
+            bodies[5],
+            Vec3::new(1.0, 0.0, 0.5),
+            Vec3::new(0.0, 2.0, 0.0),
+        )
+        .unwrap();
+    world
+}
+
+/// Every body slot's pose (each coordinate's low part too) and
+/// velocities, as bits.
+fn body_bits(world: &World) -> Vec<u32> {
+    let b = world.bodies();
+    let vecs = [
+        &b.position[..],
+        b.position_low(),
+        &b.linear_velocity,
+        &b.angular_velocity,
+    ];
+    let vecs = vecs
+        .into_iter()
+        .flat_map(|v| v.iter().flat_map(|v| v.to_array()));
+    let quats = b.orientation.iter().flat_map(|q| q.to_array());
+    vecs.chain(quats).map(f32::to_bits).collect()
+}
+
+#[test]
+fn driven_joints_step_on_bit_for_bit_after_restoring() {
+    // A restored world lays each drive out again from its description
+    // (the target written back after each step): that must be what the
+    // original's lane holds, for moving and still targets alike. Snapshots
+    // after each of the first steps, restored into a fresh world.
+    let bits = |q: Quat| q.to_array().map(f32::to_bits);
+    let once = still_target().normalize();
+    assert_ne!(
+        bits(once.normalize()),
+        bits(once),
+        "the still target's premise"
+    );
+    let mut failed = Vec::new();
+    for steps in 1..=12 {
+        let mut original = driven_chain();
+        for _ in 0..steps {
+            original.step(DT).unwrap();
+        }
+        let mut copy = common::world(4, 6);
+        copy.restore(&original.snapshot()).unwrap();
+        assert_eq!(copy.state_hash(), original.state_hash());
+        let mut same = true;
+        for _ in 0..30 {
+            original.step(DT).unwrap();
+            copy.step(DT).unwrap();
+            same &= copy.state_hash() == original.state_hash();
+            same &= body_bits(&copy) == body_bits(&original);
+        }
+        if !same {
+            failed.push(steps);
+        }
+    }
+    assert!(
+        failed.is_empty(),
+        "diverged after restoring at steps {failed:?}"
+    );
+}
+
+/// Steps `a` and `b` `steps` times each: both must give the same hashes
+/// and body bits after every step.
+fn step_alike(a: &mut World, b: &mut World, steps: usize, what: &str) {
+    for k in 0..steps {
+        a.step(DT).unwrap();
+        b.step(DT).unwrap();
+        assert_eq!(a.state_hash(), b.state_hash(), "{what}: step {k}");
+        assert!(body_bits(a) == body_bits(b), "{what}: step {k}");
+    }
+}
+
+#[test]
+fn a_drive_set_back_as_read_changes_nothing_and_dirty_layouts_restore_alike() {
+    for steps in 1..=8 {
+        let mut original = driven_chain();
+        for _ in 0..steps {
+            original.step(DT).unwrap();
+        }
+        // Every drive set back to what `joint` reads: no bit changes.
+        let mut twin = common::world(4, 6);
+        twin.restore(&original.snapshot()).unwrap();
+        twin.step(DT).unwrap();
+        original.step(DT).unwrap();
+        let joints: Vec<_> = twin.joints().collect();
+        for (handle, desc) in joints {
+            twin.set_joint_drive(handle, desc.drive).unwrap();
+        }
+        step_alike(
+            &mut original,
+            &mut twin,
+            10,
+            &format!("set back after {steps}"),
+        );
+        // A joint removed (the layout dirty when the snapshot is taken):
+        // the original lays its drives out again from their descriptions,
+        // as the restored world does.
+        let still = original.joints().last().unwrap().0;
+        original.remove_joint(still).unwrap();
+        let mut copy = common::world(4, 6);
+        copy.restore(&original.snapshot()).unwrap();
+        step_alike(
+            &mut original,
+            &mut copy,
+            10,
+            &format!("removed after {steps}"),
+        );
+        // A joint added back, then a snapshot before any step.
+        let (handle, mut desc) = original.joints().nth(2).unwrap();
+        original.remove_joint(handle).unwrap();
+        desc.drive = desc
+            .drive
+            .map(|d| d.with_target_velocity(Vec3::new(0.0, -2.0, 0.5)));
+        original.add_joint(desc).unwrap();
+        copy.restore(&original.snapshot()).unwrap();
+        step_alike(
+            &mut original,
+            &mut copy,
+            10,
+            &format!("re-added after {steps}"),
+        );
+    }
+}
+
+#[test]
+fn a_still_target_reads_back_as_given() {
+    let mut world = driven_chain();
+    for _ in 0..5 {
+        world.step(DT).unwrap();
+    }
+    let targets: Vec<_> = world
+        .joints()
+        .filter_map(|(_, d)| d.drive)
+        .filter(|d| d.target_velocity == Vec3::ZERO)
+        .map(|d| d.target.to_array().map(f32::to_bits))
+        .collect();
+    let given = [Quat::IDENTITY, still_target(), Quat::from_rotation_x(0.7)]
+        .map(|q| q.to_array().map(f32::to_bits));
+    assert_eq!(targets, given);
 }
 
 /// The child half of the test below: restores the snapshot in the file the
