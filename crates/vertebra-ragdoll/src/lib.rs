@@ -37,6 +37,7 @@
 //! # }
 //! ```
 
+mod assemble;
 mod description;
 mod drive;
 mod drive_def;
@@ -47,12 +48,21 @@ mod motion;
 mod pose;
 mod ragdoll;
 mod skeleton;
+mod skeleton_file;
+mod spec;
+mod text;
+mod write;
 
-pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
+pub use description::{
+    ANATOMICAL_HUMANOID, BodyDef, BoneBinding, REFERENCE_HUMANOID, RagdollDesc, SpineDef,
+};
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
-pub use joint_def::JointDef;
+pub use joint_def::{JointDef, JointFrame, JointSpec};
 pub use mapping::SpineMapping;
 pub use pose::Pose;
 pub use ragdoll::{BuildOptions, Ragdoll, SpineMode, body_masses};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
+pub use skeleton_file::REFERENCE_SKELETON;
+pub use spec::{BodyShape, BodySpec, RagdollBuilder, SpineSpec};
+pub use text::MAX_FILE_BYTES;
