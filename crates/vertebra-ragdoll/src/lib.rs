@@ -6,6 +6,13 @@
 //! ragdoll has bodies. The format and the mapping modes are documented in
 //! `docs/ragdolls.md`.
 //!
+//! A description may follow an animation skeleton ([`Skeleton`]: a file
+//! of `[[bone]]` tables, inline or next to the ragdoll file; the shipped
+//! [`Skeleton::reference`] fits both humanoids), each body bound to a bone
+//! ([`BoneBinding`]) or placed from one bone to another; it may be built in
+//! code ([`RagdollDesc::builder`]), checked by hand
+//! ([`RagdollDesc::validate`]) and written back ([`RagdollDesc::to_toml`]).
+//!
 //! How an engine wires it in, once per character:
 //!
 //! ```
