@@ -1,7 +1,9 @@
 //! `vertebra`: reproduce the paper's results on the reference humanoid
-//! (`vertebra reproduce`), or run one scene, the paper's or one on the
-//! anatomical humanoid (`vertebra scene NAME ...`).
+//! (`vertebra reproduce`), run one scene, the paper's or one on the
+//! anatomical humanoid (`vertebra scene NAME ...`), or check a ragdoll or
+//! skeleton file (`vertebra check FILE`).
 
+mod check;
 mod output;
 mod plots;
 mod reproduce;
@@ -89,6 +91,13 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Checks a ragdoll file (with its skeleton) or a skeleton file and
+    /// prints what it holds, or the problem with its file and line.
+    Check {
+        /// A ragdoll file (`[[body]]` tables) or a skeleton file (`[[bone]]`
+        /// tables only), TOML, at most 1 MiB.
+        file: PathBuf,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -141,6 +150,10 @@ fn main() -> ExitCode {
 fn execute(command: Command) -> Result<(), String> {
     match command {
         Command::Reproduce { out, seeds } => reproduce::reproduce(&out, seeds),
+        Command::Check { file } => {
+            print!("{}", check::check(&file)?);
+            Ok(())
+        }
         Command::Scene {
             name,
             spine,

@@ -463,3 +463,117 @@ fn the_new_scenes_run_by_name_and_report_their_figures() {
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.contains("largest limit violation"), "{stdout}");
 }
+
+/// A shipped model file.
+fn model(name: &str) -> String {
+    format!(
+        "{}/../vertebra-ragdoll/models/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+#[test]
+fn check_prints_what_a_ragdoll_file_holds() {
+    let (code, stdout, stderr) = vertebra(&["check", &model("anatomical.toml")]);
+    assert_eq!(code, 0, "{stderr}");
+    // The file's own numbers: 13 bodies and 12 joints, 69 kg, the hips
+    // 11 kg, knees hinged 0 to 150 degrees, shoulders elliptical 90 by 70,
+    // the spine's rod limits, the [drive] table, no skeleton.
+    for expected in [
+        "ragdoll `anatomical-humanoid`: 13 bodies, 12 joints, 69 kg",
+        "hips ",
+        "11 kg  radius 0.1 m\n",
+        "hinge   thigh_l -> shin_l  range 0 .. 150 deg",
+        "socket  chest -> upper_arm_l  swing ellipse y 90 z 70 deg, twist -60 .. 60 deg",
+        "spine: hips, spine_lower, spine_upper, chest (one rod in the simplified ragdoll): bend 60 deg, twist -30 .. 30 deg, stiffness 2 / 2 N m^2",
+        "drive: spring 4 Hz, damping ratio 1, max torque 400 N m",
+        "skeleton: none",
+    ] {
+        assert!(stdout.contains(expected), "`{expected}` in\n{stdout}");
+    }
+}
+
+#[test]
+fn check_prints_what_a_skeleton_file_holds_and_a_ragdoll_its_bones() {
+    let (code, stdout, stderr) = vertebra(&["check", &model("skeleton.toml")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("skeleton: 63 bones, 1 root\n"), "{stdout}");
+    // The hips 1 m up, the chest 1.45 m, the left toes at (0.1, 0.04, 0.08)
+    // (the foot turned so it points forward and down, 3-4-5).
+    for expected in ["(0, 1, 0)", "(0, 1.45, 0)", "toes_l", "(0.1, 0.04, 0.08)"] {
+        assert!(stdout.contains(expected), "`{expected}` in\n{stdout}");
+    }
+    // A ragdoll file naming a skeleton file next to it.
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(model("skeleton.toml"), dir.join("skeleton.toml")).unwrap();
+    let text = vertebra_ragdoll::REFERENCE_HUMANOID.replacen(
+        "total_mass = 69.0",
+        "total_mass = 69.0\nskeleton = \"skeleton.toml\"",
+        1,
+    );
+    let ragdoll = dir.join("humanoid.toml");
+    std::fs::write(&ragdoll, text).unwrap();
+    let (code, stdout, stderr) = vertebra(&["check", ragdoll.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    for expected in [
+        "bone forearm_l",
+        "skeleton: 63 bones, 13 followed by a body",
+        "socket  hips -> spine_lower  swing 20 deg, twist -10 .. 10 deg",
+    ] {
+        assert!(stdout.contains(expected), "`{expected}` in\n{stdout}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn check_names_the_file_and_line_of_a_problem() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_owned()
+    };
+    let humanoid = vertebra_ragdoll::REFERENCE_HUMANOID;
+    let line = humanoid[..humanoid.find("[[body]]\nname = \"hips\"").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
+    let ragdoll = write(
+        "bad.toml",
+        &humanoid.replacen("mass = 11.0", "mass = nan", 1),
+    );
+    fails_with(
+        &["check", &ragdoll],
+        &format!("vertebra: {ragdoll}: line {line}: body `hips`: mass is not finite"),
+    );
+    let skeleton = write(
+        "bones.toml",
+        "[[bone]]\nname = \"root\"\ntranslation = [0.0, 0.0, 0.0]\n\n[[bone]]\nname = \"hips\"\nparent = \"pelvis\"\ntranslation = [0.0, 1.0, 0.0]\n",
+    );
+    fails_with(
+        &["check", &skeleton],
+        &format!("{skeleton}: line 5: bone `hips`: parent `pelvis` is not a bone of the skeleton"),
+    );
+    let broken = write(
+        "broken.toml",
+        "[[bone]]\nname = \"root\"\ntranslation = [0.0, 0.0\n",
+    );
+    fails_with(
+        &["check", &broken],
+        &format!("{broken}: malformed skeleton file: line 3"),
+    );
+    let neither = write("neither.toml", "name = \"x\"\n");
+    fails_with(
+        &["check", &neither],
+        &format!(
+            "{neither}: neither a ragdoll file ([[body]] tables) nor a skeleton file ([[bone]] tables)"
+        ),
+    );
+    fails_with(
+        &["check", "/dev/zero"],
+        "/dev/zero: cannot read the ragdoll file: larger than 1048576 bytes",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

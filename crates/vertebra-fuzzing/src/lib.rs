@@ -15,8 +15,10 @@
 //!   the step's NaN guard never needed.
 //! - [`world_settings`]: the same on a world with arbitrary solver
 //!   settings (speed limits up to their ceilings, gravity, push-out).
-//! - [`ragdoll_loader`]: arbitrary bytes as a ragdoll file: an error or a
-//!   ragdoll that builds, never a panic.
+//! - [`ragdoll_loader`]: arbitrary bytes as a ragdoll file (alone and on
+//!   the reference skeleton) and as a skeleton file: an error, or a
+//!   description or skeleton that reads back from its TOML as itself and a
+//!   ragdoll that builds; never a panic.
 //! - [`collisions`]: bodies, colliders and ragdolls added and removed, the
 //!   world and the collision set saved and restored (also from crafted
 //!   bytes), steps with detection: a refused call changes nothing, no

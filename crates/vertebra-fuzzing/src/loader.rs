@@ -1,23 +1,61 @@
-//! Arbitrary bytes as a ragdoll file.
+//! Arbitrary bytes as a ragdoll file or a skeleton file.
 
-use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
+use std::sync::OnceLock;
+
+use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, Skeleton, SpineMode};
 use vertebra_world::{SolverConfig, World};
 
-/// Arbitrary bytes (as UTF-8, lossily) through the TOML loader: an error,
-/// or a description that builds both ways, is driven by its own drive
-/// settings, and steps to a finite state without the step's NaN guard.
+/// The reference skeleton, parsed once.
+fn reference() -> &'static Skeleton {
+    static REFERENCE: OnceLock<Skeleton> = OnceLock::new();
+    REFERENCE.get_or_init(Skeleton::reference)
+}
+
+/// Arbitrary bytes (as UTF-8, lossily) through the TOML loaders. As a
+/// skeleton file: an error, or a skeleton that reads back from its TOML
+/// as itself and converts to model space. As a ragdoll file, alone and on
+/// the reference skeleton: an error, or a description that validates,
+/// reads back from its TOML as itself, builds both ways, is driven by its
+/// own drive settings, and steps to a finite state without the step's NaN
+/// guard.
 pub fn ragdoll_loader(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
-    let Ok(desc) = RagdollDesc::from_toml(&text) else {
-        return;
-    };
+    if let Ok(skeleton) = Skeleton::from_toml(&text) {
+        assert_eq!(
+            Skeleton::from_toml(&skeleton.to_toml()).as_ref(),
+            Ok(&skeleton),
+            "a skeleton reads back from its TOML as itself"
+        );
+        skeleton
+            .bind_pose()
+            .to_model(&skeleton)
+            .expect("a loaded skeleton's bind pose converts to model space");
+    }
+    let alone = RagdollDesc::from_toml(&text);
+    let on_bones = RagdollDesc::from_toml_with_skeleton(&text, reference());
+    for desc in [&alone, &on_bones].into_iter().flatten() {
+        assert_eq!(desc.validate(), Ok(()), "a loaded description validates");
+        assert_eq!(
+            RagdollDesc::from_toml(&desc.to_toml()).as_ref(),
+            Ok(desc),
+            "a description reads back from its TOML as itself"
+        );
+    }
+    // The skeleton changes the bodies only where they are placed from bones
+    // (which needs it): build the one that loaded, alone first.
+    if let Some(desc) = alone.ok().or(on_bones.ok()) {
+        build(&desc);
+    }
+}
+
+fn build(desc: &RagdollDesc) {
     for spine in [SpineMode::Sockets, SpineMode::Rod] {
         let mut world = World::new(SolverConfig::default()).expect("the default config is valid");
         let built = Ragdoll::build(
             &mut world,
-            &desc,
+            desc,
             BuildOptions::new(spine),
-            &Pose::bind(&desc),
+            &Pose::bind(desc),
             None,
         );
         let Ok(ragdoll) = built else {
@@ -31,7 +69,7 @@ pub fn ragdoll_loader(data: &[u8]) {
         // Drive settings the loader accepted drive the ragdoll.
         if let Some(drive) = &desc.drive {
             ragdoll
-                .drive_to(&mut world, &Pose::bind(&desc), drive)
+                .drive_to(&mut world, &Pose::bind(desc), drive)
                 .expect("accepted drive settings drive the ragdoll");
         }
         for _ in 0..4 {

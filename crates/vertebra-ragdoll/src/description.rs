@@ -1,23 +1,32 @@
 //! The ragdoll description format (`docs/ragdolls.md`): TOML with bodies as
-//! capsules, joints (sockets with swing and twist limits, hinges, fixed
-//! joints: `joint_def.rs`), and an
-//! optional `[spine]` chain that the simplified ragdoll replaces by a rod.
+//! capsules (given by a segment, or from one bone of the skeleton to
+//! another), joints (sockets with swing and twist limits, hinges, fixed
+//! joints: `joint_def.rs`), an optional `[spine]` chain that the simplified
+//! ragdoll replaces by a rod, an optional `[drive]`, and an optional
+//! skeleton (`[[bone]]` tables, or a skeleton file) the bodies follow.
 //! Units in the file: metres, kilograms, degrees; here: metres, kilograms,
 //! radians.
+//!
+//! A file is read into specs (what [`RagdollDesc::builder`] takes too) and
+//! assembled (`assemble.rs`): one path, one set of checks, whichever way a
+//! description is made.
 
-use std::collections::HashMap;
-use std::io::Read;
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
-use vertebra_world::{Shape, check_coordinate};
+use vertebra_world::Shape;
 
+use crate::assemble::{Document, Item, assemble};
 use crate::drive::DriveSettings;
 use crate::drive_def::{RawDrive, drive_settings};
 use crate::error::RagdollError;
-use crate::joint_def::{JointDef, RawJoint, joint};
+use crate::joint_def::{JointDef, RawJoint, joint_spec};
+use crate::skeleton::{Skeleton, Transform};
+use crate::skeleton_file::{RawBone, bones};
+use crate::spec::{BodyShape, BodySpec, SpineSpec};
+use crate::text::{Lines, in_file, item, read_text, syntax};
 
 /// The reference humanoid, shipped with the crate: 13 bodies, 12 joints,
 /// a 4-body spine.
@@ -28,17 +37,14 @@ pub const REFERENCE_HUMANOID: &str = include_str!("../models/humanoid.toml");
 /// hips and spine joints, and a neck (`models/anatomical.toml`).
 pub const ANATOMICAL_HUMANOID: &str = include_str!("../models/anatomical.toml");
 
-/// The largest ragdoll file [`RagdollDesc::from_file`] reads (bytes): the
-/// reference humanoid is 5 KB and a body or joint about 150 bytes, so
-/// 1 MiB holds thousands; a larger file (or `/dev/zero`) is refused before
-/// it is read whole.
-pub const MAX_FILE_BYTES: u64 = 1 << 20;
-
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawFile {
     name: String,
     total_mass: Option<f32>,
+    skeleton: Option<Spanned<String>>,
+    #[serde(default)]
+    bone: Vec<Spanned<RawBone>>,
     body: Vec<Spanned<RawBody>>,
     #[serde(default)]
     joint: Vec<Spanned<RawJoint>>,
@@ -50,9 +56,22 @@ struct RawFile {
 #[serde(deny_unknown_fields)]
 struct RawBody {
     name: String,
-    segment: [[f32; 3]; 2],
+    segment: Option<[[f32; 3]; 2]>,
+    from: Option<String>,
+    to: Option<String>,
     radius: f32,
     mass: f32,
+    bone: Option<String>,
+    offset: Option<RawTransform>,
+}
+
+/// `offset = { translation = [x, y, z], rotation = [x, y, z, w] }`, each
+/// part optional (zero, identity).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTransform {
+    translation: Option<[f32; 3]>,
+    rotation: Option<[f32; 4]>,
 }
 
 #[derive(Deserialize)]
@@ -77,12 +96,35 @@ pub struct BodyDef {
     pub radius: f32,
     /// Mass (kg).
     pub mass: f32,
+    /// The skeleton bone this body follows, if the description has a
+    /// skeleton and the body a bone.
+    pub bone: Option<BoneBinding>,
+}
+
+/// Which bone of the description's skeleton a body follows, and where the
+/// body sits on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoneBinding {
+    /// The bone's index in [`RagdollDesc::skeleton`].
+    pub bone: usize,
+    /// The body's frame (its centre of mass, and the world's axes at bind
+    /// pose) in the bone's frame: the body's world transform is the bone's
+    /// model transform times `offset` (then the model's placement in the
+    /// world). Unless the file gives one, it is what the two bind poses
+    /// give: the bone's bind model transform, inverted, times the body's.
+    pub offset: Transform,
 }
 
 impl BodyDef {
     /// The centre of mass at bind pose (m, world).
     pub fn centre(&self) -> Vec3 {
         (self.segment[0] + self.segment[1]) * 0.5
+    }
+
+    /// The body's frame at bind pose: its centre of mass (m, world) and the
+    /// world's axes.
+    pub fn bind_frame(&self) -> Transform {
+        Transform::new(self.centre(), Quat::IDENTITY)
     }
 
     /// The capsule in its body frame (centred on the centre of mass).
@@ -114,7 +156,8 @@ pub struct SpineDef {
 }
 
 /// A validated ragdoll description: names unique, joints a tree over the
-/// bodies rooted at body `root`, every number finite and in range.
+/// bodies rooted at body `root`, every number finite and in range, each
+/// bone followed by at most one body.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RagdollDesc {
     /// The model's name.
@@ -132,6 +175,10 @@ pub struct RagdollDesc {
     /// How the ragdoll is driven toward an animation pose (the file's
     /// `[drive]` table, with each joint's own strength), if the file says.
     pub drive: Option<DriveSettings>,
+    /// The animation skeleton the bodies follow ([`BodyDef::bone`]), its
+    /// model frame the description's world frame at bind pose; if the
+    /// description has one.
+    pub skeleton: Option<Skeleton>,
 }
 
 pub(crate) fn finite(
@@ -166,6 +213,17 @@ pub(crate) fn range(
     }
 }
 
+/// Where a file's skeleton may come from besides its own `[[bone]]`
+/// tables.
+enum Given<'a> {
+    /// Nothing: a `skeleton = "file"` cannot be found.
+    Nothing,
+    /// The ragdoll file's directory, where `skeleton = "file"` is found.
+    Dir(&'a Path),
+    /// A skeleton from the caller.
+    Skeleton(&'a Skeleton),
+}
+
 impl RagdollDesc {
     /// The reference humanoid (`models/humanoid.toml`).
     pub fn reference_humanoid() -> Self {
@@ -178,86 +236,116 @@ impl RagdollDesc {
     }
 
     /// Reads, parses and validates a description file of at most
-    /// [`MAX_FILE_BYTES`]; every error names the file (and the line, where
+    /// [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES), with the skeleton file
+    /// it names (`skeleton = "skeleton.toml"`, relative to the ragdoll
+    /// file's directory); every error names the file (and the line, where
     /// there is one).
     pub fn from_file(path: &Path) -> Result<Self, RagdollError> {
-        let in_file = |error| RagdollError::File {
-            path: path.display().to_string(),
-            error: Box::new(error),
-        };
-        let unreadable = |reason: String| in_file(RagdollError::Unreadable(reason));
-        let mut bytes = Vec::new();
-        std::fs::File::open(path)
-            .and_then(|file| file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
-            .map_err(|e| unreadable(e.to_string()))?;
-        if bytes.len() as u64 > MAX_FILE_BYTES {
-            return Err(unreadable(format!(
-                "larger than {MAX_FILE_BYTES} bytes; a ragdoll file is a few KB"
-            )));
-        }
-        let text = String::from_utf8(bytes).map_err(|e| {
-            unreadable(format!(
-                "not UTF-8 text (at byte {})",
-                e.utf8_error().valid_up_to()
-            ))
-        })?;
-        Self::from_toml(&text).map_err(in_file)
+        let text = read_text(path, "ragdoll")?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        Self::parse(&text, Given::Dir(dir)).map_err(|e| in_file(path, e))
     }
 
-    /// Parses and validates a description. Errors about a body, joint or
-    /// the spine start with the line where it is defined.
+    /// Parses and validates a description. Errors about a body, joint,
+    /// bone or the spine start with the line where it is defined. A file
+    /// that names a skeleton file is refused: only
+    /// [`RagdollDesc::from_file`] knows where to look for it.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
+        Self::parse(text, Given::Nothing)
+    }
+
+    /// Parses and validates a description whose bodies follow the bones of
+    /// `skeleton` (its model frame the file's world frame at bind pose):
+    /// each body the bone of its name unless it says `bone = "..."`, and
+    /// bodies may be defined `from` one bone `to` another. A file that
+    /// carries its own skeleton is refused.
+    pub fn from_toml_with_skeleton(text: &str, skeleton: &Skeleton) -> Result<Self, RagdollError> {
+        Self::parse(text, Given::Skeleton(skeleton))
+    }
+
+    fn parse(text: &str, given: Given<'_>) -> Result<Self, RagdollError> {
         let lines = Lines::new(text);
-        let raw: RawFile = toml::from_str(text).map_err(|e| syntax(&lines, &e))?;
+        let raw: RawFile = toml::from_str(text).map_err(|e| syntax("ragdoll", &lines, &e))?;
         let at = |span: core::ops::Range<usize>| lines.at(span.start);
+        let inline = if raw.bone.is_empty() {
+            None
+        } else {
+            Some(bones(&raw.bone, &lines)?)
+        };
+        let refuse = |line: Option<usize>, reason: &str| RagdollError::OutOfRange {
+            context: item(line, "ragdoll"),
+            field: "skeleton",
+            reason: reason.to_owned(),
+        };
+        let named = raw.skeleton.as_ref().map(|s| (s.get_ref(), at(s.span())));
+        let skeleton = match (inline, named, given) {
+            (Some(_), Some((_, line)), _) => {
+                return Err(refuse(
+                    Some(line),
+                    "names a file, and the file has [[bone]] tables too; give one skeleton",
+                ));
+            }
+            (Some(_), None, Given::Skeleton(_)) | (None, Some(_), Given::Skeleton(_)) => {
+                return Err(refuse(
+                    None,
+                    "is given twice: the file has its own, and from_toml_with_skeleton gives one",
+                ));
+            }
+            (None, Some((_, line)), Given::Nothing) => {
+                return Err(refuse(
+                    Some(line),
+                    "names a file, which only RagdollDesc::from_file finds (relative to the ragdoll file)",
+                ));
+            }
+            (None, Some((file, _)), Given::Dir(dir)) => Some(Skeleton::from_file(&dir.join(file))?),
+            (None, None, Given::Skeleton(given)) => Some(given.clone()),
+            (inline, None, _) => inline,
+        };
         let bodies = raw
             .body
             .iter()
-            .map(|b| body(b.get_ref(), at(b.span())))
+            .map(|b| {
+                let line = at(b.span());
+                let context = item(Some(line), &format!("body `{}`", b.get_ref().name));
+                body_spec(b.get_ref(), &context).map(|value| Item::at(value, line))
+            })
             .collect::<Result<Vec<_>, _>>()?;
-        let index = names(
-            &raw.body
-                .iter()
-                .map(|b| (b.get_ref().name.as_str(), at(b.span())))
-                .collect::<Vec<_>>(),
-            "body",
-        )?;
-        names(
-            &raw.joint
-                .iter()
-                .map(|j| (j.get_ref().name.as_str(), at(j.span())))
-                .collect::<Vec<_>>(),
-            "joint",
-        )?;
         let joints = raw
             .joint
             .iter()
-            .map(|j| joint(j.get_ref(), at(j.span()), &index))
+            .map(|j| {
+                let line = at(j.span());
+                let context = item(Some(line), &format!("joint `{}`", j.get_ref().name));
+                joint_spec(j.get_ref(), &context).map(|value| Item::at(value, line))
+            })
             .collect::<Result<Vec<_>, _>>()?;
-        let (root, parent_joint) = tree(&bodies, &joints)?;
-        let spine = raw
-            .spine
+        let spine = raw.spine.as_ref().map(|s| {
+            let r = s.get_ref();
+            let value = SpineSpec {
+                bodies: r.bodies.clone(),
+                bend_limit: r.bend_limit.to_radians(),
+                twist_limit: r.twist_limit.map(f32::to_radians),
+                bend_stiffness: r.bend_stiffness,
+                twist_stiffness: r.twist_stiffness,
+            };
+            Item::at(value, at(s.span()))
+        });
+        let drive = raw
+            .drive
             .as_ref()
-            .map(|s| spine(s.get_ref(), at(s.span()), &index, &joints, &parent_joint))
+            .map(|d| {
+                let line = at(d.span());
+                drive_settings(d.get_ref(), &item(Some(line), "[drive]"))
+                    .map(|value| Item::at(value, line))
+            })
             .transpose()?;
-        if let Some(total) = raw.total_mass {
-            finite("ragdoll", "total_mass", &[total])?;
-            let sum: f32 = bodies.iter().map(|b| b.mass).sum();
-            range(
-                "ragdoll",
-                "total_mass",
-                (sum - total).abs() <= 1e-3 * total.abs().max(1.0),
-                &format!("is {total} but the bodies weigh {sum}"),
-            )?;
-        }
-        let drive = drive(raw.drive.as_ref(), &joints, at)?;
-        Ok(Self {
+        assemble(Document {
             name: raw.name,
+            total_mass: raw.total_mass,
+            skeleton,
             bodies,
             joints,
             spine,
-            root,
-            parent_joint,
             drive,
         })
     }
@@ -267,244 +355,61 @@ impl RagdollDesc {
         self.bodies.iter().position(|b| b.name == name)
     }
 
-    /// Total mass (kg).
+    /// The body that follows bone `bone` (an index into
+    /// [`RagdollDesc::skeleton`]), if one does.
+    pub fn body_on_bone(&self, bone: usize) -> Option<usize> {
+        self.bodies
+            .iter()
+            .position(|b| b.bone.is_some_and(|binding| binding.bone == bone))
+    }
+
+    /// Total mass (kg): the sum of the bodies' masses (a file's
+    /// `total_mass` has scaled them to it).
     pub fn total_mass(&self) -> f32 {
         self.bodies.iter().map(|b| b.mass).sum()
     }
 }
 
-/// Where a text's lines end, to name the line of a byte offset.
-struct Lines(Vec<usize>);
-
-impl Lines {
-    fn new(text: &str) -> Self {
-        Self(text.match_indices('\n').map(|(at, _)| at).collect())
-    }
-
-    /// The line (from 1) of byte `offset`.
-    fn at(&self, offset: usize) -> usize {
-        self.0.partition_point(|&end| end < offset) + 1
-    }
-}
-
-/// A parse error on one line: where, and what (without the source excerpt).
-fn syntax(lines: &Lines, e: &toml::de::Error) -> RagdollError {
-    let message = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
-    match e.span() {
-        Some(span) => RagdollError::Syntax(format!("line {}: {message}", lines.at(span.start))),
-        None => RagdollError::Syntax(message),
-    }
-}
-
-/// Indexes `(name, line)` pairs by name; a name used twice is refused at
-/// its second line.
-fn names(
-    names: &[(&str, usize)],
-    kind: &'static str,
-) -> Result<HashMap<String, usize>, RagdollError> {
-    let mut index = HashMap::new();
-    for (i, &(n, line)) in names.iter().enumerate() {
-        if index.insert(n.to_owned(), i).is_some() {
-            return Err(RagdollError::DuplicateName {
-                line,
-                kind,
-                name: n.to_owned(),
-            });
+/// A `[[body]]` table as a spec: placed by `segment` or `from` and `to`
+/// bones (one or the other), with an optional bone and offset.
+fn body_spec(b: &RawBody, context: &str) -> Result<BodySpec, RagdollError> {
+    let missing = |field, reason: &str| RagdollError::OutOfRange {
+        context: context.to_owned(),
+        field,
+        reason: reason.to_owned(),
+    };
+    let shape = match (b.segment, &b.from, &b.to) {
+        (Some(segment), None, None) => BodyShape::Segment(segment.map(Vec3::from)),
+        (Some(_), _, _) => {
+            return Err(missing(
+                "segment",
+                "and from/to both place the body; give one or the other",
+            ));
         }
-    }
-    Ok(index)
-}
-
-/// A body's segment within the world's coordinate range, and a capsule the
-/// world accepts at its mass (size within `SIZE_RANGE`, mass within
-/// `MASS_RANGE`, invertible inertia), so building it cannot fail on them.
-fn body(b: &RawBody, line: usize) -> Result<BodyDef, RagdollError> {
-    let context = format!("line {line}: body `{}`", b.name);
-    finite(&context, "segment", b.segment.as_flattened())?;
-    finite(&context, "radius", &[b.radius])?;
-    finite(&context, "mass", &[b.mass])?;
-    range(&context, "mass", b.mass > 0.0, "must be positive")?;
-    range(&context, "radius", b.radius > 0.0, "must be positive")?;
-    let def = BodyDef {
+        (None, Some(from), Some(to)) => BodyShape::Bones {
+            from: from.clone(),
+            to: to.clone(),
+        },
+        (None, Some(_), None) => return Err(missing("to", "is missing: from needs it")),
+        (None, None, Some(_)) => return Err(missing("from", "is missing: to needs it")),
+        (None, None, None) => {
+            return Err(missing(
+                "segment",
+                "is missing: give segment, or from and to (bones)",
+            ));
+        }
+    };
+    Ok(BodySpec {
         name: b.name.clone(),
-        segment: b.segment.map(Vec3::from),
+        shape,
         radius: b.radius,
         mass: b.mass,
-    };
-    for end in def.segment {
-        check_coordinate("segment end", end).map_err(|e| RagdollError::world(&context, e))?;
-    }
-    def.shape()
-        .mass_properties_with_mass(def.mass)
-        .map_err(|e| RagdollError::world(&context, e))?;
-    Ok(def)
-}
-
-/// Checks the joints form one tree over all bodies; returns the root and
-/// each body's parent joint.
-fn tree(
-    bodies: &[BodyDef],
-    joints: &[JointDef],
-) -> Result<(usize, Vec<Option<usize>>), RagdollError> {
-    let mut parent_joint = vec![None; bodies.len()];
-    for (k, j) in joints.iter().enumerate() {
-        if j.parent == j.child {
-            return Err(RagdollError::NotATree(format!(
-                "joint `{}` joins `{}` to itself",
-                j.name, bodies[j.child].name
-            )));
-        }
-        if let Some(other) = parent_joint[j.child].replace(k) {
-            return Err(RagdollError::NotATree(format!(
-                "body `{}` is the child of both `{}` and `{}`",
-                bodies[j.child].name, joints[other].name, j.name
-            )));
-        }
-    }
-    // Every body must reach the root by parent links, without a cycle.
-    for start in 0..bodies.len() {
-        let (mut body, mut steps) = (start, 0);
-        while let Some(k) = parent_joint[body] {
-            body = joints[k].parent;
-            steps += 1;
-            if steps > bodies.len() {
-                return Err(RagdollError::NotATree(format!(
-                    "a cycle runs through body `{}`",
-                    bodies[start].name
-                )));
-            }
-        }
-    }
-    let roots: Vec<usize> = (0..bodies.len())
-        .filter(|&b| parent_joint[b].is_none())
-        .collect();
-    match roots.as_slice() {
-        [root] => Ok((*root, parent_joint)),
-        [] => Err(RagdollError::NotATree("no root body".to_owned())),
-        many => Err(RagdollError::NotATree(format!(
-            "{} bodies have no parent ({}); one root is needed",
-            many.len(),
-            many.iter()
-                .map(|&b| format!("`{}`", bodies[b].name))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))),
-    }
-}
-
-fn spine(
-    s: &RawSpine,
-    line: usize,
-    index: &HashMap<String, usize>,
-    joints: &[JointDef],
-    parent_joint: &[Option<usize>],
-) -> Result<SpineDef, RagdollError> {
-    let context = &format!("line {line}: [spine]");
-    let bodies = s
-        .bodies
-        .iter()
-        .map(|n| {
-            index
-                .get(n)
-                .copied()
-                .ok_or_else(|| RagdollError::UnknownBody {
-                    context: context.to_owned(),
-                    field: "bodies",
-                    name: n.clone(),
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    if bodies.len() < 2 {
-        return Err(RagdollError::SpineNotChain(
-            "needs at least two bodies".to_owned(),
-        ));
-    }
-    let mut chain = Vec::new();
-    for pair in bodies.windows(2) {
-        let joint = parent_joint[pair[1]]
-            .filter(|&k| joints[k].parent == pair[0])
-            .ok_or_else(|| {
-                RagdollError::SpineNotChain(format!(
-                    "no joint has parent `{}` and child `{}`",
-                    s.bodies[chain.len()],
-                    s.bodies[chain.len() + 1]
-                ))
-            })?;
-        chain.push(joint);
-    }
-    // The interior bodies disappear in the simplified ragdoll: nothing but
-    // the chain may hang from them.
-    for &interior in &bodies[1..bodies.len() - 1] {
-        if let Some(j) = joints
-            .iter()
-            .find(|j| j.parent == interior && !chain.iter().any(|&k| joints[k].name == j.name))
-        {
-            return Err(RagdollError::SpineNotChain(format!(
-                "joint `{}` hangs from an interior spine body; only the chain may",
-                j.name
-            )));
-        }
-    }
-    for (field, v) in [
-        ("bend_limit", s.bend_limit),
-        ("bend_stiffness", s.bend_stiffness),
-        ("twist_stiffness", s.twist_stiffness),
-    ] {
-        finite(context, field, &[v])?;
-    }
-    finite(context, "twist_limit", &s.twist_limit)?;
-    range(
-        context,
-        "bend_limit",
-        (0.0..=180.0).contains(&s.bend_limit),
-        "must be in [0, 180] degrees",
-    )?;
-    let [lo, hi] = s.twist_limit;
-    range(
-        context,
-        "twist_limit",
-        -180.0 <= lo && lo <= hi && hi <= 180.0,
-        "must be [min, max] within [-180, 180] degrees",
-    )?;
-    range(
-        context,
-        "bend_stiffness",
-        s.bend_stiffness >= 0.0,
-        "must not be negative",
-    )?;
-    range(
-        context,
-        "twist_stiffness",
-        s.twist_stiffness >= 0.0,
-        "must not be negative",
-    )?;
-    Ok(SpineDef {
-        bodies,
-        joints: chain,
-        bend_limit: s.bend_limit.to_radians(),
-        twist_limit: [lo.to_radians(), hi.to_radians()],
-        bend_stiffness: s.bend_stiffness,
-        twist_stiffness: s.twist_stiffness,
+        bone: b.bone.clone(),
+        offset: b.offset.as_ref().map(|o| {
+            Transform::new(
+                o.translation.map_or(Vec3::ZERO, Vec3::from),
+                o.rotation.map_or(Quat::IDENTITY, Quat::from_array),
+            )
+        }),
     })
-}
-
-/// The `[drive]` table with the joints' own strengths; a joint's strength
-/// without a table to fall back on is refused at the joint.
-fn drive(
-    raw: Option<&Spanned<RawDrive>>,
-    joints: &[JointDef],
-    at: impl Fn(core::ops::Range<usize>) -> usize,
-) -> Result<Option<DriveSettings>, RagdollError> {
-    let own: Vec<_> = joints.iter().map(|j| j.drive).collect();
-    match raw {
-        Some(table) => drive_settings(table.get_ref(), at(table.span()), own).map(Some),
-        None => match joints.iter().find(|j| j.drive.is_some()) {
-            Some(j) => Err(RagdollError::OutOfRange {
-                context: format!("joint `{}`", j.name),
-                field: "drive",
-                reason: "needs a [drive] table for the ragdoll's other joints".to_owned(),
-            }),
-            None => Ok(None),
-        },
-    }
 }

@@ -7,6 +7,7 @@ use serde::Deserialize;
 use crate::description::{finite, range};
 use crate::drive::{DriveSettings, Strength};
 use crate::error::RagdollError;
+use crate::joint_def::JointDef;
 
 /// A strength as written: `strength = "infinite"`, `frequency` (Hz) with
 /// `damping_ratio`, or `compliance` (rad / (N m)).
@@ -73,47 +74,83 @@ impl RawStrength {
     }
 }
 
-/// The ragdoll's drive settings from its `[drive]` table (at `line`) and
-/// each joint's own strength (`None` where it has none), checked as the
-/// world will check them.
-pub(crate) fn drive_settings(
-    raw: &RawDrive,
-    line: usize,
-    joints: Vec<Option<Strength>>,
-) -> Result<DriveSettings, RagdollError> {
-    let context = format!("line {line}: [drive]");
+/// The `[drive]` table as drive settings without per-joint strengths (the
+/// assembly adds the joints' own): one strength, a damping only for a
+/// compliance, a torque limit. Its values are checked with the whole
+/// description (`check_drive`).
+pub(crate) fn drive_settings(raw: &RawDrive, context: &str) -> Result<DriveSettings, RagdollError> {
     let strength = RawStrength {
         strength: raw.strength,
         frequency: raw.frequency,
         damping_ratio: raw.damping_ratio,
         compliance: raw.compliance,
     }
-    .read(&context)?;
+    .read(context)?;
     let mut settings = DriveSettings::uniform(strength);
     if let Some(d) = raw.damping {
-        range(
-            &context,
-            "damping",
-            strength_is_compliance(strength),
-            "is for a compliance strength only (a spring's damping is its ratio)",
-        )?;
+        damping_for_compliance(context, strength, true)?;
         settings = settings.with_damping(d);
     }
     if let Some(t) = raw.max_torque {
         settings = settings.with_max_torque(t);
     }
-    if joints.iter().any(Option::is_some) {
-        settings.joints = joints;
-    }
-    let count = settings.joints.len();
-    settings
-        .validate(count)
-        .map_err(|e| in_context(&context, e))?;
     Ok(settings)
 }
 
-fn strength_is_compliance(s: Strength) -> bool {
-    matches!(s, Strength::Compliance(_))
+/// A damping (`given`) is for a compliance strength only.
+fn damping_for_compliance(
+    context: &str,
+    strength: Strength,
+    given: bool,
+) -> Result<(), RagdollError> {
+    range(
+        context,
+        "damping",
+        !given || matches!(strength, Strength::Compliance(_)),
+        "is for a compliance strength only (a spring's damping is its ratio)",
+    )
+}
+
+/// The joints' own strengths as the settings' per-joint list: each
+/// joint's, or none when no joint has its own.
+pub(crate) fn own_strengths(joints: &[JointDef]) -> Vec<Option<Strength>> {
+    if joints.iter().any(|j| j.drive.is_some()) {
+        joints.iter().map(|j| j.drive).collect()
+    } else {
+        Vec::new()
+    }
+}
+
+/// Checks a description's drive settings as the loader does: a joint's own
+/// strength needs settings to fall back on, the settings' per-joint list
+/// is the joints' own strengths, and every value is one the world takes.
+/// `context` names the `[drive]` table, `joint` a joint.
+pub(crate) fn check_drive(
+    drive: Option<&DriveSettings>,
+    joints: &[JointDef],
+    context: &str,
+    joint: impl Fn(usize) -> String,
+) -> Result<(), RagdollError> {
+    let Some(settings) = drive else {
+        return match joints.iter().position(|j| j.drive.is_some()) {
+            Some(k) => Err(RagdollError::OutOfRange {
+                context: joint(k),
+                field: "drive",
+                reason: "needs a [drive] table for the ragdoll's other joints".to_owned(),
+            }),
+            None => Ok(()),
+        };
+    };
+    damping_for_compliance(context, settings.strength, settings.damping != 0.0)?;
+    settings
+        .validate(joints.len())
+        .map_err(|e| in_context(context, e))?;
+    range(
+        context,
+        "joints",
+        settings.joints == own_strengths(joints),
+        "must be each joint's own strength (`JointDef::drive`), or empty when no joint has one",
+    )
 }
 
 /// `e`, said of the `[drive]` table at its line.

@@ -8,22 +8,33 @@ use core::fmt;
 pub enum RagdollError {
     /// Not TOML, a missing or mistyped field, or an unknown one (the
     /// parser's message names the line and the field).
-    Syntax(String),
-    /// A ragdoll file that could not be read: missing, unreadable, larger
-    /// than `MAX_FILE_BYTES`, or not UTF-8 (the reason).
-    Unreadable(String),
-    /// An error in the ragdoll file at `path`.
+    Syntax {
+        /// What the file holds: `ragdoll` or `skeleton`.
+        file: &'static str,
+        /// The parser's message.
+        message: String,
+    },
+    /// A ragdoll or skeleton file that could not be read: missing,
+    /// unreadable, larger than `MAX_FILE_BYTES`, or not UTF-8.
+    Unreadable {
+        /// What the file holds: `ragdoll` or `skeleton`.
+        file: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// An error in the ragdoll or skeleton file at `path`.
     File {
         /// The file, as given.
         path: String,
         /// What is wrong with it.
         error: Box<RagdollError>,
     },
-    /// A body or joint name used twice.
+    /// A body, joint or bone name used twice.
     DuplicateName {
-        /// The line of its second use.
-        line: usize,
-        /// `body` or `joint`.
+        /// The line of its second use (`None` for a description built in
+        /// code or checked by `RagdollDesc::validate`).
+        line: Option<usize>,
+        /// `body`, `joint` or `bone`.
         kind: &'static str,
         /// The name.
         name: String,
@@ -37,6 +48,15 @@ pub enum RagdollError {
         /// The name.
         name: String,
     },
+    /// A name that refers to no bone of the skeleton.
+    UnknownBone {
+        /// Where it was used, e.g. `body `hand_l``.
+        context: String,
+        /// The field, e.g. `bone`.
+        field: &'static str,
+        /// The name.
+        name: String,
+    },
     /// A value that is NaN or infinite.
     NonFinite {
         /// The item, e.g. `body `hips``.
@@ -45,7 +65,7 @@ pub enum RagdollError {
         field: &'static str,
     },
     /// A value out of its range (negative mass, zero radius, a limit
-    /// outside its interval, a total mass that does not add up, ...).
+    /// outside its interval, two bodies on one bone, ...).
     OutOfRange {
         /// The item.
         context: String,
@@ -98,11 +118,16 @@ impl RagdollError {
 impl fmt::Display for RagdollError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            RagdollError::Syntax(m) => write!(f, "malformed ragdoll file: {m}"),
-            RagdollError::Unreadable(why) => write!(f, "cannot read the ragdoll file: {why}"),
+            RagdollError::Syntax { file, message } => write!(f, "malformed {file} file: {message}"),
+            RagdollError::Unreadable { file, reason } => {
+                write!(f, "cannot read the {file} file: {reason}")
+            }
             RagdollError::File { path, error } => write!(f, "{path}: {error}"),
             RagdollError::DuplicateName { line, kind, name } => {
-                write!(f, "line {line}: {kind} name `{name}` is used twice")
+                if let Some(line) = line {
+                    write!(f, "line {line}: ")?;
+                }
+                write!(f, "{kind} name `{name}` is used twice")
             }
             RagdollError::UnknownBody {
                 context,
@@ -110,6 +135,16 @@ impl fmt::Display for RagdollError {
                 name,
             } => {
                 write!(f, "{context}: {field} `{name}` is not a body")
+            }
+            RagdollError::UnknownBone {
+                context,
+                field,
+                name,
+            } => {
+                write!(
+                    f,
+                    "{context}: {field} `{name}` is not a bone of the skeleton"
+                )
             }
             RagdollError::NonFinite { context, field } => {
                 write!(f, "{context}: {field} is not finite")

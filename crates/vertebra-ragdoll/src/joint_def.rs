@@ -1,6 +1,7 @@
 //! A described joint: its kind (socket, hinge, fixed), its frame at bind
-//! pose, and its limits, read from a `[[joint]]` table and checked field
-//! by field (`docs/ragdolls.md` gives the format).
+//! pose, and its limits. A `[[joint]]` table is read into a [`JointSpec`]
+//! (what a builder takes too), resolved into a [`JointDef`], and checked
+//! field by field (`docs/ragdolls.md` gives the format).
 
 use std::collections::HashMap;
 
@@ -8,7 +9,7 @@ use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::Deserialize;
 use vertebra_world::{
     JointKind, LimitSoftness, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY,
-    Swing, SwingTwist, check_coordinate,
+    Swing, SwingTwist, check_coordinate, check_unit_quat,
 };
 
 use crate::description::{finite, range};
@@ -57,6 +58,7 @@ pub(crate) struct RawJoint {
     child: String,
     anchor: [f32; 3],
     kind: Option<String>,
+    frame: Option<[f32; 4]>,
     axis: Option<[f32; 3]>,
     normal: Option<[f32; 3]>,
     swing: Option<RawSwing>,
@@ -90,7 +92,7 @@ struct RawSoftTable {
 
 /// `swing = 40` (a cone), `swing = { y = 80, z = 35 }` (an ellipse) or
 /// `swing = { y = [-30, 90], z = [-10, 80] }` (a pyramid), in degrees.
-#[derive(Deserialize)]
+#[derive(Clone, Copy, Deserialize)]
 #[serde(untagged)]
 enum RawSwing {
     Cone(f32),
@@ -98,7 +100,132 @@ enum RawSwing {
     Pyramid { y: [f32; 2], z: [f32; 2] },
 }
 
-/// Fields each kind takes besides name, parent, child and anchor.
+/// A joint as a builder gives it (and as a `[[joint]]` table reads): its
+/// bodies by name, its frame by an axis (and normal) or as a rotation,
+/// and its limits in radians. [`RagdollDesc::builder`] resolves and checks
+/// it as the file loader does.
+///
+/// [`RagdollDesc::builder`]: crate::RagdollDesc::builder
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointSpec {
+    /// Unique name.
+    pub name: String,
+    /// The parent body's name.
+    pub parent: String,
+    /// The child body's name.
+    pub child: String,
+    /// The pivot at bind pose (m, world: the skeleton's model frame).
+    pub anchor: Vec3,
+    /// The joint frame at bind pose.
+    pub frame: JointFrame,
+    /// The kind and its limits (rad), as the world takes them.
+    pub kind: JointKind,
+    /// The joint's own drive strength, over the ragdoll's `[drive]` one.
+    pub drive: Option<Strength>,
+}
+
+/// How a [`JointSpec`] gives its frame at bind pose (world).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum JointFrame {
+    /// +X along `axis` (longer than 1e-6; normalised), +Y along `normal`
+    /// made exactly perpendicular (it must be within 0.06 degrees of
+    /// perpendicular; sockets only), or without a normal the shortest turn
+    /// from +X to the axis. A socket with an elliptical or pyramid swing
+    /// needs the normal.
+    Axis {
+        /// A socket's twist axis (parent to child) or a hinge's rotation
+        /// axis.
+        axis: Vec3,
+        /// The frame's +Y.
+        normal: Option<Vec3>,
+    },
+    /// The frame itself: a unit quaternion (within 1e-3), kept as given
+    /// (the file's `frame = [x, y, z, w]`).
+    Rotation(Quat),
+}
+
+impl JointSpec {
+    /// A socket of `limits` (rad) whose twist axis (parent to child) is
+    /// `axis`; `anchor` in metres, world at bind pose.
+    pub fn socket(
+        name: &str,
+        parent: &str,
+        child: &str,
+        anchor: Vec3,
+        axis: Vec3,
+        limits: SwingTwist,
+    ) -> Self {
+        Self::new(name, parent, child, anchor, axis, JointKind::Socket(limits))
+    }
+
+    /// A hinge turning about `axis`, within `range` (rad, `None`:
+    /// unlimited), with hard limits.
+    pub fn hinge(
+        name: &str,
+        parent: &str,
+        child: &str,
+        anchor: Vec3,
+        axis: Vec3,
+        range: Option<[f32; 2]>,
+    ) -> Self {
+        let kind = JointKind::Hinge {
+            range,
+            softness: LimitSoftness::Hard,
+        };
+        Self::new(name, parent, child, anchor, axis, kind)
+    }
+
+    /// A fixed joint at `anchor` (m, world at bind pose), its frame the
+    /// world's axes.
+    pub fn fixed(name: &str, parent: &str, child: &str, anchor: Vec3) -> Self {
+        Self {
+            frame: JointFrame::Rotation(Quat::IDENTITY),
+            ..Self::new(name, parent, child, anchor, Vec3::X, JointKind::Fixed)
+        }
+    }
+
+    fn new(
+        name: &str,
+        parent: &str,
+        child: &str,
+        anchor: Vec3,
+        axis: Vec3,
+        kind: JointKind,
+    ) -> Self {
+        Self {
+            name: name.to_owned(),
+            parent: parent.to_owned(),
+            child: child.to_owned(),
+            anchor,
+            frame: JointFrame::Axis { axis, normal: None },
+            kind,
+            drive: None,
+        }
+    }
+
+    /// With the frame's +Y along `normal` (a socket's; an elliptical or
+    /// pyramid swing needs it). A frame given as a rotation becomes its
+    /// +X axis with this normal.
+    pub fn with_normal(mut self, normal: Vec3) -> Self {
+        let axis = match self.frame {
+            JointFrame::Axis { axis, .. } => axis,
+            JointFrame::Rotation(q) => q * Vec3::X,
+        };
+        self.frame = JointFrame::Axis {
+            axis,
+            normal: Some(normal),
+        };
+        self
+    }
+
+    /// With its own drive strength.
+    pub fn with_drive(mut self, strength: Strength) -> Self {
+        self.drive = Some(strength);
+        self
+    }
+}
+
+/// Fields each kind takes besides name, parent, child, anchor and frame.
 const SOCKET_FIELDS: [&str; 6] = ["axis", "normal", "swing", "twist", "softness", "drive"];
 const HINGE_FIELDS: [&str; 4] = ["axis", "range", "softness", "drive"];
 
@@ -117,27 +244,11 @@ impl RawJoint {
     }
 }
 
-/// Reads and checks one joint defined at `line`.
-pub(crate) fn joint(
-    j: &RawJoint,
-    line: usize,
-    index: &HashMap<String, usize>,
-) -> Result<JointDef, RagdollError> {
-    let context = format!("line {line}: joint `{}`", j.name);
-    let lookup = |field: &'static str, name: &str| {
-        index
-            .get(name)
-            .copied()
-            .ok_or_else(|| RagdollError::UnknownBody {
-                context: context.clone(),
-                field,
-                name: name.to_owned(),
-            })
-    };
-    let (parent, child) = (lookup("parent", &j.parent)?, lookup("child", &j.child)?);
-    finite(&context, "anchor", &j.anchor)?;
-    check_coordinate("anchor", Vec3::from(j.anchor))
-        .map_err(|e| RagdollError::world(&context, e))?;
+/// Reads one `[[joint]]` table (`context` names its line and the joint):
+/// its kind and the fields that kind takes, its softness and drive as one
+/// of their forms, its angles in radians. The values are checked when the
+/// joint is resolved.
+pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, RagdollError> {
     let kind = j.kind.as_deref().unwrap_or("socket");
     let allowed: &[&str] = match kind {
         "socket" => &SOCKET_FIELDS,
@@ -145,7 +256,7 @@ pub(crate) fn joint(
         "fixed" => &[],
         other => {
             return Err(RagdollError::OutOfRange {
-                context,
+                context: context.to_owned(),
                 field: "kind",
                 reason: format!("is `{other}`; must be socket, hinge or fixed"),
             });
@@ -158,53 +269,168 @@ pub(crate) fn joint(
             _ => "sockets and hinges",
         };
         range(
-            &context,
+            context,
             field,
             !present || allowed.contains(&field),
             &format!("is for {owners} only; this joint is a {kind}"),
         )?;
     }
-    let softness = softness(&context, j.softness.as_ref())?;
-    let drive = j.drive.map(|d| d.read(&context)).transpose()?;
-    let (frame, kind) = match kind {
-        "socket" => {
-            let frame = frame(
-                &context,
-                &j.name,
-                required(&context, "axis", j.axis)?,
-                j.normal,
-            )?;
-            let swing = swing(&context, j.swing.as_ref(), j.normal.is_some())?;
-            let twist = j
-                .twist
-                .map(|t| angle_range(&context, "twist", t, -180.0, 180.0))
-                .transpose()?;
-            let limits = SwingTwist {
-                swing,
-                twist,
-                softness,
-            };
-            (frame, JointKind::Socket(limits))
+    let softness = softness(context, j.softness.as_ref())?;
+    let drive = j.drive.map(|d| d.read(context)).transpose()?;
+    let frame = match (j.frame, j.axis, j.normal) {
+        (Some(q), None, None) => JointFrame::Rotation(Quat::from_array(q)),
+        (Some(_), _, _) => {
+            return Err(RagdollError::OutOfRange {
+                context: context.to_owned(),
+                field: "frame",
+                reason: "takes the place of axis and normal; give one or the other".to_owned(),
+            });
         }
-        "hinge" => {
-            let frame = frame(&context, &j.name, required(&context, "axis", j.axis)?, None)?;
-            let range = j
-                .range
-                .map(|r| angle_range(&context, "range", r, -180.0, 180.0))
-                .transpose()?;
-            (frame, JointKind::Hinge { range, softness })
-        }
-        _ => (Quat::IDENTITY, JointKind::Fixed),
+        (None, None, _) if kind == "fixed" => JointFrame::Rotation(Quat::IDENTITY),
+        (None, axis, normal) => JointFrame::Axis {
+            axis: Vec3::from(required(context, "axis", axis)?),
+            normal: normal.map(Vec3::from),
+        },
     };
-    Ok(JointDef {
+    let kind = match kind {
+        "socket" => JointKind::Socket(SwingTwist {
+            swing: match j.swing {
+                None => Swing::Free,
+                Some(RawSwing::Cone(x)) => Swing::Cone(x.to_radians()),
+                Some(RawSwing::Ellipse { y, z }) => Swing::Ellipse {
+                    y: y.to_radians(),
+                    z: z.to_radians(),
+                },
+                Some(RawSwing::Pyramid { y, z }) => Swing::Pyramid {
+                    y: y.map(f32::to_radians),
+                    z: z.map(f32::to_radians),
+                },
+            },
+            twist: j.twist.map(|t| t.map(f32::to_radians)),
+            softness,
+        }),
+        "hinge" => JointKind::Hinge {
+            range: j.range.map(|r| r.map(f32::to_radians)),
+            softness,
+        },
+        _ => JointKind::Fixed,
+    };
+    Ok(JointSpec {
         name: j.name.clone(),
-        parent,
-        child,
+        parent: j.parent.clone(),
+        child: j.child.clone(),
         anchor: Vec3::from(j.anchor),
         frame,
         kind,
         drive,
     })
+}
+
+/// Resolves a joint's body names through `index` and builds its frame,
+/// then checks every value (`context` names the joint, and its line in a
+/// file).
+pub(crate) fn resolve(
+    j: &JointSpec,
+    context: &str,
+    index: &HashMap<String, usize>,
+) -> Result<JointDef, RagdollError> {
+    let lookup = |field: &'static str, name: &str| {
+        index
+            .get(name)
+            .copied()
+            .ok_or_else(|| RagdollError::UnknownBody {
+                context: context.to_owned(),
+                field,
+                name: name.to_owned(),
+            })
+    };
+    let (parent, child) = (lookup("parent", &j.parent)?, lookup("child", &j.child)?);
+    let shaped = matches!(
+        j.kind,
+        JointKind::Socket(SwingTwist {
+            swing: Swing::Ellipse { .. } | Swing::Pyramid { .. },
+            ..
+        })
+    );
+    let frame = match j.frame {
+        JointFrame::Rotation(q) => q,
+        JointFrame::Axis { axis, normal } => {
+            if let (Some(_), JointKind::Hinge { .. } | JointKind::Fixed) = (normal, j.kind) {
+                let kind = kind_name(&j.kind);
+                range(
+                    context,
+                    "normal",
+                    false,
+                    &format!("is for sockets only; this joint is a {kind}"),
+                )?;
+            }
+            range(
+                context,
+                "normal",
+                !shaped || normal.is_some(),
+                "is missing: an elliptical or pyramid swing needs it to place its axes",
+            )?;
+            frame(
+                context,
+                &j.name,
+                axis.to_array(),
+                normal.map(|n| n.to_array()),
+            )?
+        }
+    };
+    let def = JointDef {
+        name: j.name.clone(),
+        parent,
+        child,
+        anchor: j.anchor,
+        frame,
+        kind: j.kind,
+        drive: j.drive,
+    };
+    check_joint(&def, index.len(), context)?;
+    Ok(def)
+}
+
+/// `socket`, `hinge` or `fixed`, as a file names the kind.
+pub(crate) fn kind_name(kind: &JointKind) -> &'static str {
+    match kind {
+        JointKind::Socket(_) => "socket",
+        JointKind::Hinge { .. } => "hinge",
+        JointKind::Fixed => "fixed",
+    }
+}
+
+/// Checks a joint's values as the file loader does, among `bodies` bodies:
+/// its bodies exist, its anchor is within the world's range, its frame a
+/// unit quaternion, its limits and softness in range.
+pub(crate) fn check_joint(j: &JointDef, bodies: usize, context: &str) -> Result<(), RagdollError> {
+    for (field, body) in [("parent", j.parent), ("child", j.child)] {
+        range(
+            context,
+            field,
+            body < bodies,
+            &format!("is body {body}; there are {bodies}"),
+        )?;
+    }
+    finite(context, "anchor", &j.anchor.to_array())?;
+    check_coordinate("anchor", j.anchor).map_err(|e| RagdollError::world(context, e))?;
+    check_unit_quat("frame", j.frame).map_err(|e| RagdollError::world(context, e))?;
+    match j.kind {
+        JointKind::Socket(limits) => {
+            check_swing(context, limits.swing)?;
+            if let Some(t) = limits.twist {
+                angle_range(context, "twist", t)?;
+            }
+            check_softness(context, limits.softness)
+        }
+        JointKind::Hinge { range, softness } => {
+            if let Some(r) = range {
+                angle_range(context, "range", r)?;
+            }
+            check_softness(context, softness)
+        }
+        JointKind::Fixed => Ok(()),
+    }
 }
 
 fn required<T>(context: &str, field: &'static str, value: Option<T>) -> Result<T, RagdollError> {
@@ -218,7 +444,7 @@ fn required<T>(context: &str, field: &'static str, value: Option<T>) -> Result<T
 /// The joint frame at bind pose: +X along `axis`, +Y along `normal` made
 /// exactly perpendicular, or (without a normal) the shortest turn from +X
 /// to `axis`, as every joint had before normals existed.
-fn frame(
+pub(crate) fn frame(
     context: &str,
     name: &str,
     axis: [f32; 3],
@@ -251,71 +477,58 @@ fn frame(
     Ok(Quat::from_mat3(&Mat3::from_cols(x.as_vec3(), y.as_vec3(), z.as_vec3())).normalize())
 }
 
-/// The swing limit: free without `swing`; a shaped one needs the frame's
-/// `normal` to say which way its axes lie.
-fn swing(context: &str, raw: Option<&RawSwing>, has_normal: bool) -> Result<Swing, RagdollError> {
-    let half_angle = |field, x: f32| -> Result<f32, RagdollError> {
+/// Half a turn (rad), as the file's 180 degrees reads.
+pub(crate) fn half_turn() -> f32 {
+    180.0_f32.to_radians()
+}
+
+/// A swing limit's half-angles in [0, 180] degrees, ranges within
+/// [-180, 180] degrees.
+fn check_swing(context: &str, swing: Swing) -> Result<(), RagdollError> {
+    let half_angle = |field, x: f32| -> Result<(), RagdollError> {
         finite(context, field, &[x])?;
         range(
             context,
             field,
-            (0.0..=180.0).contains(&x),
+            (0.0..=half_turn()).contains(&x),
             "must be in [0, 180] degrees",
-        )?;
-        Ok(x.to_radians())
-    };
-    let shaped = |ok: bool| {
-        range(
-            context,
-            "normal",
-            ok,
-            "is missing: an elliptical or pyramid swing needs it to place its axes",
         )
     };
-    Ok(match raw {
-        None => Swing::Free,
-        Some(RawSwing::Cone(x)) => Swing::Cone(half_angle("swing", *x)?),
-        Some(RawSwing::Ellipse { y, z }) => {
-            shaped(has_normal)?;
-            Swing::Ellipse {
-                y: half_angle("swing.y", *y)?,
-                z: half_angle("swing.z", *z)?,
-            }
+    match swing {
+        Swing::Free => Ok(()),
+        Swing::Cone(x) => half_angle("swing", x),
+        Swing::Ellipse { y, z } => {
+            half_angle("swing.y", y)?;
+            half_angle("swing.z", z)
         }
-        Some(RawSwing::Pyramid { y, z }) => {
-            shaped(has_normal)?;
-            Swing::Pyramid {
-                y: angle_range(context, "swing.y", *y, -180.0, 180.0)?,
-                z: angle_range(context, "swing.z", *z, -180.0, 180.0)?,
-            }
+        Swing::Pyramid { y, z } => {
+            angle_range(context, "swing.y", y)?;
+            angle_range(context, "swing.z", z)
         }
-    })
+    }
 }
 
-/// `[min, max]` in degrees within `[lo, hi]`, in radians.
+/// `[min, max]` (rad) within [-180, 180] degrees.
 fn angle_range(
     context: &str,
     field: &'static str,
     [min, max]: [f32; 2],
-    lo: f32,
-    hi: f32,
-) -> Result<[f32; 2], RagdollError> {
+) -> Result<(), RagdollError> {
     finite(context, field, &[min, max])?;
     range(
         context,
         field,
-        lo <= min && min <= max && max <= hi,
-        &format!("must be [min, max] within [{lo}, {hi}] degrees"),
-    )?;
-    Ok([min.to_radians(), max.to_radians()])
+        -half_turn() <= min && min <= max && max <= half_turn(),
+        "must be [min, max] within [-180, 180] degrees",
+    )
 }
 
 /// `softness = C`, `{ compliance = C, damping = D }` or `{ frequency = F,
 /// damping_ratio = Z }`: the limits' softness (`LimitSoftness`); hard
-/// without it. Checked as the world will check it, by name.
+/// without it.
 fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, RagdollError> {
-    let soft = match raw {
-        None => return Ok(LimitSoftness::Hard),
+    Ok(match raw {
+        None => LimitSoftness::Hard,
         Some(RawSoftness::Compliance(c)) => LimitSoftness::compliant(*c),
         Some(RawSoftness::Table(t)) => {
             match (t.compliance, t.damping, t.frequency, t.damping_ratio) {
@@ -337,7 +550,11 @@ fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, R
                 }
             }
         }
-    };
+    })
+}
+
+/// A limit softness checked as the world will check it, by name.
+fn check_softness(context: &str, soft: LimitSoftness) -> Result<(), RagdollError> {
     let numbers = match soft {
         LimitSoftness::Hard => vec![],
         LimitSoftness::Compliance {
@@ -368,6 +585,5 @@ fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, R
         ),
         LimitSoftness::Hard => (true, ""),
     };
-    range(context, "softness", ok, reason)?;
-    Ok(soft)
+    range(context, "softness", ok, reason)
 }

@@ -7,6 +7,13 @@
 //! animation without a pop, an example on its page). The format, the
 //! mapper and the mapping modes are documented in `docs/ragdolls.md`.
 //!
+//! A description may follow an animation skeleton ([`Skeleton`]: a file
+//! of `[[bone]]` tables, inline or next to the ragdoll file; the shipped
+//! [`Skeleton::reference`] fits both humanoids), each body bound to a bone
+//! ([`BoneBinding`]) or placed from one bone to another; it may be built in
+//! code ([`RagdollDesc::builder`]), checked by hand
+//! ([`RagdollDesc::validate`]) and written back ([`RagdollDesc::to_toml`]).
+//!
 //! How an engine wires it in, once per character:
 //!
 //! ```
@@ -38,6 +45,7 @@
 //! # }
 //! ```
 
+mod assemble;
 mod blend;
 mod blend_back;
 mod description;
@@ -52,16 +60,25 @@ mod partial;
 mod pose;
 mod ragdoll;
 mod skeleton;
+mod skeleton_file;
+mod spec;
+mod text;
 mod transition;
+mod write;
 
 pub use blend_back::{Blend, BlendBack};
-pub use description::{ANATOMICAL_HUMANOID, BodyDef, REFERENCE_HUMANOID, RagdollDesc, SpineDef};
+pub use description::{
+    ANATOMICAL_HUMANOID, BodyDef, BoneBinding, REFERENCE_HUMANOID, RagdollDesc, SpineDef,
+};
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
-pub use joint_def::JointDef;
+pub use joint_def::{JointDef, JointFrame, JointSpec};
 pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
 pub use pose::Pose;
 pub use ragdoll::{BuildOptions, Ragdoll, RodRest, SpineMode, body_masses};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
+pub use skeleton_file::REFERENCE_SKELETON;
+pub use spec::{BodyShape, BodySpec, RagdollBuilder, SpineSpec};
+pub use text::MAX_FILE_BYTES;
 pub use transition::Transition;

@@ -160,8 +160,9 @@ impl Ragdoll {
     /// pose and the spine bones between its ends. On error the world is
     /// put back as it was (its state, and so its state hash: the world
     /// restores a snapshot taken before the first body went in); only the
-    /// handles the refused build drew are never issued again. With a
-    /// collision layer, `vertebra_collide::Collisions::build_ragdoll`
+    /// handles the refused build drew are never issued again. A description
+    /// that fails [`RagdollDesc::validate`] (one edited by hand) is refused
+    /// before anything is built. With a collision layer, `vertebra_collide::Collisions::build_ragdoll`
     /// builds it and adds its colliders in one call.
     pub fn build(
         world: &mut World,
@@ -171,6 +172,7 @@ impl Ragdoll {
         previous: Option<(&Pose, f32)>,
     ) -> Result<Self, RagdollError> {
         options.validate()?;
+        desc.validate()?;
         pose.validate(desc)?;
         if let Some((p, dt)) = previous {
             p.validate(desc)?;

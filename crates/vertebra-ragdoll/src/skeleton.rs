@@ -81,10 +81,19 @@ impl Transform {
                 reason: format!("is {t}; each coordinate must be within {MAX_COORDINATE} m"),
             });
         }
-        check_unit_quat("rotation", self.rotation).map_err(|e| RagdollError::OutOfRange {
-            context: context.to_owned(),
-            field: "rotation",
-            reason: e.to_string(),
+        check_unit_quat("rotation", self.rotation).map_err(|e| match e {
+            vertebra_world::Error::NonFinite(field) => RagdollError::NonFinite {
+                context: context.to_owned(),
+                field,
+            },
+            _ => RagdollError::OutOfRange {
+                context: context.to_owned(),
+                field: "rotation",
+                reason: format!(
+                    "has length {}; must be a unit quaternion (within 1e-3)",
+                    self.rotation.length()
+                ),
+            },
         })
     }
 }

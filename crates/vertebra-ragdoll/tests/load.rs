@@ -134,8 +134,8 @@ fn malformed_files_each_get_their_own_error() {
             "joint `knee_l`: twist must be [min, max]",
         ),
         (
-            edited("total_mass = 69.0", "total_mass = 70.0"),
-            "total_mass is 70 but the bodies weigh 69",
+            edited("total_mass = 69.0", "total_mass = -69.0"),
+            "ragdoll: total_mass must be positive",
         ),
         (
             edited(

@@ -404,6 +404,9 @@ fn the_residual_tells_limit_violation_from_held_rotation_error() {
         assert!(
             (a - angular).abs() < 1e-4 && (l - limit).abs() < 1e-4,
             "{kind:?}: angular {a}, limit {l}; expected {angular}, {limit}"
+        );
+    }
+}
 
 /// A box whose three principal inertias differ (half extents 0.3, 0.1,
 /// 0.05 m, 2 kg) with its principal axes turned off the world's, centred

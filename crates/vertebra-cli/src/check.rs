@@ -1,0 +1,280 @@
+//! `vertebra check FILE`: validates a ragdoll file (with its skeleton) or a
+//! skeleton file, told apart by content (`[[body]]` tables or `[[bone]]`
+//! tables only), and prints what it holds.
+
+use std::fmt::Write as _;
+use std::io::Read as _;
+use std::path::Path;
+
+use vertebra_ragdoll::{MAX_FILE_BYTES, RagdollDesc, Skeleton, Strength};
+use vertebra_world::{JointKind, LimitSoftness, Swing};
+
+/// What the file at `path` holds, as text; or the problem, naming the
+/// file and the line.
+pub fn check(path: &Path) -> Result<String, String> {
+    match kind(path) {
+        Kind::Ragdoll => RagdollDesc::from_file(path)
+            .map(|desc| ragdoll(path, &desc))
+            .map_err(|e| e.to_string()),
+        Kind::Skeleton => Skeleton::from_file(path)
+            .map(|s| skeleton(path, &s))
+            .map_err(|e| e.to_string()),
+        Kind::Neither => Err(format!(
+            "{}: neither a ragdoll file ([[body]] tables) nor a skeleton file ([[bone]] tables)",
+            path.display()
+        )),
+    }
+}
+
+enum Kind {
+    Ragdoll,
+    Skeleton,
+    Neither,
+}
+
+/// A ragdoll file has `[[body]]` tables, a skeleton file `[[bone]]` tables
+/// only. A file that cannot be read or parsed is read as a ragdoll file,
+/// unless its text has `[[bone]]` and no `[[body]]`: the loader then names
+/// the problem.
+fn kind(path: &Path) -> Kind {
+    let mut bytes = Vec::new();
+    let read = std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+        .is_ok();
+    let Some(text) = read.then(|| String::from_utf8(bytes).ok()).flatten() else {
+        return Kind::Ragdoll;
+    };
+    match text.parse::<toml::Table>() {
+        Ok(table) if table.contains_key("body") => Kind::Ragdoll,
+        Ok(table) if table.contains_key("bone") => Kind::Skeleton,
+        Ok(_) => Kind::Neither,
+        Err(_) if text.contains("[[bone]]") && !text.contains("[[body]]") => Kind::Skeleton,
+        Err(_) => Kind::Ragdoll,
+    }
+}
+
+/// `x` with at most `digits` decimals, trailing zeros dropped.
+fn number(x: f32, digits: usize) -> String {
+    let s = format!("{x:.digits$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".to_owned()
+    } else {
+        s.to_owned()
+    }
+}
+
+/// An angle (rad) in degrees.
+fn deg(radians: f32) -> String {
+    number(radians.to_degrees(), 2)
+}
+
+fn range(name: &str, [lo, hi]: [f32; 2]) -> String {
+    format!("{name} {} .. {} deg", deg(lo), deg(hi))
+}
+
+fn strength(s: Strength) -> String {
+    match s {
+        Strength::Infinite => "infinite".to_owned(),
+        Strength::Compliance(c) => format!("compliance {c} rad/(N m)"),
+        Strength::Spring {
+            frequency,
+            damping_ratio,
+        } => format!(
+            "spring {} Hz, damping ratio {}",
+            number(frequency, 3),
+            number(damping_ratio, 3)
+        ),
+    }
+}
+
+fn softness(s: LimitSoftness) -> Option<String> {
+    match s {
+        LimitSoftness::Hard => None,
+        LimitSoftness::Compliance {
+            compliance,
+            damping,
+        } => Some(format!(
+            "soft: compliance {compliance} rad/(N m), damping {damping} N m s/rad"
+        )),
+        LimitSoftness::Spring {
+            frequency,
+            damping_ratio,
+        } => Some(format!(
+            "soft: {} Hz, damping ratio {}",
+            number(frequency, 3),
+            number(damping_ratio, 3)
+        )),
+    }
+}
+
+/// A joint's kind and limits, in degrees.
+fn limits(kind: &JointKind) -> (&'static str, Vec<String>) {
+    match kind {
+        JointKind::Socket(st) => {
+            let mut parts = Vec::new();
+            match st.swing {
+                Swing::Free => parts.push("swing free".to_owned()),
+                Swing::Cone(x) => parts.push(format!("swing {} deg", deg(x))),
+                Swing::Ellipse { y, z } => {
+                    parts.push(format!("swing ellipse y {} z {} deg", deg(y), deg(z)))
+                }
+                Swing::Pyramid { y, z } => parts.push(format!(
+                    "swing pyramid y {} .. {} z {} .. {} deg",
+                    deg(y[0]),
+                    deg(y[1]),
+                    deg(z[0]),
+                    deg(z[1])
+                )),
+            }
+            parts.push(
+                st.twist
+                    .map_or("twist free".to_owned(), |t| range("twist", t)),
+            );
+            parts.extend(softness(st.softness));
+            ("socket", parts)
+        }
+        JointKind::Hinge {
+            range: r,
+            softness: s,
+        } => {
+            let mut parts = vec![r.map_or("range free".to_owned(), |r| range("range", r))];
+            parts.extend(softness(*s));
+            ("hinge", parts)
+        }
+        JointKind::Fixed => ("fixed", Vec::new()),
+    }
+}
+
+fn ragdoll(path: &Path, desc: &RagdollDesc) -> String {
+    let mut out = String::new();
+    let bones = desc.skeleton.as_ref().map(|s| s.bones());
+    let _ = writeln!(
+        out,
+        "{}: ragdoll `{}`: {} bodies, {} joints, {} kg",
+        path.display(),
+        desc.name,
+        desc.bodies.len(),
+        desc.joints.len(),
+        number(desc.total_mass(), 3)
+    );
+    let width = desc.bodies.iter().map(|b| b.name.len()).max().unwrap_or(0);
+    let _ = writeln!(out, "bodies:");
+    for b in &desc.bodies {
+        // Each body's bone, when there is a skeleton to have one in.
+        let bone = match (b.bone, bones) {
+            (Some(binding), Some(bones)) => format!("  bone {}", bones[binding.bone].name),
+            (None, Some(_)) => "  no bone".to_owned(),
+            (_, None) => String::new(),
+        };
+        let _ = writeln!(
+            out,
+            "  {:width$}  {:>8} kg  radius {} m{bone}",
+            b.name,
+            number(b.mass, 3),
+            number(b.radius, 3)
+        );
+    }
+    let _ = writeln!(out, "joints:");
+    let jwidth = desc.joints.iter().map(|j| j.name.len()).max().unwrap_or(0);
+    for j in &desc.joints {
+        let (kind, mut parts) = limits(&j.kind);
+        if let Some(s) = j.drive {
+            parts.push(format!("drive {}", strength(s)));
+        }
+        let _ = writeln!(
+            out,
+            "  {:jwidth$}  {kind:6}  {} -> {}  {}",
+            j.name,
+            desc.bodies[j.parent].name,
+            desc.bodies[j.child].name,
+            parts.join(", ")
+        );
+    }
+    match &desc.spine {
+        Some(s) => {
+            let names: Vec<&str> = s
+                .bodies
+                .iter()
+                .map(|&b| desc.bodies[b].name.as_str())
+                .collect();
+            let _ = writeln!(
+                out,
+                "spine: {} (one rod in the simplified ragdoll): bend {} deg, {}, stiffness {} / {} N m^2",
+                names.join(", "),
+                deg(s.bend_limit),
+                range("twist", s.twist_limit),
+                number(s.bend_stiffness, 3),
+                number(s.twist_stiffness, 3)
+            );
+        }
+        None => {
+            let _ = writeln!(out, "spine: none");
+        }
+    }
+    match &desc.drive {
+        Some(d) => {
+            let mut parts = vec![strength(d.strength)];
+            if d.damping != 0.0 {
+                parts.push(format!("damping {} N m s/rad", d.damping));
+            }
+            if d.max_torque.is_finite() {
+                parts.push(format!("max torque {} N m", number(d.max_torque, 3)));
+            }
+            let _ = writeln!(out, "drive: {}", parts.join(", "));
+        }
+        None => {
+            let _ = writeln!(out, "drive: none");
+        }
+    }
+    match &desc.skeleton {
+        Some(s) => {
+            let bound = desc.bodies.iter().filter(|b| b.bone.is_some()).count();
+            let _ = writeln!(
+                out,
+                "skeleton: {} bones, {bound} followed by a body",
+                s.len()
+            );
+        }
+        None => {
+            let _ = writeln!(out, "skeleton: none");
+        }
+    }
+    out
+}
+
+fn skeleton(path: &Path, s: &Skeleton) -> String {
+    let mut out = String::new();
+    let roots = s.bones().iter().filter(|b| b.parent.is_none()).count();
+    let _ = writeln!(
+        out,
+        "{}: skeleton: {} bones, {roots} root{}",
+        path.display(),
+        s.len(),
+        if roots == 1 { "" } else { "s" }
+    );
+    let model = s
+        .bind_pose()
+        .to_model(s)
+        .map(|pose| pose.bones)
+        .unwrap_or_default();
+    let width = s.bones().iter().map(|b| b.name.len()).max().unwrap_or(0);
+    let _ = writeln!(out, "bones (parent, bind position in the model frame, m):");
+    for (b, t) in s.bones().iter().zip(&model) {
+        let parent = b.parent.map_or("-", |p| s.bones()[p].name.as_str());
+        let p = t.translation;
+        let _ = writeln!(
+            out,
+            "  {:width$}  {parent:width$}  ({}, {}, {})",
+            b.name,
+            number(p.x, 4),
+            number(p.y, 4),
+            number(p.z, 4)
+        );
+    }
+    out
+}

@@ -1,0 +1,546 @@
+//! From specs to a checked [`RagdollDesc`]: the one path a file's tables
+//! and a builder's values both take (names resolved, bodies placed on the
+//! skeleton and bound to their bones, masses scaled to a total, the joint
+//! tree and the spine chain found), and the checks
+//! [`RagdollDesc::validate`] runs on any description.
+
+use std::collections::HashMap;
+
+use vertebra_world::check_coordinate;
+
+use crate::description::{BodyDef, BoneBinding, RagdollDesc, SpineDef, finite, range};
+use crate::drive::DriveSettings;
+use crate::drive_def::{check_drive, own_strengths};
+use crate::error::RagdollError;
+use crate::joint_def::{JointDef, JointSpec, check_joint, half_turn, resolve};
+use crate::skeleton::Skeleton;
+use crate::spec::{BodyShape, BodySpec, SpineSpec};
+use crate::text::item;
+
+/// A value and the line of the file where it is defined (`None` when it
+/// was built in code).
+pub(crate) struct Item<T> {
+    pub(crate) value: T,
+    pub(crate) line: Option<usize>,
+}
+
+impl<T> Item<T> {
+    pub(crate) fn at(value: T, line: usize) -> Self {
+        Self {
+            value,
+            line: Some(line),
+        }
+    }
+
+    pub(crate) fn unlined(value: T) -> Self {
+        Self { value, line: None }
+    }
+}
+
+/// A description as specs: a file's tables or a builder's values.
+pub(crate) struct Document {
+    pub(crate) name: String,
+    pub(crate) total_mass: Option<f32>,
+    pub(crate) skeleton: Option<Skeleton>,
+    pub(crate) bodies: Vec<Item<BodySpec>>,
+    pub(crate) joints: Vec<Item<JointSpec>>,
+    pub(crate) spine: Option<Item<SpineSpec>>,
+    pub(crate) drive: Option<Item<DriveSettings>>,
+}
+
+/// The lines where a description's items are defined, to name them in
+/// errors (none for a description built in code or edited by hand).
+#[derive(Default)]
+struct At {
+    bodies: Vec<Option<usize>>,
+    joints: Vec<Option<usize>>,
+    spine: Option<usize>,
+    drive: Option<usize>,
+}
+
+impl At {
+    fn body(&self, i: usize, name: &str) -> String {
+        item(
+            self.bodies.get(i).copied().flatten(),
+            &format!("body `{name}`"),
+        )
+    }
+
+    fn joint(&self, k: usize, name: &str) -> String {
+        item(
+            self.joints.get(k).copied().flatten(),
+            &format!("joint `{name}`"),
+        )
+    }
+}
+
+/// Resolves, places, binds, scales and checks a description.
+pub(crate) fn assemble(doc: Document) -> Result<RagdollDesc, RagdollError> {
+    let at = At {
+        bodies: doc.bodies.iter().map(|b| b.line).collect(),
+        joints: doc.joints.iter().map(|j| j.line).collect(),
+        spine: doc.spine.as_ref().and_then(|s| s.line),
+        drive: doc.drive.as_ref().and_then(|d| d.line),
+    };
+    let index = names(
+        doc.bodies.iter().map(|b| (b.value.name.as_str(), b.line)),
+        "body",
+    )?;
+    names(
+        doc.joints.iter().map(|j| (j.value.name.as_str(), j.line)),
+        "joint",
+    )?;
+    let model = doc
+        .skeleton
+        .as_ref()
+        .map(|s| s.bind_pose().to_model(s).map(|pose| (s, pose.bones)))
+        .transpose()?;
+    let mut bodies = Vec::with_capacity(doc.bodies.len());
+    for (i, b) in doc.bodies.iter().enumerate() {
+        let spec = &b.value;
+        let context = at.body(i, &spec.name);
+        let bone = |field: &'static str, name: &str| -> Result<usize, RagdollError> {
+            let unknown = || RagdollError::UnknownBone {
+                context: context.clone(),
+                field,
+                name: name.to_owned(),
+            };
+            match &model {
+                Some((skeleton, _)) => skeleton.bone_index(name).ok_or_else(unknown),
+                None => Err(RagdollError::OutOfRange {
+                    context: context.clone(),
+                    field,
+                    reason: format!(
+                        "names bone `{name}`, but the ragdoll has no skeleton ([[bone]] tables, skeleton = \"file\", or one given to the loader)"
+                    ),
+                }),
+            }
+        };
+        let segment = match &spec.shape {
+            BodyShape::Segment(segment) => *segment,
+            BodyShape::Bones { from, to } => {
+                let (a, b) = (bone("from", from)?, bone("to", to)?);
+                range(
+                    &context,
+                    "to",
+                    a != b,
+                    "is the from bone; a body runs from one bone to another",
+                )?;
+                let pose = &model.as_ref().expect("a bone was found").1;
+                [pose[a].translation, pose[b].translation]
+            }
+        };
+        let mut def = BodyDef {
+            name: spec.name.clone(),
+            segment,
+            radius: spec.radius,
+            mass: spec.mass,
+            bone: None,
+        };
+        check_body(&def, &context)?;
+        let chosen = match (&spec.bone, &spec.shape, &model) {
+            (Some(name), _, _) => Some(bone("bone", name)?),
+            (None, _, None) => None,
+            (None, shape, Some((skeleton, _))) => skeleton.bone_index(&spec.name).or(match shape {
+                BodyShape::Bones { from, .. } => skeleton.bone_index(from),
+                BodyShape::Segment(_) => None,
+            }),
+        };
+        if let Some(offset) = spec.offset {
+            range(
+                &context,
+                "offset",
+                chosen.is_some(),
+                "places the body on its bone, but it has none",
+            )?;
+            offset.validate(&format!("{context}: offset"))?;
+        }
+        def.bone = match (chosen, &model) {
+            (Some(bone), Some((_, pose))) => Some(BoneBinding {
+                bone,
+                offset: spec
+                    .offset
+                    .unwrap_or_else(|| pose[bone].inverse() * def.bind_frame()),
+            }),
+            _ => None,
+        };
+        bodies.push(def);
+    }
+    if let Some(total) = doc.total_mass {
+        scale(&mut bodies, total, &at)?;
+    }
+    let joints = doc
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(k, j)| resolve(&j.value, &at.joint(k, &j.value.name), &index))
+        .collect::<Result<Vec<_>, _>>()?;
+    let (root, parent_joint) = tree(&bodies, &joints)?;
+    let spine = doc
+        .spine
+        .map(|s| {
+            spine(
+                &s.value,
+                &item(s.line, "[spine]"),
+                &index,
+                &joints,
+                &parent_joint,
+            )
+        })
+        .transpose()?;
+    let drive = match doc.drive {
+        Some(d) => {
+            let context = item(d.line, "[drive]");
+            range(
+                &context,
+                "joints",
+                d.value.joints.is_empty(),
+                "must be empty: a joint's own strength is its spec's",
+            )?;
+            Some(DriveSettings {
+                joints: own_strengths(&joints),
+                ..d.value
+            })
+        }
+        None => None,
+    };
+    let desc = RagdollDesc {
+        name: doc.name,
+        bodies,
+        joints,
+        spine,
+        root,
+        parent_joint,
+        drive,
+        skeleton: doc.skeleton,
+    };
+    check(&desc, &at)?;
+    Ok(desc)
+}
+
+/// Scales the bodies' masses to `total` (kg) in all, their ratios kept.
+fn scale(bodies: &mut [BodyDef], total: f32, at: &At) -> Result<(), RagdollError> {
+    finite("ragdoll", "total_mass", &[total])?;
+    range("ragdoll", "total_mass", total > 0.0, "must be positive")?;
+    let factor = total / bodies.iter().map(|b| b.mass).sum::<f32>();
+    for (i, b) in bodies.iter_mut().enumerate() {
+        b.mass *= factor;
+        b.shape().mass_properties_with_mass(b.mass).map_err(|e| {
+            let context = format!("{} (its mass scaled to total_mass)", at.body(i, &b.name));
+            RagdollError::world(&context, e)
+        })?;
+    }
+    Ok(())
+}
+
+impl RagdollDesc {
+    /// Checks a description as the file loader checks a file: names
+    /// unique; every body a capsule the world takes (finite, in range);
+    /// every bone binding on a bone of [`RagdollDesc::skeleton`], at most
+    /// one body per bone, its offset finite with a unit rotation; every
+    /// joint's bodies, anchor, frame, limits and softness in range; the
+    /// joints one tree whose root and parent joints are `root` and
+    /// `parent_joint`; the spine a chain of joints with nothing but the
+    /// chain hanging from its interior bodies, its limits in range; the
+    /// drive settings ones the world takes, their per-joint list the
+    /// joints' own strengths. For a description edited by hand; errors
+    /// name the item and the field.
+    pub fn validate(&self) -> Result<(), RagdollError> {
+        check(self, &At::default())
+    }
+}
+
+fn check(desc: &RagdollDesc, at: &At) -> Result<(), RagdollError> {
+    names(
+        desc.bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.name.as_str(), at.bodies.get(i).copied().flatten())),
+        "body",
+    )?;
+    names(
+        desc.joints
+            .iter()
+            .enumerate()
+            .map(|(k, j)| (j.name.as_str(), at.joints.get(k).copied().flatten())),
+        "joint",
+    )?;
+    for (i, b) in desc.bodies.iter().enumerate() {
+        check_body(b, &at.body(i, &b.name))?;
+    }
+    check_bindings(desc, at)?;
+    for (k, j) in desc.joints.iter().enumerate() {
+        check_joint(j, desc.bodies.len(), &at.joint(k, &j.name))?;
+    }
+    let (root, parent_joint) = tree(&desc.bodies, &desc.joints)?;
+    if (root, &parent_joint) != (desc.root, &desc.parent_joint) {
+        return Err(RagdollError::NotATree(
+            "root and parent_joint are not the joints' tree".to_owned(),
+        ));
+    }
+    if let Some(spine) = &desc.spine {
+        check_spine(spine, desc, &item(at.spine, "[spine]"))?;
+    }
+    check_drive(
+        desc.drive.as_ref(),
+        &desc.joints,
+        &item(at.drive, "[drive]"),
+        |k| at.joint(k, &desc.joints[k].name),
+    )
+}
+
+/// Indexes `(name, line)` pairs by name; a name used twice is refused at
+/// its second use.
+fn names<'a>(
+    names: impl Iterator<Item = (&'a str, Option<usize>)>,
+    kind: &'static str,
+) -> Result<HashMap<String, usize>, RagdollError> {
+    let mut index = HashMap::new();
+    for (i, (n, line)) in names.enumerate() {
+        if index.insert(n.to_owned(), i).is_some() {
+            return Err(RagdollError::DuplicateName {
+                line,
+                kind,
+                name: n.to_owned(),
+            });
+        }
+    }
+    Ok(index)
+}
+
+/// A body's segment within the world's coordinate range, and a capsule the
+/// world accepts at its mass (size within `SIZE_RANGE`, mass within
+/// `MASS_RANGE`, invertible inertia), so building it cannot fail on them.
+fn check_body(b: &BodyDef, context: &str) -> Result<(), RagdollError> {
+    finite(
+        context,
+        "segment",
+        b.segment.map(|e| e.to_array()).as_flattened(),
+    )?;
+    finite(context, "radius", &[b.radius])?;
+    finite(context, "mass", &[b.mass])?;
+    range(context, "mass", b.mass > 0.0, "must be positive")?;
+    range(context, "radius", b.radius > 0.0, "must be positive")?;
+    for end in b.segment {
+        check_coordinate("segment end", end).map_err(|e| RagdollError::world(context, e))?;
+    }
+    b.shape()
+        .mass_properties_with_mass(b.mass)
+        .map_err(|e| RagdollError::world(context, e))?;
+    Ok(())
+}
+
+/// Every binding on a bone of the skeleton, at most one body per bone,
+/// each offset finite with a unit rotation.
+fn check_bindings(desc: &RagdollDesc, at: &At) -> Result<(), RagdollError> {
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for (i, b) in desc.bodies.iter().enumerate() {
+        let Some(binding) = b.bone else { continue };
+        let context = at.body(i, &b.name);
+        let bones = desc.skeleton.as_ref().map_or(0, Skeleton::len);
+        range(
+            &context,
+            "bone",
+            binding.bone < bones,
+            &format!(
+                "is bone {}; the ragdoll's skeleton has {bones}",
+                binding.bone
+            ),
+        )?;
+        if let Some(other) = owner.insert(binding.bone, i) {
+            let skeleton = desc.skeleton.as_ref().expect("the bone is in it");
+            return Err(RagdollError::OutOfRange {
+                context,
+                field: "bone",
+                reason: format!(
+                    "`{}` is body `{}`'s bone too; a bone has at most one body",
+                    skeleton.bones()[binding.bone].name,
+                    desc.bodies[other].name
+                ),
+            });
+        }
+        binding.offset.validate(&format!("{context}: offset"))?;
+    }
+    Ok(())
+}
+
+/// Checks the joints form one tree over all bodies; returns the root and
+/// each body's parent joint.
+fn tree(
+    bodies: &[BodyDef],
+    joints: &[JointDef],
+) -> Result<(usize, Vec<Option<usize>>), RagdollError> {
+    let mut parent_joint = vec![None; bodies.len()];
+    for (k, j) in joints.iter().enumerate() {
+        if j.parent == j.child {
+            return Err(RagdollError::NotATree(format!(
+                "joint `{}` joins `{}` to itself",
+                j.name, bodies[j.child].name
+            )));
+        }
+        if let Some(other) = parent_joint[j.child].replace(k) {
+            return Err(RagdollError::NotATree(format!(
+                "body `{}` is the child of both `{}` and `{}`",
+                bodies[j.child].name, joints[other].name, j.name
+            )));
+        }
+    }
+    // Every body must reach the root by parent links, without a cycle.
+    for start in 0..bodies.len() {
+        let (mut body, mut steps) = (start, 0);
+        while let Some(k) = parent_joint[body] {
+            body = joints[k].parent;
+            steps += 1;
+            if steps > bodies.len() {
+                return Err(RagdollError::NotATree(format!(
+                    "a cycle runs through body `{}`",
+                    bodies[start].name
+                )));
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..bodies.len())
+        .filter(|&b| parent_joint[b].is_none())
+        .collect();
+    match roots.as_slice() {
+        [root] => Ok((*root, parent_joint)),
+        [] => Err(RagdollError::NotATree("no root body".to_owned())),
+        many => Err(RagdollError::NotATree(format!(
+            "{} bodies have no parent ({}); one root is needed",
+            many.len(),
+            many.iter()
+                .map(|&b| format!("`{}`", bodies[b].name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))),
+    }
+}
+
+/// The spine's bodies by name and the chain of joints between them.
+fn spine(
+    s: &SpineSpec,
+    context: &str,
+    index: &HashMap<String, usize>,
+    joints: &[JointDef],
+    parent_joint: &[Option<usize>],
+) -> Result<SpineDef, RagdollError> {
+    let bodies = s
+        .bodies
+        .iter()
+        .map(|n| {
+            index
+                .get(n)
+                .copied()
+                .ok_or_else(|| RagdollError::UnknownBody {
+                    context: context.to_owned(),
+                    field: "bodies",
+                    name: n.clone(),
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut chain = Vec::new();
+    for (k, pair) in bodies.windows(2).enumerate() {
+        let joint = parent_joint[pair[1]]
+            .filter(|&j| joints[j].parent == pair[0])
+            .ok_or_else(|| {
+                RagdollError::SpineNotChain(format!(
+                    "no joint has parent `{}` and child `{}`",
+                    s.bodies[k],
+                    s.bodies[k + 1]
+                ))
+            })?;
+        chain.push(joint);
+    }
+    Ok(SpineDef {
+        bodies,
+        joints: chain,
+        bend_limit: s.bend_limit,
+        twist_limit: s.twist_limit,
+        bend_stiffness: s.bend_stiffness,
+        twist_stiffness: s.twist_stiffness,
+    })
+}
+
+/// A chain of at least two bodies joined in order by its joints, nothing
+/// but the chain hanging from its interior bodies, limits and stiffness in
+/// range.
+fn check_spine(s: &SpineDef, desc: &RagdollDesc, context: &str) -> Result<(), RagdollError> {
+    if s.bodies.len() < 2 {
+        return Err(RagdollError::SpineNotChain(
+            "needs at least two bodies".to_owned(),
+        ));
+    }
+    let (bodies, joints) = (&desc.bodies, &desc.joints);
+    for &b in &s.bodies {
+        range(
+            context,
+            "bodies",
+            b < bodies.len(),
+            &format!("has body {b}; there are {}", bodies.len()),
+        )?;
+    }
+    range(
+        context,
+        "joints",
+        s.joints.len() + 1 == s.bodies.len(),
+        "must be one fewer than the bodies: the joints between them",
+    )?;
+    for (&k, pair) in s.joints.iter().zip(s.bodies.windows(2)) {
+        if joints
+            .get(k)
+            .is_none_or(|j| (j.parent, j.child) != (pair[0], pair[1]))
+        {
+            return Err(RagdollError::SpineNotChain(format!(
+                "its joint {k} does not join `{}` to `{}`",
+                bodies[pair[0]].name, bodies[pair[1]].name
+            )));
+        }
+    }
+    // The interior bodies disappear in the simplified ragdoll: nothing but
+    // the chain may hang from them.
+    for &interior in &s.bodies[1..s.bodies.len() - 1] {
+        if let Some(j) = joints
+            .iter()
+            .enumerate()
+            .find(|&(k, j)| j.parent == interior && !s.joints.contains(&k))
+        {
+            return Err(RagdollError::SpineNotChain(format!(
+                "joint `{}` hangs from an interior spine body; only the chain may",
+                j.1.name
+            )));
+        }
+    }
+    for (field, v) in [
+        ("bend_limit", s.bend_limit),
+        ("bend_stiffness", s.bend_stiffness),
+        ("twist_stiffness", s.twist_stiffness),
+    ] {
+        finite(context, field, &[v])?;
+    }
+    finite(context, "twist_limit", &s.twist_limit)?;
+    range(
+        context,
+        "bend_limit",
+        (0.0..=half_turn()).contains(&s.bend_limit),
+        "must be in [0, 180] degrees",
+    )?;
+    let [lo, hi] = s.twist_limit;
+    range(
+        context,
+        "twist_limit",
+        -half_turn() <= lo && lo <= hi && hi <= half_turn(),
+        "must be [min, max] within [-180, 180] degrees",
+    )?;
+    range(
+        context,
+        "bend_stiffness",
+        s.bend_stiffness >= 0.0,
+        "must not be negative",
+    )?;
+    range(
+        context,
+        "twist_stiffness",
+        s.twist_stiffness >= 0.0,
+        "must not be negative",
+    )
+}
