@@ -1,12 +1,11 @@
-//! The skeleton mapper on the dense skeleton: every bone's role as the
+//! The skeleton mapper on the shipped reference skeleton
+//! (`Skeleton::reference()`, 63 bones): every bone's role as the
 //! definitions give it, bind pose in and out, bones with bodies following
 //! them, the rest keeping the animation, the chain modes' properties,
 //! locked translations, and every bad input refused by name.
 
 #[path = "support/animation.rs"]
 mod animation;
-#[path = "support/dense.rs"]
-mod dense;
 
 use glam::{Quat, Vec3};
 use proptest::prelude::*;
@@ -19,7 +18,9 @@ use vertebra_ragdoll::{
 use vertebra_world::{SolverConfig, World};
 
 use animation::{earlier, random_animation};
-use dense::dense_skeleton;
+
+/// The reference skeleton's axis along a bone, in the bone's frame.
+const ALONG: Vec3 = Vec3::Y;
 
 const MAPPINGS: [SpineMapping; 3] = [
     SpineMapping::Orientation,
@@ -57,9 +58,9 @@ fn random_place(r: &mut StdRng) -> Transform {
 }
 
 #[test]
-fn every_bone_of_the_dense_skeleton_takes_the_role_the_definitions_give() {
-    let skeleton = dense_skeleton();
-    assert_eq!(skeleton.len(), 69);
+fn every_bone_of_the_reference_skeleton_takes_the_role_the_definitions_give() {
+    let skeleton = Skeleton::reference();
+    assert_eq!(skeleton.len(), 63);
     let desc = RagdollDesc::reference_humanoid();
     for spine in [SpineMode::Rod, SpineMode::Sockets] {
         let mapper = SkeletonMapper::new(&skeleton, &desc, spine).unwrap();
@@ -70,21 +71,13 @@ fn every_bone_of_the_dense_skeleton_takes_the_role_the_definitions_give() {
         };
         let mut expected: Vec<(&str, BoneRole)> = vec![
             ("root", BoneRole::Free),
-            ("ik_root", BoneRole::Free),
-            ("ik_hand_l", BoneRole::Free),
-            ("neck_01", chain("chest", "head")),
-            ("neck_02", chain("chest", "head")),
-            ("neck_03", chain("chest", "head")),
+            ("neck_1", chain("chest", "head")),
+            ("neck_2", chain("chest", "head")),
+            ("neck_3", chain("chest", "head")),
             ("clavicle_l", chain("chest", "upper_arm_l")),
             ("clavicle_r", chain("chest", "upper_arm_r")),
         ];
-        let spine_bones = [
-            "spine_01",
-            "spine_lower",
-            "spine_03",
-            "spine_upper",
-            "spine_05",
-        ];
+        let spine_bones = ["spine_lower", "spine_middle", "spine_upper", "spine_top"];
         match spine {
             SpineMode::Rod => {
                 for bone in spine_bones {
@@ -92,9 +85,8 @@ fn every_bone_of_the_dense_skeleton_takes_the_role_the_definitions_give() {
                 }
             }
             SpineMode::Sockets => {
-                expected.push(("spine_01", chain("hips", "spine_lower")));
-                expected.push(("spine_03", chain("spine_lower", "spine_upper")));
-                expected.push(("spine_05", chain("spine_upper", "chest")));
+                expected.push(("spine_middle", chain("spine_lower", "spine_upper")));
+                expected.push(("spine_top", chain("spine_upper", "chest")));
             }
         }
         for (b, body) in desc.bodies.iter().enumerate() {
@@ -122,7 +114,7 @@ fn every_bone_of_the_dense_skeleton_takes_the_role_the_definitions_give() {
 /// the model frame; and mapped back every bone is at bind, in every mode.
 #[test]
 fn the_bind_pose_maps_to_the_bodies_bind_pose_and_back() {
-    let skeleton = dense_skeleton();
+    let skeleton = Skeleton::reference();
     let desc = RagdollDesc::reference_humanoid();
     let mut r = StdRng::seed_from_u64(2);
     let bind = skeleton.bind_pose();
@@ -165,14 +157,14 @@ fn the_bind_pose_maps_to_the_bodies_bind_pose_and_back() {
 /// bodies (the mapping commutes with a rigid motion of the whole ragdoll).
 #[test]
 fn bones_with_bodies_follow_them_and_the_others_keep_the_animation() {
-    let skeleton = dense_skeleton();
+    let skeleton = Skeleton::reference();
     let desc = RagdollDesc::reference_humanoid();
     let mut r = StdRng::seed_from_u64(3);
     let moving = vec![false; skeleton.len()];
     for trial in 0..20 {
         for spine in [SpineMode::Rod, SpineMode::Sockets] {
             let mapper = SkeletonMapper::new(&skeleton, &desc, spine).unwrap();
-            let animation = random_animation(&skeleton, &moving, &mut r);
+            let animation = random_animation(&skeleton, ALONG, &moving, &mut r);
             let place = random_place(&mut r);
             let animated = animation.to_model(&skeleton).unwrap().in_world(place);
             let bodies = mapper
@@ -217,9 +209,10 @@ fn bones_with_bodies_follow_them_and_the_others_keep_the_animation() {
     }
 }
 
-/// The modes on the dense spine of a simplified ragdoll built at a random
-/// animated pose: `Orientation` keeps the lengths between the chain's
-/// points (the base body's centre, the five spine bones' origins); with
+/// The modes on the reference skeleton's spine of a simplified ragdoll
+/// built at a random animated pose: `Orientation` keeps the lengths
+/// between the chain's points (the base body's centre, the four spine
+/// bones' origins between the hips and the chest); with
 /// `PositionOrientation` each bone moves from there by its share of the
 /// chain end's miss of the chest; on the `Arc` (the spine is straight at
 /// bind: the bones sit on it) every segment is within the chord factor of
@@ -227,23 +220,17 @@ fn bones_with_bodies_follow_them_and_the_others_keep_the_animation() {
 /// rod made at an unevenly bent pose is an arc a little longer or shorter
 /// than the spine: under 0.2% here).
 #[test]
-fn the_chain_modes_keep_what_they_claim_on_the_dense_spine() {
-    let skeleton = dense_skeleton();
+fn the_chain_modes_keep_what_they_claim_on_the_reference_spine() {
+    let skeleton = Skeleton::reference();
     let desc = RagdollDesc::reference_humanoid();
     let bind = skeleton.bind_pose().to_model(&skeleton).unwrap();
     let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod).unwrap();
     let mut r = StdRng::seed_from_u64(4);
     let moving = vec![false; skeleton.len()];
-    let chain: Vec<usize> = [
-        "spine_01",
-        "spine_lower",
-        "spine_03",
-        "spine_upper",
-        "spine_05",
-    ]
-    .iter()
-    .map(|n| index(&skeleton, n))
-    .collect();
+    let chain: Vec<usize> = ["spine_lower", "spine_middle", "spine_upper", "spine_top"]
+        .iter()
+        .map(|n| index(&skeleton, n))
+        .collect();
     let (hips, chest) = (0, 3);
     let mut bind_points = vec![desc.bodies[hips].centre()];
     bind_points.extend(chain.iter().map(|&j| bind.bones[j].translation));
@@ -254,7 +241,7 @@ fn the_chain_modes_keep_what_they_claim_on_the_dense_spine() {
         .collect();
     let total: f32 = lengths.iter().sum();
     for trial in 0..20 {
-        let animation = random_animation(&skeleton, &moving, &mut r);
+        let animation = random_animation(&skeleton, ALONG, &moving, &mut r);
         let place = random_place(&mut r);
         let bodies = mapper
             .map_to_ragdoll(&animation.to_model(&skeleton).unwrap(), place)
@@ -319,7 +306,7 @@ fn the_chain_modes_keep_what_they_claim_on_the_dense_spine() {
 /// animation's local translation, and the same rotation as unlocked.
 #[test]
 fn locked_translations_keep_the_animations_local_translations() {
-    let skeleton = dense_skeleton();
+    let skeleton = Skeleton::reference();
     let desc = RagdollDesc::reference_humanoid();
     let mut r = StdRng::seed_from_u64(5);
     let moving = vec![false; skeleton.len()];
@@ -327,8 +314,8 @@ fn locked_translations_keep_the_animations_local_translations() {
         let free = SkeletonMapper::new(&skeleton, &desc, spine).unwrap();
         let locked = free.clone().with_locked_translations(true);
         for _ in 0..10 {
-            let animation = random_animation(&skeleton, &moving, &mut r);
-            let before = earlier(&skeleton, &moving, &animation, 30.0, 0.1, &mut r);
+            let animation = random_animation(&skeleton, ALONG, &moving, &mut r);
+            let before = earlier(&skeleton, ALONG, &moving, &animation, 30.0, 0.1, &mut r);
             let place = random_place(&mut r);
             // Bodies from another pose: the joints stretch.
             let bodies = free
@@ -416,7 +403,7 @@ fn a_bone_on_two_paths_belongs_to_the_first_chain() {
 
 #[test]
 fn every_bad_binding_is_refused_by_name() {
-    let skeleton = dense_skeleton();
+    let skeleton = Skeleton::reference();
     let desc = RagdollDesc::reference_humanoid();
     let spine = SpineMode::Rod;
     let mut bones: Vec<Option<usize>> = mapper_binding(&skeleton, &desc);
@@ -434,15 +421,15 @@ fn every_bad_binding_is_refused_by_name() {
         refused(&bones),
         "body `head`: bone is missing: the skeleton has no bone `head` and every body needs one"
     );
-    bones[4] = Some(69);
+    bones[4] = Some(63);
     assert_eq!(
         refused(&bones),
-        "body `head`: bone is 69; the skeleton has 69 bones"
+        "body `head`: bone is 63; the skeleton has 63 bones"
     );
     bones[4] = bones[3];
     assert_eq!(
         refused(&bones),
-        "body `head`: bone is bone 9 `chest`, which body `chest` follows too"
+        "body `head`: bone is bone 6 `chest`, which body `chest` follows too"
     );
     let mut renamed = skeleton.bones().to_vec();
     renamed[index(&skeleton, "shin_r")].name = "calf_r".to_owned();
@@ -464,7 +451,7 @@ fn mapper_binding(skeleton: &Skeleton, desc: &RagdollDesc) -> Vec<Option<usize>>
 
 #[test]
 fn every_bad_pose_is_refused_by_name() {
-    let skeleton = dense_skeleton();
+    let skeleton = Skeleton::reference();
     let desc = RagdollDesc::reference_humanoid();
     let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod).unwrap();
     let bind = skeleton.bind_pose();
@@ -482,19 +469,19 @@ fn every_bad_pose_is_refused_by_name() {
     short.bones.pop();
     assert_eq!(
         map(&bodies, None, &short, id),
-        "bad pose: animation: 68 transforms for 69 bones"
+        "bad pose: animation: 62 transforms for 63 bones"
     );
     let mut nan = bind.clone();
-    nan.bones[30].translation.y = f32::NAN;
+    nan.bones[index(&skeleton, "middle_2_l")].translation.y = f32::NAN;
     assert_eq!(
         map(&bodies, None, &nan, id),
-        "bad pose: animation: bone 30 `middle_02_l`: translation is not finite"
+        "bad pose: animation: bone 16 `middle_2_l`: translation is not finite"
     );
     let mut scaled = bind.clone();
-    scaled.bones[5].rotation *= 1.1;
+    scaled.bones[2].rotation *= 1.1;
     assert!(
         map(&bodies, None, &scaled, id)
-            .starts_with("bad pose: animation: bone 5 `spine_lower`: rotation")
+            .starts_with("bad pose: animation: bone 2 `spine_lower`: rotation")
     );
     let far = Transform::new(Vec3::new(2e6, 0.0, 0.0), Quat::IDENTITY);
     assert!(map(&bodies, None, &bind, far).starts_with("model_to_world: translation is"));
@@ -571,13 +558,13 @@ proptest! {
     /// and a finite pose whenever it is accepted.
     #[test]
     fn no_input_panics(
-        bone in 0usize..69,
+        bone in 0usize..63,
         body in 0usize..13,
         t in any_transform(),
         place in any_transform(),
         frames in (any_transform(), any_transform()),
     ) {
-        let skeleton = dense_skeleton();
+        let skeleton = Skeleton::reference();
         let desc = RagdollDesc::reference_humanoid();
         for spine in [SpineMode::Rod, SpineMode::Sockets] {
             let mapper = SkeletonMapper::new(&skeleton, &desc, spine).unwrap();

@@ -20,6 +20,8 @@ use vertebra_world::{SolverConfig, World};
 use animation::{earlier, random_animation};
 use dense::dense_skeleton;
 
+/// The dense skeleton's axis along a bone, in the bone's frame.
+const ALONG: Vec3 = Vec3::X;
 const DT: f32 = 1.0 / 60.0;
 const MAPPINGS: [SpineMapping; 3] = [
     SpineMapping::Orientation,
@@ -51,8 +53,8 @@ fn switch(spine: SpineMode, rate: f32, dt: f32, hold: bool, r: &mut StdRng) -> S
     } else {
         vec![false; skeleton.len()]
     };
-    let animation = random_animation(&skeleton, &still, r);
-    let before = earlier(&skeleton, &still, &animation, rate, dt, r);
+    let animation = random_animation(&skeleton, ALONG, &still, r);
+    let before = earlier(&skeleton, ALONG, &still, &animation, rate, dt, r);
     let place = Transform::new(
         Vec3::new(
             r.random_range(-10.0..10.0),

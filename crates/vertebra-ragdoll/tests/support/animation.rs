@@ -1,5 +1,7 @@
-//! Random animation poses of the dense skeleton (`dense.rs`), within the
-//! reference humanoid's joint limits.
+//! Random animation poses of a skeleton for the reference humanoid, within
+//! its joint limits. Each bone turns about its axis along the bone, in its
+//! own frame: `along` (+Y on the shipped `Skeleton::reference()`, +X on
+//! the test-only dense skeleton of `dense.rs`).
 
 use glam::{Quat, Vec3};
 use rand::RngExt;
@@ -7,10 +9,10 @@ use rand::rngs::StdRng;
 use vertebra_ragdoll::{LocalPose, Skeleton, Transform};
 
 /// How far a bone may turn from its bind pose in its own frame: a swing
-/// across its +X and a twist about it (rad). The spine bones each turn on
+/// across its axis `along` and a twist about it (rad). The spine bones each turn on
 /// their own (a spine with unequal joint angles); the bones between two
-/// bodies stay together within the sockets' limits (two spine bones per
-/// spine socket: 11 of 20 degrees of swing; the neck's four: 28 of 40).
+/// bodies stay together within the sockets' limits (up to two spine bones
+/// per spine socket: 11 of 20 degrees of swing; the neck's four: 28 of 40).
 fn range(name: &str) -> (f32, f32) {
     let is = |prefix: &str| name.starts_with(prefix);
     if is("hips") {
@@ -42,15 +44,20 @@ fn across(axis: Vec3, r: &mut StdRng) -> Vec3 {
 
 /// A random pose: every bone but the `still` ones turned from bind within
 /// its range, the root moved up to 1 m and turned about +Y.
-pub fn random_animation(skeleton: &Skeleton, still: &[bool], r: &mut StdRng) -> LocalPose {
+pub fn random_animation(
+    skeleton: &Skeleton,
+    along: Vec3,
+    still: &[bool],
+    r: &mut StdRng,
+) -> LocalPose {
     let bones = skeleton
         .bones()
         .iter()
         .zip(still)
         .map(|(bone, &still)| {
             let (swing, twist) = if still { (0.0, 0.0) } else { range(&bone.name) };
-            let turn = Quat::from_axis_angle(across(Vec3::X, r), r.random_range(0.0..=swing))
-                * Quat::from_rotation_x(r.random_range(-twist..=twist));
+            let turn = Quat::from_axis_angle(across(along, r), r.random_range(0.0..=swing))
+                * Quat::from_axis_angle(along, r.random_range(-twist..=twist));
             let mut local = bone.bind * Transform::new(Vec3::ZERO, turn);
             if bone.parent.is_none() {
                 local.translation +=
@@ -68,6 +75,7 @@ pub fn random_animation(skeleton: &Skeleton, still: &[bool], r: &mut StdRng) -> 
 /// `rate` (rad/s) in its own frame and moves the root at up to 1 m/s.
 pub fn earlier(
     skeleton: &Skeleton,
+    along: Vec3,
     still: &[bool],
     pose: &LocalPose,
     rate: f32,
@@ -79,8 +87,8 @@ pub fn earlier(
         .iter()
         .zip(skeleton.bones().iter().zip(still))
         .map(|(&local, (bone, &still))| {
-            let axis = across(Vec3::X, r)
-                .lerp(Vec3::X, r.random_range(0.0..1.0))
+            let axis = across(along, r)
+                .lerp(along, r.random_range(0.0..1.0))
                 .normalize();
             let rate = if still { 0.0 } else { rate };
             let back = Quat::from_axis_angle(axis, -r.random_range(0.0..=rate) * dt);

@@ -4,8 +4,13 @@
 //! on the long bones, hands with five three-bone fingers, feet with toes.
 //! The bones the humanoid's bodies follow carry the bodies' names and sit
 //! at the joints' anchors; each bone's +X points along it, so bind
-//! rotations are not the identity. Shared by the ragdoll tests and the
-//! mapping bench (`#[path]`), until the crate ships its reference skeleton.
+//! rotations are not the identity. Used by `tests/transition.rs` only:
+//! the shipped reference skeleton (`Skeleton::reference()`, which the
+//! mapper tests and the bench use) puts a body's bone at its capsule's end,
+//! not at its joint's pivot, so an animation turning those bones moves the
+//! joints' anchors apart at the switch and the first step pulls the bodies
+//! together: 9.1 mm on the first frame, which does not shrink with the
+//! frame (docs/ragdolls.md, "Transition").
 
 use core::f32::consts::{FRAC_PI_2, PI};
 
