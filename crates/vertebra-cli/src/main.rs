@@ -7,6 +7,7 @@ mod check;
 mod output;
 mod plots;
 mod reproduce;
+mod skeleton_csv;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -16,6 +17,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
 use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, Seeded};
+
+use skeleton_csv::{Failed, SkeletonCsv};
 
 #[derive(Parser)]
 #[command(
@@ -90,6 +93,11 @@ enum Command {
         /// One JSON object on stdout.
         #[arg(long)]
         json: bool,
+        /// Writes every frame's reference-skeleton bones (63 per ragdoll,
+        /// mapped from the bodies) to this CSV file:
+        /// frame,ragdoll,bone,x,y,z,qx,qy,qz,qw (m, world).
+        #[arg(long)]
+        skeleton_out: Option<PathBuf>,
     },
     /// Checks a ragdoll file (with its skeleton) or a skeleton file and
     /// prints what it holds, or the problem with its file and line.
@@ -169,6 +177,7 @@ fn execute(command: Command) -> Result<(), String> {
             max_torque,
             seeds,
             json,
+            skeleton_out,
         } => {
             let scene: Scene = name.parse()?;
             let backend: BackendChoice = backend.parse().map_err(|e| format!("{e}"))?;
@@ -195,6 +204,9 @@ fn execute(command: Command) -> Result<(), String> {
             config.drive_frequency = drive_frequency;
             config.drive_damping_ratio = damping_ratio;
             config.max_torque = max_torque;
+            if let (Some(_), Some(_)) = (seeds, &skeleton_out) {
+                return Err("--skeleton-out writes one run; not with --seeds".to_owned());
+            }
             if let Some(count) = seeds {
                 let seeded = Seeded::run(&config, count, |_, _| {}).map_err(|e| e.to_string())?;
                 if json {
@@ -204,7 +216,20 @@ fn execute(command: Command) -> Result<(), String> {
                 }
                 return Ok(());
             }
-            let run = vertebra_scenes::run(&config, |_, _| {}).map_err(|e| e.to_string())?;
+            let run = match skeleton_out {
+                Some(path) => {
+                    let mut csv = SkeletonCsv::create(&path)?;
+                    let run = vertebra_scenes::run_observed(
+                        &config,
+                        |_, _| {},
+                        |frame, scene| csv.frame(frame, scene),
+                    )
+                    .map_err(|Failed(e)| e)?;
+                    csv.finish()?;
+                    run
+                }
+                None => vertebra_scenes::run(&config, |_, _| {}).map_err(|e| e.to_string())?,
+            };
             if json {
                 println!("{}", output::run_json(&config, &run));
             } else {

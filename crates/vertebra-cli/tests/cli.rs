@@ -577,3 +577,119 @@ fn check_names_the_file_and_line_of_a_problem() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// One row per frame, ragdoll and reference-skeleton bone, parsed.
+fn skeleton_rows(path: &std::path::Path) -> Vec<(usize, usize, String, [f32; 7])> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("frame,ragdoll,bone,x,y,z,qx,qy,qz,qw"));
+    lines
+        .map(|line| {
+            let f: Vec<&str> = line.split(',').collect();
+            assert_eq!(f.len(), 10, "{line}");
+            let v: Vec<f32> = f[3..].iter().map(|x| x.parse().unwrap()).collect();
+            (
+                f[0].parse().unwrap(),
+                f[1].parse().unwrap(),
+                f[2].to_owned(),
+                v.try_into().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn scenes_write_the_reference_skeleton_frame_by_frame() {
+    let dir = std::env::temp_dir().join(format!("vertebra-skeleton-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Passive bending: one ragdoll, its hips held at the bind pose turned
+    // 30 degrees about +X through (0, 1, 0).
+    for spine in ["rod", "sockets"] {
+        let path = dir.join(format!("bending-{spine}.csv"));
+        let (code, _, stderr) = vertebra(&[
+            "scene",
+            "passive-bending",
+            "--spine",
+            spine,
+            "--frames",
+            "3",
+            "--skeleton-out",
+            path.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        let rows = skeleton_rows(&path);
+        assert_eq!(rows.len(), 3 * 63);
+        assert!(rows.iter().all(|r| r.3.iter().all(|x| x.is_finite())));
+        for (k, r) in rows.iter().enumerate() {
+            assert_eq!((r.0, r.1), (k / 63, 0));
+        }
+        let bone = |frame: usize, name: &str| {
+            let r = rows.iter().find(|r| r.0 == frame && r.2 == name).unwrap();
+            let [x, y, z, qx, qy, qz, qw] = r.3;
+            (
+                glam::Vec3::new(x, y, z),
+                glam::Quat::from_xyzw(qx, qy, qz, qw),
+            )
+        };
+        // The hips bone is the held hips body's frame (its offset is the
+        // identity: the bone sits at the body's centre, unrotated).
+        let turn = glam::Quat::from_rotation_x(30f32.to_radians());
+        let (p, q) = bone(0, "hips");
+        assert!(p.distance(glam::Vec3::Y) < 1e-3, "{spine}: hips at {p}");
+        assert!(q.angle_between(turn) < 1e-3, "{spine}: hips turned {q}");
+        // The root rides on the hips as at bind (1 m below it); a hand
+        // keeps its bind place below its forearm (it has no body).
+        let (root, _) = bone(0, "root");
+        assert!(root.distance(p + q * glam::Vec3::new(0.0, -1.0, 0.0)) < 1e-5);
+        let skeleton = vertebra_ragdoll::Skeleton::reference();
+        let hand = &skeleton.bones()[skeleton.bone_index("hand_l").unwrap()];
+        for frame in 0..3 {
+            let (fp, fq) = bone(frame, "forearm_l");
+            let (hp, hq) = bone(frame, "hand_l");
+            assert!(hp.distance(fp + fq * hand.bind.translation) < 1e-5);
+            assert!(hq.angle_between(fq * hand.bind.rotation) < 1e-4);
+        }
+    }
+    // The hit reaction (the anatomical humanoid binds by name too).
+    let path = dir.join("hit.csv");
+    let (code, _, stderr) = vertebra(&[
+        "scene",
+        "hit-reaction",
+        "--spine",
+        "rod",
+        "--frames",
+        "2",
+        "--skeleton-out",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let rows = skeleton_rows(&path);
+    assert_eq!(rows.len(), 2 * 63);
+    assert!(rows.iter().all(|r| r.3.iter().all(|x| x.is_finite())));
+    std::fs::remove_dir_all(&dir).unwrap();
+    fails_with(
+        &scene_with(&[
+            "--frames",
+            "1",
+            "--skeleton-out",
+            "/proc/vertebra-none/bones.csv",
+        ])
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>(),
+        "cannot write the skeleton poses to `/proc/vertebra-none/bones.csv`: ",
+    );
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "rod",
+            "--seeds",
+            "2",
+            "--skeleton-out",
+            "x.csv",
+        ],
+        "--skeleton-out writes one run; not with --seeds",
+    );
+}

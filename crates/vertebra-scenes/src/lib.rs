@@ -18,6 +18,7 @@ mod scene;
 mod scene_world;
 pub mod seed;
 mod seeds;
+mod skeleton_out;
 mod spread;
 
 pub use builder::build;
@@ -27,8 +28,9 @@ pub use kinematics::{Locus, kinematics};
 pub use quantity::{Quantity, Stats};
 pub use ragdoll_drop::ragdoll_drop;
 pub use recovery::{RECOVERED, Recovery};
-pub use run::{Frame, MAX_FRAMES, SceneRun, run};
+pub use run::{Frame, MAX_FRAMES, SceneRun, run, run_observed};
 pub use scene::Scene;
 pub use scene_world::SceneWorld;
 pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};
+pub use skeleton_out::SkeletonOut;
 pub use spread::Spread;

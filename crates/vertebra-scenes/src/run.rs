@@ -5,7 +5,7 @@ use std::time::Instant;
 use vertebra_math::Backend;
 use vertebra_ragdoll::{Pose, RagdollError, SpineMapping};
 
-use crate::{Scene, SceneConfig, build};
+use crate::{Scene, SceneConfig, SceneWorld, build};
 
 /// The most frames a run takes: 4.6 hours at 60 Hz. A run keeps a record
 /// per frame (20 bytes), reserved up front from the count, so the bound
@@ -63,15 +63,26 @@ pub struct SceneRun {
 /// `progress(frame, frames)` after each frame.
 pub fn run(
     config: &SceneConfig,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl FnMut(usize, usize),
 ) -> Result<SceneRun, RagdollError> {
+    run_observed(config, progress, |_, _| Ok(()))
+}
+
+/// As [`run`], calling `observe(frame, &scene)` after each frame's step
+/// (frame 0 first), before `progress`; its error ends the run.
+pub fn run_observed<E: From<RagdollError>>(
+    config: &SceneConfig,
+    mut progress: impl FnMut(usize, usize),
+    mut observe: impl FnMut(usize, &SceneWorld) -> Result<(), E>,
+) -> Result<SceneRun, E> {
     let frames = config.frames.unwrap_or(config.scene.default_frames());
     if !(1..=MAX_FRAMES).contains(&frames) {
         return Err(RagdollError::OutOfRange {
             context: "scene".to_owned(),
             field: "frames",
             reason: format!("is {frames}; must be 1 to {MAX_FRAMES}"),
-        });
+        }
+        .into());
     }
     let mut built = build(config)?;
     let dt = 1.0 / 60.0;
@@ -90,6 +101,7 @@ pub fn run(
         if frame == 0 || frame == middle || frame + 1 == frames {
             snapshots.push(built.ragdolls[0].skeleton_pose(&built.world, SpineMapping::Arc)?);
         }
+        observe(frame, &built)?;
         progress(frame + 1, frames);
     }
     let ms_per_step = start.elapsed().as_secs_f64() * 1e3 / frames.max(1) as f64;
@@ -99,7 +111,8 @@ pub fn run(
         .enumerate()
         .flat_map(|(k, r)| r.bodies.iter().flatten().map(move |b| (k, *b)))
         .map(|(k, b)| built.world.body(b).map(|s| (k, s.position)))
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(RagdollError::from)?;
     Ok(SceneRun {
         scene: config.scene,
         backend: built.world.backend(),
