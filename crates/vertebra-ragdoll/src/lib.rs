@@ -44,6 +44,73 @@
 //! # Ok(())
 //! # }
 //! ```
+//!
+//! From an engine's skeleton to a driven, partially animated ragdoll and
+//! back to animation (the walk-through of `docs/ragdolls.md`):
+//!
+//! ```
+//! use glam::Quat;
+//! use vertebra_ragdoll::{
+//!     BlendBack, BuildOptions, DriveSettings, LocalPose, Ragdoll, RagdollDesc, Skeleton,
+//!     SkeletonMapper, SpineMapping, SpineMode, Strength, Transform, Transition,
+//! };
+//! use vertebra_world::{SolverConfig, World};
+//!
+//! # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
+//! let skeleton = Skeleton::reference(); // the engine's skeleton: 63 bones
+//! let desc = RagdollDesc::reference_humanoid(); // 13 bodies, each on the bone of its name
+//! let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod)?;
+//! let place = Transform::IDENTITY; // the model frame in the world
+//! let dt = 1.0 / 60.0;
+//!
+//! // The animation's last two local poses: the bind pose, then the spine
+//! // bending forward and the root moving on.
+//! let previous = skeleton.bind_pose();
+//! let mut current = previous.clone();
+//! let spine = skeleton.bone_index("spine_middle").expect("a spine bone");
+//! current.bones[spine].rotation *= Quat::from_rotation_x(0.05);
+//! current.bones[0].translation.z += 0.02;
+//!
+//! // The switch: bodies where the animation has them, at its velocities.
+//! let bodies = |pose: &LocalPose| mapper.map_to_ragdoll(&pose.to_model(&skeleton)?, place);
+//! let (now, before) = (bodies(&current)?, bodies(&previous)?);
+//! let mut world = World::new(SolverConfig::default())?;
+//! let options = BuildOptions::new(SpineMode::Rod);
+//! let ragdoll = Ragdoll::build(&mut world, &desc, options, &now, Some((&before, dt)))?;
+//! let transition =
+//!     Transition::new(&mapper, &ragdoll, &world, &current, place, SpineMapping::Arc, 0.3)?;
+//!
+//! // The legs stay animated (kinematic, on the animation); the upper body
+//! // is powered toward it. The animation holds `current` from here on.
+//! for leg in ["thigh_l", "shin_l", "thigh_r", "shin_r"] {
+//!     ragdoll.set_body_kinematic(&mut world, leg, true)?;
+//! }
+//! let drive = DriveSettings::uniform(Strength::Compliance(1e-3));
+//! let mut bones = None;
+//! for frame in 1..=30 {
+//!     ragdoll.drive_following(&mut world, &now, &now, dt, &drive)?;
+//!     ragdoll.drive_to_pose_using_kinematics(&mut world, &now, dt)?;
+//!     world.step(dt)?;
+//!     // Every bone of the engine's skeleton, in the world.
+//!     let since = frame as f32 * dt;
+//!     let pose = transition.skeleton_pose(&mapper, &ragdoll, &world, &current, place, since)?;
+//!     assert_eq!(pose.bones.len(), 63);
+//!     assert!(pose.bones.iter().all(|b| b.translation.is_finite() && b.rotation.is_finite()));
+//!     bones = Some(pose);
+//! }
+//!
+//! // Back to animation over half a second (getting up).
+//! let last = bones.expect("30 frames").to_local(&skeleton)?;
+//! let mut back = BlendBack::new(&skeleton, last, 0.5)?;
+//! while !back.is_done() {
+//!     let out = back.pose(&skeleton, &current)?;
+//!     assert_eq!(out.bones.len(), 63);
+//!     back.advance(dt)?;
+//! }
+//! assert_eq!(back.pose(&skeleton, &current)?, current);
+//! # Ok(())
+//! # }
+//! ```
 
 mod assemble;
 mod blend;
