@@ -33,7 +33,7 @@
 //! chain's change of length.
 
 use glam::{Quat, Vec3};
-use vertebra_world::{MAX_COORDINATE, World};
+use vertebra_world::World;
 
 use crate::description::RagdollDesc;
 use crate::error::RagdollError;
@@ -485,33 +485,15 @@ impl SkeletonMapper {
         Ok(ModelPose { bones: out })
     }
 
-    /// Checks one transform per bone, each finite, within
-    /// [`MAX_COORDINATE`], with a unit rotation; the error names the bone.
+    /// Checks one transform per bone, as [`Skeleton`]'s poses are checked
+    /// (finite, within `MAX_COORDINATE`, unit rotations); the error names
+    /// `what` and the bone.
     pub(crate) fn check_bones(
         &self,
         what: &str,
         transforms: &[Transform],
     ) -> Result<(), RagdollError> {
-        if transforms.len() != self.skeleton.len() {
-            return Err(RagdollError::BadPose(format!(
-                "{what}: {} transforms for {} bones",
-                transforms.len(),
-                self.skeleton.len()
-            )));
-        }
-        for (i, (t, bone)) in transforms.iter().zip(self.skeleton.bones()).enumerate() {
-            // The common case without formatting a name; the check that
-            // names the field on any doubt.
-            let fits = t.translation.is_finite()
-                && t.translation.abs().max_element() <= MAX_COORDINATE
-                && t.rotation.is_finite()
-                && (t.rotation.length() - 1.0).abs() <= 1e-3;
-            if !fits {
-                t.validate(&format!("{what}: bone {i} `{}`", bone.name))
-                    .map_err(|e| RagdollError::BadPose(e.to_string()))?;
-            }
-        }
-        Ok(())
+        self.skeleton.check(what, transforms)
     }
 }
 

@@ -67,27 +67,33 @@ impl Transform {
     /// [`MAX_COORDINATE`] and the rotation a unit quaternion (within 1e-3);
     /// the error names `context` and the field.
     pub fn validate(self, context: &str) -> Result<(), RagdollError> {
+        self.validate_in(|| context.to_owned())
+    }
+
+    /// [`Self::validate`], naming the item only when refusing: a valid
+    /// transform costs no allocation (poses check every bone every call).
+    fn validate_in(self, context: impl Fn() -> String) -> Result<(), RagdollError> {
         let t = self.translation;
         if !t.is_finite() {
             return Err(RagdollError::NonFinite {
-                context: context.to_owned(),
+                context: context(),
                 field: "translation",
             });
         }
         if t.abs().max_element() > MAX_COORDINATE {
             return Err(RagdollError::OutOfRange {
-                context: context.to_owned(),
+                context: context(),
                 field: "translation",
                 reason: format!("is {t}; each coordinate must be within {MAX_COORDINATE} m"),
             });
         }
         check_unit_quat("rotation", self.rotation).map_err(|e| match e {
             vertebra_world::Error::NonFinite(field) => RagdollError::NonFinite {
-                context: context.to_owned(),
+                context: context(),
                 field,
             },
             _ => RagdollError::OutOfRange {
-                context: context.to_owned(),
+                context: context(),
                 field: "rotation",
                 reason: format!(
                     "has length {}; must be a unit quaternion (within 1e-3)",
@@ -192,17 +198,22 @@ impl Skeleton {
     }
 
     /// Checks that `transforms` has one transform per bone, each finite
-    /// with a unit rotation; the error names the bone.
-    fn check(&self, transforms: &[Transform]) -> Result<(), RagdollError> {
+    /// with a unit rotation; the error names `what` (if not empty) and the
+    /// bone. Nothing is formatted unless refused.
+    pub(crate) fn check(&self, what: &str, transforms: &[Transform]) -> Result<(), RagdollError> {
+        let named = |item: String| match what {
+            "" => item,
+            _ => format!("{what}: {item}"),
+        };
         if transforms.len() != self.bones.len() {
-            return Err(RagdollError::BadPose(format!(
+            return Err(RagdollError::BadPose(named(format!(
                 "{} transforms for {} bones",
                 transforms.len(),
                 self.bones.len()
-            )));
+            ))));
         }
         for (i, (t, bone)) in transforms.iter().zip(&self.bones).enumerate() {
-            t.validate(&bone_context(i, &bone.name))
+            t.validate_in(|| named(bone_context(i, &bone.name)))
                 .map_err(|e| RagdollError::BadPose(e.to_string()))?;
         }
         Ok(())
@@ -234,7 +245,7 @@ impl LocalPose {
     /// does not fit `skeleton` (count, a non-finite transform or
     /// non-unit rotation: the error names the bone).
     pub fn to_model(&self, skeleton: &Skeleton) -> Result<ModelPose, RagdollError> {
-        skeleton.check(&self.bones)?;
+        skeleton.check("", &self.bones)?;
         let mut model: Vec<Transform> = Vec::with_capacity(self.bones.len());
         for (local, bone) in self.bones.iter().zip(&skeleton.bones) {
             let placed = match bone.parent {
@@ -251,7 +262,7 @@ impl ModelPose {
     /// This pose in local space: each bone relative to its parent. Refused
     /// as [`LocalPose::to_model`] refuses.
     pub fn to_local(&self, skeleton: &Skeleton) -> Result<LocalPose, RagdollError> {
-        skeleton.check(&self.bones)?;
+        skeleton.check("", &self.bones)?;
         let bones = self
             .bones
             .iter()
@@ -288,8 +299,8 @@ impl LocalPose {
         other: &LocalPose,
         weights: &[f32],
     ) -> Result<LocalPose, RagdollError> {
-        skeleton.check(&self.bones)?;
-        skeleton.check(&other.bones)?;
+        skeleton.check("", &self.bones)?;
+        skeleton.check("", &other.bones)?;
         crate::blend::check_weights(weights, skeleton.len(), |k| {
             bone_context(k, &skeleton.bones[k].name)
         })?;
