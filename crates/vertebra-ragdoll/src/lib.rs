@@ -71,11 +71,12 @@
 //! current.bones[spine].rotation *= Quat::from_rotation_x(0.05);
 //! current.bones[0].translation.z += 0.02;
 //!
-//! // The switch: bodies where the animation has them, at its velocities.
+//! // The switch: bodies where the animation has them, at its velocities,
+//! // joints and rod made at that pose (nothing pops on the first step).
 //! let bodies = |pose: &LocalPose| mapper.map_to_ragdoll(&pose.to_model(&skeleton)?, place);
 //! let (now, before) = (bodies(&current)?, bodies(&previous)?);
 //! let mut world = World::new(SolverConfig::default())?;
-//! let options = BuildOptions::new(SpineMode::Rod);
+//! let options = BuildOptions::at_switch(SpineMode::Rod);
 //! let ragdoll = Ragdoll::build(&mut world, &desc, options, &now, Some((&before, dt)))?;
 //! let transition =
 //!     Transition::new(&mapper, &ragdoll, &world, &current, place, SpineMapping::Arc, 0.3)?;
@@ -143,7 +144,7 @@ pub use joint_def::{JointDef, JointFrame, JointSpec};
 pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
 pub use pose::Pose;
-pub use ragdoll::{BuildOptions, Ragdoll, RodRest, SpineMode, body_masses};
+pub use ragdoll::{BuildOptions, JointAnchors, Ragdoll, RodRest, SpineMode, body_masses};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
 pub use skeleton_file::REFERENCE_SKELETON;
 pub use spec::{BodyShape, BodySpec, RagdollBuilder, SpineSpec};

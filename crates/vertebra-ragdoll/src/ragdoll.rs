@@ -48,6 +48,29 @@ pub enum RodRest {
     Bind,
 }
 
+/// Where each joint's pivot sits on its parent body. Either way the child
+/// body's anchor is the description's pivot, and the joint's frames and
+/// limits are measured from the bind pose.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum JointAnchors {
+    /// The description's, and the default (as a physics asset's joints
+    /// are): both bodies' anchors at the described pivot. A pose whose
+    /// bodies are apart at a joint (an animation whose clavicle or neck
+    /// bones, which have no body, moved the child off the parent's pivot)
+    /// is pulled together by the first step.
+    #[default]
+    Bind,
+    /// The switch's: the parent's anchor is put where the child's is at
+    /// the pose the ragdoll is built at, so every joint holds exactly
+    /// there, and the offset that the animation's bodiless bones (a turned
+    /// clavicle, a bent neck) gave the child is kept for the ragdoll's
+    /// life, as the mapper's [`Transition`](crate::Transition) keeps those
+    /// bones' offsets. For the switch from animation: no body moves on the
+    /// first step for a joint being apart. [`Ragdoll::recreate`] measures
+    /// again at its pose.
+    Transition,
+}
+
 /// Options for [`Ragdoll::build`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BuildOptions {
@@ -56,6 +79,8 @@ pub struct BuildOptions {
     /// Where a simplified ragdoll's rod takes its rest shape and limits
     /// from.
     pub rod_rest: RodRest,
+    /// Where the joints' pivots sit on their parent bodies.
+    pub anchors: JointAnchors,
     /// Opt-in stabilisation (after Jolt's `Ragdoll::Stabilize`, which
     /// follows Strunk): the largest allowed mass ratio across a joint, and
     /// between a body's largest and smallest principal inertia: finite and
@@ -65,13 +90,24 @@ pub struct BuildOptions {
 }
 
 impl BuildOptions {
-    /// Standard or simplified, the rod's rest from the switch, not
-    /// stabilised.
+    /// Standard or simplified, the rod's rest from the switch, the
+    /// joints' anchors from the description, not stabilised.
     pub fn new(spine: SpineMode) -> Self {
         Self {
             spine,
             rod_rest: RodRest::Transition,
+            anchors: JointAnchors::Bind,
             stabilise: None,
+        }
+    }
+
+    /// For the switch from animation (the mapper's
+    /// [`map_to_ragdoll`](crate::SkeletonMapper::map_to_ragdoll)): the rod's
+    /// rest and the joints' anchors both from the pose built at.
+    pub fn at_switch(spine: SpineMode) -> Self {
+        Self {
+            anchors: JointAnchors::Transition,
+            ..Self::new(spine)
         }
     }
 
@@ -249,11 +285,18 @@ impl Ragdoll {
             );
             // Joint frames from bind pose (bodies unrotated there): both are
             // the described frame, so limits are measured from bind pose.
+            let anchor_b = j.anchor - desc.bodies[j.child].centre();
+            let anchor_a = match self.options.anchors {
+                JointAnchors::Bind => j.anchor - desc.bodies[j.parent].centre(),
+                JointAnchors::Transition => {
+                    pivot_on_parent(pose.bones[j.parent], pose.bones[j.child], anchor_b)
+                }
+            };
             let socket = JointDesc {
                 body_a: a,
                 body_b: b,
-                anchor_a: j.anchor - desc.bodies[j.parent].centre(),
-                anchor_b: j.anchor - desc.bodies[j.child].centre(),
+                anchor_a,
+                anchor_b,
                 frame_a: j.frame,
                 frame_b: j.frame,
                 kind: j.kind,
@@ -436,6 +479,17 @@ impl Ragdoll {
         }
         pairs
     }
+}
+
+/// The child's anchor `anchor_b` (its body frame) at the child's pose, in
+/// the parent's body frame at the parent's: the relative offset first, so
+/// that far from the origin only the bodies' separation is rounded.
+fn pivot_on_parent(
+    (parent, parent_q): (Vec3, Quat),
+    (child, child_q): (Vec3, Quat),
+    anchor_b: Vec3,
+) -> Vec3 {
+    parent_q.inverse() * ((child - parent) + child_q * anchor_b)
 }
 
 /// How errors name a simplified ragdoll's spine rod: by its end bodies.

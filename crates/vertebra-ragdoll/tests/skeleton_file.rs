@@ -83,11 +83,11 @@ fn the_reference_skeleton_has_the_bones_an_engine_exports() {
     }
 }
 
-/// Each body of both humanoids has a bone of its name where the body meets
-/// its parent: the point of its capsule segment nearest the joint to its
-/// parent (the root, the hips, at its centre); and the five spine bones
-/// lie on the spine bodies' polyline (hips centre, the two spine bodies'
-/// segments, chest centre).
+/// Each body of both humanoids has a bone of its name at the pivot of the
+/// joint to its parent body (the root, the hips, at its centre), so a bone
+/// turned about its origin turns its body about its joint; and the five
+/// spine bones lie on the spine's polyline (the hips' centre, the spine
+/// joints' pivots).
 #[test]
 fn the_reference_skeleton_fits_both_humanoids_bind_poses() {
     let s = Skeleton::reference();
@@ -100,20 +100,14 @@ fn the_reference_skeleton_fits_both_humanoids_bind_poses() {
         for (i, body) in desc.bodies.iter().enumerate() {
             let expected = match desc.parent_joint[i] {
                 None => body.centre(),
-                Some(k) => nearest_on_segment(desc.joints[k].anchor, body.segment),
+                Some(k) => desc.joints[k].anchor,
             };
             let miss = origin(&body.name).distance(expected);
-            assert!(miss < 1e-3, "{}: {}: {miss} m", desc.name, body.name);
+            assert!(miss < 1e-6, "{}: {}: {miss} m", desc.name, body.name);
         }
-        let body = |name: &str| &desc.bodies[desc.body_index(name).unwrap()];
-        let polyline = [
-            body("hips").centre(),
-            body("spine_lower").segment[0],
-            body("spine_lower").segment[1],
-            body("spine_upper").segment[0],
-            body("spine_upper").segment[1],
-            body("chest").centre(),
-        ];
+        let pivot = |name: &str| desc.joints.iter().find(|j| j.name == name).unwrap().anchor;
+        let hips = desc.bodies[desc.body_index("hips").unwrap()].centre();
+        let polyline = [hips, pivot("spine_1"), pivot("spine_2"), pivot("spine_3")];
         for bone in [
             "spine_lower",
             "spine_middle",
@@ -122,7 +116,7 @@ fn the_reference_skeleton_fits_both_humanoids_bind_poses() {
             "chest",
         ] {
             let miss = distance_to_polyline(origin(bone), &polyline);
-            assert!(miss < 1e-3, "{}: {bone}: {miss} m", desc.name);
+            assert!(miss < 1e-6, "{}: {bone}: {miss} m", desc.name);
         }
     }
 }

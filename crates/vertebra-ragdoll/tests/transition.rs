@@ -1,27 +1,24 @@
-//! The switch from animation to ragdoll on the dense skeleton: no bone
-//! pops on the first frame, and a fade ends on the pure mapping.
+//! The switch from animation to ragdoll on the shipped 63-bone reference
+//! skeleton: no bone pops on the first frame, and a fade ends on the pure
+//! mapping.
 //! `cargo test -p vertebra-ragdoll --test transition -- --nocapture` prints
 //! the figures.
 
 #[path = "support/animation.rs"]
 mod animation;
-#[path = "support/dense.rs"]
-mod dense;
 
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_ragdoll::{
-    BoneRole, BuildOptions, LocalPose, ModelPose, Ragdoll, RagdollDesc, SkeletonMapper,
+    BoneRole, BuildOptions, LocalPose, ModelPose, Ragdoll, RagdollDesc, Skeleton, SkeletonMapper,
     SpineMapping, SpineMode, Transform, Transition,
 };
 use vertebra_world::{SolverConfig, World};
 
 use animation::{earlier, random_animation};
-use dense::dense_skeleton;
-
-/// The dense skeleton's axis along a bone, in the bone's frame.
-const ALONG: Vec3 = Vec3::X;
+/// The reference skeleton's axis along a bone, in the bone's frame.
+const ALONG: Vec3 = Vec3::Y;
 const DT: f32 = 1.0 / 60.0;
 const MAPPINGS: [SpineMapping; 3] = [
     SpineMapping::Orientation,
@@ -29,8 +26,10 @@ const MAPPINGS: [SpineMapping; 3] = [
     SpineMapping::Arc,
 ];
 
-/// A ragdoll switched on at a random animated pose of the dense skeleton,
-/// moving as the animation did a frame before.
+/// A ragdoll switched on at a random animated pose of the reference
+/// skeleton (every bone turned, the neck's and clavicles' too), moving as
+/// the animation did a frame before, built with its joints' anchors and
+/// its rod's rest from that pose ([`BuildOptions::at_switch`]).
 struct Switch {
     desc: RagdollDesc,
     mapper: SkeletonMapper,
@@ -42,17 +41,15 @@ struct Switch {
     animated: ModelPose,
 }
 
-/// With `hold`, the bones between two bodies a socket joins stay at bind
-/// ([`held_by_sockets`]).
-fn switch(spine: SpineMode, rate: f32, dt: f32, hold: bool, r: &mut StdRng) -> Switch {
+fn switch(spine: SpineMode, rate: f32, dt: f32, r: &mut StdRng) -> Switch {
+    switch_with(BuildOptions::at_switch(spine), rate, dt, r)
+}
+
+fn switch_with(options: BuildOptions, rate: f32, dt: f32, r: &mut StdRng) -> Switch {
     let desc = RagdollDesc::reference_humanoid();
-    let skeleton = dense_skeleton();
-    let mapper = SkeletonMapper::new(&skeleton, &desc, spine).unwrap();
-    let still = if hold {
-        held_by_sockets(&mapper, &desc)
-    } else {
-        vec![false; skeleton.len()]
-    };
+    let skeleton = Skeleton::reference();
+    let mapper = SkeletonMapper::new(&skeleton, &desc, options.spine).unwrap();
+    let still = vec![false; skeleton.len()];
     let animation = random_animation(&skeleton, ALONG, &still, r);
     let before = earlier(&skeleton, ALONG, &still, &animation, rate, dt, r);
     let place = Transform::new(
@@ -72,7 +69,7 @@ fn switch(spine: SpineMode, rate: f32, dt: f32, hold: bool, r: &mut StdRng) -> S
     let ragdoll = Ragdoll::build(
         &mut world,
         &desc,
-        BuildOptions::new(spine),
+        options,
         &to_bodies(&animation),
         Some((&to_bodies(&before), dt)),
     )
@@ -87,26 +84,6 @@ fn switch(spine: SpineMode, rate: f32, dt: f32, hold: bool, r: &mut StdRng) -> S
         place,
         animated,
     }
-}
-
-/// The bones between two bodies a socket joins (the neck, the clavicles;
-/// a standard ragdoll's spine): turned, they would move the child's anchor
-/// off the parent's, and the socket would pull the bodies together in the
-/// first step. The rod is made at the switch pose, so its spine bones turn.
-fn held_by_sockets(mapper: &SkeletonMapper, desc: &RagdollDesc) -> Vec<bool> {
-    let spine = desc.spine.as_ref().unwrap();
-    let rod = |base: usize, top: usize| {
-        mapper.roles()[base] == BoneRole::Body(spine.bodies[0])
-            && mapper.roles()[top] == BoneRole::Body(spine.bodies[spine.bodies.len() - 1])
-    };
-    mapper
-        .roles()
-        .iter()
-        .map(|role| match *role {
-            BoneRole::Chain { base, top } => !rod(base, top),
-            _ => false,
-        })
-        .collect()
 }
 
 /// Every body's world transform (centre of mass, rotation from bind).
@@ -200,7 +177,7 @@ fn first_frame(trials: usize, rate: f32, dt: f32, seed: u64) -> (f32, f32) {
     let (mut worst, mut worst_pure) = (0.0f32, 0.0f32);
     for trial in 0..trials {
         for spine in [SpineMode::Rod, SpineMode::Sockets] {
-            let mut s = switch(spine, rate, dt, true, &mut r);
+            let mut s = switch(spine, rate, dt, &mut r);
             let before = bodies(&s);
             let transitions: Vec<Transition> = MAPPINGS
                 .iter()
@@ -250,7 +227,7 @@ fn first_frame(trials: usize, rate: f32, dt: f32, seed: u64) -> (f32, f32) {
     (worst, worst_pure)
 }
 
-/// The required figure: over 48 random animated poses of the dense
+/// The required figure: over 48 random animated poses of the reference
 /// skeleton, both spines, every mapping, the animation moving (bones at up
 /// to 0.5 rad/s, the root at up to 1 m/s), on the first 60 Hz frame after
 /// the switch every bone is where the animation had it, moved only by what
@@ -298,7 +275,7 @@ fn a_fade_ends_on_the_pure_mapping_and_a_held_transition_keeps_its_offsets() {
     let mut r = StdRng::seed_from_u64(7);
     let fade = 0.25;
     for spine in [SpineMode::Rod, SpineMode::Sockets] {
-        let mut s = switch(spine, 1.0, DT, false, &mut r);
+        let mut s = switch(spine, 1.0, DT, &mut r);
         let mapping = SpineMapping::Orientation;
         let new = |s: &Switch, fade| {
             Transition::new(
@@ -377,10 +354,68 @@ fn a_fade_ends_on_the_pure_mapping_and_a_held_transition_keeps_its_offsets() {
     }
 }
 
+/// The largest joint separation (cm) of the ragdoll's world, as built.
+fn largest_separation(s: &mut Switch) -> f32 {
+    let residuals = s.world.measure_residuals();
+    residuals
+        .joints
+        .iter()
+        .map(|j| j.linear_cm)
+        .fold(0.0, f32::max)
+}
+
+/// The largest distance (m) a body moved in a step relative to the hips
+/// (the whole ragdoll falls together, at rest at the switch).
+fn largest_relative_move(s: &mut Switch) -> f32 {
+    let before = bodies(s);
+    s.world.step(DT).unwrap();
+    let after = bodies(s);
+    let hips = s.desc.body_index("hips").unwrap();
+    let fall = after[hips].translation - before[hips].translation;
+    before
+        .iter()
+        .zip(&after)
+        .filter(|(b, _)| **b != Transform::IDENTITY)
+        .map(|(b, a)| (a.translation - b.translation - fall).length())
+        .fold(0.0, f32::max)
+}
+
+/// At an animation pose whose neck and clavicle bones (which have no body)
+/// are turned, a ragdoll built with the description's anchors has its
+/// joints apart, and its first step pulls the bodies together: a body
+/// pop. Built with the switch's anchors ([`BuildOptions::at_switch`]) the
+/// joints hold exactly there, and the first step moves the bodies as one.
+#[test]
+fn joints_made_at_the_switch_hold_there() {
+    for spine in [SpineMode::Rod, SpineMode::Sockets] {
+        // The same animation pose, from the same seed.
+        let seed = || StdRng::seed_from_u64(5);
+        let mut at_bind = switch_with(BuildOptions::new(spine), 0.0, DT, &mut seed());
+        let mut at_switch = switch(spine, 0.0, DT, &mut seed());
+        let (apart, held) = (
+            largest_separation(&mut at_bind),
+            largest_separation(&mut at_switch),
+        );
+        let (pop, still) = (
+            largest_relative_move(&mut at_bind),
+            largest_relative_move(&mut at_switch),
+        );
+        eprintln!(
+            "{spine:?}: joints apart {apart:.2} cm, first step pulls {:.2} mm; at the switch's anchors {held:.1e} cm, {:.3} mm",
+            pop * 1e3,
+            still * 1e3
+        );
+        assert!(apart > 0.5, "{spine:?}: {apart} cm");
+        assert!(pop > 2e-3, "{spine:?}: {pop} m");
+        assert!(held < 1e-4, "{spine:?}: {held} cm");
+        assert!(still < 1e-4, "{spine:?}: {still} m");
+    }
+}
+
 #[test]
 fn a_transition_refuses_what_it_cannot_use() {
     let mut r = StdRng::seed_from_u64(1);
-    let s = switch(SpineMode::Rod, 0.0, DT, false, &mut r);
+    let s = switch(SpineMode::Rod, 0.0, DT, &mut r);
     let new = |fade| {
         Transition::new(
             &s.mapper,
@@ -420,5 +455,5 @@ fn a_transition_refuses_what_it_cannot_use() {
         .skeleton_pose(&s.mapper, &s.ragdoll, &s.world, &short, s.place, 0.0)
         .unwrap_err()
         .to_string();
-    assert!(message.contains("68 transforms for 69 bones"), "{message}");
+    assert!(message.contains("62 transforms for 63 bones"), "{message}");
 }

@@ -1,7 +1,6 @@
 //! Random animation poses of a skeleton for the reference humanoid, within
 //! its joint limits. Each bone turns about its axis along the bone, in its
-//! own frame: `along` (+Y on the shipped `Skeleton::reference()`, +X on
-//! the test-only dense skeleton of `dense.rs`).
+//! own frame: `along` (+Y on the shipped `Skeleton::reference()`).
 
 use glam::{Quat, Vec3};
 use rand::RngExt;
