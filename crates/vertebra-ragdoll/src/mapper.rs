@@ -232,7 +232,7 @@ impl SkeletonMapper {
     pub(crate) fn bodies_as_bones(
         desc: &RagdollDesc,
         spine: SpineMode,
-    ) -> Result<(Skeleton, Self), RagdollError> {
+    ) -> Result<Self, RagdollError> {
         // Parents before children: the root, then each body once its
         // parent is in (the joints form a tree over the bodies).
         let parent_body = |b: usize| desc.parent_joint[b].map(|j| desc.joints[j].parent);
@@ -266,9 +266,7 @@ impl SkeletonMapper {
                 }
             })
             .collect();
-        let skeleton = Skeleton::new(bones)?;
-        let mapper = Self::with_binding(&skeleton, desc, spine, &index)?;
-        Ok((skeleton, mapper))
+        Self::with_binding(&Skeleton::new(bones)?, desc, spine, &index)
     }
 
     /// With every bone whose parent is not free keeping the animation's

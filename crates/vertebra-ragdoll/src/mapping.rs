@@ -20,7 +20,6 @@ use glam::{Quat, Vec3};
 use vertebra_world::{World, arc_tangent, rod_twist};
 
 use crate::error::RagdollError;
-use crate::mapper::SkeletonMapper;
 use crate::pose::Pose;
 use crate::ragdoll::Ragdoll;
 use crate::skeleton::Transform;
@@ -271,7 +270,7 @@ impl Ragdoll {
     /// The pose of every body as an animation bone (one bone per described
     /// body, at its centre of mass, rotation relative to bind), from the
     /// bodies in `world`; a simplified ragdoll's interior spine bodies are
-    /// placed by `mapping`. It is [`SkeletonMapper`] on a skeleton of one
+    /// placed by `mapping`. It is [`SkeletonMapper`](crate::SkeletonMapper) on a skeleton of one
     /// bone per body (each at its centre of mass, unrotated at bind); for
     /// an engine's own skeleton use the mapper.
     pub fn skeleton_pose(
@@ -279,11 +278,11 @@ impl Ragdoll {
         world: &World,
         mapping: SpineMapping,
     ) -> Result<Pose, RagdollError> {
-        let (skeleton, mapper) = SkeletonMapper::bodies_as_bones(&self.desc, self.options.spine)?;
+        let mapper = &self.as_bones;
         let model = mapper.map_to_skeleton(
             self,
             world,
-            &skeleton.bind_pose(),
+            &mapper.skeleton().bind_pose(),
             Transform::IDENTITY,
             mapping,
         )?;

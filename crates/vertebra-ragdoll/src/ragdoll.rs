@@ -2,6 +2,7 @@
 //! simplified (the spine chain replaced by one rod, paper section 6).
 
 use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
@@ -11,6 +12,7 @@ use vertebra_world::{
 
 use crate::description::RagdollDesc;
 use crate::error::RagdollError;
+use crate::mapper::SkeletonMapper;
 use crate::pose::Pose;
 
 /// How the spine is simulated.
@@ -139,6 +141,9 @@ pub struct Ragdoll {
     pub rod: Option<RodHandle>,
     /// The rod as created (its rest shape), to return to after driving.
     pub(crate) rod_rest: Option<RodDesc>,
+    /// The mapper onto a skeleton of one bone per body, made once at the
+    /// build for [`Ragdoll::skeleton_pose`] (shared by clones).
+    pub(crate) as_bones: Arc<SkeletonMapper>,
 }
 
 /// Masses per described body for `options` (interior spine masses moved to
@@ -220,6 +225,7 @@ impl Ragdoll {
                 )));
             }
         }
+        let as_bones = SkeletonMapper::bodies_as_bones(desc, options.spine)?;
         let mut ragdoll = Self {
             desc: desc.clone(),
             options,
@@ -227,6 +233,7 @@ impl Ragdoll {
             joints: vec![None; desc.joints.len()],
             rod: None,
             rod_rest: None,
+            as_bones: Arc::new(as_bones),
         };
         // Removing what went in would leave the slots it took behind (a
         // longer table, a free list): the snapshot puts them back too.
