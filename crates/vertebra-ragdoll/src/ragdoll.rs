@@ -69,7 +69,11 @@ pub enum JointAnchors {
     /// life, as the mapper's [`Transition`](crate::Transition) keeps those
     /// bones' offsets. For the switch from animation: no body moves on the
     /// first step for a joint being apart. [`Ragdoll::recreate`] measures
-    /// again at its pose.
+    /// again at its pose. The gap is kept whatever its size (within the
+    /// world's coordinate range, else the build is refused naming the
+    /// joint): a pose with a body torn off its parent (a teleported bone)
+    /// keeps it there, so build from a pose the animation system vouches
+    /// for, or with `Bind`.
     Transition,
 }
 
