@@ -44,8 +44,12 @@ pub struct SolverConfig {
     pub iterations: u32,
     /// Instruction set for the kernels.
     pub backend: BackendChoice,
-    /// Worker threads (1 to [`MAX_THREADS`]); 1 solves on the calling
-    /// thread.
+    /// Worker threads (1 to [`MAX_THREADS`]) of the rayon pool
+    /// ([`RayonTasks`](crate::RayonTasks)) that [`World::new`](crate::World::new)
+    /// starts; 1 solves on the calling thread
+    /// ([`SingleThreaded`](crate::SingleThreaded)).
+    /// [`World::set_tasks`](crate::World::set_tasks) puts the engine's job
+    /// system in their place. Results do not depend on it.
     pub threads: usize,
     /// Gravity (m/s^2, world).
     pub gravity: Vec3,

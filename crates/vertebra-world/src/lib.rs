@@ -36,6 +36,9 @@ mod parallel;
 mod rod;
 mod snapshot;
 mod step;
+mod tasks;
+
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use vertebra_math::{Backend, DefaultFloatMode};
@@ -54,6 +57,7 @@ pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTw
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
 pub use snapshot::Snapshot;
+pub use tasks::{MAX_RANGES, RayonTasks, SingleThreaded, TaskSystem};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
@@ -71,7 +75,7 @@ pub use vertebra_store::{
 pub struct World {
     config: SolverConfig,
     backend: Backend,
-    pool: Option<rayon::ThreadPool>,
+    tasks: Arc<dyn TaskSystem>,
     bodies: BodyStore,
     joints_at: Vec<u32>,
     joint_slots: Slots,
@@ -99,20 +103,19 @@ impl World {
             .backend
             .resolve()
             .map_err(|_| Error::InvalidConfig("the forced backend is not supported by this CPU"))?;
-        let pool = if config.threads > 1 {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(config.threads)
-                .build()
-                .map_err(|_| Error::InvalidConfig("could not start the worker threads"))?;
-            Some(pool)
+        let tasks: Arc<dyn TaskSystem> = if config.threads > 1 {
+            Arc::new(
+                RayonTasks::new(config.threads)
+                    .ok_or(Error::InvalidConfig("could not start the worker threads"))?,
+            )
         } else {
-            None
+            Arc::new(SingleThreaded)
         };
         let lineage = snapshot::new_lineage();
         Ok(Self {
             config,
             backend,
-            pool,
+            tasks,
             bodies: BodyStore::with_lineage(lineage),
             joints_at: Vec::new(),
             joint_slots: Slots::new(lineage),
@@ -134,6 +137,20 @@ impl World {
     /// The settings this world steps with.
     pub fn config(&self) -> &SolverConfig {
         &self.config
+    }
+
+    /// Runs the world's parallel work on `tasks`, the engine's job system,
+    /// from the next step on (in place of the pool of
+    /// [`SolverConfig::threads`] workers, or the calling thread, that
+    /// [`World::new`] starts). Results do not change, bit for bit, whatever
+    /// `tasks` is and does (`tasks.rs`).
+    pub fn set_tasks(&mut self, tasks: Arc<dyn TaskSystem>) {
+        self.tasks = tasks;
+    }
+
+    /// The task system the world runs its parallel work on.
+    pub fn tasks(&self) -> &Arc<dyn TaskSystem> {
+        &self.tasks
     }
 
     /// The backend the kernels run on.
@@ -517,18 +534,14 @@ impl World {
         let max_depth = self.config.max_push_out_speed * dt;
         self.contact_layout =
             contact::ContactLayout::build(&self.contacts, &self.bodies, max_depth);
-        // One entry into the pool per step: the colours' fork-joins then run
-        // among its workers (see step::for_each_colour).
-        match self.pool.take() {
-            Some(pool) => {
-                pool.install(|| {
-                    let _mode = DefaultFloatMode::enter();
-                    step::step(self, dt)
-                });
-                self.pool = Some(pool);
-            }
-            None => step::step(self, dt),
-        }
+        // One entry into the task system per step: the colours' fork-joins
+        // then run among its workers (see step::for_each_colour).
+        let tasks = Arc::clone(&self.tasks);
+        tasks.enter(&mut || {
+            // `enter` may move the step to one of its threads.
+            let _mode = DefaultFloatMode::enter();
+            step::step(self, dt)
+        });
         self.contacts.clear();
         self.residuals = metrics::residuals(self);
         Ok(())

@@ -11,10 +11,11 @@
 
 use std::sync::{Mutex, PoisonError};
 
-use rayon::prelude::*;
 use vertebra_kernels::body::{BodyPairs, BodyRows};
 use vertebra_math::DefaultFloatMode;
 use vertebra_math::row::NO_WRITE;
+
+use crate::tasks::{TaskSystem, for_each_range};
 
 /// The world's body rows: scratch of a step, reached only through
 /// `&mut World`. The mutex is never locked (`get_mut` takes no lock): it
@@ -42,36 +43,38 @@ impl<'a> Shared<'a> {
 // `Shared` exists only inside `chunked`, and only for blocks whose layout
 // passed `colour_is_disjoint`: every row one block writes is read and
 // written by that block's lane alone, and rows nobody writes (static,
-// kinematic, the null row) are only read.
+// kinematic, the null row) are only read. `for_each_range` runs each range
+// of blocks once, whatever the task system does, and only while `chunked`
+// holds the rows' borrow.
 // SAFETY: so no two workers touch a row that one of them writes, and the
 // kernels' plain loads and stores of rows never race.
 unsafe impl Sync for Shared<'_> {}
 
-/// Runs `run` on all `blocks` and `rows`, split over `threads` (of the
-/// current rayon pool: the step runs inside the world's) when there are at
-/// least `min_blocks` of them and `disjoint` holds.
+/// Runs `run` on all `blocks` and `rows`, split over the workers of
+/// `tasks` when it has more than one, there are at least `min_blocks`
+/// blocks and `disjoint` holds; else on this thread.
 ///
 /// `disjoint` must be a layout's verdict from [`colour_is_disjoint`] on
 /// every colour, and `blocks` one colour's blocks of that layout (their
 /// body pairs unchanged since): that is what makes sharing `rows` sound.
 pub(crate) fn chunked<B: Send>(
-    threads: usize,
+    tasks: Option<&dyn TaskSystem>,
     min_blocks: usize,
     disjoint: bool,
     blocks: &mut [B],
     rows: &BodyRows,
     run: impl Fn(&mut [B], &BodyRows) + Sync,
 ) {
-    if threads > 1 && disjoint && blocks.len() >= min_blocks {
-        let chunk = blocks.len().div_ceil(threads * 2);
-        let shared = Shared(rows);
-        blocks.par_chunks_mut(chunk).for_each(|c| {
-            // A worker starts in whatever mode its creator had.
-            let _mode = DefaultFloatMode::enter();
-            run(c, shared.rows())
-        });
-    } else {
-        run(blocks, rows);
+    match tasks {
+        Some(tasks) if tasks.workers() > 1 && disjoint && blocks.len() >= min_blocks => {
+            let shared = Shared(rows);
+            for_each_range(tasks, blocks, &|range| {
+                // A worker starts in whatever mode its creator had.
+                let _mode = DefaultFloatMode::enter();
+                run(range, shared.rows())
+            });
+        }
+        _ => run(blocks, rows),
     }
 }
 

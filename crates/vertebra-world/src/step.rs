@@ -17,6 +17,7 @@ use vertebra_store::{BodyKind, BodyStore};
 use crate::World;
 use crate::joint::JointKind;
 use crate::parallel::chunked;
+use crate::tasks::TaskSystem;
 
 pub(crate) fn step(world: &mut World, dt: f32) {
     let h = dt / world.config.substeps as f32;
@@ -361,8 +362,8 @@ trait Pass: Sync {
 
 /// Runs `pass` over this step's contacts, then the joints: each colour in
 /// order, then its overflow set with the scalar kernel. Inside a colour,
-/// constraints share no dynamic body, so blocks go to the thread pool (in
-/// chunks) when there are enough of them.
+/// constraints share no dynamic body, so blocks go to the task system (in
+/// ranges) when there are enough of them.
 ///
 /// Joints come last so that what an iteration leaves behind is contact
 /// error, not joint error: joint error is what the animation skeleton
@@ -371,9 +372,9 @@ trait Pass: Sync {
 /// while ragdolls met the floor less deeply (10 mm against 25 mm at
 /// impact, 1.4 mm against 0.5 mm at rest); see docs/contacts.md.
 fn for_each_colour(world: &mut World, pass: &impl Pass) {
-    // The whole step runs inside the pool (World::step), so a split colour
-    // is a fork-join among its workers, not a wake-up from outside.
-    let threads = world.config.threads;
+    // The whole step runs inside the task system (World::step), so a split
+    // colour is a fork-join among its workers, not a wake-up from outside.
+    let tasks: &dyn TaskSystem = &*world.tasks;
     let min_blocks = world.config.parallel_min_blocks;
     let rows = &*world.rows.get();
     // This step's contacts first, coloured on their own; the joints after.
@@ -381,11 +382,7 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
     let groups = contacts.colours.iter().map(|r| (r.clone(), world.backend));
     let overflow = core::iter::once((contacts.overflow.clone(), Backend::Scalar));
     for (range, backend) in groups.chain(overflow) {
-        let parallel = if backend == Backend::Scalar {
-            1
-        } else {
-            threads
-        };
+        let parallel = (backend != Backend::Scalar).then_some(tasks);
         let blocks = &mut contacts.blocks[range];
         chunked(
             parallel,
@@ -401,11 +398,7 @@ fn for_each_colour(world: &mut World, pass: &impl Pass) {
     let layout = &mut world.layout;
     let groups = layout.colours.iter().map(|g| (g, world.backend));
     for (group, backend) in groups.chain(core::iter::once((&layout.overflow, Backend::Scalar))) {
-        let parallel = if backend == Backend::Scalar {
-            1
-        } else {
-            threads
-        };
+        let parallel = (backend != Backend::Scalar).then_some(tasks);
         for (range, driven, shaped) in group.socket_ranges() {
             let blocks = &mut layout.sockets.blocks[range.clone()];
             let kind = SocketBlocks { driven, shaped };
