@@ -119,6 +119,7 @@ mod description;
 mod drive;
 mod drive_def;
 mod error;
+mod generate;
 mod joint_def;
 mod mapper;
 mod mapping;
@@ -139,6 +140,7 @@ pub use description::{
 };
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
+pub use generate::{BodyMass, BoneBody, MIN_SEGMENT, RagdollGenerator, RodSpine, SegmentEnd};
 pub use joint_def::{JointDef, JointFrame, JointSpec};
 pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
