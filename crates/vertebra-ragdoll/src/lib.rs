@@ -11,8 +11,10 @@
 //! of `[[bone]]` tables, inline or next to the ragdoll file; the shipped
 //! [`Skeleton::reference`] fits both humanoids), each body bound to a bone
 //! ([`BoneBinding`]) or placed from one bone to another; it may be built in
-//! code ([`RagdollDesc::builder`]), checked by hand
-//! ([`RagdollDesc::validate`]) and written back ([`RagdollDesc::to_toml`]).
+//! code ([`RagdollDesc::builder`]) or generated from the skeleton and
+//! per-bone radii, masses and joints ([`RagdollDesc::generator`]), checked
+//! by hand ([`RagdollDesc::validate`]) and written back
+//! ([`RagdollDesc::to_toml`]).
 //!
 //! How an engine wires it in, once per character:
 //!
