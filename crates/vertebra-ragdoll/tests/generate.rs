@@ -9,9 +9,10 @@
 //! humanoid files, whatever the bones' positions are.
 
 use glam::{Quat, Vec3};
+use proptest::prelude::*;
 use vertebra_ragdoll::{
     BodyMass, BoneBody, BuildOptions, MIN_SEGMENT, Pose, Ragdoll, RagdollDesc, RagdollGenerator,
-    RodSpine, Skeleton, SkeletonMapper, SpineMode, Transform,
+    RodSpine, SegmentEnd, Skeleton, SkeletonMapper, SpineMode, Transform,
 };
 use vertebra_world::{JointKind, SolverConfig, Swing, SwingTwist, World};
 
@@ -386,7 +387,7 @@ fn every_inconsistent_choice_is_refused_by_bone_and_reason() {
             "bone `thigh_l`: ancestor is not chosen, and only the root body (`spine_lower`) may have none: choose a bone above it, or leave it out".to_owned(),
         ),
         (
-            leg("head", |b| BoneBody { end: vertebra_ragdoll::SegmentEnd::Next, ..b }),
+            leg("head", |b| BoneBody { end: SegmentEnd::Next, ..b }),
             "bone `head`: end is the next bone along it, but it has no child; give its end (a bone, or a length)".to_owned(),
         ),
         (
@@ -452,5 +453,140 @@ fn every_inconsistent_choice_is_refused_by_bone_and_reason() {
     ];
     for (generator, expected) in cases {
         assert_eq!(refusal(generator), expected);
+    }
+}
+
+/// A number that is nearly always in range, once in a while not finite,
+/// zero, negative or huge (often enough that a choice of ten bones is
+/// refused about half the time).
+fn number(valid: core::ops::Range<f32>) -> impl Strategy<Value = f32> {
+    prop_oneof![
+        150 => valid,
+        1 => prop_oneof![
+            Just(f32::NAN),
+            Just(f32::INFINITY),
+            Just(0.0),
+            Just(-0.1),
+            Just(1e30),
+        ],
+    ]
+}
+
+/// Any choice of one bone: any radius, mass or density, end and joint.
+fn bone_body(name: String) -> impl Strategy<Value = BoneBody> {
+    let names = Skeleton::reference()
+        .bones()
+        .iter()
+        .map(|b| b.name.clone())
+        .chain(["nope".to_owned()])
+        .collect::<Vec<_>>();
+    let end = prop_oneof![
+        1 => Just(SegmentEnd::Next),
+        1 => proptest::sample::select(names).prop_map(SegmentEnd::Bone),
+        3 => (number(-0.3..0.3), number(-0.3..0.3), number(-0.3..0.3))
+            .prop_map(|(x, y, z)| SegmentEnd::Point(Vec3::new(x, y, z))),
+    ];
+    let mass = prop_oneof![
+        number(0.1..20.0).prop_map(BodyMass::Mass),
+        number(100.0..2000.0).prop_map(BodyMass::Density),
+    ];
+    let axis = (number(-1.0..1.0), number(-1.0..1.0), number(-1.0..1.0))
+        .prop_map(|(x, y, z)| Vec3::new(x, y, z));
+    // Angles as a file gives them: degrees, converted (an angle set in
+    // radians by hand may fall between two conversions, and is written
+    // back as the nearest one).
+    let angle = |degrees| number(degrees).prop_map(f32::to_radians);
+    let joint = prop_oneof![
+        Just(JointKind::Socket(SwingTwist::FREE)),
+        (angle(0.0..190.0), angle(-190.0..0.0), angle(0.0..190.0)).prop_map(|(cone, lo, hi)| {
+            let limits = SwingTwist::FREE.with_swing(Swing::Cone(cone));
+            JointKind::Socket(limits.with_twist(lo, hi))
+        }),
+        (angle(-190.0..0.0), angle(0.0..190.0)).prop_map(|(lo, hi)| JointKind::Hinge {
+            range: Some([lo, hi]),
+            softness: vertebra_world::LimitSoftness::Hard,
+        }),
+        Just(JointKind::Fixed),
+    ];
+    (
+        number(0.01..0.2),
+        mass,
+        end,
+        joint,
+        proptest::option::of(axis),
+    )
+        .prop_map(move |(radius, mass, end, joint, axis)| BoneBody {
+            end,
+            joint,
+            axis,
+            ..BoneBody::new(&name, radius, mass)
+        })
+}
+
+/// Any choice of bones of the reference skeleton, with or without a spine
+/// between two of its bones.
+fn any_choice() -> impl Strategy<Value = RagdollGenerator> {
+    let names: Vec<String> = Skeleton::reference()
+        .bones()
+        .iter()
+        .map(|b| b.name.clone())
+        .collect();
+    // A spine between two of the chosen bones (by their places in the
+    // choice), or none.
+    let spine = proptest::option::weighted(0.3, (any::<usize>(), any::<usize>()));
+    // Mostly the skeleton's root is chosen too, so that every other bone
+    // has a chosen ancestor.
+    let rooted = proptest::bool::weighted(0.8);
+    (proptest::sample::subsequence(names, 1..12), spine, rooted)
+        .prop_flat_map(|(mut chosen, spine, rooted)| {
+            if rooted && chosen[0] != "root" {
+                chosen.insert(0, "root".to_owned());
+            }
+            let spine = spine.map(|(a, b)| {
+                (
+                    chosen[a % chosen.len()].clone(),
+                    chosen[b % chosen.len()].clone(),
+                )
+            });
+            let bodies: Vec<_> = chosen.into_iter().map(bone_body).collect();
+            (bodies, Just(spine))
+        })
+        .prop_map(|(bodies, spine)| {
+            let generator = RagdollDesc::generator("any", &Skeleton::reference());
+            let generator = bodies.into_iter().fold(generator, RagdollGenerator::body);
+            match spine {
+                Some((from, to)) => generator.spine(RodSpine {
+                    from,
+                    to,
+                    bend_limit: 1.0,
+                    twist_limit: [-0.5, 0.5],
+                    bend_stiffness: 2.0,
+                    twist_stiffness: 2.0,
+                }),
+                None => generator,
+            }
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+    /// Whatever is chosen, generating never panics: it gives a
+    /// description that validates, reads back as itself and has its
+    /// joints at its bones' origins, or a refusal.
+    #[test]
+    fn any_choice_generates_a_valid_description_or_is_refused(generator in any_choice()) {
+        let skeleton = Skeleton::reference();
+        let pose = model(&skeleton);
+        match generator.generate() {
+            Ok(desc) => {
+                prop_assert!(desc.validate().is_ok());
+                prop_assert_eq!(&RagdollDesc::from_toml(&desc.to_toml()).unwrap(), &desc);
+                for j in &desc.joints {
+                    let b = bone(&skeleton, &desc.bodies[j.child].name);
+                    prop_assert_eq!(j.anchor, pose[b].translation);
+                }
+            }
+            Err(e) => prop_assert!(!e.to_string().is_empty()),
+        }
     }
 }
