@@ -122,6 +122,7 @@ mod drive;
 mod drive_def;
 mod error;
 mod generate;
+mod generate_file;
 mod joint_def;
 mod mapper;
 mod mapping;

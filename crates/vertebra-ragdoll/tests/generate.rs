@@ -590,3 +590,211 @@ proptest! {
         }
     }
 }
+
+/// The reference humanoid's choice as a generator file, every form of end,
+/// mass and joint on some body.
+const GENERATOR: &str = r#"
+name = "generated"
+total_mass = 69.0
+
+[[body]]
+bone = "hips"
+radius = 0.1
+mass = 11.0
+
+[[body]]
+bone = "spine_lower"
+radius = 0.1
+mass = 6.0
+joint = { swing = 20.0, twist = [-10.0, 10.0] }
+
+[[body]]
+bone = "spine_upper"
+radius = 0.1
+density = 1000.0
+joint = { kind = "socket", axis = [0.0, 1.0, 0.0], normal = [1.0, 0.0, 0.0], swing = { y = 20.0, z = 10.0 }, softness = 0.001 }
+
+[[body]]
+bone = "chest"
+radius = 0.12
+mass = 12.0
+end = "neck_1"
+joint = { kind = "fixed" }
+
+[[body]]
+bone = "head"
+radius = 0.1
+mass = 5.0
+length = 0.12
+
+[[body]]
+bone = "shin_l"
+radius = 0.055
+mass = 4.0
+point = [0.0, 0.3, 0.0]
+joint = { kind = "hinge", range = [-150.0, 0.0] }
+
+[[body]]
+bone = "thigh_l"
+radius = 0.07
+mass = 7.0
+
+[spine]
+from = "hips"
+to = "chest"
+bend_limit = 60.0
+twist_limit = [-30.0, 30.0]
+bend_stiffness = 2.0
+twist_stiffness = 2.0
+"#;
+
+#[test]
+fn a_generator_file_reads_as_the_same_choices_in_code() {
+    let skeleton = Skeleton::reference();
+    let from_file = RagdollGenerator::from_toml(GENERATOR, &skeleton)
+        .unwrap()
+        .generate()
+        .unwrap();
+    let degrees = |d: f32| d.to_radians();
+    let ellipse = SwingTwist {
+        swing: Swing::Ellipse {
+            y: degrees(20.0),
+            z: degrees(10.0),
+        },
+        twist: None,
+        softness: vertebra_world::LimitSoftness::compliant(0.001),
+    };
+    let cone = SwingTwist::FREE
+        .with_swing(Swing::Cone(degrees(20.0)))
+        .with_twist(degrees(-10.0), degrees(10.0));
+    let in_code = RagdollDesc::generator("generated", &skeleton)
+        .body(BoneBody::new("hips", 0.1, BodyMass::Mass(11.0)))
+        .body(BoneBody::new("spine_lower", 0.1, BodyMass::Mass(6.0)).socket(cone))
+        .body(BoneBody {
+            axis: Some(Vec3::Y),
+            ..BoneBody::new("spine_upper", 0.1, BodyMass::Density(1000.0))
+                .socket(ellipse)
+                .with_normal(Vec3::X)
+        })
+        .body(
+            BoneBody::new("chest", 0.12, BodyMass::Mass(12.0))
+                .ending_at("neck_1")
+                .fixed(),
+        )
+        .body(BoneBody::new("head", 0.1, BodyMass::Mass(5.0)).with_length(0.12))
+        .body(BoneBody {
+            end: SegmentEnd::Point(Vec3::new(0.0, 0.3, 0.0)),
+            axis: None,
+            ..BoneBody::new("shin_l", 0.055, BodyMass::Mass(4.0))
+                .hinge(Vec3::X, Some([degrees(-150.0), degrees(0.0)]))
+        })
+        .body(BoneBody::new("thigh_l", 0.07, BodyMass::Mass(7.0)))
+        .spine(RodSpine {
+            from: "hips".to_owned(),
+            to: "chest".to_owned(),
+            bend_limit: degrees(60.0),
+            twist_limit: [degrees(-30.0), degrees(30.0)],
+            bend_stiffness: 2.0,
+            twist_stiffness: 2.0,
+        })
+        .total_mass(69.0)
+        .generate()
+        .unwrap();
+    assert_eq!(from_file, in_code);
+    // The hinge without an axis turns about the shin's +X.
+    let pose = model(&skeleton);
+    let shin = from_file
+        .joints
+        .iter()
+        .find(|j| j.name == "shin_l")
+        .unwrap();
+    let x = pose[bone(&skeleton, "shin_l")].rotation * Vec3::X;
+    assert!(shin.axis().distance(x) < 1e-6, "{}", shin.axis());
+}
+
+#[test]
+fn malformed_generator_files_are_refused_by_line_bone_and_field() {
+    let skeleton = Skeleton::reference();
+    let edited = |from: &str, to: &str| {
+        assert!(GENERATOR.contains(from), "`{from}`");
+        GENERATOR.replacen(from, to, 1)
+    };
+    let cases = [
+        (
+            edited("mass = 11.0", "mass = 11.0\ndensity = 900.0"),
+            "line 5: bone `hips`: mass and density both give the mass; give one",
+        ),
+        (
+            edited("mass = 11.0\n", ""),
+            "line 5: bone `hips`: mass is missing: give mass or density",
+        ),
+        (
+            edited("length = 0.12", "length = 0.12\nend = \"neck_3\""),
+            "line 29: bone `head`: end is given twice: give one of end, length and point",
+        ),
+        (
+            edited(
+                "joint = { kind = \"hinge\",",
+                "joint = { kind = \"hinge\", swing = 20.0,",
+            ),
+            "line 35: bone `shin_l`: joint: swing is for sockets only; this joint is a hinge",
+        ),
+        (
+            edited("kind = \"fixed\"", "kind = \"weld\""),
+            "line 22: bone `chest`: joint: kind is `weld`; must be socket, hinge or fixed",
+        ),
+        (
+            edited(
+                "radius = 0.1\nmass = 11.0",
+                "radius = 0.1\nmass = 11.0\ncolour = \"red\"",
+            ),
+            "malformed generator file: line 9: unknown field `colour`",
+        ),
+    ];
+    for (text, expected) in cases {
+        let e = RagdollGenerator::from_toml(&text, &skeleton)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(expected), "{e}\nnot {expected}");
+    }
+    // What reads is checked when generated, by bone.
+    let unknown = edited("bone = \"thigh_l\"", "bone = \"femur\"");
+    let e = RagdollGenerator::from_toml(&unknown, &skeleton)
+        .unwrap()
+        .generate()
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e, "generator: bone `femur` is not a bone of the skeleton");
+}
+
+#[test]
+fn a_generator_file_is_read_from_disk_and_named_in_its_errors() {
+    let skeleton = Skeleton::reference();
+    let dir = std::env::temp_dir().join(format!("vertebra-generate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("generator.toml");
+    std::fs::write(&path, GENERATOR).unwrap();
+    let read = RagdollGenerator::from_file(&path, &skeleton).unwrap();
+    let parsed = RagdollGenerator::from_toml(GENERATOR, &skeleton).unwrap();
+    assert_eq!(read.generate().unwrap(), parsed.generate().unwrap());
+    std::fs::write(
+        &path,
+        GENERATOR.replacen("radius = 0.1", "radius = \"wide\"", 1),
+    )
+    .unwrap();
+    let e = RagdollGenerator::from_file(&path, &skeleton)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with(&format!(
+            "{}: malformed generator file: line 7",
+            path.display()
+        )),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    let e = RagdollGenerator::from_file(&path, &skeleton)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("cannot read the generator file"), "{e}");
+}
