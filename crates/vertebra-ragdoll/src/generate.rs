@@ -252,28 +252,12 @@ impl RagdollGenerator {
                 continue;
             };
             let name = &body.bone;
-            check_positive(name, "radius", body.radius)?;
-            let end = segment_end(body, bone, &model, skeleton, &chosen, &first_child)?;
-            let start = model[bone].translation;
-            let length = start.distance(end);
-            if length < MIN_SEGMENT {
-                return Err(refused(
-                    name,
-                    "end",
-                    format!(
-                        "is {length} m from the bone's origin; a segment is at least {MIN_SEGMENT} m long"
-                    ),
-                ));
-            }
-            let mass = match body.mass {
-                BodyMass::Mass(kg) => positive(name, "mass", kg)?,
-                BodyMass::Density(d) => positive(name, "density", d)? * volume(body.radius, length),
-            };
-            builder = builder.body(BodySpec::capsule(name, [start, end], body.radius, mass));
+            let (capsule, along) = capsule(body, bone, &model, skeleton, &chosen, &first_child)?;
+            builder = builder.body(capsule);
             match (ancestor(skeleton, bone, &chosen), root) {
                 (Some(parent), _) => {
                     let parent = &skeleton.bones()[parent].name;
-                    builder = builder.joint(joint(body, parent, model[bone], end - start));
+                    builder = builder.joint(joint(body, parent, model[bone], along));
                 }
                 (None, None) => root = Some(bone),
                 (None, Some(first)) => {
@@ -422,6 +406,38 @@ fn segment_end(
             Ok(model[bone].transform_point(*p))
         }
     }
+}
+
+/// `body`'s capsule on bone `bone` (`model`: the bind pose in model
+/// space), checked, and its segment from start to end (m).
+fn capsule(
+    body: &BoneBody,
+    bone: usize,
+    model: &[Transform],
+    skeleton: &Skeleton,
+    chosen: &[Option<usize>],
+    first_child: &[Option<usize>],
+) -> Result<(BodySpec, Vec3), RagdollError> {
+    let name = &body.bone;
+    check_positive(name, "radius", body.radius)?;
+    let end = segment_end(body, bone, model, skeleton, chosen, first_child)?;
+    let start = model[bone].translation;
+    let length = start.distance(end);
+    if length < MIN_SEGMENT {
+        return Err(refused(
+            name,
+            "end",
+            format!(
+                "is {length} m from the bone's origin; a segment is at least {MIN_SEGMENT} m long"
+            ),
+        ));
+    }
+    let mass = match body.mass {
+        BodyMass::Mass(kg) => positive(name, "mass", kg)?,
+        BodyMass::Density(d) => positive(name, "density", d)? * volume(body.radius, length),
+    };
+    let spec = BodySpec::capsule(name, [start, end], body.radius, mass);
+    Ok((spec, end - start))
 }
 
 /// The volume (m^3) of a capsule of `radius` around a segment `length`
