@@ -9,7 +9,7 @@ pub enum RagdollError {
     /// Not TOML, a missing or mistyped field, or an unknown one (the
     /// parser's message names the line and the field).
     Syntax {
-        /// What the file holds: `ragdoll` or `skeleton`.
+        /// What the file holds: `ragdoll`, `skeleton` or `generator`.
         file: &'static str,
         /// The parser's message.
         message: String,
@@ -17,7 +17,7 @@ pub enum RagdollError {
     /// A ragdoll or skeleton file that could not be read: missing,
     /// unreadable, larger than `MAX_FILE_BYTES`, or not UTF-8.
     Unreadable {
-        /// What the file holds: `ragdoll` or `skeleton`.
+        /// What the file holds: `ragdoll`, `skeleton` or `generator`.
         file: &'static str,
         /// Why.
         reason: String,

@@ -249,8 +249,55 @@ impl RawJoint {
 /// of their forms, its angles in radians. The values are checked when the
 /// joint is resolved.
 pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, RagdollError> {
-    let kind = j.kind.as_deref().unwrap_or("socket");
-    let allowed: &[&str] = match kind {
+    let named = j.kind.as_deref().unwrap_or("socket");
+    let kind = joint_kind(
+        context,
+        named,
+        &j.present(),
+        j.swing,
+        [j.twist, j.range],
+        j.softness.as_ref(),
+    )?;
+    let drive = j.drive.map(|d| d.read(context)).transpose()?;
+    let frame = match (j.frame, j.axis, j.normal) {
+        (Some(q), None, None) => JointFrame::Rotation(Quat::from_array(q)),
+        (Some(_), _, _) => {
+            return Err(RagdollError::OutOfRange {
+                context: context.to_owned(),
+                field: "frame",
+                reason: "takes the place of axis and normal; give one or the other".to_owned(),
+            });
+        }
+        (None, None, _) if named == "fixed" => JointFrame::Rotation(Quat::IDENTITY),
+        (None, axis, normal) => JointFrame::Axis {
+            axis: Vec3::from(required(context, "axis", axis)?),
+            normal: normal.map(Vec3::from),
+        },
+    };
+    Ok(JointSpec {
+        name: j.name.clone(),
+        parent: j.parent.clone(),
+        child: j.child.clone(),
+        anchor: Vec3::from(j.anchor),
+        frame,
+        kind,
+        drive,
+    })
+}
+
+/// The kind a table names (`named`: socket, hinge or fixed) with its
+/// limits in radians (the table's `swing`, `[twist, range]` and
+/// `softness`, in degrees), refusing a field among `present` that the
+/// kind does not take (`context` names the table).
+fn joint_kind(
+    context: &str,
+    named: &str,
+    present: &[(&'static str, bool)],
+    swing: Option<RawSwing>,
+    [twist, hinge_range]: [Option<[f32; 2]>; 2],
+    softness_table: Option<&RawSoftness>,
+) -> Result<JointKind, RagdollError> {
+    let allowed: &[&str] = match named {
         "socket" => &SOCKET_FIELDS,
         "hinge" => &HINGE_FIELDS,
         "fixed" => &[],
@@ -262,7 +309,7 @@ pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, Ragdo
             });
         }
     };
-    for (field, present) in j.present() {
+    for &(field, present) in present {
         let owners = match field {
             "range" => "hinges",
             "normal" | "swing" | "twist" => "sockets",
@@ -272,29 +319,13 @@ pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, Ragdo
             context,
             field,
             !present || allowed.contains(&field),
-            &format!("is for {owners} only; this joint is a {kind}"),
+            &format!("is for {owners} only; this joint is a {named}"),
         )?;
     }
-    let softness = softness(context, j.softness.as_ref())?;
-    let drive = j.drive.map(|d| d.read(context)).transpose()?;
-    let frame = match (j.frame, j.axis, j.normal) {
-        (Some(q), None, None) => JointFrame::Rotation(Quat::from_array(q)),
-        (Some(_), _, _) => {
-            return Err(RagdollError::OutOfRange {
-                context: context.to_owned(),
-                field: "frame",
-                reason: "takes the place of axis and normal; give one or the other".to_owned(),
-            });
-        }
-        (None, None, _) if kind == "fixed" => JointFrame::Rotation(Quat::IDENTITY),
-        (None, axis, normal) => JointFrame::Axis {
-            axis: Vec3::from(required(context, "axis", axis)?),
-            normal: normal.map(Vec3::from),
-        },
-    };
-    let kind = match kind {
+    let softness = softness(context, softness_table)?;
+    Ok(match named {
         "socket" => JointKind::Socket(SwingTwist {
-            swing: match j.swing {
+            swing: match swing {
                 None => Swing::Free,
                 Some(RawSwing::Cone(x)) => Swing::Cone(x.to_radians()),
                 Some(RawSwing::Ellipse { y, z }) => Swing::Ellipse {
@@ -306,24 +337,59 @@ pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, Ragdo
                     z: z.map(f32::to_radians),
                 },
             },
-            twist: j.twist.map(|t| t.map(f32::to_radians)),
+            twist: twist.map(|t| t.map(f32::to_radians)),
             softness,
         }),
         "hinge" => JointKind::Hinge {
-            range: j.range.map(|r| r.map(f32::to_radians)),
+            range: hinge_range.map(|r| r.map(f32::to_radians)),
             softness,
         },
         _ => JointKind::Fixed,
-    };
-    Ok(JointSpec {
-        name: j.name.clone(),
-        parent: j.parent.clone(),
-        child: j.child.clone(),
-        anchor: Vec3::from(j.anchor),
-        frame,
-        kind,
-        drive,
     })
+}
+
+/// A generated body's `joint = { ... }` table: a `[[joint]]` table's kind,
+/// limits and softness, with its axis and normal in the bone's frame and
+/// both optional (`docs/ragdolls.md`, "Generating a ragdoll from a
+/// skeleton").
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawBoneJoint {
+    kind: Option<String>,
+    axis: Option<[f32; 3]>,
+    normal: Option<[f32; 3]>,
+    swing: Option<RawSwing>,
+    twist: Option<[f32; 2]>,
+    range: Option<[f32; 2]>,
+    softness: Option<RawSoftness>,
+}
+
+impl RawBoneJoint {
+    /// The kind and limits (rad), the axis and the normal (the bone's
+    /// frame), checked as a `[[joint]]` table's fields are read
+    /// (`context` names the body's table).
+    pub(crate) fn read(
+        &self,
+        context: &str,
+    ) -> Result<(JointKind, Option<Vec3>, Option<Vec3>), RagdollError> {
+        let present = [
+            ("axis", self.axis.is_some()),
+            ("normal", self.normal.is_some()),
+            ("swing", self.swing.is_some()),
+            ("twist", self.twist.is_some()),
+            ("range", self.range.is_some()),
+            ("softness", self.softness.is_some()),
+        ];
+        let kind = joint_kind(
+            context,
+            self.kind.as_deref().unwrap_or("socket"),
+            &present,
+            self.swing,
+            [self.twist, self.range],
+            self.softness.as_ref(),
+        )?;
+        Ok((kind, self.axis.map(Vec3::from), self.normal.map(Vec3::from)))
+    }
 }
 
 /// Resolves a joint's body names through `index` and builds its frame,

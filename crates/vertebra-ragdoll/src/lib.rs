@@ -11,8 +11,10 @@
 //! of `[[bone]]` tables, inline or next to the ragdoll file; the shipped
 //! [`Skeleton::reference`] fits both humanoids), each body bound to a bone
 //! ([`BoneBinding`]) or placed from one bone to another; it may be built in
-//! code ([`RagdollDesc::builder`]), checked by hand
-//! ([`RagdollDesc::validate`]) and written back ([`RagdollDesc::to_toml`]).
+//! code ([`RagdollDesc::builder`]) or generated from the skeleton and
+//! per-bone radii, masses and joints ([`RagdollDesc::generator`]), checked
+//! by hand ([`RagdollDesc::validate`]) and written back
+//! ([`RagdollDesc::to_toml`]).
 //!
 //! How an engine wires it in, once per character:
 //!
@@ -120,6 +122,8 @@ mod description;
 mod drive;
 mod drive_def;
 mod error;
+mod generate;
+mod generate_file;
 mod joint_def;
 mod mapper;
 mod mapping;
@@ -140,6 +144,7 @@ pub use description::{
 };
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
+pub use generate::{BodyMass, BoneBody, MIN_SEGMENT, RagdollGenerator, RodSpine, SegmentEnd};
 pub use joint_def::{JointDef, JointFrame, JointSpec};
 pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
