@@ -51,7 +51,7 @@
 //! back to animation (the walk-through of `docs/ragdolls.md`):
 //!
 //! ```
-//! use glam::Quat;
+//! use glam::{Quat, Vec3};
 //! use vertebra_ragdoll::{
 //!     BlendBack, BuildOptions, DriveSettings, LocalPose, Ragdoll, RagdollDesc, Skeleton,
 //!     SkeletonMapper, SpineMapping, SpineMode, Strength, Transform, Transition,
@@ -62,7 +62,8 @@
 //! let skeleton = Skeleton::reference(); // the engine's skeleton: 63 bones
 //! let desc = RagdollDesc::reference_humanoid(); // 13 bodies, each on the bone of its name
 //! let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod)?;
-//! let place = Transform::IDENTITY; // the model frame in the world
+//! // The model frame in the world: the character's place and heading.
+//! let place = Transform::new(Vec3::new(40.0, 0.0, -12.0), Quat::from_rotation_y(1.0));
 //! let dt = 1.0 / 60.0;
 //!
 //! // The animation's last two local poses: the bind pose, then the spine
@@ -102,12 +103,18 @@
 //!     bones = Some(pose);
 //! }
 //!
-//! // Back to animation over half a second (getting up).
-//! let last = bones.expect("30 frames").to_local(&skeleton)?;
+//! // Back to animation over half a second (getting up), in the model
+//! // frame: the mapping's output is in the world.
+//! let last = bones.expect("30 frames").in_world(place.inverse()).to_local(&skeleton)?;
 //! let mut back = BlendBack::new(&skeleton, last, 0.5)?;
+//! let hips = skeleton.bone_index("hips").expect("a hips bone");
 //! while !back.is_done() {
 //!     let out = back.pose(&skeleton, &current)?;
-//!     assert_eq!(out.bones.len(), 63);
+//!     // Blended in the model frame, placed in the world by `place`: the
+//!     // hips stay near the animation's (1 m up at `place`).
+//!     let world = out.to_model(&skeleton)?.in_world(place);
+//!     let animated = place.transform_point(Vec3::new(0.0, 1.0, 0.02));
+//!     assert!(world.bones[hips].translation.distance(animated) < 0.2);
 //!     back.advance(dt)?;
 //! }
 //! assert_eq!(back.pose(&skeleton, &current)?, current);

@@ -83,34 +83,59 @@ pub struct SkeletonMapper {
 }
 
 impl SkeletonMapper {
-    /// A mapper where each body follows the bone of its own name (the
-    /// shipped humanoids' bodies are `hips`, `spine_lower`, `spine_upper`,
-    /// `chest`, `head`, `upper_arm_l`, `forearm_l`, ...); refused, naming
-    /// the body, when the skeleton has no such bone.
+    /// A mapper where each body follows the bone its description binds it
+    /// to (`BodyDef::bone`: the bone of that name in `skeleton`, at the
+    /// binding's offset), or else the bone of its own name (the shipped
+    /// humanoids' bodies are `hips`, `spine_lower`, `spine_upper`, `chest`,
+    /// `head`, `upper_arm_l`, `forearm_l`, ...) at the offset the two bind
+    /// poses give. Refused, naming the body, when the skeleton has no such
+    /// bone, and for a description that fails [`RagdollDesc::validate`].
     pub fn new(
         skeleton: &Skeleton,
         desc: &RagdollDesc,
         spine: SpineMode,
     ) -> Result<Self, RagdollError> {
-        let binding: Vec<Option<usize>> = desc
-            .bodies
-            .iter()
-            .map(|b| skeleton.bone_index(&b.name))
-            .collect();
-        Self::with_binding(skeleton, desc, spine, &binding)
+        desc.validate()?;
+        let mut binding = Vec::with_capacity(desc.bodies.len());
+        for def in &desc.bodies {
+            let name = match (&def.bone, &desc.skeleton) {
+                (Some(bound), Some(own)) => own.bones()[bound.bone].name.as_str(),
+                _ => def.name.as_str(),
+            };
+            let bone = skeleton
+                .bone_index(name)
+                .ok_or_else(|| RagdollError::OutOfRange {
+                    context: format!("body `{}`", def.name),
+                    field: "bone",
+                    reason: format!(
+                        "is missing: the skeleton has no bone `{name}` and every body needs one"
+                    ),
+                })?;
+            binding.push(Some(bone));
+        }
+        let mut mapper = Self::with_binding(skeleton, desc, spine, &binding)?;
+        for (offset, def) in mapper.offsets.iter_mut().zip(&desc.bodies) {
+            if let Some(bound) = &def.bone {
+                *offset = bound.offset.inverse();
+            }
+        }
+        Ok(mapper)
     }
 
-    /// A mapper where body `i` follows bone `bones[i]` (skeleton index).
-    /// Every body needs a bone of its own (a simplified ragdoll's interior
-    /// spine bodies too: the rod is made through their bones); refused,
-    /// naming the body and field, when one has none, one names a bone the
-    /// skeleton lacks or two share a bone.
+    /// A mapper where body `i` follows bone `bones[i]` (skeleton index),
+    /// at the offset the two bind poses give (the description's own
+    /// bindings are not read). Every body needs a bone of its own (a
+    /// simplified ragdoll's interior spine bodies too: the rod is made
+    /// through their bones); refused, naming the body and field, when one
+    /// has none, one names a bone the skeleton lacks or two share a bone,
+    /// and for a description that fails [`RagdollDesc::validate`].
     pub fn with_binding(
         skeleton: &Skeleton,
         desc: &RagdollDesc,
         spine: SpineMode,
         bones: &[Option<usize>],
     ) -> Result<Self, RagdollError> {
+        desc.validate()?;
         let count = skeleton.len();
         if bones.len() != desc.bodies.len() {
             return Err(RagdollError::OutOfRange {

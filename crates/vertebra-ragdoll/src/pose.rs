@@ -4,7 +4,7 @@
 //! bind, where body axes are world axes).
 
 use glam::{Quat, Vec3};
-use vertebra_world::check_unit_quat;
+use vertebra_world::{check_coordinate, check_unit_quat};
 
 use crate::description::RagdollDesc;
 use crate::error::RagdollError;
@@ -80,8 +80,9 @@ impl Pose {
         })
     }
 
-    /// Checks the pose fits `desc`: one finite transform per bone, unit
-    /// orientations.
+    /// Checks the pose fits `desc`: one transform per bone, positions
+    /// within [`MAX_COORDINATE`](vertebra_world::MAX_COORDINATE) of the
+    /// origin, unit orientations.
     pub fn validate(&self, desc: &RagdollDesc) -> Result<(), RagdollError> {
         if self.bones.len() != desc.bodies.len() {
             return Err(RagdollError::BadPose(format!(
@@ -100,8 +101,6 @@ impl Pose {
 /// A bone's transform: a finite position and a unit orientation.
 fn bone(name: &str, (p, q): (Vec3, Quat)) -> Result<(), RagdollError> {
     let bad = |e| RagdollError::BadPose(format!("bone `{name}`: {e}"));
-    if !p.is_finite() {
-        return Err(bad(vertebra_world::Error::NonFinite("position")));
-    }
+    check_coordinate("position", p).map_err(bad)?;
     check_unit_quat("orientation", q).map_err(bad)
 }

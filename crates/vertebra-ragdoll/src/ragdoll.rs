@@ -151,8 +151,17 @@ pub struct Ragdoll {
 }
 
 /// Masses per described body for `options` (interior spine masses moved to
-/// the ends in rod mode; stabilised if asked), total unchanged.
-pub fn body_masses(desc: &RagdollDesc, options: &BuildOptions) -> Vec<f32> {
+/// the ends in rod mode; stabilised if asked), total unchanged. Refused
+/// for a description that fails [`RagdollDesc::validate`] or options that
+/// fail [`BuildOptions::validate`].
+pub fn body_masses(desc: &RagdollDesc, options: &BuildOptions) -> Result<Vec<f32>, RagdollError> {
+    desc.validate()?;
+    options.validate()?;
+    Ok(masses_of(desc, options))
+}
+
+/// [`body_masses`] of a checked description and options.
+fn masses_of(desc: &RagdollDesc, options: &BuildOptions) -> Vec<f32> {
     let mut masses: Vec<f32> = desc.bodies.iter().map(|b| b.mass).collect();
     if let (SpineMode::Rod, Some(spine)) = (options.spine, &desc.spine) {
         let (first, last) = (spine.bodies[0], *spine.bodies.last().expect("a chain"));
@@ -258,7 +267,7 @@ impl Ragdoll {
         previous: Option<(&Pose, f32)>,
     ) -> Result<(), RagdollError> {
         let desc = &self.desc;
-        let masses = body_masses(desc, &self.options);
+        let masses = masses_of(desc, &self.options);
         let removed_joint = |k: usize| {
             self.options.spine == SpineMode::Rod
                 && desc.spine.as_ref().is_some_and(|s| s.joints.contains(&k))

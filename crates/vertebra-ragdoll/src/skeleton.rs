@@ -248,14 +248,22 @@ impl LocalPose {
         skeleton.check("", &self.bones)?;
         let mut model: Vec<Transform> = Vec::with_capacity(self.bones.len());
         for (local, bone) in self.bones.iter().zip(&skeleton.bones) {
+            let local = unit(*local);
             let placed = match bone.parent {
-                Some(p) => model[p] * *local,
-                None => *local,
+                Some(p) => model[p] * local,
+                None => local,
             };
             model.push(placed);
         }
         Ok(ModelPose { bones: model })
     }
+}
+
+/// `t` with its rotation normalised: a rotation accepted as unit within
+/// the checks' tolerance would otherwise scale the translations it turns
+/// by its squared length.
+fn unit(t: Transform) -> Transform {
+    Transform::new(t.translation, t.rotation.normalize())
 }
 
 impl ModelPose {
@@ -268,15 +276,17 @@ impl ModelPose {
             .iter()
             .zip(&skeleton.bones)
             .map(|(model, bone)| match bone.parent {
-                Some(p) => self.bones[p].inverse() * *model,
-                None => *model,
+                Some(p) => unit(self.bones[p]).inverse() * unit(*model),
+                None => unit(*model),
             })
             .collect();
         Ok(LocalPose { bones })
     }
 
     /// This pose placed in the world by the model frame's transform
-    /// `model_to_world` (the character's).
+    /// `model_to_world` (the character's). The other way, a pose in the
+    /// world (the mapper's and the transition's output) back in the model
+    /// frame: `pose.in_world(model_to_world.inverse())`.
     pub fn in_world(&self, model_to_world: Transform) -> ModelPose {
         ModelPose {
             bones: self.bones.iter().map(|&t| model_to_world * t).collect(),

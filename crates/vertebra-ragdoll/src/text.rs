@@ -9,8 +9,10 @@ use crate::error::RagdollError;
 
 /// The largest ragdoll or skeleton file that `from_file` reads (bytes): the
 /// reference humanoid is 5 KB and a body, joint or bone about 150 bytes,
-/// so 1 MiB holds thousands; a larger file (or `/dev/zero`) is refused
-/// before it is read whole.
+/// so 1 MiB holds thousands; a larger file is refused before it is read
+/// whole. Only regular files are read: a pipe, a device (`/dev/zero`,
+/// `/dev/stdin`) or a directory is refused without opening it (opening a
+/// pipe waits for a writer, for ever).
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
 
 /// The UTF-8 text of the `file` file (`ragdoll` or `skeleton`) at `path`,
@@ -20,9 +22,23 @@ pub(crate) fn read_text(path: &Path, file: &'static str) -> Result<String, Ragdo
         path: path.display().to_string(),
         error: Box::new(RagdollError::Unreadable { file, reason }),
     };
+    let regular = |meta: std::fs::Metadata| {
+        if meta.is_file() {
+            Ok(())
+        } else {
+            Err(unreadable(
+                "not a regular file (a directory, a device or a pipe)".to_owned(),
+            ))
+        }
+    };
+    regular(std::fs::metadata(path).map_err(|e| unreadable(e.to_string()))?)?;
+    let opened = std::fs::File::open(path).map_err(|e| unreadable(e.to_string()))?;
+    // Checked again on what was opened, in case the path changed between.
+    regular(opened.metadata().map_err(|e| unreadable(e.to_string()))?)?;
     let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+    opened
+        .take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
         .map_err(|e| unreadable(e.to_string()))?;
     if bytes.len() as u64 > MAX_FILE_BYTES {
         return Err(unreadable(format!(

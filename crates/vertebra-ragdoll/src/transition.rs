@@ -87,8 +87,8 @@ impl Transition {
     /// how long the offsets take to fade out: `f32::INFINITY` holds them,
     /// 0 drops them at once (the pure mapping, which pops). The fade is
     /// smooth at both ends: the offsets' weight is `1 - (3u^2 - 2u^3)` at
-    /// `u = t / fade`, so the first frame after the switch keeps them to
-    /// `3 (dt / fade)^2` (0.3% at 60 Hz and a 0.5 s fade).
+    /// `u = t / fade`, so the first frame after the switch drops only
+    /// `3 (dt / fade)^2` of them (0.3% at 60 Hz and a 0.5 s fade).
     pub fn new(
         mapper: &SkeletonMapper,
         ragdoll: &Ragdoll,

@@ -205,3 +205,39 @@ fn several_roots_are_refused() {
         "{message}"
     );
 }
+
+/// A pipe named as a ragdoll or skeleton file is refused without waiting
+/// for a writer (opening one for reading blocks until a writer comes:
+/// before, `from_file` and `vertebra check` hung for ever). Run on a
+/// thread with a deadline, so that a hang fails the test.
+#[cfg(unix)]
+#[test]
+fn a_pipe_is_refused_not_waited_on() {
+    use std::sync::mpsc;
+    use std::time::Duration;
+    let dir = std::env::temp_dir().join(format!("vertebra-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("fifo.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("no mkfifo on this machine: the pipe case is not run");
+        return;
+    }
+    let (send, receive) = mpsc::channel();
+    let path = fifo.clone();
+    std::thread::spawn(move || {
+        let ragdoll = RagdollDesc::from_file(&path).map(|_| ()).unwrap_err();
+        let skeleton = vertebra_ragdoll::Skeleton::from_file(&path)
+            .map(|_| ())
+            .unwrap_err();
+        send.send((ragdoll.to_string(), skeleton.to_string()))
+            .unwrap();
+    });
+    let (ragdoll, skeleton) = receive
+        .recv_timeout(Duration::from_secs(20))
+        .expect("refused at once, not blocked on the pipe");
+    for message in [ragdoll, skeleton] {
+        assert!(message.contains("not a regular file"), "{message}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

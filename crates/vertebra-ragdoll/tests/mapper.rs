@@ -587,3 +587,104 @@ proptest! {
         }
     }
 }
+
+/// A body follows the bone its description binds it to, at the binding's
+/// offset: the head bound to `neck_3`; the hips renamed `pelvis` and bound
+/// to `hips` with its frame half a metre above the bone. Before, the
+/// mapper bound bodies by name only: the head to `head`, and `pelvis` was
+/// refused.
+#[test]
+fn the_mapper_follows_the_descriptions_bindings() {
+    let skeleton = Skeleton::reference();
+    let text = vertebra_ragdoll::REFERENCE_HUMANOID
+        .replace("\"hips\"", "\"pelvis\"")
+        .replacen(
+            "name = \"pelvis\"",
+            "name = \"pelvis\"\nbone = \"hips\"\noffset = { translation = [0.0, 0.5, 0.0], rotation = [0.0, 0.0, 0.0, 1.0] }",
+            1,
+        )
+        .replacen("name = \"head\"", "name = \"head\"\nbone = \"neck_3\"", 1);
+    let desc = RagdollDesc::from_toml_with_skeleton(&text, &skeleton).unwrap();
+    for spine in [SpineMode::Rod, SpineMode::Sockets] {
+        let mapper = SkeletonMapper::new(&skeleton, &desc, spine).unwrap();
+        let body = |name: &str| desc.body_index(name).unwrap();
+        assert_eq!(mapper.binding()[body("head")], index(&skeleton, "neck_3"));
+        assert_eq!(mapper.binding()[body("pelvis")], index(&skeleton, "hips"));
+        let bind = skeleton.bind_pose().to_model(&skeleton).unwrap();
+        let place = Transform::new(Vec3::new(3.0, 0.0, -2.0), Quat::from_rotation_y(0.7));
+        let bodies = mapper.map_to_ragdoll(&bind, place).unwrap();
+        // The pelvis: the hips bone (1 m up at bind) times the offset.
+        let hips = place * bind.bones[index(&skeleton, "hips")];
+        let (p, q) = bodies.bones[body("pelvis")];
+        let expected = hips * Transform::new(Vec3::new(0.0, 0.5, 0.0), Quat::IDENTITY);
+        assert!(
+            p.distance(expected.translation) < 1e-5,
+            "{p} against {expected:?}"
+        );
+        assert!(angle(q, expected.rotation) < 1e-5);
+        // The head keeps its bind offset from `neck_3`.
+        let (p, _) = bodies.bones[body("head")];
+        let head = place.transform_point(desc.bodies[body("head")].centre());
+        assert!(p.distance(head) < 1e-5, "{p} against {head}");
+    }
+}
+
+/// A description edited by hand into one `validate` refuses is refused by
+/// the mapper and by `body_masses`, naming the problem; before, a spine of
+/// no bodies panicked in both, and a NaN segment mapped to NaN bodies.
+#[test]
+fn the_mapper_and_the_masses_refuse_a_broken_description() {
+    let skeleton = Skeleton::reference();
+    let good = RagdollDesc::reference_humanoid();
+    let mut broken = Vec::new();
+    let mut d = good.clone();
+    d.spine.as_mut().unwrap().bodies.clear();
+    broken.push(d);
+    let mut d = good.clone();
+    d.spine.as_mut().unwrap().bodies.truncate(1);
+    broken.push(d);
+    let mut d = good.clone();
+    d.spine.as_mut().unwrap().bodies[1] = 99;
+    broken.push(d);
+    let mut d = good.clone();
+    d.bodies[0].segment[0] = Vec3::NAN;
+    broken.push(d);
+    let mut d = good.clone();
+    d.root = 99;
+    broken.push(d);
+    let mut d = good.clone();
+    d.bodies.clear();
+    broken.push(d);
+    for (k, d) in broken.iter().enumerate() {
+        let expected = d.validate().unwrap_err().to_string();
+        for spine in [SpineMode::Rod, SpineMode::Sockets] {
+            let got = SkeletonMapper::new(&skeleton, d, spine).unwrap_err();
+            assert_eq!(got.to_string(), expected, "case {k}");
+            let options = BuildOptions::new(spine);
+            let got = vertebra_ragdoll::body_masses(d, &options).unwrap_err();
+            assert_eq!(got.to_string(), expected, "case {k}");
+        }
+    }
+}
+
+/// Body positions beyond the world's coordinate range are refused by the
+/// mapping from a pose, naming the body; before, 1e20 m mapped to
+/// infinite bones.
+#[test]
+fn a_pose_out_of_range_is_refused() {
+    let skeleton = Skeleton::reference();
+    let desc = RagdollDesc::reference_humanoid();
+    let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod).unwrap();
+    let bind = skeleton.bind_pose();
+    let mut pose = mapper
+        .map_to_ragdoll(&bind.to_model(&skeleton).unwrap(), Transform::IDENTITY)
+        .unwrap();
+    for far in [1e20, 2e6] {
+        pose.bones[0].0 = Vec3::splat(far);
+        let message = mapper
+            .map_pose_to_skeleton(&pose, None, &bind, Transform::IDENTITY, SpineMapping::Arc)
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("bone `hips`: position"), "{message}");
+    }
+}

@@ -175,7 +175,7 @@ fn build_errors_name_the_body_or_the_rod() {
     let (world, built) = build(&desc, BuildOptions::new(SpineMode::Sockets), &far);
     assert_eq!(
         built.expect_err("refused").to_string(),
-        "body `hips`: position is out of range"
+        "bad pose: bone `hips`: position is out of range"
     );
     assert_eq!(world.bodies().len(), 0);
     // Spine bones folded back below the hips bend the rod's arc by more
