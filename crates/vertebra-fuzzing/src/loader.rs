@@ -1,8 +1,10 @@
-//! Arbitrary bytes as a ragdoll file or a skeleton file.
+//! Arbitrary bytes as a ragdoll file, a skeleton file or a generator file.
 
 use std::sync::OnceLock;
 
-use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, Skeleton, SpineMode};
+use vertebra_ragdoll::{
+    BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollGenerator, Skeleton, SpineMode,
+};
 use vertebra_world::{SolverConfig, World};
 
 /// The reference skeleton, parsed once.
@@ -44,6 +46,18 @@ pub fn ragdoll_loader(data: &[u8]) {
     // The skeleton changes the bodies only where they are placed from bones
     // (which needs it): build the one that loaded, alone first.
     if let Some(desc) = alone.ok().or(on_bones.ok()) {
+        build(&desc);
+    }
+    // As a generator file on the reference skeleton: an error, or a
+    // description that validates, reads back as itself and builds.
+    let generated = RagdollGenerator::from_toml(&text, reference()).and_then(|g| g.generate());
+    if let Ok(desc) = generated {
+        assert_eq!(desc.validate(), Ok(()), "a generated description validates");
+        assert_eq!(
+            RagdollDesc::from_toml(&desc.to_toml()).as_ref(),
+            Ok(&desc),
+            "a generated description reads back from its TOML as itself"
+        );
         build(&desc);
     }
 }
