@@ -77,6 +77,10 @@ pub struct SkeletonMapper {
     binding: Vec<usize>,
     /// Per body, its bone's bind transform in the body's frame.
     offsets: Vec<Transform>,
+    /// Per body, its rotation at the skeleton's bind pose relative to the
+    /// description's bind (the identity unless an authored offset turns
+    /// it).
+    bind_turns: Vec<Quat>,
     roles: Vec<BoneRole>,
     chains: Vec<Chain>,
     lock_translations: bool,
@@ -96,6 +100,9 @@ impl SkeletonMapper {
         spine: SpineMode,
     ) -> Result<Self, RagdollError> {
         desc.validate()?;
+        if let Some(own) = &desc.skeleton {
+            same_bind(own, skeleton)?;
+        }
         let mut binding = Vec::with_capacity(desc.bodies.len());
         for def in &desc.bodies {
             let name = match (&def.bone, &desc.skeleton) {
@@ -113,13 +120,12 @@ impl SkeletonMapper {
                 })?;
             binding.push(Some(bone));
         }
-        let mut mapper = Self::with_binding(skeleton, desc, spine, &binding)?;
-        for (offset, def) in mapper.offsets.iter_mut().zip(&desc.bodies) {
-            if let Some(bound) = &def.bone {
-                *offset = bound.offset.inverse();
-            }
-        }
-        Ok(mapper)
+        let authored: Vec<Option<Transform>> = desc
+            .bodies
+            .iter()
+            .map(|def| def.bone.as_ref().map(|bound| bound.offset))
+            .collect();
+        Self::bound(skeleton, desc, spine, &binding, &authored)
     }
 
     /// A mapper where body `i` follows bone `bones[i]` (skeleton index),
@@ -134,6 +140,20 @@ impl SkeletonMapper {
         desc: &RagdollDesc,
         spine: SpineMode,
         bones: &[Option<usize>],
+    ) -> Result<Self, RagdollError> {
+        Self::bound(skeleton, desc, spine, bones, &vec![None; bones.len()])
+    }
+
+    /// [`SkeletonMapper::with_binding`] where body `i`'s frame in its
+    /// bone's is `authored[i]` when given (else what the bind poses give).
+    /// The chains are laid out in the skeleton's bind pose, each body where
+    /// its bone and offset put it there.
+    fn bound(
+        skeleton: &Skeleton,
+        desc: &RagdollDesc,
+        spine: SpineMode,
+        bones: &[Option<usize>],
+        authored: &[Option<Transform>],
     ) -> Result<Self, RagdollError> {
         desc.validate()?;
         let count = skeleton.len();
@@ -179,14 +199,23 @@ impl SkeletonMapper {
             binding.push(bone);
         }
         let bind = skeleton.bind_pose().to_model(skeleton)?;
-        let offsets = binding
+        // Each body at the skeleton's bind pose (centre of mass, rotation
+        // from the description's bind), and its bone in its frame.
+        let (at_bind, offsets): (Vec<Transform>, Vec<Transform>) = binding
             .iter()
             .zip(&desc.bodies)
-            .map(|(&bone, def)| {
+            .zip(authored)
+            .map(|((&bone, def), authored)| {
                 let t = bind.bones[bone];
-                Transform::new(t.translation - def.centre(), t.rotation)
+                match authored {
+                    Some(offset) => (t * *offset, offset.inverse()),
+                    None => (
+                        Transform::new(def.centre(), Quat::IDENTITY),
+                        Transform::new(t.translation - def.centre(), t.rotation),
+                    ),
+                }
             })
-            .collect();
+            .unzip();
         // Bodies the built ragdoll has: a simplified ragdoll has no
         // interior spine bodies, so their bones join the spine's chain.
         let spine_def = desc.spine.as_ref().filter(|_| spine == SpineMode::Rod);
@@ -219,9 +248,9 @@ impl SkeletonMapper {
                 roles[j] = Some(BoneRole::Chain { base, top });
             }
             let base_body = body_of[base].expect("a body bone");
-            let points = core::iter::once(desc.bodies[base_body].centre())
+            let points = core::iter::once(at_bind[base_body].translation)
                 .chain(interior.iter().map(|&j| bind.bones[j].translation))
-                .chain(core::iter::once(desc.bodies[top_body].centre()))
+                .chain(core::iter::once(at_bind[top_body].translation))
                 .collect();
             let rotations = interior.iter().map(|&j| bind.bones[j].rotation).collect();
             let rod = spine_def.is_some_and(|s| {
@@ -244,6 +273,7 @@ impl SkeletonMapper {
             spine,
             skeleton: skeleton.clone(),
             binding,
+            bind_turns: at_bind.iter().map(|t| t.rotation).collect(),
             offsets,
             roles: placed,
             chains,
@@ -455,11 +485,15 @@ impl SkeletonMapper {
         out: &mut [Transform],
     ) {
         for chain in &self.chains {
+            // The chains are laid out in the skeleton's bind pose: each
+            // body's rotation from there, and the rod's frames in those.
+            let (turn_a, turn_b) = (self.bind_turns[chain.base], self.bind_turns[chain.top]);
+            let from_bind = |(p, q): (Vec3, Quat), turn: Quat| (p, q * turn.inverse());
             chain.place(
                 mapping,
-                bodies[chain.base],
-                bodies[chain.top],
-                rod_frames,
+                from_bind(bodies[chain.base], turn_a),
+                from_bind(bodies[chain.top], turn_b),
+                rod_frames.map(|(a, b)| (turn_a * a, turn_b * b)),
                 out,
             );
         }
@@ -518,6 +552,39 @@ impl SkeletonMapper {
     ) -> Result<(), RagdollError> {
         self.skeleton.check(what, transforms)
     }
+}
+
+/// Checks that every bone of `own` (a description's skeleton) is in
+/// `given` by name, at the same bind pose (model frame, within 0.1 mm and
+/// 1e-4 rad): the bindings' offsets were made in `own`'s.
+fn same_bind(own: &Skeleton, given: &Skeleton) -> Result<(), RagdollError> {
+    let (own_bind, given_bind) = (
+        own.bind_pose().to_model(own)?,
+        given.bind_pose().to_model(given)?,
+    );
+    for (bone, at) in own.bones().iter().zip(&own_bind.bones) {
+        let refuse = |reason: String| RagdollError::OutOfRange {
+            context: format!("skeleton bone `{}`", bone.name),
+            field: "bind",
+            reason,
+        };
+        let Some(j) = given.bone_index(&bone.name) else {
+            return Err(refuse(
+                "is in the description's skeleton but not in the one given".to_owned(),
+            ));
+        };
+        let there = given_bind.bones[j];
+        let (moved, turned) = (
+            there.translation.distance(at.translation),
+            2.0 * (at.rotation.inverse() * there.rotation).xyz().length(),
+        );
+        if !(moved <= 1e-4 && turned <= 1e-4) {
+            return Err(refuse(format!(
+                "is {moved} m and {turned} rad from the description's skeleton's in the one given; map with the skeleton the description was bound to"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// `t` scaled by `weight` in `[0, 1]`: its translation times `weight`, its

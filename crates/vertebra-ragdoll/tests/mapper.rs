@@ -604,7 +604,16 @@ fn the_mapper_follows_the_descriptions_bindings() {
             1,
         )
         .replacen("name = \"head\"", "name = \"head\"\nbone = \"neck_3\"", 1);
-    let desc = RagdollDesc::from_toml_with_skeleton(&text, &skeleton).unwrap();
+    let mut desc = RagdollDesc::from_toml_with_skeleton(&text, &skeleton).unwrap();
+    // The chest's frame authored 5 cm up its bone and turned 0.3 rad: a
+    // body off its bind relation, at the end of the spine and neck chains.
+    let chest = desc.body_index("chest").unwrap();
+    let bound = desc.bodies[chest].bone.as_mut().unwrap();
+    bound.offset = Transform::new(
+        bound.offset.translation + Vec3::new(0.0, 0.05, 0.0),
+        Quat::from_rotation_z(0.3) * bound.offset.rotation,
+    );
+    desc.validate().unwrap();
     for spine in [SpineMode::Rod, SpineMode::Sockets] {
         let mapper = SkeletonMapper::new(&skeleton, &desc, spine).unwrap();
         let body = |name: &str| desc.body_index(name).unwrap();
@@ -626,6 +635,27 @@ fn the_mapper_follows_the_descriptions_bindings() {
         let (p, _) = bodies.bones[body("head")];
         let head = place.transform_point(desc.bodies[body("head")].centre());
         assert!(p.distance(head) < 1e-5, "{p} against {head}");
+        // And the skeleton's bind pose comes back through the bodies, the
+        // chains to the chest (spine, neck, clavicles) included: they are
+        // laid out where the bindings put the bodies.
+        let local = skeleton.bind_pose();
+        for mapping in MAPPINGS {
+            let back = mapper
+                .map_pose_to_skeleton(&bodies, None, &local, place, mapping)
+                .unwrap();
+            for (j, (got, want)) in back
+                .bones
+                .iter()
+                .zip(&bind.in_world(place).bones)
+                .enumerate()
+            {
+                assert!(
+                    close(*got, *want, 2e-5, 2e-5),
+                    "{spine:?} {mapping:?}: bone `{}`: {got:?} against {want:?}",
+                    skeleton.bones()[j].name
+                );
+            }
+        }
     }
 }
 
@@ -686,5 +716,37 @@ fn a_pose_out_of_range_is_refused() {
             .unwrap_err()
             .to_string();
         assert!(message.contains("bone `hips`: position"), "{message}");
+    }
+}
+
+/// A description bound to a skeleton is mapped only with that skeleton
+/// (same bones at the same bind pose, or a larger one holding them): its
+/// offsets were made there. Before, a skeleton of the same names at twice
+/// the size mapped the bind pose 1.48 m off, and one with two bones'
+/// names swapped 0.2 m off.
+#[test]
+fn a_bound_description_refuses_another_skeleton() {
+    let skeleton = Skeleton::reference();
+    let desc =
+        RagdollDesc::from_toml_with_skeleton(vertebra_ragdoll::REFERENCE_HUMANOID, &skeleton)
+            .unwrap();
+    assert!(SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod).is_ok());
+    let mut doubled = skeleton.bones().to_vec();
+    for bone in &mut doubled {
+        bone.bind.translation *= 2.0;
+    }
+    let mut swapped = skeleton.bones().to_vec();
+    let (chest, head) = (index(&skeleton, "chest"), index(&skeleton, "head"));
+    swapped[chest].name = "head".to_owned();
+    swapped[head].name = "chest".to_owned();
+    for (bones, expected) in [
+        (doubled, "skeleton bone `hips`: bind is 1 m and 0 rad"),
+        (swapped, "skeleton bone `chest`: bind is"),
+    ] {
+        let other = Skeleton::new(bones).unwrap();
+        let message = SkeletonMapper::new(&other, &desc, SpineMode::Rod)
+            .unwrap_err()
+            .to_string();
+        assert!(message.starts_with(expected), "{message}");
     }
 }
