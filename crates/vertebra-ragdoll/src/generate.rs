@@ -48,6 +48,8 @@ pub enum SegmentEnd {
     Bone(String),
     /// At this point (m) in the bone's own frame.
     Point(Vec3),
+    /// This far (m, positive) along the bone's +Y from its origin.
+    Length(f32),
 }
 
 /// One chosen bone: the body it becomes and the joint to its parent body
@@ -104,7 +106,7 @@ impl BoneBody {
     /// head. A skeleton with another convention gives the end as a point
     /// ([`SegmentEnd::Point`]).
     pub fn with_length(mut self, length: f32) -> Self {
-        self.end = SegmentEnd::Point(Vec3::Y * length);
+        self.end = SegmentEnd::Length(length);
         self
     }
 
@@ -404,6 +406,10 @@ fn segment_end(
                 });
             }
             Ok(model[bone].transform_point(*p))
+        }
+        SegmentEnd::Length(length) => {
+            let length = positive(&body.bone, "length", *length)?;
+            Ok(model[bone].transform_point(Vec3::Y * length))
         }
     }
 }

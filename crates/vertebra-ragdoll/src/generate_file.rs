@@ -116,7 +116,7 @@ fn bone_body(b: &RawBoneBody, context: &str) -> Result<BoneBody, RagdollError> {
     let end = match (&b.end, b.length, b.point) {
         (None, None, None) => SegmentEnd::Next,
         (Some(bone), None, None) => SegmentEnd::Bone(bone.clone()),
-        (None, Some(length), None) => SegmentEnd::Point(Vec3::Y * length),
+        (None, Some(length), None) => SegmentEnd::Length(length),
         (None, None, Some(point)) => SegmentEnd::Point(Vec3::from(point)),
         _ => {
             return Err(refuse(

@@ -69,11 +69,10 @@ pub enum JointAnchors {
     /// life, as the mapper's [`Transition`](crate::Transition) keeps those
     /// bones' offsets. For the switch from animation: no body moves on the
     /// first step for a joint being apart. [`Ragdoll::recreate`] measures
-    /// again at its pose. The gap is kept whatever its size (within the
-    /// world's coordinate range, else the build is refused naming the
-    /// joint): a pose with a body torn off its parent (a teleported bone)
-    /// keeps it there, so build from a pose the animation system vouches
-    /// for, or with `Bind`.
+    /// again at its pose. A gap larger than the two bodies' reach (each
+    /// capsule's half segment and radius) is a broken pose, not an
+    /// offset (a body torn off its parent by a teleported bone): the build
+    /// is refused, naming the joint.
     Transition,
 }
 
@@ -306,10 +305,14 @@ impl Ragdoll {
             // Joint frames from bind pose (bodies unrotated there): both are
             // the described frame, so limits are measured from bind pose.
             let anchor_b = j.anchor - desc.bodies[j.child].centre();
+            let described = j.anchor - desc.bodies[j.parent].centre();
             let anchor_a = match self.options.anchors {
-                JointAnchors::Bind => j.anchor - desc.bodies[j.parent].centre(),
+                JointAnchors::Bind => described,
                 JointAnchors::Transition => {
-                    pivot_on_parent(pose.bones[j.parent], pose.bones[j.child], anchor_b)
+                    let at_switch =
+                        pivot_on_parent(pose.bones[j.parent], pose.bones[j.child], anchor_b);
+                    within_reach(desc, k, at_switch.distance(described))?;
+                    at_switch
                 }
             };
             let socket = JointDesc {
@@ -499,6 +502,27 @@ impl Ragdoll {
         }
         pairs
     }
+}
+
+/// Refuses a joint `k` whose bodies are `gap` (m) apart at the pivot at
+/// the switch by more than the two bodies' reach (each capsule's half
+/// segment and radius): an offset that bones without bodies give a joint
+/// is a few centimetres, a gap larger than the bodies is a broken pose (a
+/// teleported body), which `JointAnchors::Transition` would keep.
+fn within_reach(desc: &RagdollDesc, k: usize, gap: f32) -> Result<(), RagdollError> {
+    let j = &desc.joints[k];
+    let reach = |b: usize| {
+        let body = &desc.bodies[b];
+        0.5 * body.segment[0].distance(body.segment[1]) + body.radius
+    };
+    let most = reach(j.parent) + reach(j.child);
+    if gap <= most {
+        return Ok(());
+    }
+    Err(RagdollError::BadPose(format!(
+        "joint `{}`: its bodies are {gap} m apart at its pivot at the pose built at, more than the two bodies' reach ({most} m): a broken pose, which JointAnchors::Transition would keep",
+        j.name
+    )))
 }
 
 /// The child's anchor `anchor_b` (its body frame) at the child's pose, in

@@ -380,7 +380,11 @@ fn every_inconsistent_choice_is_refused_by_bone_and_reason() {
         ),
         (
             leg("head", |b| b.with_length(0.0)),
-            format!("bone `head`: end is 0 m from the bone's origin; a segment is at least {MIN_SEGMENT} m long"),
+            "bone `head`: length is 0; must be positive".to_owned(),
+        ),
+        (
+            leg("head", |b| b.with_length(-0.2)),
+            "bone `head`: length is -0.2; must be positive".to_owned(),
         ),
         (
             leg("hips", |b| BoneBody::new("spine_lower", b.radius, b.mass)),
@@ -396,6 +400,10 @@ fn every_inconsistent_choice_is_refused_by_bone_and_reason() {
         ),
         (
             leg("head", |b| b.with_length(f32::NAN)),
+            "bone `head`: length is not finite".to_owned(),
+        ),
+        (
+            leg("head", |b| BoneBody { end: SegmentEnd::Point(Vec3::new(0.0, f32::NAN, 0.0)), ..b }),
             "bone `head`: end is not finite".to_owned(),
         ),
         (

@@ -503,3 +503,39 @@ fn a_transition_refuses_what_it_cannot_use() {
         .to_string();
     assert!(message.contains("62 transforms for 63 bones"), "{message}");
 }
+
+/// A body torn off its parent in the pose (a teleported bone) is not an
+/// offset to keep: built with the switch's anchors the ragdoll is refused,
+/// naming the joint, and the world is left as it was. Before, the forearm
+/// 1e5 m away was joined to the upper arm by a 1e5 m lever, and the joints
+/// opened to 11 km within 3 s.
+#[test]
+fn a_body_torn_off_its_parent_is_refused_at_the_switch() {
+    let desc = RagdollDesc::reference_humanoid();
+    let skeleton = Skeleton::reference();
+    let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Sockets).unwrap();
+    let bind = skeleton.bind_pose().to_model(&skeleton).unwrap();
+    let mut pose = mapper.map_to_ragdoll(&bind, Transform::IDENTITY).unwrap();
+    let forearm = desc.body_index("forearm_l").unwrap();
+    for (far, refused) in [(0.05, false), (1e5, true)] {
+        pose.bones[forearm].0.x += far;
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let before = world.state_hash();
+        let built = Ragdoll::build(
+            &mut world,
+            &desc,
+            BuildOptions::at_switch(SpineMode::Sockets),
+            &pose,
+            None,
+        );
+        assert_eq!(built.is_err(), refused, "{far} m");
+        if refused {
+            let message = built.unwrap_err().to_string();
+            assert!(
+                message.contains("joint `elbow_l`: its bodies are"),
+                "{message}"
+            );
+            assert_eq!(world.state_hash(), before);
+        }
+    }
+}
