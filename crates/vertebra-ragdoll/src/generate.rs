@@ -237,7 +237,9 @@ impl RagdollGenerator {
     /// if given. Refused, naming the bone and the reason, for an unknown
     /// bone, a bone chosen twice, a radius, mass or density not finite or
     /// not positive, an end not finite or that cannot be found, a segment
-    /// shorter than [`MIN_SEGMENT`], a second chosen bone without a chosen
+    /// shorter than [`MIN_SEGMENT`] or a length that is not positive, a
+    /// joint given to the root body, a normal on a hinge or fixed joint or
+    /// an axis on a fixed one, a second chosen bone without a chosen
     /// ancestor, or a spine whose ends are not chosen or not one above the
     /// other; and for whatever the builder refuses ([`RagdollDesc::builder`]:
     /// joint limits, axes and normals, sizes and masses out of the
@@ -259,9 +261,12 @@ impl RagdollGenerator {
             match (ancestor(skeleton, bone, &chosen), root) {
                 (Some(parent), _) => {
                     let parent = &skeleton.bones()[parent].name;
-                    builder = builder.joint(joint(body, parent, model[bone], along));
+                    builder = builder.joint(joint(body, parent, model[bone], along)?);
                 }
-                (None, None) => root = Some(bone),
+                (None, None) => {
+                    no_joint(body)?;
+                    root = Some(bone);
+                }
                 (None, Some(first)) => {
                     return Err(refused(
                         name,
@@ -455,7 +460,27 @@ fn volume(radius: f32, length: f32) -> f32 {
 /// `body`'s joint to its parent body `parent`: at its bone's origin
 /// (`placed`, the bone's bind model transform), its frame from the bone's
 /// axes, or for a socket without an axis along `along` (the segment).
-fn joint(body: &BoneBody, parent: &str, placed: Transform, along: Vec3) -> JointSpec {
+fn joint(
+    body: &BoneBody,
+    parent: &str,
+    placed: Transform,
+    along: Vec3,
+) -> Result<JointSpec, RagdollError> {
+    let unused = |field: &'static str, given: bool, kinds: &str| {
+        if given {
+            Err(refused(&body.bone, field, format!("is for {kinds} only")))
+        } else {
+            Ok(())
+        }
+    };
+    match body.joint {
+        JointKind::Fixed => {
+            unused("axis", body.axis.is_some(), "sockets and hinges")?;
+            unused("normal", body.normal.is_some(), "sockets")?;
+        }
+        JointKind::Hinge { .. } => unused("normal", body.normal.is_some(), "sockets")?,
+        JointKind::Socket(_) => {}
+    }
     let rotate = |v: Vec3| placed.rotation * v;
     let frame = match body.joint {
         JointKind::Fixed => JointFrame::Rotation(Quat::IDENTITY),
@@ -468,7 +493,7 @@ fn joint(body: &BoneBody, parent: &str, placed: Transform, along: Vec3) -> Joint
             normal: body.normal.map(rotate),
         },
     };
-    JointSpec {
+    Ok(JointSpec {
         name: body.bone.clone(),
         parent: parent.to_owned(),
         child: body.bone.clone(),
@@ -476,7 +501,21 @@ fn joint(body: &BoneBody, parent: &str, placed: Transform, along: Vec3) -> Joint
         frame,
         kind: body.joint,
         drive: None,
+    })
+}
+
+/// Refuses a joint given to the root body, which has no parent to join:
+/// it would be dropped unchecked.
+fn no_joint(body: &BoneBody) -> Result<(), RagdollError> {
+    let free = body.joint == JointKind::Socket(SwingTwist::FREE);
+    if free && body.axis.is_none() && body.normal.is_none() {
+        return Ok(());
     }
+    Err(refused(
+        &body.bone,
+        "joint",
+        "is given, but the root body has no parent body to join".to_owned(),
+    ))
 }
 
 /// The spine as the chosen bones from `spine.to` up to `spine.from`, base

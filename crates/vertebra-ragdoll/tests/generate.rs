@@ -387,6 +387,18 @@ fn every_inconsistent_choice_is_refused_by_bone_and_reason() {
             "bone `head`: length is -0.2; must be positive".to_owned(),
         ),
         (
+            leg("shin_l", |b| b.with_normal(Vec3::Y)),
+            "bone `shin_l`: normal is for sockets only".to_owned(),
+        ),
+        (
+            leg("shin_l", |b| BoneBody { axis: Some(Vec3::NAN), ..b.fixed() }),
+            "bone `shin_l`: axis is for sockets and hinges only".to_owned(),
+        ),
+        (
+            leg("hips", |b| b.hinge(Vec3::X, Some([f32::NAN, 1.0]))),
+            "bone `hips`: joint is given, but the root body has no parent body to join".to_owned(),
+        ),
+        (
             leg("hips", |b| BoneBody::new("spine_lower", b.radius, b.mass)),
             "bone `thigh_l`: ancestor is not chosen, and only the root body (`spine_lower`) may have none: choose a bone above it, or leave it out".to_owned(),
         ),
