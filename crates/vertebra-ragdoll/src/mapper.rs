@@ -107,7 +107,14 @@ impl SkeletonMapper {
         for def in &desc.bodies {
             let name = match (&def.bone, &desc.skeleton) {
                 (Some(bound), Some(own)) => own.bones()[bound.bone].name.as_str(),
-                _ => def.name.as_str(),
+                (None, Some(_)) => {
+                    return Err(RagdollError::OutOfRange {
+                        context: format!("body `{}`", def.name),
+                        field: "bone",
+                        reason: "is none: the description binds it to no bone (a prop), and the mapper needs a bone for every body".to_owned(),
+                    });
+                }
+                (_, None) => def.name.as_str(),
             };
             let bone = skeleton
                 .bone_index(name)

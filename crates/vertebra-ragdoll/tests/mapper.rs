@@ -750,3 +750,24 @@ fn a_bound_description_refuses_another_skeleton() {
         assert!(message.starts_with(expected), "{message}");
     }
 }
+
+/// A body its description binds to no bone (a prop) cannot be mapped: the
+/// mapper says so, naming it. Before, it fell back to the bone of its
+/// name, and refused that bone as followed by another body.
+#[test]
+fn a_prop_body_is_refused_by_the_mapper_by_name() {
+    let skeleton = Skeleton::reference();
+    let mut desc =
+        RagdollDesc::from_toml_with_skeleton(vertebra_ragdoll::REFERENCE_HUMANOID, &skeleton)
+            .unwrap();
+    let head = desc.body_index("head").unwrap();
+    desc.bodies[head].bone = None;
+    desc.validate().unwrap();
+    let message = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.starts_with("body `head`: bone is none"),
+        "{message}"
+    );
+}
