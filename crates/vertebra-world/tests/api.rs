@@ -211,12 +211,12 @@ fn bad_joints_are_refused() {
         .map(drop)
     });
     rejected(Error::NonPositive("drive compliance"), |w| {
-        let s = w.residuals().joints[0].joint;
+        let s = w.measure_residuals().joints[0].joint;
         let drive = AngularDrive::compliant(Quat::IDENTITY, -1.0, 0.0);
         w.set_joint_drive(s, Some(drive))
     });
     rejected(Error::NotNormalized("drive target"), |w| {
-        let s = w.residuals().joints[0].joint;
+        let s = w.measure_residuals().joints[0].joint;
         let drive = AngularDrive::rigid(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0));
         w.set_joint_drive(s, Some(drive))
     });
