@@ -686,3 +686,95 @@ fn push_manifold(
 pub fn collider_pose(world: &World, body: BodyHandle) -> Result<(Vec3, Quat), Error> {
     world.body(body).map(|s| (s.position, s.orientation))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Poses of a shape around a plane through the origin: a grid of
+    /// heights, tilts and turns (resting, touching, apart, half sunk).
+    fn poses() -> impl Iterator<Item = Pose> {
+        (0..9).flat_map(|h| {
+            (0..7).flat_map(move |t| {
+                (0..5).map(move |r| {
+                    let height = -0.3 + 0.09 * h as f32;
+                    let tilt = Quat::from_rotation_x(0.37 * t as f32);
+                    let turn = Quat::from_rotation_y(1.3 * r as f32);
+                    Pose::from_parts(Vec3::new(0.2, height, -0.1), turn * tilt)
+                })
+            })
+        })
+    }
+
+    /// Parry's manifolds for a new pair.
+    fn parry(
+        pos12: &Pose,
+        s1: &dyn ParryShape,
+        s2: &dyn ParryShape,
+    ) -> Vec<ContactManifold<(), ()>> {
+        let mut manifolds = Vec::new();
+        DefaultQueryDispatcher
+            .contact_manifolds(pos12, s1, s2, 0.05, &mut manifolds, &mut None)
+            .unwrap();
+        manifolds
+    }
+
+    /// A manifold's normals and points, bit for bit.
+    fn bits(m: &ContactManifold<(), ()>) -> Vec<u32> {
+        let v = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+        let mut out = [v(m.local_n1), v(m.local_n2)].concat();
+        for p in &m.points {
+            out.extend(v(p.local_p1));
+            out.extend(v(p.local_p2));
+            out.extend([p.dist.to_bits(), p.fid1.0, p.fid2.0]);
+        }
+        out
+    }
+
+    #[test]
+    fn the_ground_makes_parrys_contacts_bit_for_bit_in_a_kept_manifold() {
+        let plane = SharedShape::halfspace(Vec3::new(0.0, 0.6, 0.8));
+        let solids = [
+            SharedShape::capsule(Vec3::new(0.0, -0.2, 0.0), Vec3::new(0.0, 0.2, 0.0), 0.06),
+            SharedShape::cuboid(0.3, 0.15, 0.2),
+        ];
+        let mut kept = Vec::new();
+        let mut points = 0;
+        for solid in &solids {
+            for pose in poses() {
+                for (s1, s2, pos12) in [(&plane, solid, pose), (solid, &plane, pose.inverse())] {
+                    fresh(&mut kept);
+                    assert!(plane_manifold(
+                        &pos12,
+                        s1.as_ref(),
+                        s2.as_ref(),
+                        0.05,
+                        &mut kept
+                    ));
+                    let expected = parry(&pos12, s1.as_ref(), s2.as_ref());
+                    assert_eq!(kept.len(), 1);
+                    assert_eq!(bits(&kept[0]), bits(&expected[0]), "{pose:?}");
+                    points += kept[0].points.len();
+                }
+            }
+        }
+        assert!(points > 100, "the grid makes contacts: {points}");
+        // Other pairs are parry's to make.
+        let ball = SharedShape::ball(0.1);
+        let pose = Pose::from_parts(Vec3::Y * 0.05, Quat::IDENTITY);
+        assert!(!plane_manifold(
+            &pose,
+            plane.as_ref(),
+            ball.as_ref(),
+            0.05,
+            &mut kept
+        ));
+        assert!(!plane_manifold(
+            &pose,
+            solids[0].as_ref(),
+            solids[1].as_ref(),
+            0.05,
+            &mut kept
+        ));
+    }
+}

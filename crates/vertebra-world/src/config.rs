@@ -70,11 +70,12 @@ pub struct SolverConfig {
     pub max_angular_speed: f32,
     /// Measure every joint's and rod's residual error at the end of each
     /// step, from the step's own solved poses ([`World::residuals`]). Off by
-    /// default: the measurement is a pass over every constraint as long as
-    /// two position iterations of the paper's ragdoll, which a game that
-    /// does not plot the paper's figure 8 need not pay; any world measures
-    /// its current poses on demand with [`World::measure_residuals`]. The
-    /// scenes turn it on (their figures are these residuals).
+    /// default: the measurement is a pass over every constraint, about a
+    /// tenth of the reference ragdoll's step at 4 iterations
+    /// (`docs/performance.md`), which a game that does not plot the paper's
+    /// figure 8 need not pay; any world measures its current poses on
+    /// demand with [`World::measure_residuals`]. The scenes turn it on
+    /// (their figures are these residuals).
     ///
     /// [`World::residuals`]: crate::World::residuals
     /// [`World::measure_residuals`]: crate::World::measure_residuals

@@ -242,3 +242,93 @@ fn append(
 pub(crate) fn validate_all(contacts: &[Contact], bodies: &BodyStore) -> Result<(), Error> {
     contacts.iter().try_for_each(|c| c.validate_with(bodies))
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use rand::rngs::StdRng;
+    use rand::{RngExt, SeedableRng};
+    use vertebra_scheduler::Colouring;
+
+    use super::*;
+    use crate::{BodyDesc, Shape, SolverConfig, World};
+
+    /// The solve order the scheduler's colouring gives `contacts` (a
+    /// `Colouring` fed in order: what the layout was built from before it
+    /// kept its buffers): colour by colour, keys ascending, overflow last.
+    fn scheduler_order(contacts: &[Contact], bodies: &BodyStore) -> (Vec<u32>, Vec<usize>) {
+        let mut colouring = Colouring::new();
+        let dynamic = |h: BodyHandle| {
+            (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
+        };
+        for (k, c) in contacts.iter().enumerate() {
+            colouring.add(k as u64, [dynamic(c.body_a), dynamic(c.body_b)]);
+        }
+        let sets = (0..MAX_COLOURS)
+            .map(|c| colouring.colour(c))
+            .chain([colouring.overflow()]);
+        let mut order = Vec::new();
+        let mut sizes = Vec::new();
+        for set in sets {
+            order.extend(set.iter().map(|&k| k as u32));
+            sizes.push(set.len());
+        }
+        (order, sizes)
+    }
+
+    #[test]
+    fn contacts_are_solved_in_the_order_the_scheduler_colours_them() {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let mass = Shape::Sphere { radius: 0.1 }
+            .mass_properties_with_mass(1.0)
+            .unwrap();
+        let bodies: Vec<BodyHandle> = (0..40)
+            .map(|k| {
+                let desc = if k % 7 == 0 {
+                    BodyDesc::fixed()
+                } else {
+                    BodyDesc::dynamic(mass)
+                };
+                world.add_body(desc).unwrap()
+            })
+            .collect();
+        let mut layout = ContactLayout::default();
+        for seed in 0..20 {
+            let mut rng = StdRng::seed_from_u64(seed);
+            // Body 1 is a hub: with 30 contacts it overflows 24 colours.
+            let contacts: Vec<Contact> = (0..300)
+                .map(|k| {
+                    let a = if k < 30 { 1 } else { rng.random_range(0..40) };
+                    let b = (a + rng.random_range(1..40)) % 40;
+                    Contact {
+                        body_a: bodies[a],
+                        body_b: bodies[b],
+                        point: Vec3::ZERO,
+                        normal: Vec3::Y,
+                        depth: 0.0,
+                        friction: 0.5,
+                        restitution: 0.0,
+                    }
+                })
+                .filter(|c| {
+                    let kind = |h: BodyHandle| world.bodies().kind[h.index()];
+                    kind(c.body_a) == BodyKind::Dynamic || kind(c.body_b) == BodyKind::Dynamic
+                })
+                .collect();
+            layout.rebuild(&contacts, world.bodies(), f32::INFINITY);
+            let (order, sizes) = scheduler_order(&contacts, world.bodies());
+            assert_eq!(layout.order, order, "seed {seed}");
+            assert!(sizes[OVERFLOW] > 0, "seed {seed}: the overflow set is used");
+            let blocks = |n: usize| n.div_ceil(BLOCK_LANES);
+            let colours: Vec<usize> = layout.colours.iter().map(|r| r.len()).collect();
+            let expected: Vec<usize> = sizes[..OVERFLOW]
+                .iter()
+                .filter(|&&n| n > 0)
+                .map(|&n| blocks(n))
+                .collect();
+            assert_eq!(colours, expected, "seed {seed}");
+            assert_eq!(layout.overflow.len(), blocks(sizes[OVERFLOW]));
+            assert!(layout.disjoint, "seed {seed}: every colour may be split");
+        }
+    }
+}

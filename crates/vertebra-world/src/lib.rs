@@ -532,6 +532,10 @@ impl World {
     /// computes in the default floating-point mode on every thread it uses,
     /// whatever mode (FTZ, DAZ, rounding) the caller runs in, and gives the
     /// caller's mode back ([`vertebra_math::float_mode`]).
+    /// It measures the residuals afterwards only when the config asks
+    /// ([`SolverConfig::measure_residuals`]). Once its buffers have grown to
+    /// the world's bodies, joints and contacts, a step allocates nothing on
+    /// one thread (`crates/vertebra-scenes/tests/allocation.rs`).
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         if dt > vertebra_store::MAX_TIME_STEP {
