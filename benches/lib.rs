@@ -549,3 +549,18 @@ fn drop_scene_with(
     }
     scene
 }
+
+/// The reference ragdoll alone: passive bending (the hips held, the upper
+/// body slumping) at 1 substep x 4 iterations on one thread, one second
+/// (60 frames) in, on `backend`, its residuals not measured. No colliders,
+/// so a frame is the step.
+pub fn single_ragdoll(spine: SpineMode, backend: BackendChoice) -> SceneWorld {
+    let mut config = SceneConfig::new(Scene::PassiveBending, spine);
+    (config.substeps, config.iterations, config.backend) = (1, 4, backend);
+    config.measure_residuals = false;
+    let mut scene = build(&config).expect("the passive-bending scene");
+    for frame in 0..60 {
+        scene.advance(config.scene, frame, DT).expect("a frame");
+    }
+    scene
+}

@@ -42,16 +42,16 @@ fn standard(backend: usize) -> SceneWorld {
 // Argument k is INSTRUCTION_BACKENDS[k]: 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
 #[library_benchmark]
 #[benches::backend(args = [0, 2, 3], setup = simplified)]
-fn step_simplified(mut scene: SceneWorld) -> f32 {
+fn step_simplified(mut scene: SceneWorld) -> Option<f32> {
     scene.world.step(DT).expect("a step");
-    black_box(scene.world.residuals().eps_lin_cm)
+    black_box(scene.world.residuals().map(|r| r.eps_lin_cm))
 }
 
 #[library_benchmark]
 #[benches::backend(args = [0, 2, 3], setup = standard)]
-fn step_standard(mut scene: SceneWorld) -> f32 {
+fn step_standard(mut scene: SceneWorld) -> Option<f32> {
     scene.world.step(DT).expect("a step");
-    black_box(scene.world.residuals().eps_lin_cm)
+    black_box(scene.world.residuals().map(|r| r.eps_lin_cm))
 }
 
 library_benchmark_group!(name = drop_30; benchmarks = step_simplified, step_standard);

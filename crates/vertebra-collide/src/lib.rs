@@ -31,8 +31,12 @@ use std::collections::{HashMap, HashSet};
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
-use parry3d::shape::SharedShape;
+use parry3d::query::{
+    ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher, TrackedContact,
+};
+use parry3d::shape::{
+    PackedFeatureId, PolygonalFeature, Shape as ParryShape, ShapeType, SharedShape,
+};
 use vertebra_ragdoll::{BuildOptions, Ragdoll, RagdollDesc, RagdollError};
 use vertebra_world::{BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, World};
 
@@ -188,6 +192,45 @@ pub struct Collisions {
     apart: HashMap<BodyHandle, u64>,
     /// The group the next ragdoll whose self-collision goes off gets.
     next_apart: u64,
+    /// Working memory of [`Collisions::find_contacts_into`] (not part of
+    /// the set's state: never saved, and a clone's starts empty in effect,
+    /// as every call rewrites it).
+    scratch: Detection,
+}
+
+/// A detection's working memory, kept between calls so that a steady
+/// scene's detection allocates nothing.
+#[derive(Clone, Default)]
+struct Detection {
+    /// Each collider's body pose.
+    poses: Vec<Pose>,
+    /// How far each collider's body can move in the step (m).
+    reach: Vec<f32>,
+    /// Each collider's bounds, loosened by the prediction and its reach.
+    aabbs: Vec<Aabb>,
+    /// The solid colliders in sweep order.
+    solids: Vec<usize>,
+    /// The candidate pairs of collider indices, ascending.
+    pairs: Vec<(usize, usize)>,
+    /// Parry's output for one pair.
+    manifolds: Vec<ContactManifold<(), ()>>,
+}
+
+/// Makes `manifolds` what parry gets for a new pair (at most one manifold,
+/// as new: every query starts from the same state, whatever pair came
+/// before) while keeping its points' memory: our colliders are convex, so
+/// parry fills exactly the first manifold, and a manifold's normal seeds
+/// its search (a reused one would change contacts).
+fn fresh(manifolds: &mut Vec<ContactManifold<(), ()>>) {
+    manifolds.truncate(1);
+    if let Some(m) = manifolds.first_mut() {
+        let mut points = core::mem::take(&mut m.points);
+        points.clear();
+        *m = ContactManifold {
+            points,
+            ..ContactManifold::new()
+        };
+    }
 }
 
 fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {
@@ -402,43 +445,93 @@ impl Collisions {
     /// fast body meets the floor instead of passing into it; a gap does
     /// nothing until it closes. `Err(Error::Collider)` names the first
     /// collider whose body is no longer in `world` (remove a body's
-    /// colliders with [`Collisions::remove_body`]).
+    /// colliders with [`Collisions::remove_body`]). Allocates its list and
+    /// working memory every call: a game's loop uses
+    /// [`Collisions::find_contacts_into`].
     pub fn find_contacts(&self, world: &World, dt: f32) -> Result<Vec<Contact>, Error> {
+        let mut contacts = Vec::new();
+        self.detect(world, dt, &mut Detection::default(), &mut contacts)?;
+        Ok(contacts)
+    }
+
+    /// [`Collisions::find_contacts`] into `contacts` (emptied first, and
+    /// empty on error), with the set's own working memory (bounds, sweep
+    /// order, pairs, parry's manifolds) kept from call to call: once it and
+    /// `contacts` have grown to the scene's size, a call allocates nothing.
+    /// Hand the list to the world without a copy with
+    /// `World::swap_contacts`, which gives back the world's previous
+    /// list for the next call.
+    pub fn find_contacts_into(
+        &mut self,
+        world: &World,
+        dt: f32,
+        contacts: &mut Vec<Contact>,
+    ) -> Result<(), Error> {
+        // Taken out and put back (moving a vector allocates nothing), so
+        // that the detection reads the set while it writes its memory.
+        let mut scratch = core::mem::take(&mut self.scratch);
+        let found = self.detect(world, dt, &mut scratch, contacts);
+        self.scratch = scratch;
+        found
+    }
+
+    /// Every contact into `contacts` (emptied first), with `scratch` as
+    /// working memory.
+    fn detect(
+        &self,
+        world: &World,
+        dt: f32,
+        scratch: &mut Detection,
+        contacts: &mut Vec<Contact>,
+    ) -> Result<(), Error> {
+        contacts.clear();
         vertebra_world::check_positive("time step", dt)?;
-        let mut poses = Vec::with_capacity(self.colliders.len());
-        let mut reach = Vec::with_capacity(self.colliders.len());
+        scratch.poses.clear();
+        scratch.reach.clear();
         for (index, (c, shape)) in self.colliders.iter().enumerate() {
             let s = world.body(c.body).map_err(|e| c.refused(index, e))?;
-            poses.push(Pose::from_parts(s.position, s.orientation));
+            scratch
+                .poses
+                .push(Pose::from_parts(s.position, s.orientation));
             let extent = shape.compute_local_bounding_sphere().radius;
             let extent = if extent.is_finite() { extent } else { 0.0 };
-            reach.push((s.linear_velocity.length() + s.angular_velocity.length() * extent) * dt);
+            scratch
+                .reach
+                .push((s.linear_velocity.length() + s.angular_velocity.length() * extent) * dt);
         }
-        let mut contacts = Vec::new();
-        let mut manifolds = Vec::new();
-        for (i, j) in self.candidate_pairs(world, &poses, &reach) {
+        self.candidate_pairs(world, scratch);
+        let (poses, reach) = (&scratch.poses, &scratch.reach);
+        for &(i, j) in &scratch.pairs {
             let ((ci, si), (cj, sj)) = (&self.colliders[i], &self.colliders[j]);
-            manifolds.clear();
+            fresh(&mut scratch.manifolds);
             let relative = poses[i].inv_mul(&poses[j]);
             let prediction = self.prediction + reach[i] + reach[j];
-            if DefaultQueryDispatcher
-                .contact_manifolds(
-                    &relative,
-                    si.as_ref(),
-                    sj.as_ref(),
-                    prediction,
-                    &mut manifolds,
-                    &mut None,
-                )
-                .is_err()
+            let on_plane = plane_manifold(
+                &relative,
+                si.as_ref(),
+                sj.as_ref(),
+                prediction,
+                &mut scratch.manifolds,
+            );
+            if !on_plane
+                && DefaultQueryDispatcher
+                    .contact_manifolds(
+                        &relative,
+                        si.as_ref(),
+                        sj.as_ref(),
+                        prediction,
+                        &mut scratch.manifolds,
+                        &mut None,
+                    )
+                    .is_err()
             {
                 continue; // a pair parry has no algorithm for (none of ours)
             }
             let friction = (ci.friction * cj.friction).sqrt();
             let restitution = ci.restitution.max(cj.restitution);
-            for m in &manifolds {
+            for m in &scratch.manifolds {
                 push_manifold(
-                    &mut contacts,
+                    contacts,
                     m,
                     (ci.body, &poses[i]),
                     (cj.body, &poses[j]),
@@ -447,26 +540,32 @@ impl Collisions {
                 );
             }
         }
-        Ok(contacts)
+        Ok(())
     }
 
-    /// Pairs of collider indices whose bounds overlap and that may collide:
-    /// sort-and-sweep along x for solids, every solid against every plane.
-    fn candidate_pairs(&self, world: &World, poses: &[Pose], reach: &[f32]) -> Vec<(usize, usize)> {
-        let aabbs: Vec<Aabb> = (0..self.colliders.len())
-            .map(|k| {
-                self.colliders[k]
-                    .1
-                    .compute_aabb(&poses[k])
-                    .loosened(self.prediction + reach[k])
-            })
-            .collect();
+    /// Into `scratch.pairs`, the pairs of collider indices whose bounds
+    /// overlap and that may collide: sort-and-sweep along x for solids,
+    /// every solid against every plane.
+    fn candidate_pairs(&self, world: &World, scratch: &mut Detection) {
+        let (poses, reach) = (&scratch.poses, &scratch.reach);
+        scratch.aabbs.clear();
+        scratch.aabbs.extend((0..self.colliders.len()).map(|k| {
+            self.colliders[k]
+                .1
+                .compute_aabb(&poses[k])
+                .loosened(self.prediction + reach[k])
+        }));
+        let aabbs = &scratch.aabbs;
         let is_plane = |k: usize| matches!(self.colliders[k].0.shape, ColliderShape::Plane(_));
-        let mut solids: Vec<usize> = (0..self.colliders.len())
-            .filter(|&k| !is_plane(k))
-            .collect();
-        solids.sort_by(|&a, &b| aabbs[a].mins.x.total_cmp(&aabbs[b].mins.x).then(a.cmp(&b)));
-        let mut pairs = Vec::new();
+        let solids = &mut scratch.solids;
+        solids.clear();
+        solids.extend((0..self.colliders.len()).filter(|&k| !is_plane(k)));
+        // Unstable but in place (no buffer): the index breaks ties, so the
+        // order is the one a stable sort gives.
+        solids
+            .sort_unstable_by(|&a, &b| aabbs[a].mins.x.total_cmp(&aabbs[b].mins.x).then(a.cmp(&b)));
+        let pairs = &mut scratch.pairs;
+        pairs.clear();
         for (n, &a) in solids.iter().enumerate() {
             for &b in &solids[n + 1..] {
                 if aabbs[b].mins.x > aabbs[a].maxs.x {
@@ -482,7 +581,6 @@ impl Collisions {
         }
         pairs.retain(|&(a, b)| self.may_collide(world, a, b));
         pairs.sort_unstable();
-        pairs
     }
 
     fn may_collide(&self, world: &World, a: usize, b: usize) -> bool {
@@ -495,6 +593,64 @@ impl Collisions {
             && cb.groups.membership & ca.groups.filter != 0
             && !self.kept_apart(ca.body, cb.body)
     }
+}
+
+/// A half space against a box or capsule (the ground under a body), into
+/// `manifolds[0]`; false (nothing done) for any other pair. This is parry's
+/// `contact_manifold_halfspace_pfm` (0.31), which its dispatcher runs for
+/// these pairs, step for step (so the contacts are its bits), except that
+/// it writes into the manifold's point vector instead of a new one: parry
+/// takes the old vector away every call (to carry impulses over, which we
+/// do not keep), which cost an allocation per body on the ground per frame.
+fn plane_manifold(
+    pos12: &Pose,
+    shape1: &dyn ParryShape,
+    shape2: &dyn ParryShape,
+    prediction: f32,
+    manifolds: &mut Vec<ContactManifold<(), ()>>,
+) -> bool {
+    let polygonal =
+        |s: &dyn ParryShape| matches!(s.shape_type(), ShapeType::Cuboid | ShapeType::Capsule);
+    let (pos12, halfspace, (pfm, border_radius), flipped) =
+        match (shape1.as_halfspace(), shape2.as_halfspace()) {
+            (Some(h), None) if polygonal(shape2) => match shape2.as_polygonal_feature_map() {
+                Some(p) => (*pos12, h, p, false),
+                None => return false,
+            },
+            (None, Some(h)) if polygonal(shape1) => match shape1.as_polygonal_feature_map() {
+                Some(p) => (pos12.inverse(), h, p, true),
+                None => return false,
+            },
+            _ => return false,
+        };
+    if manifolds.is_empty() {
+        manifolds.push(ContactManifold::new());
+    }
+    let manifold = &mut manifolds[0];
+    let normal1_2 = pos12.rotation.inverse() * halfspace.normal;
+    let mut feature2 = PolygonalFeature::default();
+    pfm.local_support_feature(-normal1_2, &mut feature2);
+    for k in 0..feature2.num_vertices {
+        let vtx2 = feature2.vertices[k];
+        let vtx2_1 = pos12 * vtx2;
+        let dist_to_plane = vtx2_1.dot(halfspace.normal);
+        if dist_to_plane - border_radius <= prediction {
+            manifold.points.push(TrackedContact::flipped(
+                vtx2_1 - halfspace.normal * dist_to_plane,
+                vtx2 - normal1_2 * border_radius,
+                PackedFeatureId::face(0),
+                feature2.vids[k],
+                dist_to_plane - border_radius,
+                flipped,
+            ));
+        }
+    }
+    (manifold.local_n1, manifold.local_n2) = if flipped {
+        (-normal1_2, halfspace.normal)
+    } else {
+        (halfspace.normal, -normal1_2)
+    };
+    true
 }
 
 /// A manifold's points as solver contacts: the normal from the first shape
@@ -529,4 +685,96 @@ fn push_manifold(
 /// The world pose of a body's collider frame (for callers drawing them).
 pub fn collider_pose(world: &World, body: BodyHandle) -> Result<(Vec3, Quat), Error> {
     world.body(body).map(|s| (s.position, s.orientation))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Poses of a shape around a plane through the origin: a grid of
+    /// heights, tilts and turns (resting, touching, apart, half sunk).
+    fn poses() -> impl Iterator<Item = Pose> {
+        (0..9).flat_map(|h| {
+            (0..7).flat_map(move |t| {
+                (0..5).map(move |r| {
+                    let height = -0.3 + 0.09 * h as f32;
+                    let tilt = Quat::from_rotation_x(0.37 * t as f32);
+                    let turn = Quat::from_rotation_y(1.3 * r as f32);
+                    Pose::from_parts(Vec3::new(0.2, height, -0.1), turn * tilt)
+                })
+            })
+        })
+    }
+
+    /// Parry's manifolds for a new pair.
+    fn parry(
+        pos12: &Pose,
+        s1: &dyn ParryShape,
+        s2: &dyn ParryShape,
+    ) -> Vec<ContactManifold<(), ()>> {
+        let mut manifolds = Vec::new();
+        DefaultQueryDispatcher
+            .contact_manifolds(pos12, s1, s2, 0.05, &mut manifolds, &mut None)
+            .unwrap();
+        manifolds
+    }
+
+    /// A manifold's normals and points, bit for bit.
+    fn bits(m: &ContactManifold<(), ()>) -> Vec<u32> {
+        let v = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
+        let mut out = [v(m.local_n1), v(m.local_n2)].concat();
+        for p in &m.points {
+            out.extend(v(p.local_p1));
+            out.extend(v(p.local_p2));
+            out.extend([p.dist.to_bits(), p.fid1.0, p.fid2.0]);
+        }
+        out
+    }
+
+    #[test]
+    fn the_ground_makes_parrys_contacts_bit_for_bit_in_a_kept_manifold() {
+        let plane = SharedShape::halfspace(Vec3::new(0.0, 0.6, 0.8));
+        let solids = [
+            SharedShape::capsule(Vec3::new(0.0, -0.2, 0.0), Vec3::new(0.0, 0.2, 0.0), 0.06),
+            SharedShape::cuboid(0.3, 0.15, 0.2),
+        ];
+        let mut kept = Vec::new();
+        let mut points = 0;
+        for solid in &solids {
+            for pose in poses() {
+                for (s1, s2, pos12) in [(&plane, solid, pose), (solid, &plane, pose.inverse())] {
+                    fresh(&mut kept);
+                    assert!(plane_manifold(
+                        &pos12,
+                        s1.as_ref(),
+                        s2.as_ref(),
+                        0.05,
+                        &mut kept
+                    ));
+                    let expected = parry(&pos12, s1.as_ref(), s2.as_ref());
+                    assert_eq!(kept.len(), 1);
+                    assert_eq!(bits(&kept[0]), bits(&expected[0]), "{pose:?}");
+                    points += kept[0].points.len();
+                }
+            }
+        }
+        assert!(points > 100, "the grid makes contacts: {points}");
+        // Other pairs are parry's to make.
+        let ball = SharedShape::ball(0.1);
+        let pose = Pose::from_parts(Vec3::Y * 0.05, Quat::IDENTITY);
+        assert!(!plane_manifold(
+            &pose,
+            plane.as_ref(),
+            ball.as_ref(),
+            0.05,
+            &mut kept
+        ));
+        assert!(!plane_manifold(
+            &pose,
+            solids[0].as_ref(),
+            solids[1].as_ref(),
+            0.05,
+            &mut kept
+        ));
+    }
 }

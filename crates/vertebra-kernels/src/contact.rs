@@ -107,9 +107,16 @@ pub struct ContactLane {
 }
 
 impl ContactBlock {
-    /// A block of padding lanes: null rows, zero normal, so nothing acts.
+    /// A block of padding lanes: null rows, zero normal, so nothing acts,
+    /// and no writes, as every kernel's padding (zeroed, its lanes wrote the
+    /// null row, so that a colour's padding lanes shared a written row and
+    /// no colour of contacts could be split over threads).
     pub fn padding() -> Self {
-        Self::zeroed()
+        let mut block = Self::zeroed();
+        for lane in 0..BLOCK_LANES {
+            block.bodies.set(lane, 0, 0, false, false);
+        }
+        block
     }
 
     /// Writes one contact into `lane`.

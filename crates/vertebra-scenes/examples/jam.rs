@@ -148,6 +148,7 @@ fn joint_separations(scene: &SceneWorld) -> HashMap<(BodyHandle, BodyHandle), f3
     scene
         .world
         .residuals()
+        .expect("a scene measures its residuals every step")
         .joints
         .iter()
         .filter_map(|j| {

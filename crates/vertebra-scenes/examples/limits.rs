@@ -47,7 +47,10 @@ fn main() {
         scene
             .advance(Scene::AnatomicalDrop, frame, dt)
             .expect("a frame");
-        let r = scene.world.residuals();
+        let r = scene
+            .world
+            .residuals()
+            .expect("a scene measures its residuals every step");
         let measured = r
             .joints
             .iter()

@@ -39,6 +39,14 @@ pub struct SceneConfig {
     /// The hit-reaction drive's torque limit per joint (N m; infinity is
     /// unlimited, not negative).
     pub max_torque: f32,
+    /// Whether the world measures its residuals at the end of every step
+    /// (`SolverConfig::measure_residuals`): every figure of a scene is
+    /// measured from them, so [`SceneConfig::new`] turns it on; off only
+    /// to time the step alone (and then [`SceneWorld::measure`] needs
+    /// `World::measure_residuals` first).
+    ///
+    /// [`SceneWorld::measure`]: crate::SceneWorld::measure
+    pub measure_residuals: bool,
 }
 
 impl SceneConfig {
@@ -58,6 +66,7 @@ impl SceneConfig {
             drive_frequency: 16.0,
             drive_damping_ratio: 1.0,
             max_torque: f32::INFINITY,
+            measure_residuals: true,
         }
     }
 
@@ -100,6 +109,7 @@ impl SceneConfig {
             substeps: self.substeps,
             backend: self.backend,
             threads: self.threads,
+            measure_residuals: self.measure_residuals,
             ..SolverConfig::default()
         };
         Ok(World::new(config)?)

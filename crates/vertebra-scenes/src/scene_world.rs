@@ -6,7 +6,7 @@ use std::collections::HashSet;
 use glam::Vec3;
 use vertebra_collide::Collisions;
 use vertebra_ragdoll::{Pose, Ragdoll, RagdollError};
-use vertebra_world::{BodyHandle, JointHandle, RodHandle, World};
+use vertebra_world::{BodyHandle, Contact, JointHandle, RodHandle, World};
 
 use crate::{Frame, Scene};
 
@@ -32,6 +32,8 @@ pub struct SceneWorld {
     /// holding hips in place).
     joints: HashSet<JointHandle>,
     rods: HashSet<RodHandle>,
+    /// The contact list the detection fills and swaps into the world.
+    contacts: Vec<Contact>,
 }
 
 impl SceneWorld {
@@ -56,6 +58,7 @@ impl SceneWorld {
             hits: Vec::new(),
             joints,
             rods,
+            contacts: Vec::new(),
         }
     }
 
@@ -67,11 +70,12 @@ impl SceneWorld {
 
     /// Collision detection for a step of `dt` seconds: this scene's
     /// contacts, handed to the world for its next step (nothing without
-    /// colliders).
+    /// colliders), through a list kept from frame to frame
+    /// (`World::swap_contacts`): no allocation once it has grown.
     pub fn detect(&mut self, dt: f32) -> Result<(), RagdollError> {
-        if let Some(collisions) = &self.collisions {
-            let contacts = collisions.find_contacts(&self.world, dt)?;
-            self.world.set_contacts(&contacts)?;
+        if let Some(collisions) = &mut self.collisions {
+            collisions.find_contacts_into(&self.world, dt, &mut self.contacts)?;
+            self.world.swap_contacts(&mut self.contacts)?;
         }
         Ok(())
     }
@@ -97,8 +101,16 @@ impl SceneWorld {
     /// joint, and deviation from the target, in
     /// `world`: this scene's own world, or one holding the same bodies and
     /// joints under the same handles (the peer comparison's mirror).
+    ///
+    /// # Panics
+    /// If `world`'s residuals were not measured since its last step: a
+    /// scene's world measures them every step unless its config turned
+    /// [`SceneConfig::measure_residuals`](crate::SceneConfig::measure_residuals)
+    /// off.
     pub fn measure(&self, world: &World) -> Frame {
-        let r = world.residuals();
+        let r = world
+            .residuals()
+            .expect("the residuals are measured after every step or on demand");
         let joint_errors = r
             .joints
             .iter()

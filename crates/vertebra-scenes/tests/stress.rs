@@ -108,7 +108,7 @@ fn mass_ratio(light_on_top: bool, substeps: u32) -> (f32, f32) {
     let mut worst = 0.0f32;
     for _ in 0..300 {
         world.step(DT).unwrap();
-        worst = worst.max(world.residuals().eps_lin_cm);
+        worst = worst.max(world.measure_residuals().eps_lin_cm);
     }
     (worst, fastest(&world))
 }
@@ -268,7 +268,7 @@ fn a_ragdoll_at_a_thousand_metres_per_second_stops_at_the_ground() {
                 late = late.max(fastest(&world));
             }
         }
-        let (speed, eps) = (fastest(&world), world.residuals().eps_lin_cm);
+        let (speed, eps) = (fastest(&world), world.measure_residuals().eps_lin_cm);
         eprintln!(
             "{spine:?} from {height} m at 1000 m/s: lowest centre {low:.3} m; fastest after \
              the impact {rebound:.1} m/s, after 2 s {late:.1} m/s; after 5 s fastest \
@@ -333,7 +333,7 @@ fn a_rod_bent_past_its_limit_at_creation_returns_to_the_limit() {
         speed = speed.max(fastest(&world));
     }
     let residual = world
-        .residuals()
+        .measure_residuals()
         .rods
         .iter()
         .find(|j| j.joint == rod)

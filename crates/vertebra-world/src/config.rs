@@ -72,6 +72,18 @@ pub struct SolverConfig {
     /// Bodies never spin faster than this (rad/s): 50 turns a second by
     /// default, at most [`MAX_ANGULAR_SPEED_LIMIT`].
     pub max_angular_speed: f32,
+    /// Measure every joint's and rod's residual error at the end of each
+    /// step, from the step's own solved poses ([`World::residuals`]). Off by
+    /// default: the measurement is a pass over every constraint, about a
+    /// tenth of the reference ragdoll's step at 4 iterations
+    /// (`docs/performance.md`), which a game that does not plot the paper's
+    /// figure 8 need not pay; any world measures its current poses on
+    /// demand with [`World::measure_residuals`]. The scenes turn it on
+    /// (their figures are these residuals).
+    ///
+    /// [`World::residuals`]: crate::World::residuals
+    /// [`World::measure_residuals`]: crate::World::measure_residuals
+    pub measure_residuals: bool,
 }
 
 impl Default for SolverConfig {
@@ -86,6 +98,7 @@ impl Default for SolverConfig {
             max_push_out_speed: f32::INFINITY,
             max_linear_speed: 500.0,
             max_angular_speed: 100.0 * core::f32::consts::PI,
+            measure_residuals: false,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! Contacts fed to the solver: by an engine's own collision detection, or
 //! by `vertebra-collide`. They are coloured on their own every step (they
-//! change every step) and solved after the joints in each iteration.
+//! change every step), into buffers the world keeps, and solved before the
+//! joints in each iteration.
 
 use core::ops::Range;
 
@@ -8,7 +9,7 @@ use glam::Vec3;
 use vertebra_kernels::body::StartLane;
 use vertebra_kernels::contact::{ContactBlock, ContactLane};
 use vertebra_math::block::BLOCK_LANES;
-use vertebra_scheduler::{Colouring, MAX_COLOURS};
+use vertebra_scheduler::MAX_COLOURS;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_point, check_unit_vec};
 
 /// A contact between two bodies for the next step.
@@ -115,7 +116,9 @@ impl Contact {
     }
 }
 
-/// This step's contacts, coloured and in blocks.
+/// This step's contacts, coloured and in blocks. Kept by the world and
+/// laid out again every step into the same buffers: once they have grown
+/// to the world's contact count, a step's layout allocates nothing.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ContactLayout {
     pub blocks: Vec<ContactBlock>,
@@ -125,52 +128,112 @@ pub(crate) struct ContactLayout {
     pub overflow: Range<usize>,
     /// Every colour passed [`crate::parallel::colour_is_disjoint`].
     pub disjoint: bool,
+    /// Scratch: each contact's colour ([`OVERFLOW`] for the overflow set).
+    colour_of: Vec<u8>,
+    /// Scratch: per dynamic body, the bitset of colours its contacts use.
+    body_colours: Vec<u32>,
+    /// Scratch: the contacts' indices in solve order (colour by colour,
+    /// the order given inside each).
+    order: Vec<u32>,
+    /// Scratch of the disjointness check.
+    reads: Vec<u32>,
 }
 
+/// The colour index of the overflow set.
+const OVERFLOW: usize = MAX_COLOURS;
+
 impl ContactLayout {
-    /// Colours `contacts` greedily (in the order given) and lays them out,
-    /// each overlap capped at `max_depth` (m) for this step.
-    pub fn build(contacts: &[Contact], bodies: &BodyStore, max_depth: f32) -> Self {
-        let mut colouring = Colouring::new();
-        let dynamic = |h: BodyHandle| {
-            (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
-        };
-        for (k, c) in contacts.iter().enumerate() {
-            colouring.add(k as u64, [dynamic(c.body_a), dynamic(c.body_b)]);
-        }
-        let mut layout = Self::default();
-        for colour in 0..MAX_COLOURS {
-            let range = layout.append(colouring.colour(colour).iter(), contacts, bodies, max_depth);
-            if !range.is_empty() {
-                layout.colours.push(range);
+    /// Colours `contacts` greedily in the order given (each takes the
+    /// lowest colour free at both its dynamic bodies, after
+    /// [`MAX_COLOURS`] the overflow set: `vertebra_scheduler::Colouring`'s
+    /// rule, with bitsets that live for one step) and lays them out, each
+    /// overlap capped at `max_depth` (m) for this step.
+    pub fn rebuild(&mut self, contacts: &[Contact], bodies: &BodyStore, max_depth: f32) {
+        self.colour(contacts, bodies);
+        let starts = self.sort_by_colour();
+        self.blocks.clear();
+        self.colours.clear();
+        for colour in 0..=OVERFLOW {
+            let keys = &self.order[starts[colour]..starts[colour + 1]];
+            let start = self.blocks.len();
+            append(&mut self.blocks, keys, contacts, bodies, max_depth);
+            let range = start..self.blocks.len();
+            if colour == OVERFLOW {
+                self.overflow = range;
+            } else if !range.is_empty() {
+                self.colours.push(range);
             }
         }
-        layout.overflow = layout.append(colouring.overflow().iter(), contacts, bodies, max_depth);
-        layout.disjoint = layout.colours.iter().all(|r| {
-            crate::parallel::colour_is_disjoint(layout.blocks[r.clone()].iter().map(|b| &b.bodies))
+        let (blocks, reads) = (&self.blocks, &mut self.reads);
+        self.disjoint = self.colours.iter().all(|r| {
+            crate::parallel::colour_is_disjoint(blocks[r.clone()].iter().map(|b| &b.bodies), reads)
         });
-        layout
     }
 
-    fn append<'k>(
-        &mut self,
-        keys: impl Iterator<Item = &'k u64>,
-        contacts: &[Contact],
-        bodies: &BodyStore,
-        max_depth: f32,
-    ) -> Range<usize> {
-        let start = self.blocks.len();
-        for (k, &key) in keys.enumerate() {
-            if k % BLOCK_LANES == 0 {
-                self.blocks.push(ContactBlock::padding());
+    /// Each contact's colour into `colour_of`.
+    fn colour(&mut self, contacts: &[Contact], bodies: &BodyStore) {
+        self.body_colours.clear();
+        self.body_colours.resize(bodies.capacity(), 0);
+        self.colour_of.clear();
+        let dynamic =
+            |h: BodyHandle| (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index());
+        for c in contacts {
+            let ends = [dynamic(c.body_a), dynamic(c.body_b)];
+            let used = ends
+                .iter()
+                .flatten()
+                .fold(0u32, |acc, &b| acc | self.body_colours[b]);
+            let colour = (!used).trailing_zeros() as usize;
+            if colour < MAX_COLOURS {
+                for &b in ends.iter().flatten() {
+                    self.body_colours[b] |= 1 << colour;
+                }
+                self.colour_of.push(colour as u8);
+            } else {
+                self.colour_of.push(OVERFLOW as u8);
             }
-            let block = self.blocks.len() - 1;
-            self.blocks[block].set(
-                k % BLOCK_LANES,
-                &contacts[key as usize].lane(bodies, max_depth),
-            );
         }
-        start..self.blocks.len()
+    }
+
+    /// `order` as the contacts sorted by colour, stably (a counting sort);
+    /// returns where each colour starts in it, and its end.
+    fn sort_by_colour(&mut self) -> [usize; OVERFLOW + 2] {
+        let mut starts = [0usize; OVERFLOW + 2];
+        for &c in &self.colour_of {
+            starts[c as usize + 1] += 1;
+        }
+        for c in 0..=OVERFLOW {
+            starts[c + 1] += starts[c];
+        }
+        let mut next = starts;
+        self.order.clear();
+        self.order.resize(self.colour_of.len(), 0);
+        for (k, &c) in self.colour_of.iter().enumerate() {
+            self.order[next[c as usize]] = k as u32;
+            next[c as usize] += 1;
+        }
+        starts
+    }
+}
+
+/// Lays out `keys` (indices into `contacts`) at the end of `blocks`, eight
+/// to a block.
+fn append(
+    blocks: &mut Vec<ContactBlock>,
+    keys: &[u32],
+    contacts: &[Contact],
+    bodies: &BodyStore,
+    max_depth: f32,
+) {
+    for (k, &key) in keys.iter().enumerate() {
+        if k % BLOCK_LANES == 0 {
+            blocks.push(ContactBlock::padding());
+        }
+        let block = blocks.len() - 1;
+        blocks[block].set(
+            k % BLOCK_LANES,
+            &contacts[key as usize].lane(bodies, max_depth),
+        );
     }
 }
 
@@ -178,4 +241,94 @@ impl ContactLayout {
 /// any is used.
 pub(crate) fn validate_all(contacts: &[Contact], bodies: &BodyStore) -> Result<(), Error> {
     contacts.iter().try_for_each(|c| c.validate_with(bodies))
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use rand::rngs::StdRng;
+    use rand::{RngExt, SeedableRng};
+    use vertebra_scheduler::Colouring;
+
+    use super::*;
+    use crate::{BodyDesc, Shape, SolverConfig, World};
+
+    /// The solve order the scheduler's colouring gives `contacts` (a
+    /// `Colouring` fed in order: what the layout was built from before it
+    /// kept its buffers): colour by colour, keys ascending, overflow last.
+    fn scheduler_order(contacts: &[Contact], bodies: &BodyStore) -> (Vec<u32>, Vec<usize>) {
+        let mut colouring = Colouring::new();
+        let dynamic = |h: BodyHandle| {
+            (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index() as u32)
+        };
+        for (k, c) in contacts.iter().enumerate() {
+            colouring.add(k as u64, [dynamic(c.body_a), dynamic(c.body_b)]);
+        }
+        let sets = (0..MAX_COLOURS)
+            .map(|c| colouring.colour(c))
+            .chain([colouring.overflow()]);
+        let mut order = Vec::new();
+        let mut sizes = Vec::new();
+        for set in sets {
+            order.extend(set.iter().map(|&k| k as u32));
+            sizes.push(set.len());
+        }
+        (order, sizes)
+    }
+
+    #[test]
+    fn contacts_are_solved_in_the_order_the_scheduler_colours_them() {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let mass = Shape::Sphere { radius: 0.1 }
+            .mass_properties_with_mass(1.0)
+            .unwrap();
+        let bodies: Vec<BodyHandle> = (0..40)
+            .map(|k| {
+                let desc = if k % 7 == 0 {
+                    BodyDesc::fixed()
+                } else {
+                    BodyDesc::dynamic(mass)
+                };
+                world.add_body(desc).unwrap()
+            })
+            .collect();
+        let mut layout = ContactLayout::default();
+        for seed in 0..20 {
+            let mut rng = StdRng::seed_from_u64(seed);
+            // Body 1 is a hub: with 30 contacts it overflows 24 colours.
+            let contacts: Vec<Contact> = (0..300)
+                .map(|k| {
+                    let a = if k < 30 { 1 } else { rng.random_range(0..40) };
+                    let b = (a + rng.random_range(1..40)) % 40;
+                    Contact {
+                        body_a: bodies[a],
+                        body_b: bodies[b],
+                        point: Vec3::ZERO,
+                        normal: Vec3::Y,
+                        depth: 0.0,
+                        friction: 0.5,
+                        restitution: 0.0,
+                    }
+                })
+                .filter(|c| {
+                    let kind = |h: BodyHandle| world.bodies().kind[h.index()];
+                    kind(c.body_a) == BodyKind::Dynamic || kind(c.body_b) == BodyKind::Dynamic
+                })
+                .collect();
+            layout.rebuild(&contacts, world.bodies(), f32::INFINITY);
+            let (order, sizes) = scheduler_order(&contacts, world.bodies());
+            assert_eq!(layout.order, order, "seed {seed}");
+            assert!(sizes[OVERFLOW] > 0, "seed {seed}: the overflow set is used");
+            let blocks = |n: usize| n.div_ceil(BLOCK_LANES);
+            let colours: Vec<usize> = layout.colours.iter().map(|r| r.len()).collect();
+            let expected: Vec<usize> = sizes[..OVERFLOW]
+                .iter()
+                .filter(|&&n| n > 0)
+                .map(|&n| blocks(n))
+                .collect();
+            assert_eq!(colours, expected, "seed {seed}");
+            assert_eq!(layout.overflow.len(), blocks(sizes[OVERFLOW]));
+            assert!(layout.disjoint, "seed {seed}: every colour may be split");
+        }
+    }
 }

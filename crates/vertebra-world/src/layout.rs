@@ -27,9 +27,6 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
 use crate::rod::RodDesc;
 
-/// No joint in this lane.
-pub(crate) const EMPTY: u32 = u32::MAX;
-
 /// Added to a rod's slot to make its colouring key.
 pub(crate) const ROD_KEY: u64 = 1 << 32;
 
@@ -78,13 +75,10 @@ impl Group {
     }
 }
 
-/// Blocks of one joint type, with the slot in each lane and each slot's
-/// place.
+/// Blocks of one joint type, with each slot's place.
 #[derive(Clone, Debug)]
 pub(crate) struct Blocks<B> {
     pub blocks: Vec<B>,
-    /// For each block lane, the joint slot it holds, or `EMPTY`.
-    pub lane_slot: Vec<u32>,
     /// For each joint slot, its (block, lane).
     pub place: Vec<(usize, usize)>,
 }
@@ -93,7 +87,6 @@ impl<B> Default for Blocks<B> {
     fn default() -> Self {
         Self {
             blocks: Vec::new(),
-            lane_slot: Vec::new(),
             place: Vec::new(),
         }
     }
@@ -111,11 +104,9 @@ impl<B: Copy> Blocks<B> {
             let lane = k % BLOCK_LANES;
             if lane == 0 {
                 self.blocks.push(padding);
-                self.lane_slot.extend([EMPTY; BLOCK_LANES]);
             }
             let block = self.blocks.len() - 1;
             set(&mut self.blocks[block], lane, slot);
-            self.lane_slot[block * BLOCK_LANES + lane] = slot as u32;
             if self.place.len() <= slot {
                 self.place.resize(slot + 1, (0, 0));
             }
@@ -157,10 +148,11 @@ impl Layout {
             }
         }
         layout.overflow = layout.append(colouring.overflow(), joints, rods, bodies);
+        let mut reads = Vec::new();
         layout.disjoint = layout
             .colours
             .iter()
-            .all(|g| crate::parallel::colour_is_disjoint(layout.pairs(g)));
+            .all(|g| crate::parallel::colour_is_disjoint(layout.pairs(g), &mut reads));
         layout
     }
 

@@ -1,6 +1,6 @@
 //! The vertebra world: bodies and joints, stepped by the coloured XPBD
-//! solver at a fixed iteration count, with residual metrics and a hash of
-//! the full state after every step.
+//! solver at a fixed iteration count, with a hash of the full state and
+//! residual metrics (on demand, or after every step when asked for).
 //!
 //! ```
 //! use glam::{Quat, Vec3};
@@ -18,7 +18,7 @@
 //! for _ in 0..60 {
 //!     world.step(1.0 / 60.0)?;
 //! }
-//! assert!(world.residuals().eps_lin_cm < 0.01);
+//! assert!(world.measure_residuals().eps_lin_cm < 0.01);
 //! # Ok::<(), vertebra_world::Error>(())
 //! ```
 
@@ -90,6 +90,10 @@ pub struct World {
     rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
     residuals: Residuals,
+    /// `residuals` holds the current poses' measurement (false after a step
+    /// that did not measure).
+    residuals_measured: bool,
+    residual_lanes: metrics::LaneResiduals,
     /// Bodies put back by the step's last-line NaN guard, ever.
     repaired: u64,
 }
@@ -130,6 +134,8 @@ impl World {
             rows: parallel::Scratch::default(),
             previous: Vec::new(),
             residuals: Residuals::default(),
+            residuals_measured: false,
+            residual_lanes: metrics::LaneResiduals::default(),
             repaired: 0,
         })
     }
@@ -449,12 +455,31 @@ impl World {
     }
 
     /// Sets the contacts for the next step (they apply to that step only:
-    /// feed them every step). The whole list is checked first; on error
-    /// the previous list stays.
+    /// feed them every step), copied into the world's own list (whose
+    /// capacity is kept from step to step). The whole list is checked
+    /// first; on error the previous list stays. [`World::swap_contacts`]
+    /// hands a list over without the copy.
     pub fn set_contacts(&mut self, contacts: &[Contact]) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         contact::validate_all(contacts, &self.bodies)?;
-        self.contacts = contacts.to_vec();
+        self.contacts.clear();
+        self.contacts.extend_from_slice(contacts);
+        Ok(())
+    }
+
+    /// Sets the contacts for the next step as [`World::set_contacts`] does,
+    /// without copying them: the world takes `contacts`' vector and leaves
+    /// its own in its place, emptied, with its capacity. A detection that
+    /// fills the same vector every step (`Collisions::find_contacts_into`)
+    /// and swaps it in then moves the two vectors back and forth and, once
+    /// both have grown to the contact count, allocates nothing. The whole
+    /// list is checked first; on error nothing is swapped and both lists
+    /// stay as they were.
+    pub fn swap_contacts(&mut self, contacts: &mut Vec<Contact>) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
+        contact::validate_all(contacts, &self.bodies)?;
+        core::mem::swap(&mut self.contacts, contacts);
+        contacts.clear();
         Ok(())
     }
 
@@ -463,14 +488,18 @@ impl World {
         &self.contacts
     }
 
-    /// Residual joint error of the current poses, without stepping (e.g.
-    /// right after building a ragdoll).
+    /// Measures the residual joint error of the current poses, without
+    /// stepping (e.g. right after building a ragdoll, or after a step of a
+    /// world that does not measure every step:
+    /// [`SolverConfig::measure_residuals`]). [`World::residuals`] returns it
+    /// until the next step.
     pub fn measure_residuals(&mut self) -> &Residuals {
         let _mode = DefaultFloatMode::enter();
         self.refresh_layout();
         step::upload(&self.bodies, self.rows.get());
         self.layout.start_step(&self.bodies);
-        self.residuals = metrics::residuals(self);
+        metrics::residuals(self);
+        self.residuals_measured = true;
         &self.residuals
     }
 
@@ -482,9 +511,13 @@ impl World {
         }
     }
 
-    /// Residual joint error after the last step.
-    pub fn residuals(&self) -> &Residuals {
-        &self.residuals
+    /// Residual joint error as of the last step, when it was measured: by
+    /// the step itself ([`SolverConfig::measure_residuals`] on: the step's
+    /// solved poses), or by [`World::measure_residuals`] since. `None` after
+    /// a step that did not measure (nor any call since): stale figures are
+    /// never shown as current.
+    pub fn residuals(&self) -> Option<&Residuals> {
+        self.residuals_measured.then_some(&self.residuals)
     }
 
     /// How many times a step found a body's state no longer finite and put
@@ -516,6 +549,10 @@ impl World {
     /// computes in the default floating-point mode on every thread it uses,
     /// whatever mode (FTZ, DAZ, rounding) the caller runs in, and gives the
     /// caller's mode back ([`vertebra_math::float_mode`]).
+    /// It measures the residuals afterwards only when the config asks
+    /// ([`SolverConfig::measure_residuals`]). Once its buffers have grown to
+    /// the world's bodies, joints and contacts, a step allocates nothing on
+    /// one thread (`crates/vertebra-scenes/tests/allocation.rs`).
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         if dt > vertebra_store::MAX_TIME_STEP {
@@ -532,8 +569,8 @@ impl World {
             (self.config.max_linear_speed, self.config.max_angular_speed);
         step::hold_speeds(&mut self.bodies, max_linear, max_angular);
         let max_depth = self.config.max_push_out_speed * dt;
-        self.contact_layout =
-            contact::ContactLayout::build(&self.contacts, &self.bodies, max_depth);
+        self.contact_layout
+            .rebuild(&self.contacts, &self.bodies, max_depth);
         // One entry into the task system per step: the colours' fork-joins
         // then run among its workers (see step::for_each_colour).
         let tasks = Arc::clone(&self.tasks);
@@ -543,7 +580,10 @@ impl World {
             step::step(self, dt)
         });
         self.contacts.clear();
-        self.residuals = metrics::residuals(self);
+        self.residuals_measured = self.config.measure_residuals;
+        if self.residuals_measured {
+            metrics::residuals(self);
+        }
         Ok(())
     }
 }

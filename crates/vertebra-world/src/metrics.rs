@@ -9,8 +9,7 @@ use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyHandle, BodyStore, Slots};
 
-use crate::joint::JointHandle;
-use crate::layout::EMPTY;
+use crate::joint::{JointHandle, JointKind};
 use crate::rod::RodHandle;
 use crate::{Contact, JointDesc, RodDesc, RodStiffness, World};
 
@@ -47,77 +46,86 @@ pub struct Residuals {
     pub rods: Vec<JointResidual<RodHandle>>,
 }
 
-/// Per-lane residuals of blocks (each `(lane_slot, per_lane)`) to
-/// per-joint ones, in slot order.
-fn collect<H>(
-    kinds: &[(&[u32], &[[f32; 3]])],
-    handle: impl Fn(usize) -> Option<H>,
-) -> Vec<JointResidual<H>> {
-    let mut joints: Vec<(u32, JointResidual<H>)> = kinds
-        .iter()
-        .flat_map(|(lane_slot, per_lane)| lane_slot.iter().zip(per_lane.iter()))
-        .filter(|(slot, _)| **slot != EMPTY)
-        .map(|(&slot, &[lin, ang, limit])| {
-            let joint = handle(slot as usize).expect("laid-out joints are live");
-            (
-                slot,
-                JointResidual {
-                    joint,
-                    linear_cm: lin * 100.0,
-                    angular_rad: ang,
-                    limit_rad: limit,
-                },
-            )
-        })
-        .collect();
-    joints.sort_by_key(|j| j.0);
-    joints.into_iter().map(|j| j.1).collect()
+/// Per-lane residuals of every joint and rod block, kept by the world
+/// between measurements so that measuring allocates nothing once warm.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LaneResiduals {
+    sockets: Vec<[f32; 3]>,
+    hinges: Vec<[f32; 3]>,
+    fixed: Vec<[f32; 3]>,
+    rods: Vec<[f32; 3]>,
 }
 
-/// Every lane's residual of `blocks`.
-fn measure<B: Residual>(backend: Backend, blocks: &[B], rows: &BodyRows) -> Vec<[f32; 3]> {
-    let mut out = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
-    backend.dispatch(ResidualPass {
-        blocks,
-        rows,
-        out: &mut out,
-    });
-    out
+/// Every lane's residual of `blocks`, into `out` (its capacity kept).
+fn measure<B: Residual>(backend: Backend, blocks: &[B], rows: &BodyRows, out: &mut Vec<[f32; 3]>) {
+    out.clear();
+    out.resize(blocks.len() * BLOCK_LANES, [0.0; 3]);
+    backend.dispatch(ResidualPass { blocks, rows, out });
 }
 
-pub(crate) fn residuals(world: &mut World) -> Residuals {
+/// A lane's residual as a joint's: the linear error in cm.
+fn joint_residual<H>(joint: H, [lin, ang, limit]: [f32; 3]) -> JointResidual<H> {
+    JointResidual {
+        joint,
+        linear_cm: lin * 100.0,
+        angular_rad: ang,
+        limit_rad: limit,
+    }
+}
+
+/// Measures every laid-out joint and rod at the rows' poses into
+/// `world.residuals`, in slot order, reusing its vectors and the lane
+/// buffers (no allocation once they have grown to the world's size).
+pub(crate) fn residuals(world: &mut World) {
     let rows = &*world.rows.get();
     let layout = &world.layout;
     let backend = world.backend;
-    let sockets = measure(backend, &layout.sockets.blocks, rows);
-    let hinges = measure(backend, &layout.hinges.blocks, rows);
-    let fixed = measure(backend, &layout.fixed.blocks, rows);
-    let rods = measure(backend, &layout.rods.blocks, rows);
-    let joints = collect(
-        &[
-            (&layout.sockets.lane_slot, &sockets),
-            (&layout.hinges.lane_slot, &hinges),
-            (&layout.fixed.lane_slot, &fixed),
-        ],
-        |s| world.joint_slots.handle_at(s),
-    );
-    let rods = collect(&[(&layout.rods.lane_slot, &rods)], |s| {
-        world.rod_slots.handle_at(s)
-    });
-    let lin = joints
+    let lanes = &mut world.residual_lanes;
+    measure(backend, &layout.sockets.blocks, rows, &mut lanes.sockets);
+    measure(backend, &layout.hinges.blocks, rows, &mut lanes.hinges);
+    measure(backend, &layout.fixed.blocks, rows, &mut lanes.fixed);
+    measure(backend, &layout.rods.blocks, rows, &mut lanes.rods);
+    let out = &mut world.residuals;
+    out.joints.clear();
+    for (slot, desc) in world.joints.iter().enumerate() {
+        let Some(desc) = desc else { continue };
+        let (per_lane, place) = match desc.kind {
+            JointKind::Socket(_) => (&lanes.sockets, &layout.sockets.place),
+            JointKind::Hinge { .. } => (&lanes.hinges, &layout.hinges.place),
+            JointKind::Fixed => (&lanes.fixed, &layout.fixed.place),
+        };
+        let (block, lane) = place[slot];
+        let joint = world
+            .joint_slots
+            .handle_at(slot)
+            .expect("laid-out joints are live");
+        out.joints
+            .push(joint_residual(joint, per_lane[block * BLOCK_LANES + lane]));
+    }
+    out.rods.clear();
+    for (slot, desc) in world.rods.iter().enumerate() {
+        if desc.is_none() {
+            continue;
+        }
+        let (block, lane) = layout.rods.place[slot];
+        let rod = world
+            .rod_slots
+            .handle_at(slot)
+            .expect("laid-out rods are live");
+        out.rods
+            .push(joint_residual(rod, lanes.rods[block * BLOCK_LANES + lane]));
+    }
+    let lin = out
+        .joints
         .iter()
         .map(|j| j.linear_cm)
-        .chain(rods.iter().map(|j| j.linear_cm));
-    let ang = joints
+        .chain(out.rods.iter().map(|j| j.linear_cm));
+    let ang = out
+        .joints
         .iter()
         .map(|j| j.angular_rad)
-        .chain(rods.iter().map(|j| j.angular_rad));
-    Residuals {
-        eps_lin_cm: lin.sum(),
-        eps_ang_rad: ang.sum(),
-        joints,
-        rods,
-    }
+        .chain(out.rods.iter().map(|j| j.angular_rad));
+    (out.eps_lin_cm, out.eps_ang_rad) = (lin.sum(), ang.sum());
 }
 
 /// What [`World::state_hash`] covers: everything a step reads that

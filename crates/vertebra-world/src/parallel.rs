@@ -81,9 +81,14 @@ pub(crate) fn chunked<B: Send>(
 /// Whether one colour's blocks may run on several threads at once: every
 /// lane writes only its own body's row (or nothing), and a row that is
 /// written is read by no other lane of the colour. True for every colouring
-/// `vertebra_scheduler` makes; a crafted one fails it.
-pub(crate) fn colour_is_disjoint<'a>(pairs: impl Iterator<Item = &'a BodyPairs> + Clone) -> bool {
-    let mut reads: Vec<u32> = Vec::new();
+/// `vertebra_scheduler` makes; a crafted one fails it. `reads` is scratch
+/// (each row's readers), kept by the caller so that a check every step
+/// allocates nothing once it has grown to the row count.
+pub(crate) fn colour_is_disjoint<'a>(
+    pairs: impl Iterator<Item = &'a BodyPairs> + Clone,
+    reads: &mut Vec<u32>,
+) -> bool {
+    reads.clear();
     for p in pairs.clone() {
         for &row in p.body_a.iter().chain(&p.body_b) {
             let row = row as usize;
@@ -157,16 +162,16 @@ mod tests {
             pairs(&[(1, 2, false, true), (3, 4, true, true)]),
             pairs(&[(1, 5, false, true)]),
         ];
-        assert!(colour_is_disjoint(good.iter()));
+        assert!(colour_is_disjoint(good.iter(), &mut Vec::new()));
         // Row 2 written by one lane and read by another (another block).
         let written_twice = [pairs(&[(1, 2, false, true)]), pairs(&[(2, 5, false, true)])];
-        assert!(!colour_is_disjoint(written_twice.iter()));
+        assert!(!colour_is_disjoint(written_twice.iter(), &mut Vec::new()));
         // Two lanes of one block writing row 3.
         let in_one_block = [pairs(&[(3, 4, true, true), (3, 5, true, true)])];
-        assert!(!colour_is_disjoint(in_one_block.iter()));
+        assert!(!colour_is_disjoint(in_one_block.iter(), &mut Vec::new()));
         // A lane writing a row it does not read.
         let mut stray = pairs(&[(1, 2, false, true)]);
         stray.write_a[0] = 6;
-        assert!(!colour_is_disjoint([stray].iter()));
+        assert!(!colour_is_disjoint([stray].iter(), &mut Vec::new()));
     }
 }

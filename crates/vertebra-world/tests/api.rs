@@ -211,12 +211,12 @@ fn bad_joints_are_refused() {
         .map(drop)
     });
     rejected(Error::NonPositive("drive compliance"), |w| {
-        let s = w.residuals().joints[0].joint;
+        let s = w.joints().next().expect("a joint").0;
         let drive = AngularDrive::compliant(Quat::IDENTITY, -1.0, 0.0);
         w.set_joint_drive(s, Some(drive))
     });
     rejected(Error::NotNormalized("drive target"), |w| {
-        let s = w.residuals().joints[0].joint;
+        let s = w.joints().next().expect("a joint").0;
         let drive = AngularDrive::rigid(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0));
         w.set_joint_drive(s, Some(drive))
     });
@@ -809,4 +809,53 @@ fn bad_kind_changes_and_kinematic_moves_are_refused() {
             w.move_kinematic(b, position, orientation, dt)
         });
     }
+}
+
+/// A pendulum swinging from rest at 45 degrees, measuring its residuals
+/// every step or not.
+fn pendulum(measure_residuals: bool) -> World {
+    let mut w = World::new(SolverConfig {
+        iterations: 2,
+        measure_residuals,
+        ..SolverConfig::default()
+    })
+    .unwrap();
+    let a = w.add_body(BodyDesc::fixed()).unwrap();
+    let down = Quat::from_rotation_z(0.8) * -Vec3::Y;
+    let b = capsule(&mut w, Vec3::ZERO, down * 0.4, 1.0);
+    w.add_joint(JointDesc::socket_at_world_anchor(w.bodies(), a, b, Vec3::ZERO, down).unwrap())
+        .unwrap();
+    w
+}
+
+#[test]
+fn residuals_are_measured_when_asked_for_and_never_shown_stale() {
+    let (mut off, mut on) = (pendulum(false), pendulum(true));
+    assert!(off.residuals().is_none() && on.residuals().is_none());
+    for _ in 0..30 {
+        off.step(1.0 / 60.0).unwrap();
+        on.step(1.0 / 60.0).unwrap();
+        assert!(off.residuals().is_none(), "not measured by the step");
+        let each_step = on.residuals().expect("measured by the step");
+        assert_eq!(each_step.joints.len(), 1);
+        // Two iterations leave the swinging joint apart: a real error.
+        assert!(each_step.eps_lin_cm > 0.0);
+        // Measuring changes nothing a step reads.
+        assert_eq!(off.state_hash(), on.state_hash());
+    }
+    let on_demand = off.measure_residuals().clone();
+    assert_eq!(off.residuals(), Some(&on_demand));
+    // The same poses, measured from the committed pose instead of the
+    // step's rows: the same error to rounding.
+    let each_step = on.residuals().unwrap();
+    let close = (on_demand.eps_lin_cm - each_step.eps_lin_cm).abs();
+    assert!(
+        close <= 1e-4 * each_step.eps_lin_cm,
+        "{on_demand:?} {each_step:?}"
+    );
+    off.step(1.0 / 60.0).unwrap();
+    assert!(
+        off.residuals().is_none(),
+        "the measurement is of the last poses"
+    );
 }

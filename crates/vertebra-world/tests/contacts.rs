@@ -215,3 +215,47 @@ fn an_overlap_comes_out_at_the_same_speed_at_any_substep_count() {
         );
     }
 }
+
+/// The box resting on its corners, for the next step: contacts both ways.
+fn resting_box() -> (World, Vec<Contact>) {
+    let (mut w, ground, body, half) = box_world(1);
+    let pose = Vec3::new(0.0, half.y, 0.0);
+    w.set_body_pose(body, pose, Quat::IDENTITY).unwrap();
+    let contacts = corner_contacts(&w, ground, body, half, 0.6, Vec3::Y);
+    assert_eq!(contacts.len(), 4);
+    (w, contacts)
+}
+
+#[test]
+fn swapped_contacts_step_as_copied_ones_and_the_world_gives_its_list_back() {
+    let (mut copied, contacts) = resting_box();
+    // The same box in another world (handles are each world's own).
+    let (mut swapped, own) = resting_box();
+    copied.set_contacts(&contacts).unwrap();
+    let mut list = own.clone();
+    swapped.swap_contacts(&mut list).unwrap();
+    assert!(list.is_empty(), "the world's previous list, emptied");
+    assert_eq!(swapped.contacts(), own.as_slice());
+    copied.step(DT).unwrap();
+    swapped.step(DT).unwrap();
+    assert_eq!(copied.state_hash(), swapped.state_hash());
+    // The world's list comes back to the caller at the next swap, its
+    // capacity kept: the two vectors change places frame after frame.
+    let mut list = own.clone();
+    swapped.swap_contacts(&mut list).unwrap();
+    assert!(list.is_empty() && list.capacity() >= own.len());
+}
+
+#[test]
+fn a_refused_swap_leaves_both_lists_as_they_were() {
+    let (mut w, contacts) = resting_box();
+    w.set_contacts(&contacts[..2]).unwrap();
+    let mut bad = contacts.clone();
+    bad[3].normal = Vec3::new(0.0, 2.0, 0.0);
+    let before = w.state_hash();
+    assert!(w.swap_contacts(&mut bad).is_err());
+    assert_eq!(w.state_hash(), before);
+    assert_eq!(w.contacts(), &contacts[..2]);
+    assert_eq!(bad.len(), 4);
+    assert_eq!(bad[..3], contacts[..3]);
+}

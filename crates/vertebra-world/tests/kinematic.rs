@@ -305,7 +305,7 @@ fn kinds_switched_mid_run_survive_a_snapshot_and_keep_the_joints() {
             restored.step(DT).unwrap();
             assert_eq!(restored.state_hash(), w.state_hash(), "frame {frame}");
         }
-        worst = worst.max(w.residuals().eps_lin_cm);
+        worst = worst.max(w.measure_residuals().eps_lin_cm);
     }
     eprintln!("chain with kinds switched: worst joint error {worst:.3} cm");
     assert!(worst < 0.2, "{worst}");
