@@ -168,8 +168,8 @@ impl RodDesc {
         // The tangent-chord angle is half the arc's angle.
         let psi = 2.0 * ta.angle_between(o);
         if psi >= PI - 1e-3 {
-            return Err(Error::InvalidLimit(
-                "bend: the bones bend the arc by pi or more",
+            return Err(Error::DegenerateShape(
+                "the rod's bones bend its arc by pi or more",
             ));
         }
         let tb = 2.0 * ta.dot(o) * o - ta;

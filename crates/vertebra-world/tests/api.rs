@@ -548,6 +548,16 @@ fn bad_rods_are_refused() {
         let r = rod(w, ends)?.with_bend_limit(4.0);
         w.add_rod(r).map(drop)
     });
+    // A bone far to the side of the chord puts the rod on the major arc.
+    let bent = Error::DegenerateShape("the rod's bones bend its arc by pi or more");
+    assert_eq!(
+        bent.to_string(),
+        "degenerate shape: the rod's bones bend its arc by pi or more"
+    );
+    rejected_after(above, bent, |w, (b, c)| {
+        let side = w.body(b)?.position + Vec3::new(1.0, -0.1, 0.0);
+        RodDesc::from_pose(w.bodies(), b, c, &[side]).map(drop)
+    });
     rejected_after(
         new_body(Vec3::ZERO),
         Error::DegenerateShape("the rod's ends coincide"),
