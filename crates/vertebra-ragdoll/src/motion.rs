@@ -145,8 +145,7 @@ impl Ragdoll {
 
     /// The root body's handle; a removed ragdoll has none.
     pub(crate) fn root(&self) -> Result<BodyHandle, RagdollError> {
-        self.bodies[self.desc.root]
-            .ok_or_else(|| self.removed(&self.body_context(self.desc.root)))
+        self.bodies[self.desc.root].ok_or_else(|| self.removed(&self.body_context(self.desc.root)))
     }
 
     /// The error for a call about `item` (e.g. `body `hips``) of a removed

@@ -293,7 +293,9 @@ fn refused_partial_calls_name_the_item_and_change_nothing() {
             error: Error::StaleHandle("body")
         }
     );
-    let one = ragdoll.set_body_kinematic(&mut w, "hips", true).unwrap_err();
+    let one = ragdoll
+        .set_body_kinematic(&mut w, "hips", true)
+        .unwrap_err();
     assert_eq!(
         one.to_string(),
         "set_body_kinematic: body `hips` (the ragdoll has been removed from the world): \
