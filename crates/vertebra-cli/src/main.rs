@@ -227,7 +227,7 @@ fn execute(command: Command) -> Result<(), String> {
             }
             let run = match skeleton_out {
                 Some(path) => {
-                    let mut csv = SkeletonCsv::create(&path)?;
+                    let mut csv = SkeletonCsv::new(&path);
                     let run = vertebra_scenes::run_observed(
                         &config,
                         |_, _| {},

@@ -694,6 +694,39 @@ fn scenes_write_the_reference_skeleton_frame_by_frame() {
     );
 }
 
+/// A `--ragdoll` whose bodies are not bones of the reference skeleton is
+/// refused saying that `--skeleton-out` maps onto that skeleton, and
+/// leaves no file behind.
+#[test]
+fn skeleton_out_refuses_a_ragdoll_off_the_reference_skeleton_without_a_file() {
+    let dir = std::env::temp_dir().join(format!("vertebra-skeleton-off-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ragdoll = dir.join("pendulum.toml");
+    std::fs::write(
+        &ragdoll,
+        "name = \"pendulum\"\n\n[[body]]\nname = \"a\"\nsegment = [[0.0, 1.0, 0.0], [0.0, 0.8, 0.0]]\nradius = 0.05\nmass = 1.0\n\n[[body]]\nname = \"b\"\nsegment = [[0.0, 0.7, 0.0], [0.0, 0.5, 0.0]]\nradius = 0.05\nmass = 1.0\n\n[[joint]]\nname = \"j\"\nparent = \"a\"\nchild = \"b\"\nanchor = [0.0, 0.75, 0.0]\naxis = [0.0, -1.0, 0.0]\n",
+    )
+    .unwrap();
+    let out = dir.join("bones.csv");
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "sockets",
+            "--frames",
+            "2",
+            "--ragdoll",
+            ragdoll.to_str().unwrap(),
+            "--skeleton-out",
+            out.to_str().unwrap(),
+        ],
+        "vertebra: --skeleton-out maps each ragdoll onto the reference skeleton (63 bones) by body name: body `a`: bone is missing",
+    );
+    assert!(!out.exists(), "a file was left behind");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Fails with exactly the `expected` lines on stderr.
 fn fails_with_lines(args: &[&str], expected: &[String]) {
     let (code, _, stderr) = vertebra(args);
