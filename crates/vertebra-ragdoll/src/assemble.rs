@@ -357,23 +357,17 @@ fn check(desc: &RagdollDesc, at: &At, problems: &mut Problems) {
     let tree = (failed == 0)
         .then(|| problems.note(None, tree(&names, &desc.joints)))
         .flatten();
-    if let Some((root, parent_joint)) = tree {
+    let stands = tree.is_some_and(|(root, parent_joint)| {
         let same = (root, &parent_joint) == (desc.root, &desc.parent_joint);
-        let wrong = "root and parent_joint are not the joints' tree".to_owned();
-        if problems
-            .note(
-                None,
-                same.then_some(()).ok_or(RagdollError::NotATree(wrong)),
-            )
+        let wrong =
+            || RagdollError::NotATree("root and parent_joint are not the joints' tree".to_owned());
+        problems
+            .note(None, same.then_some(()).ok_or_else(wrong))
             .is_some()
-        {
-            if let Some(spine) = &desc.spine {
-                problems.note(
-                    at.spine,
-                    check_spine(spine, desc, &item(at.spine, "[spine]")),
-                );
-            }
-        }
+    });
+    if let (true, Some(spine)) = (stands, &desc.spine) {
+        let checked = check_spine(spine, desc, &item(at.spine, "[spine]"));
+        problems.note(at.spine, checked);
     }
     let drive = check_drive(
         desc.drive.as_ref(),
