@@ -342,7 +342,7 @@ fn check_stiffness(s: RodStiffness, names: [&'static str; 4]) -> Result<(), Erro
     match s {
         RodStiffness::Kirchhoff(k) => not_negative(what, k),
         RodStiffness::Relaxation(r) if !(0.0..=1.0).contains(&r) => {
-            Err(Error::InvalidLimit("relaxation factor (must be in [0, 1])"))
+            Err(Error::OutOfRange("rod relaxation factor (0 to 1)"))
         }
         RodStiffness::Relaxation(_) => Ok(()),
         RodStiffness::Damped { stiffness, damping } => {

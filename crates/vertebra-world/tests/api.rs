@@ -478,7 +478,7 @@ fn bad_rods_are_refused() {
     });
     rejected_after(
         above,
-        Error::InvalidLimit("relaxation factor (must be in [0, 1])"),
+        Error::OutOfRange("rod relaxation factor (0 to 1)"),
         |w, ends| {
             let r = rod(w, ends)?
                 .with_stiffness(RodStiffness::Relaxation(1.5), RodStiffness::Kirchhoff(1.0));
