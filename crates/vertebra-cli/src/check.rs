@@ -17,7 +17,7 @@ use vertebra_world::{JointKind, LimitSoftness, Swing};
 /// one); it is refused for other files.
 pub fn check(path: &Path, skeleton: Option<&Path>) -> Result<String, String> {
     let kind = kind(path);
-    if let (Some(_), Kind::Ragdoll | Kind::Skeleton | Kind::Neither) = (skeleton, &kind) {
+    if skeleton.is_some() && !matches!(kind, Kind::Generator) {
         return Err(format!(
             "{}: --skeleton is for a generator file ([[body]] tables that name a bone and no body name)",
             path.display()
