@@ -1,24 +1,36 @@
-//! `vertebra check FILE`: validates a ragdoll file (with its skeleton) or a
-//! skeleton file, told apart by content (`[[body]]` tables or `[[bone]]`
-//! tables only), and prints what it holds.
+//! `vertebra check FILE`: validates a ragdoll file (with its skeleton), a
+//! ragdoll generator file (on a skeleton) or a skeleton file, told apart
+//! by content, and prints what it holds, or every problem found.
 
 use std::fmt::Write as _;
 use std::io::Read as _;
 use std::path::Path;
 
-use vertebra_ragdoll::{MAX_FILE_BYTES, RagdollDesc, Skeleton, Strength};
+use vertebra_ragdoll::{
+    MAX_FILE_BYTES, RagdollDesc, RagdollError, RagdollGenerator, Skeleton, Strength,
+};
 use vertebra_world::{JointKind, LimitSoftness, Swing};
 
-/// What the file at `path` holds, as text; or the problem, naming the
-/// file and the line.
-pub fn check(path: &Path) -> Result<String, String> {
-    match kind(path) {
-        Kind::Ragdoll => RagdollDesc::from_file(path)
+/// What the file at `path` holds, as text; or every problem found, one a
+/// line, each naming the file and the line. `skeleton` is the skeleton
+/// file a generator file is read against (the reference skeleton without
+/// one); it is refused for other files.
+pub fn check(path: &Path, skeleton: Option<&Path>) -> Result<String, String> {
+    let kind = kind(path);
+    if skeleton.is_some() && !matches!(kind, Kind::Generator) {
+        return Err(format!(
+            "{}: --skeleton is for a generator file ([[body]] tables that name a bone and no body name)",
+            path.display()
+        ));
+    }
+    match kind {
+        Kind::Ragdoll => RagdollDesc::check_file(path)
             .map(|desc| ragdoll(path, &desc))
-            .map_err(|e| e.to_string()),
-        Kind::Skeleton => Skeleton::from_file(path)
-            .map(|s| skeleton(path, &s))
-            .map_err(|e| e.to_string()),
+            .map_err(lines),
+        Kind::Generator => generated(path, skeleton),
+        Kind::Skeleton => Skeleton::check_file(path)
+            .map(|s| self::skeleton(path, &s))
+            .map_err(lines),
         Kind::Neither => Err(format!(
             "{}: neither a ragdoll file ([[body]] tables) nor a skeleton file ([[bone]] tables)",
             path.display()
@@ -26,16 +38,44 @@ pub fn check(path: &Path) -> Result<String, String> {
     }
 }
 
+/// Problems, one a line.
+fn lines(problems: Vec<RagdollError>) -> String {
+    let lines: Vec<String> = problems.iter().map(ToString::to_string).collect();
+    lines.join("\n")
+}
+
+/// What the generator file at `path` generates on the skeleton file at
+/// `skeleton` (the reference skeleton without one), or its problems.
+fn generated(path: &Path, skeleton: Option<&Path>) -> Result<String, String> {
+    let (bones, on) = match skeleton {
+        Some(file) => (
+            Skeleton::check_file(file).map_err(lines)?,
+            file.display().to_string(),
+        ),
+        None => (Skeleton::reference(), "the reference skeleton".to_owned()),
+    };
+    let desc = RagdollGenerator::check_file(path, &bones).map_err(lines)?;
+    Ok(format!(
+        "{}: ragdoll generator, on {on} ({} bones): generates\n{}",
+        path.display(),
+        bones.len(),
+        ragdoll(path, &desc)
+    ))
+}
+
 enum Kind {
     Ragdoll,
+    Generator,
     Skeleton,
     Neither,
 }
 
-/// A ragdoll file has `[[body]]` tables, a skeleton file `[[bone]]` tables
-/// only. A file that cannot be read or parsed is read as a ragdoll file,
-/// unless its text has `[[bone]]` and no `[[body]]`: the loader then names
-/// the problem.
+/// A ragdoll file has `[[body]]` tables, each with a `name`; a generator
+/// file has `[[body]]` tables that name a `bone` and none a `name` (a
+/// generated body is named after its bone); a skeleton file has `[[bone]]`
+/// tables only. A file that cannot be read or parsed is read as a ragdoll
+/// file, unless its text has `[[bone]]` and no `[[body]]`: the loader then
+/// names the problem.
 fn kind(path: &Path) -> Kind {
     let mut bytes = Vec::new();
     let read = std::fs::File::open(path)
@@ -45,12 +85,23 @@ fn kind(path: &Path) -> Kind {
         return Kind::Ragdoll;
     };
     match text.parse::<toml::Table>() {
-        Ok(table) if table.contains_key("body") => Kind::Ragdoll,
-        Ok(table) if table.contains_key("bone") => Kind::Skeleton,
-        Ok(_) => Kind::Neither,
+        Ok(table) => match table.get("body") {
+            Some(toml::Value::Array(bodies)) if bodies.iter().all(generator_body) => {
+                Kind::Generator
+            }
+            Some(_) => Kind::Ragdoll,
+            None if table.contains_key("bone") => Kind::Skeleton,
+            None => Kind::Neither,
+        },
         Err(_) if text.contains("[[bone]]") && !text.contains("[[body]]") => Kind::Skeleton,
         Err(_) => Kind::Ragdoll,
     }
+}
+
+/// A generator's `[[body]]` table: a `bone`, no `name`.
+fn generator_body(body: &toml::Value) -> bool {
+    body.as_table()
+        .is_some_and(|t| t.contains_key("bone") && !t.contains_key("name"))
 }
 
 /// `x` with at most `digits` decimals, trailing zeros dropped.

@@ -99,12 +99,18 @@ enum Command {
         #[arg(long)]
         skeleton_out: Option<PathBuf>,
     },
-    /// Checks a ragdoll file (with its skeleton) or a skeleton file and
-    /// prints what it holds, or the problem with its file and line.
+    /// Checks a ragdoll file (with its skeleton), a ragdoll generator file
+    /// or a skeleton file and prints what it holds (or generates), or
+    /// every problem found, one a line, with its file and line.
     Check {
-        /// A ragdoll file (`[[body]]` tables) or a skeleton file (`[[bone]]`
-        /// tables only), TOML, at most 1 MiB.
+        /// A ragdoll file (`[[body]]` tables with a `name`), a generator
+        /// file (`[[body]]` tables with a `bone` and no `name`) or a
+        /// skeleton file (`[[bone]]` tables only), TOML, at most 1 MiB.
         file: PathBuf,
+        /// For a generator file: the skeleton file it is read against
+        /// (default: the reference skeleton shipped with vertebra).
+        #[arg(long)]
+        skeleton: Option<PathBuf>,
     },
 }
 
@@ -149,7 +155,10 @@ fn main() -> ExitCode {
     match execute(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
-            eprintln!("vertebra: {message}");
+            // One line per problem (`vertebra check` may find several).
+            for line in message.lines() {
+                eprintln!("vertebra: {line}");
+            }
             ExitCode::from(1)
         }
     }
@@ -158,8 +167,8 @@ fn main() -> ExitCode {
 fn execute(command: Command) -> Result<(), String> {
     match command {
         Command::Reproduce { out, seeds } => reproduce::reproduce(&out, seeds),
-        Command::Check { file } => {
-            print!("{}", check::check(&file)?);
+        Command::Check { file, skeleton } => {
+            print!("{}", check::check(&file, skeleton.as_deref())?);
             Ok(())
         }
         Command::Scene {
@@ -218,7 +227,7 @@ fn execute(command: Command) -> Result<(), String> {
             }
             let run = match skeleton_out {
                 Some(path) => {
-                    let mut csv = SkeletonCsv::create(&path)?;
+                    let mut csv = SkeletonCsv::new(&path);
                     let run = vertebra_scenes::run_observed(
                         &config,
                         |_, _| {},

@@ -6,7 +6,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use vertebra_ragdoll::RagdollError;
+use vertebra_ragdoll::{RagdollError, Skeleton};
 use vertebra_scenes::{SceneWorld, SkeletonOut};
 
 /// A run's error as the command prints it.
@@ -18,39 +18,36 @@ impl From<RagdollError> for Failed {
     }
 }
 
-/// The open file and, from the first frame on, the scene's mappers.
+/// Where the poses go and, from the first frame on, the scene's mappers
+/// with the open file.
 pub struct SkeletonCsv {
     path: PathBuf,
-    out: BufWriter<File>,
-    bones: Option<SkeletonOut>,
+    open: Option<(SkeletonOut, BufWriter<File>)>,
 }
 
 impl SkeletonCsv {
-    /// Creates the file and writes the header; refused, naming the path,
-    /// when it cannot be written.
-    pub fn create(path: &Path) -> Result<Self, String> {
-        let mut csv = Self {
+    /// Poses to be written to `path`, which is created at the first frame,
+    /// once the scene's ragdolls map onto the reference skeleton.
+    pub fn new(path: &Path) -> Self {
+        Self {
             path: path.to_owned(),
-            out: BufWriter::new(File::create(path).map_err(|e| cannot(path, e))?),
-            bones: None,
-        };
-        writeln!(csv.out, "frame,ragdoll,bone,x,y,z,qx,qy,qz,qw").map_err(|e| cannot(path, e))?;
-        Ok(csv)
+            open: None,
+        }
     }
 
     /// One row per ragdoll and bone of `scene` after frame `frame`.
     pub fn frame(&mut self, frame: usize, scene: &SceneWorld) -> Result<(), Failed> {
-        if self.bones.is_none() {
-            self.bones = Some(SkeletonOut::new(scene)?);
+        if self.open.is_none() {
+            self.open = Some(self.open(scene)?);
         }
-        let bones = self.bones.as_ref().expect("made above");
+        let (bones, out) = self.open.as_mut().expect("opened above");
         let names = bones.skeleton().bones();
         for (ragdoll, pose) in bones.poses(scene)?.iter().enumerate() {
             for (bone, t) in names.iter().zip(&pose.bones) {
                 let [x, y, z] = t.translation.to_array();
                 let [qx, qy, qz, qw] = t.rotation.to_array();
                 writeln!(
-                    self.out,
+                    out,
                     "{frame},{ragdoll},{},{x},{y},{z},{qx},{qy},{qz},{qw}",
                     bone.name
                 )
@@ -60,9 +57,30 @@ impl SkeletonCsv {
         Ok(())
     }
 
+    /// The mappers of `scene`'s ragdolls onto the reference skeleton, then
+    /// the file with its header: a ragdoll that does not map (a
+    /// `--ragdoll` file whose bodies are not named after its bones) is
+    /// refused, saying so, before there is a file to leave behind.
+    fn open(&self, scene: &SceneWorld) -> Result<(SkeletonOut, BufWriter<File>), Failed> {
+        let bones = SkeletonOut::new(scene).map_err(|e| {
+            Failed(format!(
+                "--skeleton-out maps each ragdoll onto the reference skeleton ({} bones) by body name: {e}",
+                Skeleton::reference().len()
+            ))
+        })?;
+        let path = &self.path;
+        let mut out = BufWriter::new(File::create(path).map_err(|e| Failed(cannot(path, e)))?);
+        writeln!(out, "frame,ragdoll,bone,x,y,z,qx,qy,qz,qw")
+            .map_err(|e| Failed(cannot(path, e)))?;
+        Ok((bones, out))
+    }
+
     /// Writes out what is buffered.
-    pub fn finish(mut self) -> Result<(), String> {
-        self.out.flush().map_err(|e| cannot(&self.path, e))
+    pub fn finish(self) -> Result<(), String> {
+        match self.open {
+            Some((_, mut out)) => out.flush().map_err(|e| cannot(&self.path, e)),
+            None => Ok(()),
+        }
     }
 }
 

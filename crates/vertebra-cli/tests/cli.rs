@@ -693,3 +693,188 @@ fn scenes_write_the_reference_skeleton_frame_by_frame() {
         "--skeleton-out writes one run; not with --seeds",
     );
 }
+
+/// A `--ragdoll` whose bodies are not bones of the reference skeleton is
+/// refused saying that `--skeleton-out` maps onto that skeleton, and
+/// leaves no file behind.
+#[test]
+fn skeleton_out_refuses_a_ragdoll_off_the_reference_skeleton_without_a_file() {
+    let dir = std::env::temp_dir().join(format!("vertebra-skeleton-off-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ragdoll = dir.join("pendulum.toml");
+    std::fs::write(
+        &ragdoll,
+        "name = \"pendulum\"\n\n[[body]]\nname = \"a\"\nsegment = [[0.0, 1.0, 0.0], [0.0, 0.8, 0.0]]\nradius = 0.05\nmass = 1.0\n\n[[body]]\nname = \"b\"\nsegment = [[0.0, 0.7, 0.0], [0.0, 0.5, 0.0]]\nradius = 0.05\nmass = 1.0\n\n[[joint]]\nname = \"j\"\nparent = \"a\"\nchild = \"b\"\nanchor = [0.0, 0.75, 0.0]\naxis = [0.0, -1.0, 0.0]\n",
+    )
+    .unwrap();
+    let out = dir.join("bones.csv");
+    fails_with(
+        &[
+            "scene",
+            "passive-bending",
+            "--spine",
+            "sockets",
+            "--frames",
+            "2",
+            "--ragdoll",
+            ragdoll.to_str().unwrap(),
+            "--skeleton-out",
+            out.to_str().unwrap(),
+        ],
+        "vertebra: --skeleton-out maps each ragdoll onto the reference skeleton (63 bones) by body name: body `a`: bone is missing",
+    );
+    assert!(!out.exists(), "a file was left behind");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Fails with exactly the `expected` lines on stderr.
+fn fails_with_lines(args: &[&str], expected: &[String]) {
+    let (code, _, stderr) = vertebra(args);
+    assert_eq!(code, 1, "{args:?} should fail: {stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines, expected, "{args:?}");
+}
+
+/// The line (from 1) of the first `needle` in `text`.
+fn line_of(text: &str, needle: &str) -> usize {
+    let at = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("`{needle}` in the text"));
+    text[..at].matches('\n').count() + 1
+}
+
+#[test]
+fn check_lists_every_problem_of_a_ragdoll_file_in_file_order() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-all-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(model("skeleton.toml"), dir.join("skeleton.toml")).unwrap();
+    // Four independent problems: a NaN segment (hips), an unknown bone
+    // (forearm_l), a joint name used twice (elbow_l renamed shoulder_l), a
+    // twist limit with its ends swapped (knee_l).
+    let text = vertebra_ragdoll::REFERENCE_HUMANOID
+        .replacen(
+            "total_mass = 69.0",
+            "total_mass = 69.0\nskeleton = \"skeleton.toml\"",
+            1,
+        )
+        .replacen("[[-0.06, 1.00, 0.0]", "[[nan, 1.00, 0.0]", 1)
+        .replacen("mass = 1.5", "mass = 1.5\nbone = \"nope\"", 1)
+        .replacen("name = \"elbow_l\"", "name = \"shoulder_l\"", 1)
+        .replacen(
+            "child = \"shin_l\"\nanchor = [0.10, 0.525, 0.0]\naxis = [0.0, -1.0, 0.0]\nswing = 70.0\ntwist = [-5.0, 5.0]",
+            "child = \"shin_l\"\nanchor = [0.10, 0.525, 0.0]\naxis = [0.0, -1.0, 0.0]\nswing = 70.0\ntwist = [5.0, -5.0]",
+            1,
+        );
+    let table = |name: &str| line_of(&text, &format!("name = \"{name}\"")) - 1;
+    let second_shoulder = {
+        let first = text.find("name = \"shoulder_l\"").unwrap() + 1;
+        line_of(&text[first..], "name = \"shoulder_l\"") + text[..first].matches('\n').count() - 1
+    };
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, &text).unwrap();
+    let path = path.to_str().unwrap();
+    fails_with_lines(
+        &["check", path],
+        &[
+            format!(
+                "vertebra: {path}: line {}: body `hips`: segment is not finite",
+                table("hips")
+            ),
+            format!(
+                "vertebra: {path}: line {}: body `forearm_l`: bone `nope` is not a bone of the skeleton",
+                table("forearm_l")
+            ),
+            format!(
+                "vertebra: {path}: line {second_shoulder}: joint name `shoulder_l` is used twice"
+            ),
+            format!(
+                "vertebra: {path}: line {}: joint `knee_l`: twist must be [min, max] within [-180, 180] degrees",
+                table("knee_l")
+            ),
+        ],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A generator for three bones of the reference skeleton.
+const GENERATOR: &str = "\
+name = \"small\"
+
+[[body]]
+bone = \"hips\"
+radius = 0.1
+mass = 11.0
+end = \"spine_lower\"
+
+[[body]]
+bone = \"chest\"
+radius = 0.12
+mass = 12.0
+end = \"neck_1\"
+
+[[body]]
+bone = \"head\"
+radius = 0.1
+mass = 5.0
+length = 0.12
+";
+
+#[test]
+fn check_prints_what_a_generator_file_generates_or_its_problems() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-gen-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_owned()
+    };
+    let generator = write("generator.toml", GENERATOR);
+    let (code, stdout, stderr) = vertebra(&["check", &generator]);
+    assert_eq!(code, 0, "{stderr}");
+    for expected in [
+        "ragdoll generator, on the reference skeleton (63 bones): generates\n",
+        "ragdoll `small`: 3 bodies, 2 joints, 28 kg",
+        "socket  hips -> chest  swing free, twist free",
+        "socket  chest -> head  swing free, twist free",
+        "skeleton: 63 bones, 3 followed by a body",
+    ] {
+        assert!(stdout.contains(expected), "`{expected}` in\n{stdout}");
+    }
+    // The same on a skeleton file given.
+    let skeleton = write(
+        "skeleton.toml",
+        &std::fs::read_to_string(model("skeleton.toml")).unwrap(),
+    );
+    let (code, stdout, stderr) = vertebra(&["check", &generator, "--skeleton", &skeleton]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains(&format!("on {skeleton} (63 bones): generates")),
+        "{stdout}"
+    );
+    // Every table's problem of form, in file order.
+    let bad = GENERATOR
+        .replacen("mass = 11.0", "mass = 11.0\ndensity = 1000.0", 1)
+        .replacen("length = 0.12", "length = 0.12\nend = \"neck_2\"", 1);
+    let head = line_of(&bad, "bone = \"head\"") - 1;
+    let bad = write("bad.toml", &bad);
+    fails_with_lines(
+        &["check", &bad],
+        &[
+            format!(
+                "vertebra: {bad}: line 3: bone `hips`: mass and density both give the mass; give one"
+            ),
+            format!(
+                "vertebra: {bad}: line {head}: bone `head`: end is given twice: give one of end, length and point"
+            ),
+        ],
+    );
+    // --skeleton is for generator files only.
+    let (code, _, stderr) =
+        vertebra(&["check", &model("anatomical.toml"), "--skeleton", &skeleton]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("--skeleton is for a generator file"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

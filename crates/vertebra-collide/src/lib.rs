@@ -117,7 +117,7 @@ impl Collider {
             return Err(Error::NonPositive("collider friction"));
         }
         if !(0.0..=1.0).contains(&self.restitution) {
-            return Err(Error::InvalidLimit("restitution (must be in [0, 1])"));
+            return Err(Error::OutOfRange("collider restitution (0 to 1)"));
         }
         Ok(shape)
     }

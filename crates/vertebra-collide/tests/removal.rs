@@ -121,6 +121,15 @@ fn colliders_beyond_the_size_limit_are_refused() {
             "{shape:?}"
         );
     }
+    // A restitution outside [0, 1], in words (it read "invalid restitution
+    // (must be in [0, 1]) limit").
+    let mut bouncy = Collider::new(b, ColliderShape::Solid(Shape::Sphere { radius: 0.1 }));
+    bouncy.restitution = 1.5;
+    let refused = c.add(bouncy).unwrap_err();
+    assert_eq!(
+        refused.to_string(),
+        format!("collider 3 on body {b:?}: collider restitution (0 to 1) is out of range")
+    );
     assert_eq!(c.snapshot(), before);
     let floor = Shape::Box {
         half_extents: Vec3::new(MAX_COLLIDER_EXTENT, 1.0, MAX_COLLIDER_EXTENT),

@@ -11,9 +11,9 @@ use vertebra_world::check_coordinate;
 use crate::description::{BodyDef, BoneBinding, RagdollDesc, SpineDef, finite, range};
 use crate::drive::DriveSettings;
 use crate::drive_def::{check_drive, own_strengths};
-use crate::error::RagdollError;
+use crate::error::{Problems, RagdollError, first};
 use crate::joint_def::{JointDef, JointSpec, check_joint, half_turn, resolve};
-use crate::skeleton::Skeleton;
+use crate::skeleton::{Skeleton, Transform};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
 use crate::text::item;
 
@@ -22,6 +22,9 @@ use crate::text::item;
 pub(crate) struct Item<T> {
     pub(crate) value: T,
     pub(crate) line: Option<usize>,
+    /// A stand-in for a table that could not be read (its problem already
+    /// found): its name counts, its value is not checked.
+    pub(crate) refused: bool,
 }
 
 impl<T> Item<T> {
@@ -29,11 +32,24 @@ impl<T> Item<T> {
         Self {
             value,
             line: Some(line),
+            refused: false,
+        }
+    }
+
+    /// A stand-in at `line` for a table that could not be read.
+    pub(crate) fn refused(value: T, line: usize) -> Self {
+        Self {
+            refused: true,
+            ..Self::at(value, line)
         }
     }
 
     pub(crate) fn unlined(value: T) -> Self {
-        Self { value, line: None }
+        Self {
+            value,
+            line: None,
+            refused: false,
+        }
     }
 }
 
@@ -66,6 +82,14 @@ impl At {
         )
     }
 
+    fn body_line(&self, i: usize) -> Option<usize> {
+        self.bodies.get(i).copied().flatten()
+    }
+
+    fn joint_line(&self, k: usize) -> Option<usize> {
+        self.joints.get(k).copied().flatten()
+    }
+
     fn joint(&self, k: usize, name: &str) -> String {
         item(
             self.joints.get(k).copied().flatten(),
@@ -74,8 +98,26 @@ impl At {
     }
 }
 
-/// Resolves, places, binds, scales and checks a description.
+/// A skeleton and its bones' bind transforms in its model frame.
+type Model<'a> = (&'a Skeleton, Vec<Transform>);
+
+/// Resolves, places, binds, scales and checks a description; refused with
+/// the first of [`assemble_all`]'s problems.
 pub(crate) fn assemble(doc: Document) -> Result<RagdollDesc, RagdollError> {
+    assemble_all(doc, Problems::default()).map_err(first)
+}
+
+/// [`assemble`], refused with every problem it finds, after `problems`
+/// (those of a file's tables that could not be read: their items are
+/// stand-ins, [`Item::refused`], whose names count but whose values are
+/// not checked). Every body and joint is checked on its own; the joint
+/// tree once every joint resolves; the spine's chain once the tree stands;
+/// the whole description ([`RagdollDesc::validate`]'s checks) once every
+/// part passed.
+pub(crate) fn assemble_all(
+    doc: Document,
+    mut problems: Problems,
+) -> Result<RagdollDesc, Vec<RagdollError>> {
     let at = At {
         bodies: doc.bodies.iter().map(|b| b.line).collect(),
         joints: doc.joints.iter().map(|j| j.line).collect(),
@@ -85,124 +127,67 @@ pub(crate) fn assemble(doc: Document) -> Result<RagdollDesc, RagdollError> {
     let index = names(
         doc.bodies.iter().map(|b| (b.value.name.as_str(), b.line)),
         "body",
-    )?;
+        &mut problems,
+    );
     names(
         doc.joints.iter().map(|j| (j.value.name.as_str(), j.line)),
         "joint",
-    )?;
+        &mut problems,
+    );
     let model = doc
         .skeleton
         .as_ref()
         .map(|s| s.bind_pose().to_model(s).map(|pose| (s, pose.bones)))
-        .transpose()?;
-    let mut bodies = Vec::with_capacity(doc.bodies.len());
-    for (i, b) in doc.bodies.iter().enumerate() {
-        let spec = &b.value;
-        let context = at.body(i, &spec.name);
-        let bone = |field: &'static str, name: &str| -> Result<usize, RagdollError> {
-            let unknown = || RagdollError::UnknownBone {
-                context: context.clone(),
-                field,
-                name: name.to_owned(),
-            };
-            match &model {
-                Some((skeleton, _)) => skeleton.bone_index(name).ok_or_else(unknown),
-                None => Err(RagdollError::OutOfRange {
-                    context: context.clone(),
-                    field,
-                    reason: format!(
-                        "names bone `{name}`, but the ragdoll has no skeleton ([[bone]] tables, skeleton = \"file\", or one given to the loader)"
-                    ),
-                }),
-            }
-        };
-        let segment = match &spec.shape {
-            BodyShape::Segment(segment) => *segment,
-            BodyShape::Bones { from, to } => {
-                let (a, b) = (bone("from", from)?, bone("to", to)?);
-                range(
-                    &context,
-                    "to",
-                    a != b,
-                    "is the from bone; a body runs from one bone to another",
-                )?;
-                let pose = &model.as_ref().expect("a bone was found").1;
-                [pose[a].translation, pose[b].translation]
-            }
-        };
-        let mut def = BodyDef {
-            name: spec.name.clone(),
-            segment,
-            radius: spec.radius,
-            mass: spec.mass,
-            bone: None,
-        };
-        check_body(&def, &context)?;
-        let chosen = match (&spec.bone, &spec.shape, &model) {
-            (Some(name), _, _) => Some(bone("bone", name)?),
-            (None, _, None) => None,
-            (None, shape, Some((skeleton, _))) => skeleton.bone_index(&spec.name).or(match shape {
-                BodyShape::Bones { from, .. } => skeleton.bone_index(from),
-                BodyShape::Segment(_) => None,
-            }),
-        };
-        if let Some(offset) = spec.offset {
-            range(
-                &context,
-                "offset",
-                chosen.is_some(),
-                "places the body on its bone, but it has none",
-            )?;
-            offset.validate(&format!("{context}: offset"))?;
-        }
-        def.bone = match (chosen, &model) {
-            (Some(bone), Some((_, pose))) => Some(BoneBinding {
-                bone,
-                offset: spec
-                    .offset
-                    .unwrap_or_else(|| pose[bone].inverse() * def.bind_frame()),
-            }),
-            _ => None,
-        };
-        bodies.push(def);
+        .transpose()
+        .map_err(|e| vec![e])?;
+    let mut bodies: Vec<BodyDef> = doc
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| !b.refused)
+        .filter_map(|(i, b)| {
+            let context = at.body(i, &b.value.name);
+            problems.note(b.line, body_def(&b.value, &context, model.as_ref()))
+        })
+        .collect();
+    if let (Some(total), true) = (doc.total_mass, problems.is_empty()) {
+        problems.note(None, scale(&mut bodies, total, &at));
     }
-    if let Some(total) = doc.total_mass {
-        scale(&mut bodies, total, &at)?;
-    }
-    let joints = doc
+    let joints: Vec<JointDef> = doc
         .joints
         .iter()
         .enumerate()
-        .map(|(k, j)| resolve(&j.value, &at.joint(k, &j.value.name), &index))
-        .collect::<Result<Vec<_>, _>>()?;
-    let (root, parent_joint) = tree(&bodies, &joints)?;
-    let spine = doc
-        .spine
-        .map(|s| {
-            spine(
-                &s.value,
-                &item(s.line, "[spine]"),
-                &index,
-                &joints,
-                &parent_joint,
-            )
+        .filter_map(|(k, j)| {
+            let context = at.joint(k, &j.value.name);
+            problems.note(j.line, resolve(&j.value, &context, &index))
         })
-        .transpose()?;
-    let drive = match doc.drive {
-        Some(d) => {
-            let context = item(d.line, "[drive]");
-            range(
-                &context,
-                "joints",
-                d.value.joints.is_empty(),
-                "must be empty: a joint's own strength is its spec's",
-            )?;
-            Some(DriveSettings {
-                joints: own_strengths(&joints),
-                ..d.value
-            })
-        }
-        None => None,
+        .collect();
+    let names: Vec<&str> = doc.bodies.iter().map(|b| b.value.name.as_str()).collect();
+    let tree = (joints.len() == doc.joints.len())
+        .then(|| problems.note(None, tree(&names, &joints)))
+        .flatten();
+    let spine = doc.spine.as_ref().and_then(|s| {
+        let context = item(s.line, "[spine]");
+        let v = &s.value;
+        let limits = [v.bend_limit, v.bend_stiffness, v.twist_stiffness];
+        problems.note(s.line, rod_limits(&context, limits, v.twist_limit));
+        let (_, parent_joint) = tree.as_ref()?;
+        problems.note(s.line, spine(v, &context, &index, &joints, parent_joint))
+    });
+    let drive = doc.drive.and_then(|d| {
+        let context = item(d.line, "[drive]");
+        let empty = d.value.joints.is_empty();
+        let reason = "must be empty: a joint's own strength is its spec's";
+        problems.note(d.line, range(&context, "joints", empty, reason))?;
+        Some(DriveSettings {
+            joints: own_strengths(&joints),
+            ..d.value
+        })
+    });
+    let (Some((root, parent_joint)), true) = (tree, problems.is_empty()) else {
+        return Err(problems
+            .done()
+            .expect_err("a part of the description failed"));
     };
     let desc = RagdollDesc {
         name: doc.name,
@@ -214,8 +199,84 @@ pub(crate) fn assemble(doc: Document) -> Result<RagdollDesc, RagdollError> {
         drive,
         skeleton: doc.skeleton,
     };
-    check(&desc, &at)?;
+    check(&desc, &at, &mut problems);
+    problems.done()?;
     Ok(desc)
+}
+
+/// A body's spec placed (its segment from its bones, in `model`'s bind
+/// pose), checked and bound to its bone (`context` names it).
+fn body_def(
+    spec: &BodySpec,
+    context: &str,
+    model: Option<&Model<'_>>,
+) -> Result<BodyDef, RagdollError> {
+    let bone = |field: &'static str, name: &str| -> Result<usize, RagdollError> {
+        let unknown = || RagdollError::UnknownBone {
+            context: context.to_owned(),
+            field,
+            name: name.to_owned(),
+        };
+        match model {
+            Some((skeleton, _)) => skeleton.bone_index(name).ok_or_else(unknown),
+            None => Err(RagdollError::OutOfRange {
+                context: context.to_owned(),
+                field,
+                reason: format!(
+                    "names bone `{name}`, but the ragdoll has no skeleton ([[bone]] tables, skeleton = \"file\", or one given to the loader)"
+                ),
+            }),
+        }
+    };
+    let segment = match &spec.shape {
+        BodyShape::Segment(segment) => *segment,
+        BodyShape::Bones { from, to } => {
+            let (a, b) = (bone("from", from)?, bone("to", to)?);
+            range(
+                context,
+                "to",
+                a != b,
+                "is the from bone; a body runs from one bone to another",
+            )?;
+            let pose = &model.expect("a bone was found").1;
+            [pose[a].translation, pose[b].translation]
+        }
+    };
+    let mut def = BodyDef {
+        name: spec.name.clone(),
+        segment,
+        radius: spec.radius,
+        mass: spec.mass,
+        bone: None,
+    };
+    check_body(&def, context)?;
+    let chosen = match (&spec.bone, &spec.shape, model) {
+        (Some(name), _, _) => Some(bone("bone", name)?),
+        (None, _, None) => None,
+        (None, shape, Some((skeleton, _))) => skeleton.bone_index(&spec.name).or(match shape {
+            BodyShape::Bones { from, .. } => skeleton.bone_index(from),
+            BodyShape::Segment(_) => None,
+        }),
+    };
+    if let Some(offset) = spec.offset {
+        range(
+            context,
+            "offset",
+            chosen.is_some(),
+            "places the body on its bone, but it has none",
+        )?;
+        offset.validate(&format!("{context}: offset"))?;
+    }
+    def.bone = match (chosen, model) {
+        (Some(bone), Some((_, pose))) => Some(BoneBinding {
+            bone,
+            offset: spec
+                .offset
+                .unwrap_or_else(|| pose[bone].inverse() * def.bind_frame()),
+        }),
+        _ => None,
+    };
+    Ok(def)
 }
 
 /// Scales the bodies' masses to `total` (kg) in all, their ratios kept.
@@ -246,66 +307,96 @@ impl RagdollDesc {
     /// joints' own strengths. For a description edited by hand; errors
     /// name the item and the field.
     pub fn validate(&self) -> Result<(), RagdollError> {
-        check(self, &At::default())
+        self.problems().into_iter().next().map_or(Ok(()), Err)
+    }
+
+    /// Every problem [`RagdollDesc::validate`] finds, in order (its first
+    /// is the one `validate` returns): each body, binding and joint on its
+    /// own, then the joint tree (once every joint passed), the spine (once
+    /// the tree stands) and the drive settings.
+    pub fn problems(&self) -> Vec<RagdollError> {
+        let mut problems = Problems::default();
+        check(self, &At::default(), &mut problems);
+        problems.done().err().unwrap_or_default()
     }
 }
 
-fn check(desc: &RagdollDesc, at: &At) -> Result<(), RagdollError> {
+/// `validate`'s checks of `desc`, each problem kept in `problems`.
+fn check(desc: &RagdollDesc, at: &At, problems: &mut Problems) {
     names(
         desc.bodies
             .iter()
             .enumerate()
-            .map(|(i, b)| (b.name.as_str(), at.bodies.get(i).copied().flatten())),
+            .map(|(i, b)| (b.name.as_str(), at.body_line(i))),
         "body",
-    )?;
+        problems,
+    );
     names(
         desc.joints
             .iter()
             .enumerate()
-            .map(|(k, j)| (j.name.as_str(), at.joints.get(k).copied().flatten())),
+            .map(|(k, j)| (j.name.as_str(), at.joint_line(k))),
         "joint",
-    )?;
+        problems,
+    );
     for (i, b) in desc.bodies.iter().enumerate() {
-        check_body(b, &at.body(i, &b.name))?;
+        problems.note(at.body_line(i), check_body(b, &at.body(i, &b.name)));
     }
-    check_bindings(desc, at)?;
-    for (k, j) in desc.joints.iter().enumerate() {
-        check_joint(j, desc.bodies.len(), &at.joint(k, &j.name))?;
+    check_bindings(desc, at, problems);
+    let bodies = desc.bodies.len();
+    let failed = desc
+        .joints
+        .iter()
+        .enumerate()
+        .filter(|&(k, j)| {
+            let checked = check_joint(j, bodies, &at.joint(k, &j.name));
+            problems.note(at.joint_line(k), checked).is_none()
+        })
+        .count();
+    let names: Vec<&str> = desc.bodies.iter().map(|b| b.name.as_str()).collect();
+    let tree = (failed == 0)
+        .then(|| problems.note(None, tree(&names, &desc.joints)))
+        .flatten();
+    let stands = tree.is_some_and(|(root, parent_joint)| {
+        let same = (root, &parent_joint) == (desc.root, &desc.parent_joint);
+        let wrong =
+            || RagdollError::NotATree("root and parent_joint are not the joints' tree".to_owned());
+        problems
+            .note(None, same.then_some(()).ok_or_else(wrong))
+            .is_some()
+    });
+    if let (true, Some(spine)) = (stands, &desc.spine) {
+        let checked = check_spine(spine, desc, &item(at.spine, "[spine]"));
+        problems.note(at.spine, checked);
     }
-    let (root, parent_joint) = tree(&desc.bodies, &desc.joints)?;
-    if (root, &parent_joint) != (desc.root, &desc.parent_joint) {
-        return Err(RagdollError::NotATree(
-            "root and parent_joint are not the joints' tree".to_owned(),
-        ));
-    }
-    if let Some(spine) = &desc.spine {
-        check_spine(spine, desc, &item(at.spine, "[spine]"))?;
-    }
-    check_drive(
+    let drive = check_drive(
         desc.drive.as_ref(),
         &desc.joints,
         &item(at.drive, "[drive]"),
         |k| at.joint(k, &desc.joints[k].name),
-    )
+    );
+    problems.note(at.drive, drive);
 }
 
-/// Indexes `(name, line)` pairs by name; a name used twice is refused at
-/// its second use.
+/// Indexes `(name, line)` pairs by name; a name used twice is a problem
+/// at its second use.
 fn names<'a>(
     names: impl Iterator<Item = (&'a str, Option<usize>)>,
     kind: &'static str,
-) -> Result<HashMap<String, usize>, RagdollError> {
+    problems: &mut Problems,
+) -> HashMap<String, usize> {
     let mut index = HashMap::new();
     for (i, (n, line)) in names.enumerate() {
         if index.insert(n.to_owned(), i).is_some() {
-            return Err(RagdollError::DuplicateName {
+            let twice = RagdollError::DuplicateName {
                 line,
                 kind,
                 name: n.to_owned(),
-            });
+            };
+            problems.note(line, Err::<(), _>(twice));
         }
     }
-    Ok(index)
+    index
 }
 
 /// A body's segment within the world's coordinate range, and a capsule the
@@ -331,57 +422,67 @@ fn check_body(b: &BodyDef, context: &str) -> Result<(), RagdollError> {
 }
 
 /// Every binding on a bone of the skeleton, at most one body per bone,
-/// each offset finite with a unit rotation.
-fn check_bindings(desc: &RagdollDesc, at: &At) -> Result<(), RagdollError> {
+/// each offset finite with a unit rotation: a problem per body.
+fn check_bindings(desc: &RagdollDesc, at: &At, problems: &mut Problems) {
     let mut owner: HashMap<usize, usize> = HashMap::new();
     for (i, b) in desc.bodies.iter().enumerate() {
-        let Some(binding) = b.bone else { continue };
-        let context = at.body(i, &b.name);
-        let bones = desc.skeleton.as_ref().map_or(0, Skeleton::len);
-        range(
-            &context,
-            "bone",
-            binding.bone < bones,
-            &format!(
-                "is bone {}; the ragdoll's skeleton has {bones}",
-                binding.bone
-            ),
-        )?;
-        if let Some(other) = owner.insert(binding.bone, i) {
-            let skeleton = desc.skeleton.as_ref().expect("the bone is in it");
-            return Err(RagdollError::OutOfRange {
-                context,
-                field: "bone",
-                reason: format!(
-                    "`{}` is body `{}`'s bone too; a bone has at most one body",
-                    skeleton.bones()[binding.bone].name,
-                    desc.bodies[other].name
-                ),
-            });
+        if let Some(binding) = b.bone {
+            let checked = check_binding(desc, i, binding, &at.body(i, &b.name), &mut owner);
+            problems.note(at.body_line(i), checked);
         }
-        binding.offset.validate(&format!("{context}: offset"))?;
     }
-    Ok(())
 }
 
-/// Checks the joints form one tree over all bodies; returns the root and
+/// Body `i`'s `binding` (`context` names the body), its bone taken in
+/// `owner` (bone to body).
+fn check_binding(
+    desc: &RagdollDesc,
+    i: usize,
+    binding: BoneBinding,
+    context: &str,
+    owner: &mut HashMap<usize, usize>,
+) -> Result<(), RagdollError> {
+    let reason = match &desc.skeleton {
+        Some(s) => format!(
+            "is bone {}; the ragdoll's skeleton has {}",
+            binding.bone,
+            s.len()
+        ),
+        None => format!("is bone {}, but the ragdoll has no skeleton", binding.bone),
+    };
+    let bones = desc.skeleton.as_ref().map_or(0, Skeleton::len);
+    range(context, "bone", binding.bone < bones, &reason)?;
+    if let Some(&other) = owner.get(&binding.bone) {
+        let skeleton = desc.skeleton.as_ref().expect("the bone is in it");
+        return Err(RagdollError::OutOfRange {
+            context: context.to_owned(),
+            field: "bone",
+            reason: format!(
+                "`{}` is body `{}`'s bone too; a bone has at most one body",
+                skeleton.bones()[binding.bone].name,
+                desc.bodies[other].name
+            ),
+        });
+    }
+    owner.insert(binding.bone, i);
+    binding.offset.validate(&format!("{context}: offset"))
+}
+
+/// Checks the joints form one tree over all bodies (their names); returns the root and
 /// each body's parent joint.
-fn tree(
-    bodies: &[BodyDef],
-    joints: &[JointDef],
-) -> Result<(usize, Vec<Option<usize>>), RagdollError> {
+fn tree(bodies: &[&str], joints: &[JointDef]) -> Result<(usize, Vec<Option<usize>>), RagdollError> {
     let mut parent_joint = vec![None; bodies.len()];
     for (k, j) in joints.iter().enumerate() {
         if j.parent == j.child {
             return Err(RagdollError::NotATree(format!(
                 "joint `{}` joins `{}` to itself",
-                j.name, bodies[j.child].name
+                j.name, bodies[j.child]
             )));
         }
         if let Some(other) = parent_joint[j.child].replace(k) {
             return Err(RagdollError::NotATree(format!(
                 "body `{}` is the child of both `{}` and `{}`",
-                bodies[j.child].name, joints[other].name, j.name
+                bodies[j.child], joints[other].name, j.name
             )));
         }
     }
@@ -394,7 +495,7 @@ fn tree(
             if steps > bodies.len() {
                 return Err(RagdollError::NotATree(format!(
                     "a cycle runs through body `{}`",
-                    bodies[start].name
+                    bodies[start]
                 )));
             }
         }
@@ -409,7 +510,7 @@ fn tree(
             "{} bodies have no parent ({}); one root is needed",
             many.len(),
             many.iter()
-                .map(|&b| format!("`{}`", bodies[b].name))
+                .map(|&b| format!("`{}`", bodies[b]))
                 .collect::<Vec<_>>()
                 .join(", ")
         ))),
@@ -510,21 +611,32 @@ fn check_spine(s: &SpineDef, desc: &RagdollDesc, context: &str) -> Result<(), Ra
             )));
         }
     }
+    let limits = [s.bend_limit, s.bend_stiffness, s.twist_stiffness];
+    rod_limits(context, limits, s.twist_limit)
+}
+
+/// The rod's `[bend_limit, bend_stiffness, twist_stiffness]` and
+/// `twist_limit` in range (`context` names the spine).
+fn rod_limits(
+    context: &str,
+    [bend_limit, bend_stiffness, twist_stiffness]: [f32; 3],
+    twist_limit: [f32; 2],
+) -> Result<(), RagdollError> {
     for (field, v) in [
-        ("bend_limit", s.bend_limit),
-        ("bend_stiffness", s.bend_stiffness),
-        ("twist_stiffness", s.twist_stiffness),
+        ("bend_limit", bend_limit),
+        ("bend_stiffness", bend_stiffness),
+        ("twist_stiffness", twist_stiffness),
     ] {
         finite(context, field, &[v])?;
     }
-    finite(context, "twist_limit", &s.twist_limit)?;
+    finite(context, "twist_limit", &twist_limit)?;
     range(
         context,
         "bend_limit",
-        (0.0..=half_turn()).contains(&s.bend_limit),
+        (0.0..=half_turn()).contains(&bend_limit),
         "must be in [0, 180] degrees",
     )?;
-    let [lo, hi] = s.twist_limit;
+    let [lo, hi] = twist_limit;
     range(
         context,
         "twist_limit",
@@ -534,13 +646,13 @@ fn check_spine(s: &SpineDef, desc: &RagdollDesc, context: &str) -> Result<(), Ra
     range(
         context,
         "bend_stiffness",
-        s.bend_stiffness >= 0.0,
+        bend_stiffness >= 0.0,
         "must not be negative",
     )?;
     range(
         context,
         "twist_stiffness",
-        s.twist_stiffness >= 0.0,
+        twist_stiffness >= 0.0,
         "must not be negative",
     )
 }

@@ -18,15 +18,15 @@ use serde::Deserialize;
 use toml::Spanned;
 use vertebra_world::Shape;
 
-use crate::assemble::{Document, Item, assemble};
+use crate::assemble::{Document, Item, assemble_all};
 use crate::drive::DriveSettings;
 use crate::drive_def::{RawDrive, drive_settings};
-use crate::error::RagdollError;
+use crate::error::{Problems, RagdollError, first};
 use crate::joint_def::{JointDef, RawJoint, joint_spec};
 use crate::skeleton::{Skeleton, Transform};
-use crate::skeleton_file::{RawBone, bones};
+use crate::skeleton_file::{RawBone, bones_all, syntax_naming};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
-use crate::text::{Lines, in_file, item, read_text, syntax};
+use crate::text::{Lines, in_file, item, read_text};
 
 /// The reference humanoid, shipped with the crate: 13 bodies, 12 joints,
 /// a 4-body spine.
@@ -241,9 +241,23 @@ impl RagdollDesc {
     /// file's directory); every error names the file (and the line, where
     /// there is one).
     pub fn from_file(path: &Path) -> Result<Self, RagdollError> {
-        let text = read_text(path, "ragdoll")?;
+        Self::check_file(path).map_err(first)
+    }
+
+    /// [`RagdollDesc::from_file`], refused with every problem found rather
+    /// than the first (which is what `from_file` says), in file order by
+    /// line, each naming the file: `vertebra check`. A file that cannot be
+    /// read or parsed as TOML has one problem; so has a skeleton that
+    /// cannot be used (its file's problems, or its `[[bone]]` tables'),
+    /// since the bodies are placed on it. Otherwise every body, joint,
+    /// `[spine]` and `[drive]` table is checked on its own, the joint tree
+    /// once every joint resolves, the spine's chain once the tree stands,
+    /// and the whole description once every part passed.
+    pub fn check_file(path: &Path) -> Result<Self, Vec<RagdollError>> {
+        let text = read_text(path, "ragdoll").map_err(|e| vec![e])?;
         let dir = path.parent().unwrap_or(Path::new(""));
-        Self::parse(&text, Given::Dir(dir)).map_err(|e| in_file(path, e))
+        Self::parse(&text, Given::Dir(dir))
+            .map_err(|problems| problems.into_iter().map(|e| in_file(path, e)).collect())
     }
 
     /// Parses and validates a description. Errors about a body, joint,
@@ -251,6 +265,12 @@ impl RagdollDesc {
     /// that names a skeleton file is refused: only
     /// [`RagdollDesc::from_file`] knows where to look for it.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
+        Self::check_toml(text).map_err(first)
+    }
+
+    /// [`RagdollDesc::from_toml`], refused with every problem found, in
+    /// file order ([`RagdollDesc::check_file`] says what is checked when).
+    pub fn check_toml(text: &str) -> Result<Self, Vec<RagdollError>> {
         Self::parse(text, Given::Nothing)
     }
 
@@ -260,65 +280,48 @@ impl RagdollDesc {
     /// bodies may be defined `from` one bone `to` another. A file that
     /// carries its own skeleton is refused.
     pub fn from_toml_with_skeleton(text: &str, skeleton: &Skeleton) -> Result<Self, RagdollError> {
-        Self::parse(text, Given::Skeleton(skeleton))
+        Self::parse(text, Given::Skeleton(skeleton)).map_err(first)
     }
 
-    fn parse(text: &str, given: Given<'_>) -> Result<Self, RagdollError> {
+    /// The description in `text`, or every problem found in it.
+    fn parse(text: &str, given: Given<'_>) -> Result<Self, Vec<RagdollError>> {
         let lines = Lines::new(text);
-        let raw: RawFile = toml::from_str(text).map_err(|e| syntax("ragdoll", &lines, &e))?;
+        let raw: RawFile = toml::from_str(text).map_err(|e| {
+            vec![syntax_naming(
+                "ragdoll",
+                text,
+                &lines,
+                &e,
+                &["bone", "body", "joint"],
+            )]
+        })?;
         let at = |span: core::ops::Range<usize>| lines.at(span.start);
-        let inline = if raw.bone.is_empty() {
-            None
-        } else {
-            Some(bones(&raw.bone, &lines)?)
-        };
-        let refuse = |line: Option<usize>, reason: &str| RagdollError::OutOfRange {
-            context: item(line, "ragdoll"),
-            field: "skeleton",
-            reason: reason.to_owned(),
-        };
-        let named = raw.skeleton.as_ref().map(|s| (s.get_ref(), at(s.span())));
-        let skeleton = match (inline, named, given) {
-            (Some(_), Some((_, line)), _) => {
-                return Err(refuse(
-                    Some(line),
-                    "names a file, and the file has [[bone]] tables too; give one skeleton",
-                ));
-            }
-            (Some(_), None, Given::Skeleton(_)) | (None, Some(_), Given::Skeleton(_)) => {
-                return Err(refuse(
-                    None,
-                    "is given twice: the file has its own, and from_toml_with_skeleton gives one",
-                ));
-            }
-            (None, Some((_, line)), Given::Nothing) => {
-                return Err(refuse(
-                    Some(line),
-                    "names a file, which only RagdollDesc::from_file finds (relative to the ragdoll file)",
-                ));
-            }
-            (None, Some((file, _)), Given::Dir(dir)) => Some(Skeleton::from_file(&dir.join(file))?),
-            (None, None, Given::Skeleton(given)) => Some(given.clone()),
-            (inline, None, _) => inline,
-        };
+        let skeleton = skeleton(&raw, given, &lines)?;
+        let mut problems = Problems::default();
         let bodies = raw
             .body
             .iter()
             .map(|b| {
-                let line = at(b.span());
-                let context = item(Some(line), &format!("body `{}`", b.get_ref().name));
-                body_spec(b.get_ref(), &context).map(|value| Item::at(value, line))
+                let (line, r) = (at(b.span()), b.get_ref());
+                let context = item(Some(line), &format!("body `{}`", r.name));
+                match problems.note(Some(line), body_spec(r, &context)) {
+                    Some(value) => Item::at(value, line),
+                    None => Item::refused(r.stand_in(), line),
+                }
             })
-            .collect::<Result<Vec<_>, _>>()?;
+            .collect();
         let joints = raw
             .joint
             .iter()
             .map(|j| {
-                let line = at(j.span());
-                let context = item(Some(line), &format!("joint `{}`", j.get_ref().name));
-                joint_spec(j.get_ref(), &context).map(|value| Item::at(value, line))
+                let (line, r) = (at(j.span()), j.get_ref());
+                let context = item(Some(line), &format!("joint `{}`", r.name));
+                match problems.note(Some(line), joint_spec(r, &context)) {
+                    Some(value) => Item::at(value, line),
+                    None => Item::refused(r.stand_in(), line),
+                }
             })
-            .collect::<Result<Vec<_>, _>>()?;
+            .collect();
         let spine = raw.spine.as_ref().map(|s| {
             let r = s.get_ref();
             let value = SpineSpec {
@@ -330,16 +333,14 @@ impl RagdollDesc {
             };
             Item::at(value, at(s.span()))
         });
-        let drive = raw
-            .drive
-            .as_ref()
-            .map(|d| {
-                let line = at(d.span());
-                drive_settings(d.get_ref(), &item(Some(line), "[drive]"))
-                    .map(|value| Item::at(value, line))
-            })
-            .transpose()?;
-        assemble(Document {
+        let drive = raw.drive.as_ref().and_then(|d| {
+            let line = at(d.span());
+            let read = drive_settings(d.get_ref(), &item(Some(line), "[drive]"));
+            problems
+                .note(Some(line), read)
+                .map(|value| Item::at(value, line))
+        });
+        let doc = Document {
             name: raw.name,
             total_mass: raw.total_mass,
             skeleton,
@@ -347,7 +348,8 @@ impl RagdollDesc {
             joints,
             spine,
             drive,
-        })
+        };
+        assemble_all(doc, problems)
     }
 
     /// The body index of `name`.
@@ -367,6 +369,58 @@ impl RagdollDesc {
     /// `total_mass` has scaled them to it).
     pub fn total_mass(&self) -> f32 {
         self.bodies.iter().map(|b| b.mass).sum()
+    }
+}
+
+/// The skeleton of a file `raw`: its own `[[bone]]` tables, the skeleton
+/// file it names (found through `given`), or the one `given`; refused with
+/// the skeleton's problems, or with the one of having two.
+fn skeleton(
+    raw: &RawFile,
+    given: Given<'_>,
+    lines: &Lines,
+) -> Result<Option<Skeleton>, Vec<RagdollError>> {
+    let inline = if raw.bone.is_empty() {
+        None
+    } else {
+        Some(bones_all(&raw.bone, lines)?)
+    };
+    let refuse = |line: Option<usize>, reason: &str| {
+        vec![RagdollError::OutOfRange {
+            context: item(line, "ragdoll"),
+            field: "skeleton",
+            reason: reason.to_owned(),
+        }]
+    };
+    let named = raw
+        .skeleton
+        .as_ref()
+        .map(|s| (s.get_ref(), lines.at(s.span().start)));
+    match (inline, named, given) {
+        (Some(_), Some((_, line)), _) => Err(refuse(
+            Some(line),
+            "names a file, and the file has [[bone]] tables too; give one skeleton",
+        )),
+        (Some(_), None, Given::Skeleton(_)) | (None, Some(_), Given::Skeleton(_)) => Err(refuse(
+            None,
+            "is given twice: the file has its own, and from_toml_with_skeleton gives one",
+        )),
+        (None, Some((_, line)), Given::Nothing) => Err(refuse(
+            Some(line),
+            "names a file, which only RagdollDesc::from_file finds (relative to the ragdoll file)",
+        )),
+        (None, Some((file, _)), Given::Dir(dir)) => Skeleton::check_file(&dir.join(file)).map(Some),
+        (None, None, Given::Skeleton(given)) => Ok(Some(given.clone())),
+        (inline, None, _) => Ok(inline),
+    }
+}
+
+impl RawBody {
+    /// A capsule of the table's radius and mass on a zero segment: what a
+    /// table that could not be read stands for, so that its name still
+    /// counts while its problem is reported.
+    fn stand_in(&self) -> BodySpec {
+        BodySpec::capsule(&self.name, [Vec3::ZERO; 2], self.radius, self.mass)
     }
 }
 

@@ -176,3 +176,46 @@ impl From<vertebra_world::Error> for RagdollError {
         RagdollError::world("", error)
     }
 }
+
+/// Every problem found in a description or a file, each with the line of
+/// its item (`None` for one about no single line, or built in code), so
+/// that a checker lists them all in file order and a loader refuses with
+/// the first.
+#[derive(Debug, Default)]
+pub(crate) struct Problems(Vec<(Option<usize>, RagdollError)>);
+
+impl Problems {
+    /// `result`'s value, or `None` with its error kept as a problem of the
+    /// item at `line`.
+    pub(crate) fn note<T>(
+        &mut self,
+        line: Option<usize>,
+        result: Result<T, RagdollError>,
+    ) -> Option<T> {
+        result.map_err(|e| self.0.push((line, e))).ok()
+    }
+
+    /// Whether none has been found.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// `Ok` if no problem was found, else the problems in file order: by
+    /// line (in the order found within a line), those without a line after
+    /// them.
+    pub(crate) fn done(mut self) -> Result<(), Vec<RagdollError>> {
+        if self.0.is_empty() {
+            return Ok(());
+        }
+        self.0.sort_by_key(|&(line, _)| line.unwrap_or(usize::MAX));
+        Err(self.0.into_iter().map(|(_, e)| e).collect())
+    }
+}
+
+/// The first of a refusal's problems: what the single-error loaders say.
+pub(crate) fn first(problems: Vec<RagdollError>) -> RagdollError {
+    problems
+        .into_iter()
+        .next()
+        .expect("a refusal has at least one problem")
+}

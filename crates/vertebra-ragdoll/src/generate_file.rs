@@ -14,7 +14,8 @@ use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::error::RagdollError;
+use crate::description::RagdollDesc;
+use crate::error::{Problems, RagdollError, first};
 use crate::generate::{BodyMass, BoneBody, RagdollGenerator, RodSpine, SegmentEnd};
 use crate::joint_def::RawBoneJoint;
 use crate::skeleton::Skeleton;
@@ -61,17 +62,25 @@ impl RagdollGenerator {
     /// table) and for sense by [`RagdollGenerator::generate`] (errors
     /// name the bone).
     pub fn from_toml(text: &str, skeleton: &Skeleton) -> Result<Self, RagdollError> {
+        Self::read(text, skeleton).map_err(first)
+    }
+
+    /// [`RagdollGenerator::from_toml`], refused with every table's problem
+    /// of form, in file order.
+    fn read(text: &str, skeleton: &Skeleton) -> Result<Self, Vec<RagdollError>> {
         let lines = Lines::new(text);
         let raw: RawGenerator =
-            toml::from_str(text).map_err(|e| syntax("generator", &lines, &e))?;
+            toml::from_str(text).map_err(|e| vec![syntax("generator", &lines, &e)])?;
         let mut generator = crate::RagdollDesc::generator(&raw.name, skeleton);
+        let mut problems = Problems::default();
         for b in &raw.body {
-            let context = item(
-                Some(lines.at(b.span().start)),
-                &format!("bone `{}`", b.get_ref().bone),
-            );
-            generator = generator.body(bone_body(b.get_ref(), &context)?);
+            let line = lines.at(b.span().start);
+            let context = item(Some(line), &format!("bone `{}`", b.get_ref().bone));
+            if let Some(body) = problems.note(Some(line), bone_body(b.get_ref(), &context)) {
+                generator = generator.body(body);
+            }
         }
+        problems.done()?;
         if let Some(s) = &raw.spine {
             let s = s.get_ref();
             generator = generator.spine(RodSpine {
@@ -95,6 +104,17 @@ impl RagdollGenerator {
     pub fn from_file(path: &Path, skeleton: &Skeleton) -> Result<Self, RagdollError> {
         let text = read_text(path, "generator")?;
         Self::from_toml(&text, skeleton).map_err(|e| in_file(path, e))
+    }
+
+    /// Reads a generator file over `skeleton` and generates its
+    /// description (`vertebra check`): refused with every `[[body]]`
+    /// table's problem of form (by line), else with what
+    /// [`RagdollGenerator::generate`] refuses; each names the file.
+    pub fn check_file(path: &Path, skeleton: &Skeleton) -> Result<RagdollDesc, Vec<RagdollError>> {
+        let text = read_text(path, "generator").map_err(|e| vec![e])?;
+        Self::read(&text, skeleton)
+            .and_then(|generator| generator.generate().map_err(|e| vec![e]))
+            .map_err(|problems| problems.into_iter().map(|e| in_file(path, e)).collect())
     }
 }
 

@@ -244,6 +244,20 @@ impl RawJoint {
     }
 }
 
+impl RawJoint {
+    /// A fixed joint between the table's bodies at its anchor: what a
+    /// table that could not be read stands for, so that its names still
+    /// count while its problem is reported.
+    pub(crate) fn stand_in(&self) -> JointSpec {
+        JointSpec::fixed(
+            &self.name,
+            &self.parent,
+            &self.child,
+            Vec3::from(self.anchor),
+        )
+    }
+}
+
 /// Reads one `[[joint]]` table (`context` names its line and the joint):
 /// its kind and the fields that kind takes, its softness and drive as one
 /// of their forms, its angles in radians. The values are checked when the

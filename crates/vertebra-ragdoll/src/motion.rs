@@ -115,8 +115,8 @@ impl Ragdoll {
 
     /// The described index and the handle of the body named `name`, for
     /// the call `call` (which errors name): refused for a name that is not
-    /// a described body, and for an interior spine bone of a simplified
-    /// ragdoll (it has no body).
+    /// a described body, for a body of a removed ragdoll, and for an
+    /// interior spine bone of a simplified ragdoll (it has no body).
     pub(crate) fn named_body(
         &self,
         name: &str,
@@ -133,6 +133,8 @@ impl Ragdoll {
             .iter()
             .position(|b| b.name == name)
             .ok_or_else(|| unknown(call.to_owned()))?;
+        self.root()
+            .map_err(|_| self.removed(&format!("{call}: {}", self.body_context(k))))?;
         let handle = self.bodies[k].ok_or_else(|| {
             unknown(format!(
                 "{call} (an interior spine bone of a simplified ragdoll has no body)"
@@ -143,12 +145,16 @@ impl Ragdoll {
 
     /// The root body's handle; a removed ragdoll has none.
     pub(crate) fn root(&self) -> Result<BodyHandle, RagdollError> {
-        self.bodies[self.desc.root].ok_or_else(|| {
-            RagdollError::world(
-                &self.body_context(self.desc.root),
-                vertebra_world::Error::StaleHandle("body"),
-            )
-        })
+        self.bodies[self.desc.root].ok_or_else(|| self.removed(&self.body_context(self.desc.root)))
+    }
+
+    /// The error for a call about `item` (e.g. `body `hips``) of a removed
+    /// ragdoll: its bodies are no longer in the world.
+    fn removed(&self, item: &str) -> RagdollError {
+        RagdollError::world(
+            &format!("{item} (the ragdoll has been removed from the world)"),
+            vertebra_world::Error::StaleHandle("body"),
+        )
     }
 
     /// Every body the ragdoll has, with its described index.

@@ -220,7 +220,7 @@ fn refused_ragdoll_calls_change_nothing() {
     gone.remove(&mut w).unwrap();
     let removed = w.state_hash();
     let no_root = RagdollError::World {
-        context: "body `hips`".to_owned(),
+        context: "body `hips` (the ragdoll has been removed from the world)".to_owned(),
         error: Error::StaleHandle("body"),
     };
     assert_eq!(gone.root_transform(&w), Err(no_root.clone()));

@@ -289,9 +289,17 @@ fn refused_partial_calls_name_the_item_and_change_nothing() {
     assert_eq!(
         removed,
         RagdollError::World {
-            context: "body `hips`".to_owned(),
+            context: "body `hips` (the ragdoll has been removed from the world)".to_owned(),
             error: Error::StaleHandle("body")
         }
+    );
+    let one = ragdoll
+        .set_body_kinematic(&mut w, "hips", true)
+        .unwrap_err();
+    assert_eq!(
+        one.to_string(),
+        "set_body_kinematic: body `hips` (the ragdoll has been removed from the world): \
+         stale or unknown body handle"
     );
     assert!(ragdoll.kinematic(&w).is_err());
     assert_eq!(w.state_hash(), hash);

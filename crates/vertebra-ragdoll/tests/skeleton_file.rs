@@ -294,7 +294,7 @@ fn malformed_skeleton_files_are_refused_by_line_bone_and_field() {
         (
             "name = \"root\"",
             "name = \"root\"\nparent = \"hips\"",
-            "line 1: bone `root`: parent `hips` is defined at line 6, not before this bone",
+            "line 1: bone `root`: parent makes the bone its own ancestor: `root` -> `hips` -> `root`",
         ),
         (
             "name = \"hips\"",
@@ -329,7 +329,7 @@ fn malformed_skeleton_files_are_refused_by_line_bone_and_field() {
         (
             "translation = [0.0, 1.0, 0.0]\n",
             "",
-            "missing field `translation`",
+            "malformed skeleton file: line 5: bone `hips`: missing field `translation`",
         ),
     ];
     for (from, to, expected) in cases {
@@ -338,6 +338,15 @@ fn malformed_skeleton_files_are_refused_by_line_bone_and_field() {
             .to_string();
         assert!(e.contains(expected), "expected `{expected}` in `{e}`");
     }
+    // A parent defined after its child, without a cycle.
+    let later = TWO_BONES
+        .replacen("name = \"root\"", "name = \"root\"\nparent = \"hips\"", 1)
+        .replacen("parent = \"root\"\n", "", 1);
+    let e = Skeleton::from_toml(&later).unwrap_err().to_string();
+    assert!(
+        e.ends_with("line 1: bone `root`: parent `hips` is defined at line 6, not before this bone; a parent comes before its children"),
+        "{e}"
+    );
     let e = Skeleton::from_toml("bone = []").unwrap_err().to_string();
     assert_eq!(e, "skeleton: bone has 0 bones; must have 1 to 4096");
     let e = Skeleton::from_toml("[[body]]\nname = \"x\"")

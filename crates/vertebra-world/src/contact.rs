@@ -55,7 +55,7 @@ impl Contact {
             return Err(Error::NonPositive("contact friction"));
         }
         if !(0.0..=1.0).contains(&self.restitution) {
-            return Err(Error::InvalidLimit("restitution (must be in [0, 1])"));
+            return Err(Error::OutOfRange("contact restitution (0 to 1)"));
         }
         Ok(())
     }

@@ -168,8 +168,8 @@ impl RodDesc {
         // The tangent-chord angle is half the arc's angle.
         let psi = 2.0 * ta.angle_between(o);
         if psi >= PI - 1e-3 {
-            return Err(Error::InvalidLimit(
-                "bend: the bones bend the arc by pi or more",
+            return Err(Error::DegenerateShape(
+                "the rod's bones bend its arc by pi or more",
             ));
         }
         let tb = 2.0 * ta.dot(o) * o - ta;
@@ -342,7 +342,7 @@ fn check_stiffness(s: RodStiffness, names: [&'static str; 4]) -> Result<(), Erro
     match s {
         RodStiffness::Kirchhoff(k) => not_negative(what, k),
         RodStiffness::Relaxation(r) if !(0.0..=1.0).contains(&r) => {
-            Err(Error::InvalidLimit("relaxation factor (must be in [0, 1])"))
+            Err(Error::OutOfRange("rod relaxation factor (0 to 1)"))
         }
         RodStiffness::Relaxation(_) => Ok(()),
         RodStiffness::Damped { stiffness, damping } => {

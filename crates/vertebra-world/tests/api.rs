@@ -478,7 +478,7 @@ fn bad_rods_are_refused() {
     });
     rejected_after(
         above,
-        Error::InvalidLimit("relaxation factor (must be in [0, 1])"),
+        Error::OutOfRange("rod relaxation factor (0 to 1)"),
         |w, ends| {
             let r = rod(w, ends)?
                 .with_stiffness(RodStiffness::Relaxation(1.5), RodStiffness::Kirchhoff(1.0));
@@ -547,6 +547,16 @@ fn bad_rods_are_refused() {
     rejected_after(above, Error::InvalidLimit("bend"), |w, ends| {
         let r = rod(w, ends)?.with_bend_limit(4.0);
         w.add_rod(r).map(drop)
+    });
+    // A bone far to the side of the chord puts the rod on the major arc.
+    let bent = Error::DegenerateShape("the rod's bones bend its arc by pi or more");
+    assert_eq!(
+        bent.to_string(),
+        "degenerate shape: the rod's bones bend its arc by pi or more"
+    );
+    rejected_after(above, bent, |w, (b, c)| {
+        let side = w.body(b)?.position + Vec3::new(1.0, -0.1, 0.0);
+        RodDesc::from_pose(w.bodies(), b, c, &[side]).map(drop)
     });
     rejected_after(
         new_body(Vec3::ZERO),

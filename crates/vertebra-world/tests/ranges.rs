@@ -328,6 +328,25 @@ fn contact(a: BodyHandle, b: BodyHandle, depth: f32) -> Contact {
     }
 }
 
+/// A restitution outside [0, 1] is refused as out of range, in words (it
+/// read "invalid restitution (must be in [0, 1]) limit").
+#[test]
+fn contact_restitution_beyond_zero_to_one_is_refused_in_words() {
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let (a, b) = two_bodies(&mut world);
+    for restitution in [1.5, -0.1, f32::NAN] {
+        let bouncy = Contact {
+            restitution,
+            ..contact(a, b, 0.01)
+        };
+        let e = world.set_contacts(&[bouncy]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "contact restitution (0 to 1) is out of range"
+        );
+    }
+}
+
 #[test]
 fn contact_depths_beyond_the_coordinate_range_are_refused() {
     let mut world = World::new(SolverConfig::default()).unwrap();
