@@ -82,12 +82,10 @@ pub fn solve<L: Lane>(
     start: &PairStart<L>,
 ) -> L {
     let c = measure(a, b, f, start);
-    let w = a.angular_weight(c.n_a)
-        + b.angular_weight(c.n_b)
-        + c.g.length_squared() * (a.inv_mass + b.inv_mass);
+    let ((s_a, w_a), (s_b, w_b)) = (a.angular_response(c.n_a), b.angular_response(c.n_b));
+    let w = w_a + w_b + c.g.length_squared() * (a.inv_mass + b.inv_mass);
     let dlambda = safe_ratio(-c.theta, w);
-    b.rotate(b.inv_inertia_mul(c.n_b.scale(dlambda)));
-    a.rotate(a.inv_inertia_mul(c.n_a.scale(-dlambda)));
+    crate::parts::angle::turn(a, b, s_a, s_b, dlambda);
     b.p += c.g.scale(dlambda * b.inv_mass);
     a.p -= c.g.scale(dlambda * a.inv_mass);
     c.theta
