@@ -164,10 +164,10 @@ impl<L: Lane> BodyLanes<L> {
     }
 
     /// Writes the pose back to the rows named by `write` (`NO_WRITE` lanes
-    /// are skipped), the orientation renormalised.
+    /// are skipped).
     #[inline(always)]
     pub fn scatter_pose(&self, rows: &BodyRows, write: &[u32]) {
-        let (p, q) = (self.p, self.q.normalize());
+        let (p, q) = (self.p, self.q);
         L::scatter_rows(
             &[p.x, p.y, p.z, self.inv_mass, q.x, q.y, q.z, q.w],
             &rows.pose,
@@ -230,15 +230,14 @@ impl<L: Lane> BodyLanes<L> {
     }
 
     /// Turns the body by the small rotation vector `theta` (rad, world):
-    /// `q += 1/2 (theta, 0) q` ([`Quat::turned`]), not renormalised. The
-    /// orientation's length drifts from 1 by `|theta|^2 / 4` per turn, a
-    /// change of the second order as the update itself is; the parts'
-    /// measurements tolerate it (most are ratios that do not see the length
-    /// at all), and [`BodyLanes::scatter_pose`] renormalises once, as the
-    /// body is written back.
+    /// `q += 1/2 (theta, 0) q` ([`Quat::turned`]), renormalised. (Left
+    /// unnormalised until the scatter, the orientation's length drifted by
+    /// `|theta|^2 / 4` per turn, and the lever arms with it: a ragdoll
+    /// thrown at the ground at 1000 m/s kept fighting it at up to 25 m/s
+    /// instead of settling, `tests/stress.rs` in vertebra-scenes.)
     #[inline(always)]
     pub fn rotate(&mut self, theta: Vec3<L>) {
-        self.q = self.q.turned(theta);
+        self.q = self.q.turned(theta).normalize();
     }
 }
 

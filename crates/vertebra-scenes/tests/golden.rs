@@ -74,12 +74,12 @@ fn ragdoll_drop_rod() {
 // All four updated 2026-11-30 by issue 17's cheaper kernels, which are
 // meant to compute differently: the inertia row holds the world-space
 // inverse inertia (refreshed each substep, no rotation into the body frame
-// and back per correction), a correction turns a body without
-// renormalising (the scatter renormalises once), each weight and turn come
-// from one `I^-1 n`, frames take +X from the matrix column, and the rod's
-// twist limit shares the soft twist's measurement. The scenes' figures
-// stay within the seeds' spread (docs/reproduction.md).
-const GOLDEN_BENDING_SOCKETS: u64 = 0x8b68_6c0e_c13d_684a;
-const GOLDEN_BENDING_ROD: u64 = 0x1163_872f_6ebc_708a;
-const GOLDEN_DROP_SOCKETS: u64 = 0xb60a_4f54_481f_569f;
-const GOLDEN_DROP_ROD: u64 = 0xebe9_f39b_4763_c2f0;
+// and back per correction), each weight and turn come from one `I^-1 n`, a
+// turn is the pure quaternion product written out, frames take +X from the
+// matrix column, and the rod's twist limit shares the soft twist's
+// measurement. The scenes' figures stay within the seeds' spread
+// (docs/reproduction.md).
+const GOLDEN_BENDING_SOCKETS: u64 = 0xfff6_723e_3f3a_629f;
+const GOLDEN_BENDING_ROD: u64 = 0x3bce_13f9_78a9_e70c;
+const GOLDEN_DROP_SOCKETS: u64 = 0x1e70_63bc_b9a8_fb72;
+const GOLDEN_DROP_ROD: u64 = 0x1a1a_0a4b_3cff_5993;

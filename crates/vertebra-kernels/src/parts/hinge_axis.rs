@@ -23,7 +23,7 @@
 //!
 //! The error `E` on the `n` row is not the linearised `theta` but what
 //! the bodies' update makes exact. [`BodyLanes::rotate`] turns by `w` as
-//! `q + 1/2 (w, 0) q` (renormalised after this part): exactly the rotation whose Gibbs
+//! `q + 1/2 (w, 0) q`, renormalised: exactly the rotation whose Gibbs
 //! (Rodrigues) vector is `g = w / 2` (angle `2 atan(|w| / 2)` about `w`).
 //! A rotation with Gibbs vector `g` takes `t_b` to `t_a` if and only if
 //! `t_a - t_b = g x s` (Rodrigues' formula). Both sides are perpendicular
@@ -126,9 +126,5 @@ pub fn solve<L: Lane>(
     let (l1, l2) = (-e * r22, e * r12);
     b.rotate(sb1.scale(l1) + sb2.scale(l2));
     a.rotate(-(sa1.scale(l1) + sa2.scale(l2)));
-    // A turn of up to half a revolution leaves the orientations far from
-    // unit length (`BodyLanes::rotate`): renormalised here, for the parts
-    // after this one.
-    (a.q, b.q) = (a.q.normalize(), b.q.normalize());
     sin
 }
