@@ -197,7 +197,7 @@ impl SocketWorkload {
             );
             let inertia = Mat3::from_diagonal(GVec3::new(20.0, 30.0, 60.0));
             rows.pose[body + 1].set(BodyRows::pose_row(p, 1.0, q));
-            rows.inertia[body + 1].set(BodyRows::inertia_row(inertia, q));
+            rows.inertia[body + 1].set(BodyRows::inertia_row(inertia));
         }
         let mut out = vec![SocketBlock::padding(); blocks];
         for k in 0..blocks * BLOCK_LANES {

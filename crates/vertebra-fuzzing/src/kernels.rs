@@ -41,7 +41,7 @@ fn raw_rows(input: &mut Input) -> RawRows {
         };
         *row = [
             BodyRows::pose_row(input.vec3(5.0), inverse_mass, input.quat()),
-            BodyRows::inertia_row(inverse_inertia, glam::Quat::IDENTITY),
+            BodyRows::inertia_row(inverse_inertia),
             BodyRows::velocity_row(input.vec3(10.0), input.vec3(10.0)),
         ];
     }

@@ -4,7 +4,7 @@
 //! | row | floats |
 //! | --- | --- |
 //! | pose | `p.x p.y p.z inv_mass q.x q.y q.z q.w` (m, 1/kg, unit quaternion) |
-//! | inertia | `I.xx I.yy I.zz I.xy I.xz I.yz 0 0`: inverse inertia, world frame (1/(kg m^2)) |
+//! | inertia | `S.xx S.yy S.zz S.xy S.xz S.yz 0 0`: inverse inertia, body frame (1/(kg m^2)) |
 //! | velocity | `v.x v.y v.z 0 w.x w.y w.z 0` (m/s, rad/s, world) |
 //!
 //! `p` is the body's *displacement* since the step began, not its
@@ -22,16 +22,7 @@
 //! Generalised inverse masses (Müller et al. 2020, eqs. 2-3): a positional
 //! correction along unit `n` at lever arm `r` sees
 //! `w = 1/m + (r x n)^T I^-1 (r x n)`, a rotational one about `n` sees
-//! `w = n^T I^-1 n`, with `I^-1 = R S R^T` the world-space inverse inertia
-//! (`S` the body-frame one).
-//!
-//! The inertia row holds `I^-1` itself, at the orientation the body had
-//! when the world last wrote the row: as the step begins
-//! ([`BodyRows::inertia_row`]) and after every substep's prediction. The
-//! corrections of a substep turn the body by a fraction of what the
-//! prediction did and see the tensor of the predicted orientation, as
-//! Rapier's solver bodies keep their world-space inverse inertia per
-//! substep: so no correction rotates into the body frame and back.
+//! `w = n^T I^-1 n`, with `I^-1 = R S R^T` the world-space inverse inertia.
 
 use bytemuck::{Pod, Zeroable};
 use vertebra_math::block::{BLOCK_LANES, Vec3Block};
@@ -98,23 +89,11 @@ impl BodyRows {
         [p.x, p.y, p.z, inverse_mass, q.x, q.y, q.z, q.w]
     }
 
-    /// Packs an inverse-inertia row: the world-space `R S R^T` of the
-    /// symmetric body-frame inverse inertia `inverse_inertia` (1/(kg m^2))
-    /// of a body at `orientation`, by the kernels' own arithmetic (the
-    /// scalar twin of every backend's), so every backend reads the same
-    /// tensor.
-    pub fn inertia_row(inverse_inertia: glam::Mat3, orientation: glam::Quat) -> [f32; ROW_LEN] {
-        let m = inverse_inertia;
-        let body = Sym3 {
-            xx: m.x_axis.x,
-            yy: m.y_axis.y,
-            zz: m.z_axis.z,
-            xy: m.y_axis.x,
-            xz: m.z_axis.x,
-            yz: m.z_axis.y,
-        };
-        let w = body.rotated(Quat::from(orientation));
-        [w.xx, w.yy, w.zz, w.xy, w.xz, w.yz, 0.0, 0.0]
+    /// Packs an inverse-inertia row from a symmetric body-frame matrix.
+    pub fn inertia_row(m: glam::Mat3) -> [f32; ROW_LEN] {
+        [
+            m.x_axis.x, m.y_axis.y, m.z_axis.z, m.y_axis.x, m.z_axis.x, m.z_axis.y, 0.0, 0.0,
+        ]
     }
 
     /// Packs a velocity row.
@@ -125,7 +104,7 @@ impl BodyRows {
     }
 }
 
-/// One body per lane: pose and world-space inverse inertia.
+/// One body per lane: pose and body-frame inverse inertia.
 #[derive(Clone, Copy, Debug)]
 pub struct BodyLanes<L> {
     /// Displacement of the centre of mass since the step began (m, world).
@@ -134,8 +113,7 @@ pub struct BodyLanes<L> {
     pub inv_mass: L,
     /// Orientation.
     pub q: Quat<L>,
-    /// Inverse inertia, world frame (1/(kg m^2)), as the inertia row holds
-    /// it (see the module documentation).
+    /// Inverse inertia, body frame.
     pub inv_inertia: Sym3<L>,
 }
 
@@ -143,11 +121,8 @@ impl<L: Lane> BodyLanes<L> {
     /// Gathers the pose and inertia rows of `indices` (`L::WIDTH` of them).
     #[inline(always)]
     pub fn gather(rows: &BodyRows, indices: &[u32]) -> Self {
-        // Both tables cut to one length: a row index checked against the
-        // first is known to be inside the second.
-        let len = rows.pose.len().min(rows.inertia.len());
-        let [px, py, pz, inv_mass, qx, qy, qz, qw] = L::gather_rows(&rows.pose[..len], indices);
-        let [xx, yy, zz, xy, xz, yz, _, _] = L::gather_rows(&rows.inertia[..len], indices);
+        let [px, py, pz, inv_mass, qx, qy, qz, qw] = L::gather_rows(&rows.pose, indices);
+        let [xx, yy, zz, xy, xz, yz, _, _] = L::gather_rows(&rows.inertia, indices);
         Self {
             p: Vec3::new(px, py, pz),
             inv_mass,
@@ -175,25 +150,23 @@ impl<L: Lane> BodyLanes<L> {
         );
     }
 
-    /// `I^-1 v` with the world-space inverse inertia.
+    /// `I^-1 v` with the world-space inverse inertia `R S R^T`.
     #[inline(always)]
     pub fn inv_inertia_mul(&self, v: Vec3<L>) -> Vec3<L> {
-        self.inv_inertia.mul_vec(v)
+        self.q
+            .rotate(self.inv_inertia.mul_vec(self.q.inverse_rotate(v)))
+    }
+
+    /// The world-space inverse inertia `R S R^T`.
+    #[inline(always)]
+    pub fn world_inv_inertia(&self) -> Sym3<L> {
+        self.inv_inertia.rotated(self.q)
     }
 
     /// `n^T I^-1 n`: the generalised inverse mass of a rotation about `n`.
     #[inline(always)]
     pub fn angular_weight(&self, n: Vec3<L>) -> L {
-        self.inv_inertia.quadratic(n)
-    }
-
-    /// `(I^-1 n, n^T I^-1 n)`: the turn per unit multiplier of a rotation
-    /// about `n` (rad per N m s^2) and its generalised inverse mass, from one
-    /// product (a correction needs both).
-    #[inline(always)]
-    pub fn angular_response(&self, n: Vec3<L>) -> (Vec3<L>, L) {
-        let s = self.inv_inertia.mul_vec(n);
-        (s, n.dot(s))
+        self.inv_inertia.quadratic(self.q.inverse_rotate(n))
     }
 
     /// `1/m + (r x n)^T I^-1 (r x n)`: the generalised inverse mass of a
@@ -201,24 +174,6 @@ impl<L: Lane> BodyLanes<L> {
     #[inline(always)]
     pub fn positional_weight(&self, r: Vec3<L>, n: Vec3<L>) -> L {
         self.inv_mass + self.angular_weight(r.cross(n))
-    }
-
-    /// `(I^-1 (r x n), 1/m + (r x n)^T I^-1 (r x n))`: the turn per unit
-    /// impulse along `n` at lever arm `r` (rad per kg m) and the generalised
-    /// inverse mass, from one product ([`BodyLanes::push`] applies it).
-    #[inline(always)]
-    pub fn positional_response(&self, r: Vec3<L>, n: Vec3<L>) -> (Vec3<L>, L) {
-        let (s, w) = self.angular_response(r.cross(n));
-        (s, self.inv_mass + w)
-    }
-
-    /// Applies the impulse `dlambda n` (kg m) whose turn per unit impulse is
-    /// `turn` (from [`BodyLanes::positional_response`]): `p += dlambda n / m`,
-    /// turned by `dlambda turn`.
-    #[inline(always)]
-    pub fn push(&mut self, n: Vec3<L>, turn: Vec3<L>, dlambda: L) {
-        self.p += n.scale(dlambda * self.inv_mass);
-        self.rotate(turn.scale(dlambda));
     }
 
     /// Applies a positional impulse `impulse` (kg m) at lever arm `r`:
@@ -230,14 +185,10 @@ impl<L: Lane> BodyLanes<L> {
     }
 
     /// Turns the body by the small rotation vector `theta` (rad, world):
-    /// `q += 1/2 (theta, 0) q` ([`Quat::turned`]), renormalised. (Left
-    /// unnormalised until the scatter, the orientation's length drifted by
-    /// `|theta|^2 / 4` per turn, and the lever arms with it: a ragdoll
-    /// thrown at the ground at 1000 m/s kept fighting it at up to 25 m/s
-    /// instead of settling, `tests/stress.rs` in vertebra-scenes.)
+    /// `q += 1/2 (theta, 0) q`, renormalised.
     #[inline(always)]
     pub fn rotate(&mut self, theta: Vec3<L>) {
-        self.q = self.q.turned(theta).normalize();
+        self.q = self.q.integrate(theta, L::splat(1.0));
     }
 }
 

@@ -5,9 +5,12 @@
 //!
 //! The range is the `twist` part's angle: the relative rotation's twist
 //! about +X, in [-pi, pi], which for a hinge (no swing) is the hinge angle
-//! itself; `[-pi, pi]` disables it, and `limit` makes it hard or soft.
-//! The drive is the socket's drive part (`driven.rs`), with the same
-//! settings and the same substep start.
+//! itself; `[-pi, pi]` disables it. Both the axis part and the range
+//! measure in the bodies' own frames, from b's orientation relative to a
+//! (`hinge_axis`, `twist::violation_local`, `limit::solve_local`): fewer
+//! rotations than the socket's world-frame parts. The drive is the
+//! socket's drive part (`driven.rs`), with the same settings and the same
+//! substep start.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
@@ -153,7 +156,7 @@ impl Limited for HingeBlock {
             L::load(&self.range_min[start..]),
             L::load(&self.range_max[start..]),
         );
-        let (_, c0) = twist::violation(a, b, fa, fb, lo, hi);
+        let (_, c0) = twist::violation_local(a, b, fa, fb, lo, hi);
         c0.store(&mut self.limit_start[start..]);
     }
 }
@@ -210,11 +213,12 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
         L::load(&block.range_min[start..]),
         L::load(&block.range_max[start..]),
     );
-    let (n, c) = twist::violation(&a, &b, frame_a, frame_b, lo, hi);
+    let (axes, c) = twist::violation_local(&a, &b, frame_a, frame_b, lo, hi);
     let soft = block.limit_softness.lanes(start, inv_h, inv_h2);
     let lambda = L::load(&block.limit_lambda[start..]);
     let c0 = L::load(&block.limit_start[start..]);
-    limit::solve(&mut a, &mut b, n, (c, c0), soft, lambda).store(&mut block.limit_lambda[start..]);
+    limit::solve_local(&mut a, &mut b, axes, (c, c0), soft, lambda)
+        .store(&mut block.limit_lambda[start..]);
     point::solve(
         &mut a,
         &mut b,
@@ -245,7 +249,7 @@ impl Residual for HingeBlock {
             L::load(&self.range_min[start..]),
             L::load(&self.range_max[start..]),
         );
-        let (_, overshoot) = twist::violation(&a, &b, fa, fb, lo, hi);
+        let (_, overshoot) = twist::violation_local(&a, &b, fa, fb, lo, hi);
         Measured {
             linear: d.length(),
             angular: misalignment + overshoot,

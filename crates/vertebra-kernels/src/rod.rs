@@ -10,8 +10,7 @@
 //! [`StartPass`] advances it every substep at its rates, as the drives'
 //! start pass advances their targets (`driven.rs`).
 //!
-//! Part order per iteration: soft bend, soft twist with the twist limit
-//! (one turn about the twist's axes: `parts::rod::twist::solve`), bend
+//! Part order per iteration: soft bend, soft twist, bend limit, twist
 //! limit, curve, length. The hard geometric parts come last so that the arc
 //! is closest to admissible at the end of an iteration; the length last of
 //! all, because the curve changes `psi` and so the chord the length aims at.
@@ -379,24 +378,17 @@ fn solve_positions<L: Lane>(
     let lambda = L::load(&block.twist_lambda[start..]);
     let rest = L::load(&block.twist_rest[start..]);
     let start_twist = L::load(&block.twist_start[start..]);
-    let range = [
-        L::load(&block.twist_min[start..]),
-        L::load(&block.twist_max[start..]),
-    ];
-    let lambda = twist::solve(
-        &mut a,
-        &mut b,
-        &f,
-        rest,
-        &twist_drive,
-        start_twist,
-        lambda,
-        range,
-    );
+    let lambda = twist::solve(&mut a, &mut b, &f, rest, &twist_drive, start_twist, lambda);
     lambda.store(&mut block.twist_lambda[start..]);
 
     let f = frames(&a, &b, frame_a, frame_b);
     bend::limit(&mut a, &mut b, &f, L::load(&block.bend_max[start..]));
+    let f = frames(&a, &b, frame_a, frame_b);
+    let (lo, hi) = (
+        L::load(&block.twist_min[start..]),
+        L::load(&block.twist_max[start..]),
+    );
+    twist::limit(&mut a, &mut b, &f, lo, hi);
 
     let chord = block.bodies.start(start);
     let f = frames(&a, &b, frame_a, frame_b);

@@ -94,7 +94,7 @@ fn degenerate_inertia(r: &mut StdRng, rows: &mut RawRows) {
             } else {
                 glam::Mat3::from_cols(axis * axis.x, axis * axis.y, axis * axis.z) * 3.0
             };
-            row[1] = vertebra_kernels::body::BodyRows::inertia_row(inertia, glam::Quat::IDENTITY);
+            row[1] = vertebra_kernels::body::BodyRows::inertia_row(inertia);
         }
     }
 }

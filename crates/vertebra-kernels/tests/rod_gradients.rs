@@ -253,7 +253,7 @@ fn generalised_masses_match_their_definitions() {
         let q = GQuat::from_scaled_axis(unit(&mut r) * 2.0);
         let s = Mat3::from_diagonal(GVec3::new(1.0, 2.0, 5.0));
         let mut b = body(GVec3::ZERO, q);
-        b.inv_inertia = Sym3::diagonal(Vec3::splat(GVec3::new(1.0, 2.0, 5.0))).rotated(q.into());
+        b.inv_inertia = Sym3::diagonal(Vec3::splat(GVec3::new(1.0, 2.0, 5.0)));
         let (arm, n) = (unit(&mut r) * 0.3, unit(&mut r));
         let world = Mat3::from_quat(q) * s * Mat3::from_quat(q).transpose();
         let expected = 1.0 + arm.cross(n).dot(world * arm.cross(n));

@@ -108,31 +108,19 @@ impl<L: Lane> Quat<L> {
     }
 
     /// The orientation after turning at world-space angular velocity
-    /// `omega` (rad/s) for `dt` seconds: [`Quat::turned`] by `omega dt`,
-    /// renormalised (the first-order update of XPBD rigid bodies, Müller et
-    /// al. 2020, eq. 8).
+    /// `omega` (rad/s) for `dt` seconds: `q + dt/2 (omega, 0) q`,
+    /// renormalised (the first-order update of XPBD rigid bodies).
     #[inline(always)]
     pub fn integrate(self, omega: Vec3<L>, dt: L) -> Self {
-        self.turned(omega.scale(dt)).normalize()
-    }
-
-    /// `q + 1/2 (theta, 0) q`, not renormalised: the first-order turn by the
-    /// small world-space rotation vector `theta` (rad). The result is the
-    /// rotation of Gibbs vector `theta / 2` scaled by `sqrt(1 + |theta|^2 /
-    /// 4)` times `q`'s length. The product with the pure quaternion
-    /// `u = theta / 2` is written out as `(q.w u + u x q.xyz, -u . q.xyz)`:
-    /// no multiplication by its zero real part.
-    #[inline(always)]
-    pub fn turned(self, theta: Vec3<L>) -> Self {
-        let u = theta.scale(L::splat(0.5));
-        let v = self.vector();
-        let spin = u.scale(self.w) + u.cross(v);
+        let h = dt * L::splat(0.5);
+        let spin = Self::from_parts(omega, L::splat(0.0)) * self;
         Self::new(
-            self.x + spin.x,
-            self.y + spin.y,
-            self.z + spin.z,
-            self.w - u.dot(v),
+            self.x + spin.x * h,
+            self.y + spin.y * h,
+            self.z + spin.z * h,
+            self.w + spin.w * h,
         )
+        .normalize()
     }
 
     /// The rotation by `angle` radians about the unit vector `axis`.

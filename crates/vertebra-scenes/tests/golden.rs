@@ -71,15 +71,7 @@ fn ragdoll_drop_rod() {
 // variants). The bodies' bits are unchanged: with `max_torque` left out of
 // the serialisation the old hashes came back on every backend and thread
 // count (undriven rods take the old correction bit for bit).
-// All four updated 2026-11-30 by issue 17's cheaper kernels, which are
-// meant to compute differently: the inertia row holds the world-space
-// inverse inertia (refreshed each substep, no rotation into the body frame
-// and back per correction), each weight and turn come from one `I^-1 n`, a
-// turn is the pure quaternion product written out, frames take +X from the
-// matrix column, and the rod's twist limit shares the soft twist's
-// measurement. The scenes' figures stay within the seeds' spread
-// (docs/reproduction.md).
-const GOLDEN_BENDING_SOCKETS: u64 = 0xfff6_723e_3f3a_629f;
-const GOLDEN_BENDING_ROD: u64 = 0x3bce_13f9_78a9_e70c;
-const GOLDEN_DROP_SOCKETS: u64 = 0x1e70_63bc_b9a8_fb72;
-const GOLDEN_DROP_ROD: u64 = 0x1a1a_0a4b_3cff_5993;
+const GOLDEN_BENDING_SOCKETS: u64 = 0x72b8_cc15_033e_3505;
+const GOLDEN_BENDING_ROD: u64 = 0x91fc_ac92_3106_001f;
+const GOLDEN_DROP_SOCKETS: u64 = 0x554e_4f30_f575_bb42;
+const GOLDEN_DROP_ROD: u64 = 0x634e_2c17_abeb_9fa5;

@@ -191,10 +191,7 @@ pub(crate) fn upload(bodies: &BodyStore, rows: &mut BodyRows) {
         *rows = BodyRows::with_bodies(bodies.capacity());
     }
     for i in 0..bodies.capacity() {
-        rows.inertia[i + 1].set(BodyRows::inertia_row(
-            bodies.inverse_inertia[i],
-            bodies.orientation[i],
-        ));
+        rows.inertia[i + 1].set(BodyRows::inertia_row(bodies.inverse_inertia[i]));
         rows.velocity[i + 1].set(BodyRows::velocity_row(
             bodies.linear_velocity[i],
             bodies.angular_velocity[i],
@@ -230,9 +227,8 @@ fn commit(world: &mut World) {
 
 /// Integration of velocities (gravity, forces, the implicit gyroscopic
 /// term in the body frame) and of the rows' displacements and
-/// orientations, with the world-space inverse inertia of the predicted
-/// orientation (the substep's corrections use it); the previous poses are
-/// kept for deriving velocities afterwards.
+/// orientations; the previous ones are kept for deriving velocities
+/// afterwards.
 fn predict(world: &mut World, h: f32) {
     let g = world.config.gravity;
     let (max_linear, max_angular) = (
@@ -262,14 +258,11 @@ fn predict(world: &mut World, h: f32) {
         }
         let (displacement, orientation) = pose(world.rows.get(), i);
         world.previous[i] = (displacement, orientation);
-        let predicted = integrate(orientation, b.angular_velocity[i], h);
-        let rows = world.rows.get();
-        rows.pose[i + 1].set(BodyRows::pose_row(
+        world.rows.get().pose[i + 1].set(BodyRows::pose_row(
             displacement + b.linear_velocity[i] * h,
             b.inverse_mass[i],
-            predicted,
+            integrate(orientation, b.angular_velocity[i], h),
         ));
-        rows.inertia[i + 1].set(BodyRows::inertia_row(b.inverse_inertia[i], predicted));
     }
 }
 

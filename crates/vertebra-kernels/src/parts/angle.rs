@@ -68,25 +68,40 @@ pub fn correct_axes<L: Lane>(
     soft: Softness<L>,
     lambda: L,
 ) -> L {
-    let ((s_a, w_a), (s_b, w_b)) = (a.angular_response(n_a), b.angular_response(n_b));
+    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
     let dlambda = safe_ratio(
         -soft.relaxation * c - soft.alpha_tilde * lambda,
-        w_a + w_b + soft.alpha_tilde,
+        w + soft.alpha_tilde,
     );
-    turn(a, b, s_a, s_b, dlambda);
+    apply(a, b, n_a, n_b, dlambda);
     dlambda
 }
 
-/// Turns `b` by `s_b dlambda` and `a` by `-s_a dlambda`, with the bodies'
-/// responses `s = I^-1 n` ([`BodyLanes::angular_response`]).
+/// Turns `b` by `I_b^-1 n_b dlambda` and `a` by `-I_a^-1 n_a dlambda`.
 #[inline(always)]
-pub fn turn<L: Lane>(
+pub fn apply<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    s_a: Vec3<L>,
-    s_b: Vec3<L>,
+    n_a: Vec3<L>,
+    n_b: Vec3<L>,
     dlambda: L,
 ) {
-    b.rotate(s_b.scale(dlambda));
-    a.rotate(s_a.scale(-dlambda));
+    b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
+    a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
+}
+
+/// Turns `b` by `R_b turn_b` and `a` by `-R_a turn_a`, each turn given in
+/// its body's own frame (`turn = S n dlambda` with the body-frame inverse
+/// inertia `S` and axis `n = R^T n_world`: the parts that measure in the
+/// bodies' frames form `w = n^T S n` from the same `S n`, and need no
+/// rotation into the body).
+#[inline(always)]
+pub fn apply_local<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    turn_a: Vec3<L>,
+    turn_b: Vec3<L>,
+) {
+    b.rotate(b.q.rotate(turn_b));
+    a.rotate(-a.q.rotate(turn_a));
 }

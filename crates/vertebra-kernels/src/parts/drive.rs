@@ -151,7 +151,7 @@ pub fn solve<L: Lane>(
     lambda: Vec3<L>,
 ) -> Vec3<L> {
     let c = measure(a, b, frame_a, frame_b, d.target).scale(d.enabled);
-    let w = a.inv_inertia + b.inv_inertia;
+    let w = a.world_inv_inertia() + b.world_inv_inertia();
     let gamma = d.damping_time * inv_h;
     let spring = d.period2 * inv_h2;
     let alpha = d.compliance * inv_h2;

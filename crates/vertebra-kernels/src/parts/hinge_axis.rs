@@ -54,31 +54,35 @@
 //! undefined: `u = 0` gives no correction (an unstable equilibrium no
 //! other pose heads for).
 //!
-//! The rows are world vectors, from the two frames' axes
-//! ([`super::frames`]); `K` is formed from them and the world-space
-//! inverse inertias (`crate::body`), which also give each body's turn
-//! `I^-1 J^T dlambda`; `dlambda` comes from `k22 / det` and `k12 / det`,
-//! which stay bounded as `|m| = |s|` vanishes near 180 degrees (`k22` and
-//! `det` shrink together). A singular `K` (no dynamic body) gives no
-//! correction.
+//! The rows are measured in each body's own frame: in a's, `t_a = F_a x`
+//! and `t_b = (q_a* q_b F_b) x` (b's orientation relative to a, one
+//! quaternion product), then `n` and `m` there, turned into b's frame by
+//! the same relative rotation. `K` is formed from them
+//! (`j^T I^-1 j = (R^T j)^T S (R^T j)`), which also gives each body's turn
+//! `R S (R^T j)` with one rotation out of it (`angle::apply_local`);
+//! `dlambda` comes from `k22 / det` and `k12 / det`, which stay bounded as
+//! `|m| = |s|` vanishes near 180 degrees (`k22` and `det` shrink
+//! together). A singular `K` (no dynamic body) gives no correction.
 
 use vertebra_math::{Lane, Quat, Vec3};
 
-use super::swing;
+use super::{angle, swing};
 use crate::body::{BodyLanes, safe_ratio};
 
-/// The part's measurement: its rows and the angle.
+/// The part's measurement: its rows in each body's frame, and the angle.
 #[derive(Clone, Copy, Debug)]
 pub struct Rows<L> {
-    /// `[n, m]` (world): b's gradients, a's their negatives.
-    pub rows: [Vec3<L>; 2],
+    /// `[n, m]` in a's body frame (`R_a^T n`, `R_a^T m`).
+    pub a: [Vec3<L>; 2],
+    /// `[n, m]` in b's body frame.
+    pub b: [Vec3<L>; 2],
     /// `sin theta = |t_a x t_b|`.
     pub sin: L,
     /// `d = 1 + cos theta = |t_a + t_b|^2 / 2`.
     pub d: L,
 }
 
-/// The rows (the gradients for b) and the angle.
+/// The rows (the gradients for b, in each body's frame) and the angle.
 #[inline(always)]
 pub fn measure<L: Lane>(
     a: &BodyLanes<L>,
@@ -86,11 +90,14 @@ pub fn measure<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> Rows<L> {
-    let f = super::frames(a, b, frame_a, frame_b);
-    let (n, sin) = swing::axis(f.ta, f.tb);
-    let s = f.ta + f.tb;
+    let relative = a.q.conjugate() * b.q;
+    let (ta, tb) = (super::axis_x(frame_a), super::axis_x(relative * frame_b));
+    let (n, sin) = swing::axis(ta, tb);
+    let s = ta + tb;
+    let m = n.cross(s);
     Rows {
-        rows: [n, n.cross(s)],
+        a: [n, m],
+        b: [relative.inverse_rotate(n), relative.inverse_rotate(m)],
         sin,
         d: s.dot(s) * L::splat(0.5),
     }
@@ -105,16 +112,17 @@ pub fn solve<L: Lane>(
     frame_b: Quat<L>,
 ) -> L {
     let Rows {
-        rows: [j1, j2],
+        a: [ja1, ja2],
+        b: [jb1, jb2],
         sin,
         d,
     } = measure(a, b, frame_a, frame_b);
-    let (sa1, sa2) = (a.inv_inertia.mul_vec(j1), a.inv_inertia.mul_vec(j2));
-    let (sb1, sb2) = (b.inv_inertia.mul_vec(j1), b.inv_inertia.mul_vec(j2));
-    let (kb11, kb12) = (j1.dot(sb1), j2.dot(sb1));
-    let k11 = j1.dot(sa1) + kb11;
-    let k12 = j2.dot(sa1) + kb12;
-    let k22 = j2.dot(sa2) + j2.dot(sb2);
+    let (sa1, sa2) = (a.inv_inertia.mul_vec(ja1), a.inv_inertia.mul_vec(ja2));
+    let (sb1, sb2) = (b.inv_inertia.mul_vec(jb1), b.inv_inertia.mul_vec(jb2));
+    let (kb11, kb12) = (jb1.dot(sb1), jb2.dot(sb1));
+    let k11 = ja1.dot(sa1) + kb11;
+    let k12 = ja2.dot(sa1) + kb12;
+    let k22 = ja2.dot(sa2) + jb2.dot(sb2);
     let det = k11 * k22 - k12 * k12;
     // K^-1 = [k22 -k12; -k12 k11] / det.
     let (r22, r12) = (safe_ratio(k22, det), safe_ratio(k12, det));
@@ -124,7 +132,11 @@ pub fn solve<L: Lane>(
     let e = safe_ratio(four * sin, d + (d * d + four * p * (sin * sin)).sqrt());
     // dlambda = -K^-1 (E, 0).
     let (l1, l2) = (-e * r22, e * r12);
-    b.rotate(sb1.scale(l1) + sb2.scale(l2));
-    a.rotate(-(sa1.scale(l1) + sa2.scale(l2)));
+    angle::apply_local(
+        a,
+        b,
+        sa1.scale(l1) + sa2.scale(l2),
+        sb1.scale(l1) + sb2.scale(l2),
+    );
     sin
 }

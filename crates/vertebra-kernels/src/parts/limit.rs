@@ -80,9 +80,27 @@ pub fn solve<L: Lane>(
     soft: Softness<L>,
     lambda: L,
 ) -> L {
-    let ((s_a, w_a), (s_b, w_b)) = (a.angular_response(n), b.angular_response(n));
-    let dlambda = step(w_a + w_b, (c, c0), soft, lambda);
-    angle::turn(a, b, s_a, s_b, dlambda);
+    let w = a.angular_weight(n) + b.angular_weight(n);
+    let dlambda = step(w, (c, c0), soft, lambda);
+    angle::apply(a, b, n, n, dlambda);
+    lambda + dlambda
+}
+
+/// As [`solve`], with the axis given in each body's own frame, `[R_a^T n,
+/// R_b^T n]` (as the hinge measures its range): `w` and the turns come
+/// from the same body-frame `S n` ([`angle::apply_local`]).
+#[inline(always)]
+pub fn solve_local<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    [n_a, n_b]: [Vec3<L>; 2],
+    (c, c0): (L, L),
+    soft: Softness<L>,
+    lambda: L,
+) -> L {
+    let (s_a, s_b) = (a.inv_inertia.mul_vec(n_a), b.inv_inertia.mul_vec(n_b));
+    let dlambda = step(n_a.dot(s_a) + n_b.dot(s_b), (c, c0), soft, lambda);
+    angle::apply_local(a, b, s_a.scale(dlambda), s_b.scale(dlambda));
     lambda + dlambda
 }
 

@@ -35,7 +35,7 @@ pub fn solve<L: Lane>(
     frame_b: Quat<L>,
 ) -> L {
     let c = measure(a, b, frame_a, frame_b);
-    let w = a.inv_inertia + b.inv_inertia;
+    let w = a.world_inv_inertia() + b.world_inv_inertia();
     let dlambda = -w.inverse_or_zero().mul_vec(c);
     b.rotate(b.inv_inertia_mul(dlambda));
     a.rotate(a.inv_inertia_mul(-dlambda));

@@ -54,18 +54,19 @@ pub fn frames<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> Frames<L> {
+    let x = Vec3::splat(crate::TWIST_AXIS);
     let (fa, fb) = (a.q * frame_a, b.q * frame_b);
     Frames {
         fa,
         fb,
-        ta: axis_x(fa),
-        tb: axis_x(fb),
+        ta: fa.rotate(x),
+        tb: fb.rotate(x),
     }
 }
 
 /// `q x`: the unit quaternion's rotation of +X, its matrix's first column
-/// (fewer operations than [`Quat::rotate`], and other roundings): the
-/// twist axes and tangents of [`frames`], and the hinge's axes.
+/// (fewer operations than [`Quat::rotate`], and other roundings). The
+/// hinge's parts measure in the bodies' own frames with it.
 #[inline(always)]
 pub fn axis_x<L: Lane>(q: Quat<L>) -> Vec3<L> {
     let (one, two) = (L::splat(1.0), L::splat(2.0));

@@ -40,9 +40,10 @@ pub fn solve<L: Lane>(
 ) -> L {
     let (ra, rb, d) = separation(a, b, local_a, local_b, start);
     let (n, c) = d.normalize_or_zero();
-    let ((s_a, w_a), (s_b, w_b)) = (a.positional_response(ra, n), b.positional_response(rb, n));
-    let dlambda = safe_ratio(-c, w_a + w_b);
-    b.push(n, s_b, dlambda);
-    a.push(n, s_a, -dlambda);
+    let w = a.positional_weight(ra, n) + b.positional_weight(rb, n);
+    let dlambda = safe_ratio(-c, w);
+    let impulse = n.scale(dlambda);
+    b.apply_impulse(rb, impulse);
+    a.apply_impulse(ra, -impulse);
     c
 }

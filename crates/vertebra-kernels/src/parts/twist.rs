@@ -9,8 +9,12 @@
 //! multiplies `r` by a twist of `x` on the right, which adds exactly `x` to
 //! `phi`. A range of `[-pi, pi]` never binds: a disabled limit.
 //!
-//! Of `r` the twist needs only `r_x` and `r_w` ([`angle_about_x`]): half
-//! the quaternion product.
+//! The hinge measures the same angle in the bodies' own frames
+//! ([`violation_local`]): from b's orientation relative to a,
+//! `R_a^T R_b` (one quaternion product), `r = F_a* (q_a* q_b F_b)`, whose
+//! twist about +X is `2 atan2(r_x, r_w)` (the sign of `r_w` taken out),
+//! and the axis `t_b` is `(q_a* q_b F_b) x` in a's frame and `F_b x` in
+//! b's, ready for [`super::limit::solve_local`].
 
 use vertebra_math::{Lane, Quat, Vec3, poly};
 
@@ -25,18 +29,10 @@ pub fn measure<L: Lane>(
     frame_b: Quat<L>,
 ) -> (Vec3<L>, L) {
     let f = super::frames(a, b, frame_a, frame_b);
-    (f.tb, angle_about_x(f.fa, f.fb))
-}
-
-/// The signed angle in [-pi, pi] of the twist about +X of `fa* fb`
-/// (rad): [`Quat::twist_angle`] of the product, from the two of its
-/// components it reads.
-#[inline(always)]
-pub fn angle_about_x<L: Lane>(fa: Quat<L>, fb: Quat<L>) -> L {
-    let x = fa.w * fb.x - fa.x * fb.w - fa.y * fb.z + fa.z * fb.y;
-    let w = fa.w * fb.w + fa.x * fb.x + fa.y * fb.y + fa.z * fb.z;
-    let sign = L::splat(1.0).copysign(w);
-    L::splat(2.0) * poly::atan2(x * sign, w * sign)
+    (
+        f.tb,
+        (f.fa.conjugate() * f.fb).twist_angle(Vec3::splat(crate::TWIST_AXIS)),
+    )
 }
 
 /// `phi - clamp(phi, lo, hi)`: signed excess beyond the range (rad).
@@ -71,7 +67,42 @@ pub fn solve<L: Lane>(
     lo: L,
     hi: L,
 ) -> L {
-    let (n, c) = violation(a, b, frame_a, frame_b, lo, hi);
-    super::angle::correct(a, b, n, c, L::splat(0.0), L::splat(0.0));
-    c
+    let (axis, phi) = measure(a, b, frame_a, frame_b);
+    let e = excess(phi, lo, hi);
+    let n = axis.scale(L::splat(1.0).copysign(e));
+    super::angle::correct(a, b, n, e.abs(), L::splat(0.0), L::splat(0.0));
+    e.abs()
+}
+
+/// The twist angle `phi` (rad) and the axis `t_b` in each body's own frame
+/// (`[R_a^T t_b, R_b^T t_b]`), from b's orientation relative to a's.
+#[inline(always)]
+pub fn measure_local<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+) -> ([Vec3<L>; 2], L) {
+    // b's joint frame in a's body frame, then relative to a's joint frame.
+    let fb = (a.q.conjugate() * b.q) * frame_b;
+    let r = frame_a.conjugate() * fb;
+    let sign = L::splat(1.0).copysign(r.w);
+    let phi = L::splat(2.0) * poly::atan2(r.x * sign, r.w * sign);
+    ([super::axis_x(fb), super::axis_x(frame_b)], phi)
+}
+
+/// As [`violation`], in the bodies' own frames ([`measure_local`]).
+#[inline(always)]
+pub fn violation_local<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+    lo: L,
+    hi: L,
+) -> ([Vec3<L>; 2], L) {
+    let ([axis_a, axis_b], phi) = measure_local(a, b, frame_a, frame_b);
+    let e = excess(phi, lo, hi);
+    let sign = L::splat(1.0).copysign(e);
+    ([axis_a.scale(sign), axis_b.scale(sign)], e.abs())
 }

@@ -66,7 +66,7 @@ pub fn rows(r: &mut StdRng, lanes: usize, statics: usize, adversarial: bool) -> 
         };
         *row = [
             BodyRows::pose_row(vec(r, 3.0), inv_mass, q),
-            BodyRows::inertia_row(inertia, q),
+            BodyRows::inertia_row(inertia),
             BodyRows::velocity_row(vec(r, 5.0), vec(r, 5.0)),
         ];
     }

@@ -82,10 +82,12 @@ pub fn solve<L: Lane>(
     start: &PairStart<L>,
 ) -> L {
     let c = measure(a, b, f, start);
-    let ((s_a, w_a), (s_b, w_b)) = (a.angular_response(c.n_a), b.angular_response(c.n_b));
-    let w = w_a + w_b + c.g.length_squared() * (a.inv_mass + b.inv_mass);
+    let w = a.angular_weight(c.n_a)
+        + b.angular_weight(c.n_b)
+        + c.g.length_squared() * (a.inv_mass + b.inv_mass);
     let dlambda = safe_ratio(-c.theta, w);
-    crate::parts::angle::turn(a, b, s_a, s_b, dlambda);
+    b.rotate(b.inv_inertia_mul(c.n_b.scale(dlambda)));
+    a.rotate(a.inv_inertia_mul(c.n_a.scale(-dlambda)));
     b.p += c.g.scale(dlambda * b.inv_mass);
     a.p -= c.g.scale(dlambda * a.inv_mass);
     c.theta

@@ -161,17 +161,7 @@ pub fn correct<L: Lane>(
     d: &Drive<L>,
     lambda: L,
 ) -> L {
-    let ((s_a, w_a), (s_b, w_b)) = (a.angular_response(n_a), b.angular_response(n_b));
-    let (lambda, dlambda) = step(c, rate, w_a + w_b, w_spring, d, lambda);
-    crate::parts::angle::turn(a, b, s_a, s_b, dlambda);
-    lambda
-}
-
-/// The correction's step for the generalised inverse mass `w` (the other
-/// arguments as for [`correct`]): the new accumulated `lambda` and
-/// `dlambda`, not applied.
-#[inline(always)]
-pub fn step<L: Lane>(c: L, rate: L, w: L, w_spring: L, d: &Drive<L>, lambda: L) -> (L, L) {
+    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
     let s = d.soft;
     let plain = safe_ratio(
         -s.relaxation * c - s.alpha_tilde * lambda,
@@ -183,7 +173,10 @@ pub fn step<L: Lane>(c: L, rate: L, w: L, w_spring: L, d: &Drive<L>, lambda: L) 
         (L::splat(1.0) + d.gamma) * w + alpha,
     );
     let dlambda = L::select((d.spring + d.gamma).gt(L::splat(0.0)), damped, plain);
-    cap(lambda, dlambda, d.limit)
+    let (lambda, dlambda) = cap(lambda, dlambda, d.limit);
+    b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
+    a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
+    lambda
 }
 
 /// `lambda + dlambda` held to `[-limit, limit]`, and the step that gets

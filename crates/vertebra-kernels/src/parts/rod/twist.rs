@@ -27,7 +27,7 @@ use vertebra_math::{Lane, Quat, Vec3, poly};
 use super::Frames;
 use super::drive::{self, Drive};
 use crate::body::{BodyLanes, safe_ratio};
-use crate::parts::angle;
+use crate::parts::angle::{self, Softness};
 use crate::parts::twist::excess;
 
 /// The axes `(n_a, n_b)` with `dtau/dtheta_a = -n_a`, `dtau/dtheta_b = n_b`.
@@ -49,12 +49,11 @@ pub fn axes<L: Lane>(f: &Frames<L>) -> (Vec3<L>, Vec3<L>) {
 /// The twist angle `tau` in [-pi, pi] (rad).
 #[inline(always)]
 pub fn measure<L: Lane>(f: &Frames<L>) -> L {
-    // M = (t_a x t_b, 1 + t_a . t_b): the half-way quaternion, not
-    // normalised (the twist's angle is a ratio of two of the product's
-    // components: its length cancels). Folded back (t_b = -t_a) it is zero
-    // and the twist 0, where it is undefined.
-    let minimal = Quat::from_parts(f.ta.cross(f.tb), L::splat(1.0) + f.ta.dot(f.tb));
-    crate::parts::twist::angle_about_x(minimal * f.fa, f.fb)
+    // M = normalize(1 + t_a . t_b, t_a x t_b): the half-way quaternion.
+    // Folded back (t_b = -t_a) it is zero and normalises to the identity.
+    let minimal = Quat::from_parts(f.ta.cross(f.tb), L::splat(1.0) + f.ta.dot(f.tb)).normalize();
+    let relative = (minimal * f.fa).conjugate() * f.fb;
+    relative.twist_angle(Vec3::splat(crate::TWIST_AXIS))
 }
 
 /// The error `tau - rest`, wrapped to [-pi, pi]: a rod twisted past pi
@@ -65,15 +64,10 @@ pub fn error<L: Lane>(f: &Frames<L>, rest: L) -> L {
 }
 
 /// One soft twisting correction toward `rest`, damped against the error
-/// `start` as the substep began (the rate wraps too), and the hard limit
-/// `lo <= tau <= hi`, in one turn: both correct `tau` about the same
-/// axes, so the limit's excess is taken on the twist the soft step leaves,
-/// `tau + w dlambda` (exact to first order, as every correction is), and
-/// each body turns once by the sum. Returns the soft part's new `lambda`.
-/// Twisting moves no centre: its effective inverse inertia is the angle
-/// part's `w` (`super::drive`).
+/// `start` as the substep began (the rate wraps too); returns the new
+/// `lambda`. Twisting moves no centre: its effective inverse inertia is
+/// the angle part's `w` (`super::drive`).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
@@ -82,15 +76,25 @@ pub fn solve<L: Lane>(
     d: &Drive<L>,
     start: L,
     lambda: L,
-    [lo, hi]: [L; 2],
 ) -> L {
-    let tau = measure(f);
-    let c = poly::wrap_angle(tau - rest);
+    let c = error(f, rest);
     let (n_a, n_b) = axes(f);
-    let ((s_a, w_a), (s_b, w_b)) = (a.angular_response(n_a), b.angular_response(n_b));
-    let w = w_a + w_b;
-    let (lambda, soft) = drive::step(c, poly::wrap_angle(c - start), w, w, d, lambda);
-    let hard = safe_ratio(-excess(tau + w * soft, lo, hi), w);
-    angle::turn(a, b, s_a, s_b, soft + hard);
-    lambda
+    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
+    let rate = poly::wrap_angle(c - start);
+    drive::correct(a, b, n_a, n_b, c, rate, w, d, lambda)
+}
+
+/// Enforces `lo <= tau <= hi`; returns |excess| before the correction.
+#[inline(always)]
+pub fn limit<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    f: &Frames<L>,
+    lo: L,
+    hi: L,
+) -> L {
+    let e = excess(measure(f), lo, hi);
+    let (n_a, n_b) = axes(f);
+    angle::correct_axes(a, b, n_a, n_b, e, Softness::hard(), L::splat(0.0));
+    e.abs()
 }
