@@ -9,8 +9,10 @@
 //! - [`poly`]: `sin`, `cos`, `acos`, `asin`, `atan2` and `sin(x/2)/x`.
 //! - [`block`]: `bytemuck` lane blocks for structure-of-arrays storage.
 //! - [`row`]: body rows, gathered into lanes and scattered back.
-//! - [`map`]: one lane function applied across arrays on any backend.
-//! - [`check`]: comparing every backend with the scalar reference, bit for bit.
+//! - `map` and `check` (with the `harness` feature, for this workspace's
+//!   tests, benches and fuzz targets only): one lane function applied
+//!   across arrays on any backend, and every backend compared with the
+//!   scalar reference, bit for bit.
 //! - [`float_mode`]: the default floating-point mode for a solver step,
 //!   whatever mode (FTZ, DAZ, rounding) the caller's thread runs in.
 //!
@@ -19,9 +21,11 @@
 
 pub mod backend;
 pub mod block;
+#[cfg(feature = "harness")]
 pub mod check;
 pub mod float_mode;
 pub mod lane;
+#[cfg(feature = "harness")]
 pub mod map;
 pub mod poly;
 pub mod quat;
