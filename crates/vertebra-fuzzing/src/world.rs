@@ -202,7 +202,22 @@ pub(crate) fn set_contacts(world: &mut World, seen: &Seen, input: &mut Input) ->
             restitution: input.float(1.0),
         });
     }
-    world.set_contacts(&contacts)
+    if !input.flag() {
+        return world.set_contacts(&contacts);
+    }
+    // Handed over without a copy: on a refusal the caller keeps its list.
+    let offered = contacts.clone();
+    let swapped = world.swap_contacts(&mut contacts);
+    match &swapped {
+        Ok(()) => assert!(contacts.is_empty(), "a swap hands back an empty list"),
+        // Compared as printed: a NaN field is not equal to itself.
+        Err(_) => assert_eq!(
+            format!("{contacts:?}"),
+            format!("{offered:?}"),
+            "a refused swap changed the caller's list"
+        ),
+    }
+    swapped
 }
 
 /// An impulse of one of the three kinds, at a point near the body or
@@ -276,7 +291,7 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
 }
 
 /// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
-/// removed, poses, velocities, forces and impulses set, kinds switched,
+/// removed, contacts copied in or swapped in without a copy, poses, velocities, forces and impulses set, kinds switched,
 /// kinematic bodies moved, steps) with arbitrary floats
 /// one time in eight: no panic; every refused call leaves the world as it
 /// was; every body stays finite; no pending contact names a removed body;
@@ -293,7 +308,8 @@ pub fn world_api(data: &[u8]) {
 }
 
 /// As [`world_api`], on a world with arbitrary settings: speed limits up
-/// to their ceilings (or wild), gravity and push-out speed arbitrary, now
+/// to their ceilings (or wild), gravity and push-out speed arbitrary,
+/// residuals measured every step or not, now
 /// and then a count far out of range. A refused setting is an error, and
 /// every accepted one steps as [`world_api`] promises.
 pub fn world_settings(data: &[u8]) {
@@ -328,6 +344,7 @@ fn settings(input: &mut Input) -> SolverConfig {
         },
         gravity: input.vec3(100.0),
         parallel_min_blocks: 1 + input.pick(8),
+        measure_residuals: input.flag(),
         ..SolverConfig::default()
     }
 }
@@ -366,5 +383,11 @@ fn calls(mut world: World, input: &mut Input) {
             0,
             "accepted input tripped the step's NaN guard"
         );
+        if let Some(r) = world.residuals() {
+            assert!(
+                r.eps_lin_cm.is_finite() && r.eps_ang_rad.is_finite(),
+                "measured residuals are not finite"
+            );
+        }
     }
 }
