@@ -8,8 +8,12 @@
 //! and reason. Expectations come from the skeleton's bind pose and the
 //! humanoid files, whatever the bones' positions are.
 
+#[path = "support/separation.rs"]
+mod separation;
+
 use glam::{Quat, Vec3};
 use proptest::prelude::*;
+use separation::worst_separation;
 use vertebra_ragdoll::{
     BodyMass, BoneBody, BuildOptions, MIN_SEGMENT, Pose, Ragdoll, RagdollDesc, RagdollGenerator,
     RodSpine, SegmentEnd, Skeleton, SkeletonMapper, SpineMode, Transform,
@@ -260,16 +264,6 @@ fn the_next_chosen_bone_ends_a_body_and_a_density_gives_its_mass() {
         core::f32::consts::PI * r * r * length + 4.0 / 3.0 * core::f32::consts::PI * r.powi(3);
     assert!((desc.bodies[1].mass - density * volume).abs() < 1e-4 * density * volume);
     assert_eq!(desc.spine, None);
-}
-
-/// The largest joint separation (cm) of the current poses, sockets and
-/// rod.
-fn worst_separation(w: &mut World) -> f32 {
-    let r = w.measure_residuals();
-    let sockets = r.joints.iter().map(|j| j.linear_cm);
-    sockets
-        .chain(r.rods.iter().map(|j| j.linear_cm))
-        .fold(0.0, f32::max)
 }
 
 /// The ragdoll's linear momentum (kg m/s) and mass (kg) in the world.

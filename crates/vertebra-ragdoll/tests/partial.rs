@@ -4,8 +4,12 @@
 
 mod common;
 
+#[path = "support/separation.rs"]
+mod separation;
+
 use common::{angle, walking};
 use glam::{Quat, Vec3};
+use separation::worst_separation;
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
 use vertebra_world::{Error, SolverConfig, World};
 
@@ -24,15 +28,6 @@ fn mask(desc: &RagdollDesc, names: &[&str]) -> Vec<bool> {
 
 fn index(desc: &RagdollDesc, name: &str) -> usize {
     desc.bodies.iter().position(|b| b.name == name).unwrap()
-}
-
-/// The largest joint separation (cm) at the current poses, sockets and rod.
-fn worst_separation(w: &mut World) -> f32 {
-    let r = w.measure_residuals();
-    let sockets = r.joints.iter().map(|j| j.linear_cm);
-    sockets
-        .chain(r.rods.iter().map(|j| j.linear_cm))
-        .fold(0.0, f32::max)
 }
 
 /// The legs and hips follow a walk kinematically while the upper body is
