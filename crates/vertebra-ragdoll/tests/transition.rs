@@ -11,8 +11,8 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_ragdoll::{
-    BoneRole, BuildOptions, LocalPose, ModelPose, Ragdoll, RagdollDesc, Skeleton, SkeletonMapper,
-    SpineMapping, SpineMode, Transform, Transition,
+    BoneRole, BuildOptions, LocalPose, ModelPose, Ragdoll, RagdollDesc, RagdollError, Skeleton,
+    SkeletonMapper, SpineMapping, SpineMode, Transform, Transition,
 };
 use vertebra_world::{SolverConfig, World};
 
@@ -39,6 +39,22 @@ struct Switch {
     place: Transform,
     /// The animation's pose in the world at the switch.
     animated: ModelPose,
+}
+
+impl Switch {
+    /// The transition at the switch, mapped by `mapping`, faded over
+    /// `fade` s.
+    fn transition(&self, mapping: SpineMapping, fade: f32) -> Result<Transition, RagdollError> {
+        Transition::new(
+            &self.mapper,
+            &self.ragdoll,
+            &self.world,
+            &self.animation,
+            self.place,
+            mapping,
+            fade,
+        )
+    }
 }
 
 fn switch(spine: SpineMode, rate: f32, dt: f32, r: &mut StdRng) -> Switch {
@@ -193,18 +209,7 @@ fn first_frames(trials: usize, rate: f32, dt: f32, seed: u64) -> Frames {
             let mut s = switch(spine, rate, dt, &mut r);
             let transitions: Vec<Transition> = MAPPINGS
                 .iter()
-                .map(|&m| {
-                    Transition::new(
-                        &s.mapper,
-                        &s.ragdoll,
-                        &s.world,
-                        &s.animation,
-                        s.place,
-                        m,
-                        f32::INFINITY,
-                    )
-                    .unwrap()
-                })
+                .map(|&m| s.transition(m, f32::INFINITY).unwrap())
                 .collect();
             let poses = |s: &Switch, t: f32| -> Vec<Vec<Transform>> {
                 transitions
@@ -323,18 +328,7 @@ fn a_fade_ends_on_the_pure_mapping_and_a_held_transition_keeps_its_offsets() {
     for spine in [SpineMode::Rod, SpineMode::Sockets] {
         let mut s = switch(spine, 1.0, DT, &mut r);
         let mapping = SpineMapping::Orientation;
-        let new = |s: &Switch, fade| {
-            Transition::new(
-                &s.mapper,
-                &s.ragdoll,
-                &s.world,
-                &s.animation,
-                s.place,
-                mapping,
-                fade,
-            )
-            .unwrap()
-        };
+        let new = |s: &Switch, fade| s.transition(mapping, fade).unwrap();
         let (fading, held) = (new(&s, fade), new(&s, f32::INFINITY));
         assert_eq!(fading.weight(0.0), 1.0);
         assert!((fading.weight(fade / 2.0) - 0.5).abs() < 1e-6);
@@ -462,17 +456,7 @@ fn joints_made_at_the_switch_hold_there() {
 fn a_transition_refuses_what_it_cannot_use() {
     let mut r = StdRng::seed_from_u64(1);
     let s = switch(SpineMode::Rod, 0.0, DT, &mut r);
-    let new = |fade| {
-        Transition::new(
-            &s.mapper,
-            &s.ragdoll,
-            &s.world,
-            &s.animation,
-            s.place,
-            SpineMapping::Arc,
-            fade,
-        )
-    };
+    let new = |fade| s.transition(SpineMapping::Arc, fade);
     for fade in [f32::NAN, -1.0] {
         let message = new(fade).unwrap_err().to_string();
         assert!(message.starts_with("transition: fade is"), "{message}");
