@@ -573,12 +573,19 @@ impl World {
             .rebuild(&self.contacts, &self.bodies, max_depth);
         // One entry into the task system per step: the colours' fork-joins
         // then run among its workers (see step::for_each_colour).
+        // The step runs once whatever `enter` does: a second call does
+        // nothing, and a step `enter` never ran runs here.
         let tasks = Arc::clone(&self.tasks);
-        tasks.enter(&mut || {
-            // `enter` may move the step to one of its threads.
-            let _mode = DefaultFloatMode::enter();
-            step::step(self, dt)
-        });
+        let mut stepped = false;
+        let mut once = |world: &mut World| {
+            if !core::mem::replace(&mut stepped, true) {
+                // `enter` may move the step to one of its threads.
+                let _mode = DefaultFloatMode::enter();
+                step::step(world, dt)
+            }
+        };
+        tasks.enter(&mut || once(self));
+        once(self);
         self.contacts.clear();
         self.residuals_measured = self.config.measure_residuals;
         if self.residuals_measured {

@@ -38,7 +38,9 @@ pub trait TaskSystem: Send + Sync {
     /// Runs one whole step (`step`, which calls
     /// [`parallel_for`](Self::parallel_for)); by default on the calling
     /// thread. A pool runs it inside itself, so that the step's fork-joins
-    /// happen among its workers.
+    /// happen among its workers. The step runs once either way: calling
+    /// `step` again does nothing, and a step not run here runs on the
+    /// caller afterwards.
     fn enter(&self, step: &mut (dyn FnMut() + Send)) {
         step()
     }

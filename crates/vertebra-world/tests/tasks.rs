@@ -1,6 +1,7 @@
 //! The engine's threads: a world steps to the same bits on every task
 //! system, the default ones and an engine's own, and on task systems that
-//! run items twice, leave items out or call with indices out of range.
+//! run items twice, leave items out, call with indices out of range, or
+//! run the step they are given to enter twice or not at all.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -70,6 +71,10 @@ enum Behaviour {
     Skipping,
     /// Each item once, and indices past the count as well.
     OutOfRange,
+    /// Each item once, but the step given to `enter` never run.
+    NoStep,
+    /// Each item once, and the step given to `enter` run twice.
+    StepTwice,
 }
 
 /// An engine's job system, counting the calls it gets.
@@ -102,6 +107,18 @@ impl TaskSystem for Engine {
             }
             Behaviour::Skipping => (0..count).step_by(2).for_each(task),
             Behaviour::OutOfRange => (0..count + 100).for_each(task),
+            Behaviour::NoStep | Behaviour::StepTwice => (0..count).for_each(task),
+        }
+    }
+
+    fn enter(&self, step: &mut (dyn FnMut() + Send)) {
+        match self.behaviour {
+            Behaviour::NoStep => {}
+            Behaviour::StepTwice => {
+                step();
+                step();
+            }
+            _ => step(),
         }
     }
 }
@@ -134,6 +151,8 @@ fn an_engines_job_system_runs_the_work_and_cannot_spoil_it() {
         Behaviour::Twice,
         Behaviour::Skipping,
         Behaviour::OutOfRange,
+        Behaviour::NoStep,
+        Behaviour::StepTwice,
     ] {
         let engine = Arc::new(Engine {
             behaviour,
