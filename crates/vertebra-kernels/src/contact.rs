@@ -147,8 +147,18 @@ impl ContactBlock {
     }
 }
 
-/// Lever arms and the world points' difference `(p_b + r_b) - (p_a + r_a)`
-/// (the point part's measure).
+/// The lever arms the corrections act through, and the world points'
+/// difference `(p_b + r_b) - (p_a + r_a)` now (the point part's measure).
+///
+/// The arms are the step's first (`PairStart`), not the turned ones the
+/// difference is measured with (Box2D v3's contact anchors do the same).
+/// A contact's points are where the bodies touched at detection; on a
+/// round body that turns, the point turns away from the bottom, and a
+/// normal correction through the turned arm spins the body on, each
+/// substep more: a capsule lying still on the ground spun up about its
+/// axis by 11% a frame (`m g R h^2 / I` a substep) until it turned at
+/// 188 rad/s. Through the first arms the normal acts through the axis, as
+/// at detection.
 #[inline(always)]
 fn arms<L: Lane>(
     block: &ContactBlock,
@@ -156,13 +166,15 @@ fn arms<L: Lane>(
     a: &BodyLanes<L>,
     b: &BodyLanes<L>,
 ) -> (Vec3<L>, Vec3<L>, Vec3<L>) {
-    point::separation(
+    let first = block.bodies.start(start);
+    let (_, _, d) = point::separation(
         a,
         b,
         block.point_a.load(start),
         block.point_b.load(start),
-        &block.bodies.start(start),
-    )
+        &first,
+    );
+    (first.arm_a, first.arm_b, d)
 }
 
 /// Moves both bodies by the positional impulse `impulse` (b) and its
