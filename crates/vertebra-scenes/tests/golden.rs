@@ -73,5 +73,9 @@ fn ragdoll_drop_rod() {
 // count (undriven rods take the old correction bit for bit).
 const GOLDEN_BENDING_SOCKETS: u64 = 0x72b8_cc15_033e_3505;
 const GOLDEN_BENDING_ROD: u64 = 0x91fc_ac92_3106_001f;
-const GOLDEN_DROP_SOCKETS: u64 = 0x554e_4f30_f575_bb42;
-const GOLDEN_DROP_ROD: u64 = 0x634e_2c17_abeb_9fa5;
+const GOLDEN_DROP_SOCKETS: u64 = 0x3ba1_35df_40d4_a94e;
+const GOLDEN_DROP_ROD: u64 = 0x347d_fa1b_5a96_7063;
+// The drop's two updated 2026-11-30 by the contact fix (issue 17): a
+// contact's corrections act through the step's first lever arms, not the
+// turned ones (a capsule lying on the ground spun up about its axis).
+// Passive bending has no contacts and keeps its bits.
