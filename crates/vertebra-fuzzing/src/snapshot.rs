@@ -4,7 +4,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use glam::{Mat3, Quat, Vec3};
+use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
     AngularDrive, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointHandle, JointKind,
@@ -62,6 +62,23 @@ struct Colouring {
     placed: BTreeMap<u64, (Slot, [Option<u32>; 2])>,
 }
 
+#[derive(Clone, Copy, Serialize, Deserialize)]
+struct Island {
+    live: bool,
+    asleep: bool,
+    split: bool,
+    touching: u64,
+}
+
+#[derive(Clone, Serialize, Deserialize)]
+struct Islands {
+    of: Vec<u32>,
+    still: Vec<f32>,
+    anchor: Vec<(DVec3, Quat)>,
+    allowed: Vec<bool>,
+    islands: Vec<Island>,
+}
+
 #[derive(Clone, Serialize, Deserialize)]
 struct State {
     bodies: Bodies,
@@ -71,6 +88,7 @@ struct State {
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
+    islands: Islands,
     contacts: Vec<Contact>,
 }
 
@@ -384,9 +402,49 @@ fn contact(input: &mut Input, state: &mut State) {
     }
 }
 
+/// A change to the islands' state: a body moved to another island (or to
+/// none), a stillness or anchor broken, an island's flags flipped.
+fn islands(input: &mut Input, islands: &mut Islands) {
+    let n = islands.of.len().max(1);
+    match input.pick(4) {
+        0 => {
+            if let Some(of) = islands.of.get_mut(input.pick(n)) {
+                *of = [0, 1, u32::MAX][input.pick(3)];
+            }
+        }
+        1 => {
+            if let Some(still) = islands.still.get_mut(input.pick(n)) {
+                *still = value(input);
+            }
+        }
+        2 => {
+            if let Some(anchor) = islands.anchor.get_mut(input.pick(n)) {
+                anchor.0.y = f64::from(value(input));
+            }
+        }
+        _ => {
+            let k = islands.islands.len();
+            match k {
+                0 => islands.islands.push(Island {
+                    live: true,
+                    asleep: true,
+                    split: false,
+                    touching: 0,
+                }),
+                _ => {
+                    let island = &mut islands.islands[input.pick(k)];
+                    island.live = !island.live;
+                    island.asleep = !island.asleep;
+                }
+            }
+        }
+    }
+}
+
 /// One change to the state, chosen by the input.
 fn change(input: &mut Input, state: &mut State) {
-    match input.pick(7) {
+    match input.pick(8) {
+        7 => islands(input, &mut state.islands),
         0 | 1 => body(input, &mut state.bodies),
         2 => socket(input, state),
         3 => rod(input, state),

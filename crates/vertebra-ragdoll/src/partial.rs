@@ -141,22 +141,20 @@ impl Ragdoll {
             });
         }
         let kinematic = self.kinematic(world)?;
-        let mut targets = Vec::new();
+        // Every body checked before any moves: a refused one leaves the
+        // world as it was (velocities, and islands asleep).
+        let mut moves = Vec::new();
         for (k, handle) in self.live_bodies().filter(|&(k, _)| kinematic[k]) {
-            let in_body = |e| RagdollError::world(&self.body_context(k), e);
-            targets.push((k, handle, world.body(handle).map_err(in_body)?));
-        }
-        for (n, &(k, handle, _)) in targets.iter().enumerate() {
             let (position, orientation) = pose.bones[k];
-            if let Err(e) = world.move_kinematic(handle, position, orientation, dt) {
-                // Put back the velocities already set.
-                for &(j, h, s) in &targets[..n] {
-                    world
-                        .set_body_velocity(h, s.linear_velocity, s.angular_velocity)
-                        .map_err(|e| RagdollError::world(&self.body_context(j), e))?;
-                }
-                return Err(RagdollError::world(&self.body_context(k), e));
-            }
+            let velocities = world
+                .kinematic_velocities(handle, position, orientation, dt)
+                .map_err(|e| RagdollError::world(&self.body_context(k), e))?;
+            moves.push((k, handle, velocities));
+        }
+        for (k, handle, (linear, angular)) in moves {
+            world
+                .set_body_velocity(handle, linear, angular)
+                .map_err(|e| RagdollError::world(&self.body_context(k), e))?;
         }
         Ok(())
     }

@@ -34,6 +34,8 @@ fn rig(spine: SpineMode, settings: &DriveSettings) -> Rig {
         substeps: 4,
         iterations: 20,
         gravity: Vec3::ZERO,
+        // The oscillation is measured to its end (a small one would sleep).
+        sleep: None,
         ..SolverConfig::default()
     })
     .unwrap();

@@ -1,5 +1,6 @@
 //! Solver settings.
 
+use crate::SleepSettings;
 use glam::Vec3;
 use vertebra_math::BackendChoice;
 use vertebra_store::{Error, MAX_COORDINATE, MAX_TIME_STEP, check_finite};
@@ -84,6 +85,11 @@ pub struct SolverConfig {
     /// [`World::residuals`]: crate::World::residuals
     /// [`World::measure_residuals`]: crate::World::measure_residuals
     pub measure_residuals: bool,
+    /// When islands fall asleep (`islands.rs`: still bodies stop costing
+    /// anything until something wakes them); `None`: never. On by default,
+    /// as in Box2D, Jolt and Rapier. The paper's scenes turn it off (their
+    /// figures measure every joint at every step).
+    pub sleep: Option<SleepSettings>,
 }
 
 impl Default for SolverConfig {
@@ -99,6 +105,7 @@ impl Default for SolverConfig {
             max_linear_speed: 500.0,
             max_angular_speed: 100.0 * core::f32::consts::PI,
             measure_residuals: false,
+            sleep: Some(SleepSettings::default()),
         }
     }
 }
@@ -148,6 +155,9 @@ impl SolverConfig {
             if !(speed > 0.0 && speed <= ceiling) {
                 return Err(Error::InvalidConfig(what));
             }
+        }
+        if let Some(sleep) = &self.sleep {
+            sleep.validate()?;
         }
         check_finite("gravity", self.gravity)
     }

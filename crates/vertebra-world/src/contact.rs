@@ -142,14 +142,23 @@ pub(crate) struct ContactLayout {
 /// The colour index of the overflow set.
 const OVERFLOW: usize = MAX_COLOURS;
 
+/// The colour of a contact left out (its dynamic bodies sleep).
+const ASLEEP: usize = OVERFLOW + 1;
+
 impl ContactLayout {
     /// Colours `contacts` greedily in the order given (each takes the
     /// lowest colour free at both its dynamic bodies, after
     /// [`MAX_COLOURS`] the overflow set: `vertebra_scheduler::Colouring`'s
     /// rule, with bitsets that live for one step) and lays them out, each
     /// overlap capped at `max_depth` (m) for this step.
-    pub fn rebuild(&mut self, contacts: &[Contact], bodies: &BodyStore, max_depth: f32) {
-        self.colour(contacts, bodies);
+    pub fn rebuild(
+        &mut self,
+        contacts: &[Contact],
+        bodies: &BodyStore,
+        asleep: &[bool],
+        max_depth: f32,
+    ) {
+        self.colour(contacts, bodies, asleep);
         let starts = self.sort_by_colour();
         self.blocks.clear();
         self.colours.clear();
@@ -171,7 +180,7 @@ impl ContactLayout {
     }
 
     /// Each contact's colour into `colour_of`.
-    fn colour(&mut self, contacts: &[Contact], bodies: &BodyStore) {
+    fn colour(&mut self, contacts: &[Contact], bodies: &BodyStore, asleep: &[bool]) {
         self.body_colours.clear();
         self.body_colours.resize(bodies.capacity(), 0);
         self.colour_of.clear();
@@ -179,6 +188,11 @@ impl ContactLayout {
             |h: BodyHandle| (bodies.kind[h.index()] == BodyKind::Dynamic).then_some(h.index());
         for c in contacts {
             let ends = [dynamic(c.body_a), dynamic(c.body_b)];
+            // Between sleeping (or sleeping and still) bodies: not solved.
+            if ends.iter().flatten().all(|&b| asleep[b]) {
+                self.colour_of.push(ASLEEP as u8);
+                continue;
+            }
             let used = ends
                 .iter()
                 .flatten()
@@ -197,12 +211,12 @@ impl ContactLayout {
 
     /// `order` as the contacts sorted by colour, stably (a counting sort);
     /// returns where each colour starts in it, and its end.
-    fn sort_by_colour(&mut self) -> [usize; OVERFLOW + 2] {
-        let mut starts = [0usize; OVERFLOW + 2];
+    fn sort_by_colour(&mut self) -> [usize; ASLEEP + 2] {
+        let mut starts = [0usize; ASLEEP + 2];
         for &c in &self.colour_of {
             starts[c as usize + 1] += 1;
         }
-        for c in 0..=OVERFLOW {
+        for c in 0..=ASLEEP {
             starts[c + 1] += starts[c];
         }
         let mut next = starts;
@@ -315,7 +329,8 @@ mod tests {
                     kind(c.body_a) == BodyKind::Dynamic || kind(c.body_b) == BodyKind::Dynamic
                 })
                 .collect();
-            layout.rebuild(&contacts, world.bodies(), f32::INFINITY);
+            let asleep = vec![false; world.bodies().capacity()];
+            layout.rebuild(&contacts, world.bodies(), &asleep, f32::INFINITY);
             let (order, sizes) = scheduler_order(&contacts, world.bodies());
             assert_eq!(layout.order, order, "seed {seed}");
             assert!(sizes[OVERFLOW] > 0, "seed {seed}: the overflow set is used");

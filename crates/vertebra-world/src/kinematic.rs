@@ -43,6 +43,7 @@ impl World {
         self.bodies.set_kind(handle, kind)?;
         if before != kind {
             self.recolour(handle);
+            self.rejoin(handle, before);
         }
         Ok(())
     }
@@ -99,6 +100,24 @@ impl World {
         orientation: Quat,
         dt: f32,
     ) -> Result<(), Error> {
+        let (linear, angular) = self.kinematic_velocities(handle, position, orientation, dt)?;
+        self.bodies.set_velocity(handle, linear, angular)?;
+        self.stir(handle);
+        Ok(())
+    }
+
+    /// The linear (m/s) and angular (rad/s) velocities, world, that
+    /// [`World::move_kinematic`] would set for the same arguments, or its
+    /// refusal; changes nothing. A caller moving several bodies checks
+    /// them all first, so that a refused one leaves every body (and every
+    /// island's sleep) as it was.
+    pub fn kinematic_velocities(
+        &self,
+        handle: BodyHandle,
+        position: Vec3,
+        orientation: Quat,
+        dt: f32,
+    ) -> Result<(Vec3, Vec3), Error> {
         let _mode = DefaultFloatMode::enter();
         let i = self.bodies.index(handle)?;
         if self.bodies.kind[i] != BodyKind::Kinematic {
@@ -128,6 +147,6 @@ impl World {
                 "orientation (reaching it in dt needs more than max_angular_speed)",
             ));
         }
-        self.bodies.set_velocity(handle, linear, angular)
+        Ok((linear, angular))
     }
 }

@@ -1,7 +1,9 @@
-//! The solver's constraint layout: every joint in a lane of a block of its
-//! type, the blocks ordered by colour, then the overflow set. Rebuilt only
-//! when the colouring changes (a joint added or removed, a joined body's
-//! kind changed: lanes cache which bodies are dynamic), never per step.
+//! The solver's constraint layout: every awake joint in a lane of a block
+//! of its type, the blocks ordered by colour, then the overflow set. A
+//! sleeping island's joints keep their colours but are not laid out.
+//! Rebuilt only when the colouring changes (a joint added or removed, a
+//! joined body's kind changed: lanes cache which bodies are dynamic) or an
+//! island falls asleep or wakes, never per step.
 //!
 //! Colouring keys: a joint is its slot, a rod its slot plus [`ROD_KEY`].
 //! Each joint kind has its own blocks (sockets of the plain and the shaped
@@ -139,15 +141,25 @@ impl Layout {
         joints: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
+        asleep: &[bool],
     ) -> Self {
         let mut layout = Self::default();
+        let awake = |a: BodyHandle, b: BodyHandle| !(asleep[a.index()] || asleep[b.index()]);
+        let joints: Vec<_> = joints
+            .iter()
+            .map(|d| d.filter(|d| awake(d.body_a, d.body_b)))
+            .collect();
+        let rods: Vec<_> = rods
+            .iter()
+            .map(|d| d.filter(|d| awake(d.body_a, d.body_b)))
+            .collect();
         for c in 0..MAX_COLOURS {
-            let group = layout.append(colouring.colour(c), joints, rods, bodies);
+            let group = layout.append(colouring.colour(c), &joints, &rods, bodies);
             if !group.is_empty() {
                 layout.colours.push(group);
             }
         }
-        layout.overflow = layout.append(colouring.overflow(), joints, rods, bodies);
+        layout.overflow = layout.append(colouring.overflow(), &joints, &rods, bodies);
         let mut reads = Vec::new();
         layout.disjoint = layout
             .colours
@@ -210,6 +222,12 @@ impl Layout {
         (block.bend_lambda[lane], block.twist_lambda[lane]) = lambdas;
     }
 
+    /// The layout with its step started ([`Layout::start_step`]).
+    pub fn started(mut self, bodies: &BodyStore) -> Self {
+        self.start_step(bodies);
+        self
+    }
+
     /// Measures where every joint's bodies stand as the step begins (the
     /// rows then hold displacements from there): each socket's anchors,
     /// each rod's chord between centres of mass.
@@ -247,8 +265,14 @@ impl Layout {
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
     ) -> Group {
-        let joint = |slot: usize| joints[slot].as_ref().expect("coloured joints are live");
-        let joint_slots = || keys.iter().filter(|&&k| k < ROD_KEY).map(|&k| k as usize);
+        let joint = |slot: usize| joints[slot].as_ref().expect("awake joints are laid out");
+        // A sleeping joint is `None` here: coloured, not laid out.
+        let joint_slots = || {
+            keys.iter()
+                .filter(|&&k| k < ROD_KEY)
+                .map(|&k| k as usize)
+                .filter(|&s| joints[s].is_some())
+        };
         let sockets = |driven: bool, shaped: bool| {
             joint_slots().filter(move |&s| {
                 let d = joint(s);
@@ -299,13 +323,17 @@ impl Layout {
         let rod_slots = keys
             .iter()
             .filter(|&&k| k >= ROD_KEY)
-            .map(|&k| (k - ROD_KEY) as usize);
+            .map(|&k| (k - ROD_KEY) as usize)
+            .filter(|&s| rods[s].is_some());
         let rods = self
             .rods
             .append(rod_slots, RodBlock::padding(), |block, lane, slot| {
                 block.set(
                     lane,
-                    &rod_lane(rods[slot].as_ref().expect("coloured rods are live"), bodies),
+                    &rod_lane(
+                        rods[slot].as_ref().expect("awake rods are laid out"),
+                        bodies,
+                    ),
                 );
             });
         Group {

@@ -27,6 +27,7 @@ mod config;
 mod contact;
 mod drive;
 mod impulse;
+mod islands;
 mod joint;
 mod joint_wire;
 mod kinematic;
@@ -34,6 +35,7 @@ mod layout;
 mod metrics;
 mod parallel;
 mod rod;
+mod sleep;
 mod snapshot;
 mod step;
 mod tasks;
@@ -53,6 +55,7 @@ pub use drive::{
     AngularDrive, DriveStrength, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
     MIN_DRIVE_FREQUENCY,
 };
+pub use islands::SleepSettings;
 pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
@@ -83,6 +86,7 @@ pub struct World {
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
+    islands: islands::Islands,
     layout: layout::Layout,
     layout_dirty: bool,
     contacts: Vec<Contact>,
@@ -127,6 +131,7 @@ impl World {
             rod_slots: Slots::new(lineage),
             rods: Vec::new(),
             colouring: Colouring::new(),
+            islands: islands::Islands::default(),
             layout: layout::Layout::default(),
             layout_dirty: false,
             contacts: Vec::new(),
@@ -177,6 +182,9 @@ impl World {
             self.joints_at.resize(self.bodies.capacity(), 0);
         }
         self.joints_at[handle.index()] = 0;
+        let i = handle.index();
+        self.islands
+            .add_body(i, self.bodies.kind[i], self.bodies.capacity());
         Ok(handle)
     }
 
@@ -189,6 +197,7 @@ impl World {
         if self.joints_at[i] > 0 {
             return Err(Error::BodyInUse);
         }
+        self.layout_dirty |= self.islands.take_out(i);
         self.bodies.remove(handle)?;
         self.contacts
             .retain(|c| c.body_a != handle && c.body_b != handle);
@@ -208,7 +217,9 @@ impl World {
         orientation: Quat,
     ) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
-        self.bodies.set_pose(handle, position, orientation)
+        self.bodies.set_pose(handle, position, orientation)?;
+        self.stir(handle);
+        Ok(())
     }
 
     /// Sets a body's velocities (m/s, rad/s, world).
@@ -218,13 +229,17 @@ impl World {
         linear: Vec3,
         angular: Vec3,
     ) -> Result<(), Error> {
-        self.bodies.set_velocity(handle, linear, angular)
+        self.bodies.set_velocity(handle, linear, angular)?;
+        self.stir(handle);
+        Ok(())
     }
 
     /// Adds a force (N, world) through the centre of mass, for the next step.
     pub fn add_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
-        self.bodies.add_force(handle, force)
+        self.bodies.add_force(handle, force)?;
+        self.stir(handle);
+        Ok(())
     }
 
     /// Adds a force (N, world) at a world point (m), for the next step.
@@ -235,13 +250,17 @@ impl World {
         point: Vec3,
     ) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
-        self.bodies.add_force_at(handle, force, point)
+        self.bodies.add_force_at(handle, force, point)?;
+        self.stir(handle);
+        Ok(())
     }
 
     /// Adds a torque (N m, world), for the next step.
     pub fn add_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
-        self.bodies.add_torque(handle, torque)
+        self.bodies.add_torque(handle, torque)?;
+        self.stir(handle);
+        Ok(())
     }
 
     /// Applies a linear impulse (N s, world) through a dynamic body's
@@ -297,7 +316,9 @@ impl World {
     ) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         let limits = (self.config.max_linear_speed, self.config.max_angular_speed);
-        impulse::apply(&mut self.bodies, handle, linear, angular, limits)
+        impulse::apply(&mut self.bodies, handle, linear, angular, limits)?;
+        self.stir(handle);
+        Ok(())
     }
 
     /// Adds a joint; `Err` (and no change) for invalid input.
@@ -324,6 +345,8 @@ impl World {
         self.colouring.remove(handle.index() as u64);
         self.joints_at[desc.body_a.index()] -= 1;
         self.joints_at[desc.body_b.index()] -= 1;
+        self.islands
+            .unlink(desc.body_a.index(), desc.body_b.index());
         self.layout_dirty = true;
         Ok(())
     }
@@ -368,6 +391,8 @@ impl World {
         }
         desc.validate()?;
         self.rods[handle.index()] = Some(desc);
+        self.stir(desc.body_a);
+        self.stir(desc.body_b);
         if !self.layout_dirty {
             self.layout.update_rod(handle.index(), &desc, &self.bodies);
         }
@@ -386,6 +411,7 @@ impl World {
             .add(key, checks::dynamic_bodies(&self.bodies, a, b));
         self.joints_at[a.index()] += 1;
         self.joints_at[b.index()] += 1;
+        self.islands.link(a.index(), b.index());
         self.layout_dirty = true;
     }
 
@@ -394,6 +420,7 @@ impl World {
         self.colouring.remove(key);
         self.joints_at[a.index()] -= 1;
         self.joints_at[b.index()] -= 1;
+        self.islands.unlink(a.index(), b.index());
         self.layout_dirty = true;
     }
 
@@ -433,6 +460,8 @@ impl World {
         let regroup = desc.drive.is_some() != drive.is_some();
         desc.drive = drive;
         self.joints[handle.index()] = Some(desc);
+        self.stir(desc.body_a);
+        self.stir(desc.body_b);
         if regroup {
             // Driven and plain joints live in different blocks.
             self.layout_dirty = true;
@@ -505,8 +534,13 @@ impl World {
 
     fn refresh_layout(&mut self) {
         if self.layout_dirty {
-            self.layout =
-                layout::Layout::build(&self.colouring, &self.joints, &self.rods, &self.bodies);
+            self.layout = layout::Layout::build(
+                &self.colouring,
+                &self.joints,
+                &self.rods,
+                &self.bodies,
+                self.islands.asleep(),
+            );
             self.layout_dirty = false;
         }
     }
@@ -564,13 +598,18 @@ impl World {
             ));
         }
         let _mode = DefaultFloatMode::enter();
+        self.layout_dirty |= match self.config.sleep {
+            Some(_) => self.islands.touch(&self.contacts, &self.bodies),
+            None => self.islands.wake_all(),
+        };
         self.refresh_layout();
         let (max_linear, max_angular) =
             (self.config.max_linear_speed, self.config.max_angular_speed);
-        step::hold_speeds(&mut self.bodies, max_linear, max_angular);
+        step::hold_speeds(&mut self.bodies, &self.islands, max_linear, max_angular);
         let max_depth = self.config.max_push_out_speed * dt;
+        let asleep = self.islands.asleep();
         self.contact_layout
-            .rebuild(&self.contacts, &self.bodies, max_depth);
+            .rebuild(&self.contacts, &self.bodies, asleep, max_depth);
         // One entry into the task system per step: the colours' fork-joins
         // then run among its workers (see step::for_each_colour).
         // The step runs once whatever `enter` does: a second call does
@@ -586,6 +625,12 @@ impl World {
         };
         tasks.enter(&mut || once(self));
         once(self);
+        if let Some(settings) = &self.config.sleep {
+            let links = islands::links(&self.joints, &self.rods);
+            self.layout_dirty |=
+                self.islands
+                    .settle(settings, dt, &mut self.bodies, links, &self.contacts);
+        }
         self.contacts.clear();
         self.residuals_measured = self.config.measure_residuals;
         if self.residuals_measured {

@@ -10,6 +10,7 @@ use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyHandle, BodyStore, Slots};
 
 use crate::joint::{JointHandle, JointKind};
+use crate::layout::Layout;
 use crate::rod::RodHandle;
 use crate::{Contact, JointDesc, RodDesc, RodStiffness, World};
 
@@ -73,12 +74,31 @@ fn joint_residual<H>(joint: H, [lin, ang, limit]: [f32; 3]) -> JointResidual<H> 
     }
 }
 
-/// Measures every laid-out joint and rod at the rows' poses into
+/// Measures every joint and rod at the rows' poses into
 /// `world.residuals`, in slot order, reusing its vectors and the lane
-/// buffers (no allocation once they have grown to the world's size).
+/// buffers (no allocation once they have grown to the world's size, while
+/// no island sleeps). A sleeping island's joints are not laid out: while
+/// one sleeps, the measurement lays out every joint for itself.
 pub(crate) fn residuals(world: &mut World) {
+    let everything;
+    let layout = if world.islands.asleep().contains(&true) {
+        // Rows and layout both from the poses now (the rows held each
+        // awake body's motion since the step's start).
+        crate::step::upload(&world.bodies, world.rows.get());
+        let awake = vec![false; world.bodies.capacity()];
+        everything = Layout::build(
+            &world.colouring,
+            &world.joints,
+            &world.rods,
+            &world.bodies,
+            &awake,
+        )
+        .started(&world.bodies);
+        &everything
+    } else {
+        &world.layout
+    };
     let rows = &*world.rows.get();
-    let layout = &world.layout;
     let backend = world.backend;
     let lanes = &mut world.residual_lanes;
     measure(backend, &layout.sockets.blocks, rows, &mut lanes.sockets);
@@ -145,6 +165,9 @@ struct Hashed<'a> {
     rods: Vec<HashedRod<'a>>,
     /// The solve order.
     colouring: &'a Colouring,
+    /// Every body's island and stillness, every island's sleep and split
+    /// state.
+    islands: &'a crate::islands::Islands,
     /// The contacts set for the next step.
     contacts: &'a [Contact],
 }
@@ -217,6 +240,7 @@ pub(crate) fn state_hash(world: &World) -> u64 {
         rod_slots: &world.rod_slots,
         rods: world.rods.iter().map(HashedRod::from).collect(),
         colouring: &world.colouring,
+        islands: &world.islands,
         contacts: &world.contacts,
     };
     // Which world issued the handles, and their generations, change no

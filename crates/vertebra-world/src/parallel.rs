@@ -141,7 +141,8 @@ mod tests {
         let mut crafted = Colouring::new();
         crafted.add(0, [None, None]);
         crafted.add(1, [None, None]);
-        let layout = Layout::build(&crafted, &world.joints, &world.rods, &world.bodies);
+        let asleep = world.islands.asleep();
+        let layout = Layout::build(&crafted, &world.joints, &world.rods, &world.bodies, asleep);
         assert_eq!(layout.colours.len(), 1);
         assert!(!layout.disjoint);
     }

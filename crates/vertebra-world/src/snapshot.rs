@@ -3,7 +3,7 @@
 //!
 //! A snapshot holds everything a step reads that outlives a step: the body
 //! store (poses, velocities, masses, pending forces, slots), the joints and
-//! their slots, the colouring (its history decides the solve order, so it
+//! their slots, the islands and their sleep state, the colouring (its history decides the solve order, so it
 //! is saved, not rebuilt), and the contacts set for the next step. The
 //! block layout is rebuilt from those on the next step, exactly as it was
 //! built before: between steps every lane holds what its description lays
@@ -18,7 +18,7 @@
 //! not the snapshot's). To step on bit for bit as the original would have,
 //! the settings that change results must match: `substeps`, `iterations`,
 //! `gravity`, `max_push_out_speed`, `max_linear_speed`,
-//! `max_angular_speed`; `backend`, `threads` and `parallel_min_blocks` may
+//! `max_angular_speed`, `sleep`; `backend`, `threads` and `parallel_min_blocks` may
 //! differ (stepping is bit-identical across them). "The same build" is the
 //! same vertebra version and snapshot format; identity across compilers and
 //! targets is not promised (see `docs/robustness.md`).
@@ -45,7 +45,7 @@
 //! `Err(IncompatibleSnapshot)` for another build) and the world is
 //! unchanged.
 //!
-//! Bytes: `"VTBSNAP8"` (the format), the build id (u64 LE: a hash of the
+//! Bytes: `"VTBSNAP9"` (the format), the build id (u64 LE: a hash of the
 //! crate version and the format), the xxh3 hash of the payload (u64 LE),
 //! then the payload (postcard).
 
@@ -56,12 +56,13 @@ use serde::{Deserialize, Serialize};
 use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 
+use crate::islands::{Islands, links};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
 /// 8: rods' rest shapes gained their rates (`bend_rest_velocity`,
-/// `twist_rest_velocity`).
-const FORMAT: u8 = b'8';
+/// `twist_rest_velocity`). 9: islands and sleep state.
+const FORMAT: u8 = b'9';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
@@ -110,6 +111,7 @@ struct State {
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
+    islands: Islands,
     contacts: Vec<Contact>,
 }
 
@@ -199,6 +201,9 @@ impl State {
         self.colouring
             .validate(&edges, bodies.capacity())
             .map_err(|why| corrupt(format!("colouring: {why}")))?;
+        self.islands
+            .validate(bodies, links(&self.joints, &self.rods))
+            .map_err(corrupt)?;
         // A pending contact, too, may have lost its dynamic body to a kind
         // change since it was set.
         for (k, c) in self.contacts.iter().enumerate() {
@@ -261,6 +266,7 @@ impl World {
             rod_slots: self.rod_slots.clone(),
             rods: self.rods.clone(),
             colouring: self.colouring.clone(),
+            islands: self.islands.clone(),
             contacts: self.contacts.clone(),
         };
         Snapshot {
@@ -289,6 +295,8 @@ impl World {
         self.rod_slots = state.rod_slots;
         self.rods = state.rods;
         self.colouring = state.colouring;
+        self.islands = state.islands;
+        self.islands.derive();
         self.contacts = state.contacts;
         self.layout_dirty = true;
         self.measure_residuals();
@@ -301,6 +309,7 @@ mod tests {
     use glam::{Quat, Vec3};
 
     use super::*;
+    use crate::islands::NO_ISLAND;
     use crate::{
         AngularDrive, BodyDesc, BodyKind, JointKind, LimitSoftness, RodStiffness, Shape,
         SolverConfig, Swing, SwingTwist,
@@ -602,6 +611,43 @@ mod tests {
             (
                 Box::new(|s| s.contacts[0].body_b = s.contacts[0].body_a),
                 "contact 0: a joint needs two different bodies",
+            ),
+            (
+                Box::new(|s| {
+                    s.islands.of.pop();
+                }),
+                "islands: per-body arrays for 5 body slots",
+            ),
+            (
+                Box::new(|s| s.islands.of[0] = 0),
+                "body 0: in an island but not dynamic",
+            ),
+            (
+                Box::new(|s| s.islands.of[1] = NO_ISLAND),
+                "body 1: dynamic in no island",
+            ),
+            (
+                Box::new(|s| s.islands.of[2] = 1),
+                "body 2: in island 1, which is not live",
+            ),
+            (
+                Box::new(|s| s.islands.still[3] = NAN),
+                "body 3: stillness NaN",
+            ),
+            (
+                Box::new(|s| s.islands.anchor[3].0.x = f64::INFINITY),
+                "body 3: stillness anchor not finite",
+            ),
+            (
+                Box::new(|s| s.islands.islands[1].live = true),
+                "island 1: live without bodies, or free with them",
+            ),
+            (
+                Box::new(|s| {
+                    s.islands.islands[1].live = true;
+                    s.islands.of[3] = 1;
+                }),
+                "bodies 2 and 3: linked but in islands 0 and 1",
             ),
         ];
         for (change, expected) in cases {

@@ -15,6 +15,7 @@ use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
 
 use crate::World;
+use crate::islands::Islands;
 use crate::joint::JointKind;
 use crate::parallel::chunked;
 use crate::tasks::TaskSystem;
@@ -61,7 +62,7 @@ pub(crate) fn step(world: &mut World, dt: f32) {
         }
         derive_velocities(world, h);
         solve_velocities(world, h);
-        damp(&mut world.bodies, h);
+        damp(&mut world.bodies, &world.islands, h);
         world.repaired += repair(world);
     }
     commit(world);
@@ -135,6 +136,9 @@ fn keep_drive_targets(world: &mut World) {
     let layout = &mut world.layout;
     for (slot, desc) in world.joints.iter_mut().enumerate() {
         let Some(desc) = desc.as_mut() else { continue };
+        if world.islands.holds_asleep(desc.body_a, desc.body_b) {
+            continue; // not laid out
+        }
         let Some(drive) = desc.drive.as_mut() else {
             continue;
         };
@@ -165,6 +169,9 @@ fn keep_rod_rests(world: &mut World) {
     let layout = &mut world.layout;
     for (slot, desc) in world.rods.iter_mut().enumerate() {
         let Some(desc) = desc.as_mut() else { continue };
+        if world.islands.holds_asleep(desc.body_a, desc.body_b) {
+            continue; // not laid out
+        }
         let (bend, twist) = (
             desc.bend_rest_velocity != Vec3::ZERO,
             desc.twist_rest_velocity != 0.0,
@@ -216,9 +223,9 @@ fn pose(rows: &BodyRows, i: usize) -> (Vec3, Quat) {
 /// precision (`BodyStore::displace`: the coordinate keeps what an `f32`
 /// cannot hold, and the world's edge holds bodies in).
 fn commit(world: &mut World) {
-    let b = &mut world.bodies;
+    let (b, islands) = (&mut world.bodies, &world.islands);
     for i in 0..b.capacity() {
-        if b.is_live(i) && b.kind[i] != BodyKind::Static {
+        if b.is_live(i) && b.kind[i] != BodyKind::Static && !islands.is_asleep(i) {
             let (displacement, orientation) = pose(world.rows.get(), i);
             b.displace(i, displacement);
             b.orientation[i] = orientation;
@@ -236,9 +243,9 @@ fn predict(world: &mut World, h: f32) {
         world.config.max_linear_speed,
         world.config.max_angular_speed,
     );
-    let b = &mut world.bodies;
+    let (b, islands) = (&mut world.bodies, &world.islands);
     for i in 0..b.capacity() {
-        if !b.is_live(i) || b.kind[i] == BodyKind::Static {
+        if !b.is_live(i) || b.kind[i] == BodyKind::Static || islands.is_asleep(i) {
             continue;
         }
         // The speed limits, before and after the forces: huge but finite
@@ -271,9 +278,9 @@ fn predict(world: &mut World, h: f32) {
 /// begins: the contacts measure their approach speed from them before any
 /// substep has held them (an accepted spin of 1e38 rad/s overflowed
 /// `w x r` there and turned both bodies NaN).
-pub(crate) fn hold_speeds(b: &mut BodyStore, max_linear: f32, max_angular: f32) {
+pub(crate) fn hold_speeds(b: &mut BodyStore, islands: &Islands, max_linear: f32, max_angular: f32) {
     for i in 0..b.capacity() {
-        if b.is_live(i) && b.kind[i] != BodyKind::Static {
+        if b.is_live(i) && b.kind[i] != BodyKind::Static && !islands.is_asleep(i) {
             b.linear_velocity[i] = limit(b.linear_velocity[i], max_linear);
             b.angular_velocity[i] = limit(b.angular_velocity[i], max_angular);
         }
@@ -559,9 +566,9 @@ fn solve_velocities(world: &mut World, h: f32) {
         world.config.max_linear_speed,
         world.config.max_angular_speed,
     );
-    let b = &mut world.bodies;
+    let (b, islands) = (&mut world.bodies, &world.islands);
     for i in 0..b.capacity() {
-        if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
+        if b.is_live(i) && b.kind[i] == BodyKind::Dynamic && !islands.is_asleep(i) {
             let [vx, vy, vz, _, wx, wy, wz, _] = world.rows.get().velocity[i + 1].get();
             b.linear_velocity[i] = limit(Vec3::new(vx, vy, vz), max_linear);
             b.angular_velocity[i] = limit(Vec3::new(wx, wy, wz), max_angular);
@@ -578,9 +585,9 @@ fn derive_velocities(world: &mut World, h: f32) {
         world.config.max_linear_speed,
         world.config.max_angular_speed,
     );
-    let b = &mut world.bodies;
+    let (b, islands) = (&mut world.bodies, &world.islands);
     for i in 0..b.capacity() {
-        if !b.is_live(i) || b.kind[i] != BodyKind::Dynamic {
+        if !b.is_live(i) || b.kind[i] != BodyKind::Dynamic || islands.is_asleep(i) {
             continue;
         }
         let (d, q) = pose(world.rows.get(), i);
@@ -623,9 +630,9 @@ fn repair(world: &mut World) -> u64 {
 }
 
 /// Linear and angular damping: `v /= 1 + h c`.
-fn damp(b: &mut BodyStore, h: f32) {
+fn damp(b: &mut BodyStore, islands: &Islands, h: f32) {
     for i in 0..b.capacity() {
-        if b.is_live(i) && b.kind[i] == BodyKind::Dynamic {
+        if b.is_live(i) && b.kind[i] == BodyKind::Dynamic && !islands.is_asleep(i) {
             b.linear_velocity[i] /= 1.0 + h * b.linear_damping[i];
             b.angular_velocity[i] /= 1.0 + h * b.angular_damping[i];
         }

@@ -24,6 +24,9 @@ fn rig(mass: f32, drive: AngularDrive) -> (World, BodyHandle, JointHandle) {
         substeps: SUBSTEPS,
         iterations: 4,
         gravity: Vec3::ZERO,
+        // The drive's own response: a slow drive would sleep within
+        // `linear_speed / omega` of its target.
+        sleep: None,
         ..SolverConfig::default()
     })
     .unwrap();

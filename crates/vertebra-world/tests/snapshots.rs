@@ -145,6 +145,7 @@ fn another_world_restores_a_snapshot_takes_on_its_handles_and_steps_on_bit_for_b
             iterations: 8,
             threads: 2,
             backend: BackendChoice::Forced(Backend::Scalar),
+            sleep: None,
             ..SolverConfig::default()
         })
         .unwrap();

@@ -43,11 +43,14 @@ pub fn hanging_chain(
     (bodies, sockets)
 }
 
-/// A world with `substeps` and `iterations`, otherwise default.
+/// A world with `substeps` and `iterations`, otherwise default, that
+/// never sleeps: these tests measure responses to their end, and a small
+/// slow oscillation or a slow return would fall asleep short of it.
 pub fn world(substeps: u32, iterations: u32) -> World {
     World::new(SolverConfig {
         substeps,
         iterations,
+        sleep: None,
         ..SolverConfig::default()
     })
     .expect("valid config")
