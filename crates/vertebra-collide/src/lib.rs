@@ -214,7 +214,21 @@ struct Detection {
     pairs: Vec<(usize, usize)>,
     /// Parry's output for one pair.
     manifolds: Vec<ContactManifold<(), ()>>,
+    /// Each collider's body moves on its own (awake and dynamic, or
+    /// kinematic with a velocity).
+    acts: Vec<bool>,
+    /// Each collider's body's island while it sleeps, else `NO_ISLAND`.
+    asleep_in: Vec<u32>,
+    /// Per island id: [`UNTOUCHED`], [`WAKING`] (touched by the last
+    /// round's contacts: its pairs are found in this round) or [`DONE`].
+    islands: Vec<u8>,
 }
+
+/// A collider whose body does not sleep.
+const NO_ISLAND: u32 = u32::MAX;
+const UNTOUCHED: u8 = 0;
+const WAKING: u8 = 1;
+const DONE: u8 = 2;
 
 /// Makes `manifolds` what parry gets for a new pair (at most one manifold,
 /// as new: every query starts from the same state, whatever pair came
@@ -499,7 +513,52 @@ impl Collisions {
                 .reach
                 .push((s.linear_velocity.length() + s.angular_velocity.length() * extent) * dt);
         }
-        self.candidate_pairs(world, scratch);
+        self.sleep_state(world, scratch)?;
+        self.bounds(scratch);
+        // Pairs where a body moves; then, round after round, the pairs of
+        // the sleeping islands those contacts touch (the step wakes them,
+        // and they need their contacts with the ground and each other).
+        let mut first = true;
+        loop {
+            self.candidate_pairs(world, scratch, first);
+            first = false;
+            let from = contacts.len();
+            self.narrow(scratch, contacts);
+            if !wake_touched(scratch, world, &contacts[from..]) {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Each collider's body's sleep state into `scratch`.
+    fn sleep_state(&self, world: &World, scratch: &mut Detection) -> Result<(), Error> {
+        scratch.acts.clear();
+        scratch.asleep_in.clear();
+        scratch.islands.clear();
+        for (index, (c, _)) in self.colliders.iter().enumerate() {
+            let refused = |e| c.refused(index, e);
+            let s = world.body(c.body).map_err(refused)?;
+            let asleep = world.is_asleep(c.body).map_err(refused)?;
+            let moving = s.linear_velocity != Vec3::ZERO || s.angular_velocity != Vec3::ZERO;
+            scratch
+                .acts
+                .push(match world.bodies().kind[c.body.index()] {
+                    BodyKind::Dynamic => !asleep,
+                    BodyKind::Kinematic => moving,
+                    BodyKind::Static => false,
+                });
+            let island = world.island(c.body).map_err(refused)?.filter(|_| asleep);
+            let island = island.unwrap_or(NO_ISLAND);
+            if island != NO_ISLAND && scratch.islands.len() <= island as usize {
+                scratch.islands.resize(island as usize + 1, UNTOUCHED);
+            }
+            scratch.asleep_in.push(island);
+        }
+        Ok(())
+    }
+
+    /// Every pair's contacts into `contacts` (appended).
+    fn narrow(&self, scratch: &mut Detection, contacts: &mut Vec<Contact>) {
         let (poses, reach) = (&scratch.poses, &scratch.reach);
         for &(i, j) in &scratch.pairs {
             let ((ci, si), (cj, sj)) = (&self.colliders[i], &self.colliders[j]);
@@ -540,13 +599,10 @@ impl Collisions {
                 );
             }
         }
-        Ok(())
     }
 
-    /// Into `scratch.pairs`, the pairs of collider indices whose bounds
-    /// overlap and that may collide: sort-and-sweep along x for solids,
-    /// every solid against every plane.
-    fn candidate_pairs(&self, world: &World, scratch: &mut Detection) {
+    /// Each collider's bounds, and the solids in sweep order.
+    fn bounds(&self, scratch: &mut Detection) {
         let (poses, reach) = (&scratch.poses, &scratch.reach);
         scratch.aabbs.clear();
         scratch.aabbs.extend((0..self.colliders.len()).map(|k| {
@@ -564,6 +620,16 @@ impl Collisions {
         // order is the one a stable sort gives.
         solids
             .sort_unstable_by(|&a, &b| aabbs[a].mins.x.total_cmp(&aabbs[b].mins.x).then(a.cmp(&b)));
+    }
+
+    /// Into `scratch.pairs`, the pairs of collider indices whose bounds
+    /// overlap and that may collide (sort-and-sweep along x for solids,
+    /// every solid against every plane), of this round: in the `first`,
+    /// those with a body that moves on its own; in each later one, those
+    /// of the islands the last round woke (and of no island woken before).
+    fn candidate_pairs(&self, world: &World, scratch: &mut Detection, first: bool) {
+        let (aabbs, solids) = (&scratch.aabbs, &scratch.solids);
+        let is_plane = |k: usize| matches!(self.colliders[k].0.shape, ColliderShape::Plane(_));
         let pairs = &mut scratch.pairs;
         pairs.clear();
         for (n, &a) in solids.iter().enumerate() {
@@ -579,7 +645,22 @@ impl Collisions {
         for plane in (0..self.colliders.len()).filter(|&k| is_plane(k)) {
             pairs.extend(solids.iter().map(|&s| (plane.min(s), plane.max(s))));
         }
-        pairs.retain(|&(a, b)| self.may_collide(world, a, b));
+        let (acts, asleep_in, islands) = (&scratch.acts, &scratch.asleep_in, &scratch.islands);
+        let mark = |k: usize| {
+            let island = asleep_in[k];
+            (island != NO_ISLAND).then(|| islands[island as usize])
+        };
+        let in_round = |a: usize, b: usize| {
+            if first {
+                return acts[a] || acts[b];
+            }
+            let (ma, mb) = (mark(a), mark(b));
+            !(acts[a] || acts[b])
+                && (ma == Some(WAKING) || mb == Some(WAKING))
+                && ma != Some(DONE)
+                && mb != Some(DONE)
+        };
+        pairs.retain(|&(a, b)| in_round(a, b) && self.may_collide(world, a, b));
         pairs.sort_unstable();
     }
 
@@ -593,6 +674,37 @@ impl Collisions {
             && cb.groups.membership & ca.groups.filter != 0
             && !self.kept_apart(ca.body, cb.body)
     }
+}
+
+/// Marks the sleeping islands `found` touches (the step will wake them) as
+/// waking, and those that were waking as done; true when any island is
+/// newly waking.
+fn wake_touched(scratch: &mut Detection, world: &World, found: &[Contact]) -> bool {
+    for mark in &mut scratch.islands {
+        if *mark == WAKING {
+            *mark = DONE;
+        }
+    }
+    // The contacts' bodies are live: they were just read.
+    let marks = scratch.islands.len();
+    let island_of = |body: BodyHandle| {
+        let asleep = world.is_asleep(body).unwrap_or(false);
+        let island = world.island(body).ok().flatten().filter(|_| asleep)?;
+        Some(island as usize).filter(|&k| k < marks)
+    };
+    let mut woke = false;
+    for c in found {
+        for island in [island_of(c.body_a), island_of(c.body_b)]
+            .into_iter()
+            .flatten()
+        {
+            if scratch.islands[island] == UNTOUCHED {
+                scratch.islands[island] = WAKING;
+                woke = true;
+            }
+        }
+    }
+    woke
 }
 
 /// A half space against a box or capsule (the ground under a body), into
