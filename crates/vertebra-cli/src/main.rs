@@ -17,6 +17,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
 use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, Seeded};
+use vertebra_world::SleepSettings;
 
 use skeleton_csv::{Failed, SkeletonCsv};
 
@@ -90,6 +91,11 @@ enum Command {
         /// figure's median and spread over them.
         #[arg(long)]
         seeds: Option<u64>,
+        /// Let still islands sleep (the world's default thresholds: 0.05
+        /// m/s and 0.05 rad/s on average over 0.5 s). Off by default: the
+        /// paper's figures step every body every frame.
+        #[arg(long)]
+        sleep: bool,
         /// One JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -185,6 +191,7 @@ fn execute(command: Command) -> Result<(), String> {
             damping_ratio,
             max_torque,
             seeds,
+            sleep,
             json,
             skeleton_out,
         } => {
@@ -213,6 +220,7 @@ fn execute(command: Command) -> Result<(), String> {
             config.drive_frequency = drive_frequency;
             config.drive_damping_ratio = damping_ratio;
             config.max_torque = max_torque;
+            config.sleep = sleep.then(SleepSettings::default);
             if let (Some(_), Some(_)) = (seeds, &skeleton_out) {
                 return Err("--skeleton-out writes one run; not with --seeds".to_owned());
             }

@@ -57,6 +57,7 @@ fn setting_json(config: &SceneConfig, run: &SceneRun) -> serde_json::Map<String,
         "substeps": config.substeps,
         "backend": run.backend.name(),
         "threads": config.threads,
+        "sleep": config.sleep.is_some(),
     }) else {
         unreachable!("a JSON object literal")
     };

@@ -34,6 +34,7 @@ fn scene_json_has_every_field() {
         "substeps",
         "backend",
         "threads",
+        "sleep",
         "seed",
         "frames",
         "summary",
@@ -44,6 +45,7 @@ fn scene_json_has_every_field() {
     assert_eq!(v["scene"], "passive-bending");
     assert_eq!(v["spine"], "rod");
     assert_eq!(v["iterations"], 20);
+    assert_eq!(v["sleep"], false, "the paper's scenes do not sleep");
     let frames = v["frames"].as_array().unwrap();
     assert_eq!(frames.len(), 12);
     assert!(

@@ -1,7 +1,7 @@
 //! How to run a scene: spine, solver settings, ragdoll, seed.
 
 use vertebra_ragdoll::{DriveSettings, RagdollDesc, RagdollError, SpineMode, Strength};
-use vertebra_world::{BackendChoice, SolverConfig, World};
+use vertebra_world::{BackendChoice, SleepSettings, SolverConfig, World};
 
 use crate::Scene;
 
@@ -47,6 +47,10 @@ pub struct SceneConfig {
     ///
     /// [`SceneWorld::measure`]: crate::SceneWorld::measure
     pub measure_residuals: bool,
+    /// When islands fall asleep (`SolverConfig::sleep`). Off (`None`) in
+    /// [`SceneConfig::new`]: the paper's figures, and the engines they are
+    /// compared with, step every body at every frame.
+    pub sleep: Option<SleepSettings>,
 }
 
 impl SceneConfig {
@@ -67,6 +71,7 @@ impl SceneConfig {
             drive_damping_ratio: 1.0,
             max_torque: f32::INFINITY,
             measure_residuals: true,
+            sleep: None,
         }
     }
 
@@ -110,6 +115,7 @@ impl SceneConfig {
             backend: self.backend,
             threads: self.threads,
             measure_residuals: self.measure_residuals,
+            sleep: self.sleep,
             ..SolverConfig::default()
         };
         Ok(World::new(config)?)
