@@ -58,6 +58,8 @@ pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTw
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
 pub use snapshot::Snapshot;
+#[cfg(feature = "stage-timing")]
+pub use stages::timing as stage_timing;
 pub use tasks::{RayonTasks, SingleThreaded, TaskSystem};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{

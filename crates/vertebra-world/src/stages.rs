@@ -71,6 +71,8 @@ impl Stages {
             *c.done.get_mut() = 0;
         }
         *self.poisoned.get_mut() = false;
+        #[cfg(feature = "stage-timing")]
+        timing::launch();
         let (counters, poisoned) = (&self.counters[..count], &self.poisoned);
         let worker = || {
             // A worker starts in whatever mode its creator had.
@@ -133,6 +135,8 @@ impl Cursor<'_> {
             if chunk >= chunks {
                 break;
             }
+            #[cfg(feature = "stage-timing")]
+            let started = std::time::Instant::now();
             for part in parts {
                 if chunk < part.chunks() {
                     part.run(chunk);
@@ -140,6 +144,8 @@ impl Cursor<'_> {
                 }
                 chunk -= part.chunks();
             }
+            #[cfg(feature = "stage-timing")]
+            timing::chunk(index, started.elapsed());
             // Release: this chunk's writes are seen by whoever sees it done.
             stage.done.fetch_add(1, Ordering::Release);
         }
@@ -200,7 +206,13 @@ impl<'s, 'a, B, F> BlockChunks<'s, 'a, B, F> {
     /// # Safety
     /// No other part of the stage this part is given to may lend any of
     /// these blocks.
-    pub unsafe fn new(blocks: &'s SharedBlocks<'a, B>, range: Range<usize>, size: usize, run: F) -> Self {
+    // SAFETY: unsafe to call: `run` below relies on this contract.
+    pub unsafe fn new(
+        blocks: &'s SharedBlocks<'a, B>,
+        range: Range<usize>,
+        size: usize,
+        run: F,
+    ) -> Self {
         assert!(range.start <= range.end && range.end <= blocks.len);
         Self {
             blocks,
@@ -218,14 +230,15 @@ impl<B: Send, F: Fn(&mut [B]) + Sync> Part for BlockChunks<'_, '_, B, F> {
     fn run(&self, chunk: usize) {
         let start = self.range.start + chunk * self.size;
         let end = (start + self.size).min(self.range.end);
-        // SAFETY: a stage hands each chunk of each part to one worker once,
-        // the chunks of a part do not overlap, the parts of a stage lend
-        // different blocks (`new`'s contract), and a
-        // stage starts only when the one before it has finished (the
-        // counters' release and acquire order every chunk of one stage
-        // before every chunk of the next): no two workers hold the same
-        // block at once.
-        (self.run)(unsafe { self.blocks.range(start..end) })
+        // A stage hands each chunk of each part to one worker once, the
+        // chunks of a part do not overlap, the parts of a stage lend
+        // different blocks (`new`'s contract), and a stage starts only
+        // when the one before it has finished (the counters' release and
+        // acquire order every chunk of one stage before every chunk of
+        // the next).
+        // SAFETY: so no two workers hold the same block at once.
+        let blocks = unsafe { self.blocks.range(start..end) };
+        (self.run)(blocks)
     }
 }
 
@@ -253,6 +266,7 @@ impl<'a, B> SharedBlocks<'a, B> {
     /// No other reference to any of these blocks may be alive while the
     /// result is.
     #[allow(clippy::mut_from_ref)]
+    // SAFETY: unsafe to call: the result is a `&mut` to blocks others hold.
     unsafe fn range(&self, range: Range<usize>) -> &mut [B] {
         assert!(range.start <= range.end && range.end <= self.len);
         // SAFETY: the range lies inside the lent slice (asserted), which
@@ -266,3 +280,56 @@ impl<'a, B> SharedBlocks<'a, B> {
 // block by one thread at a time (`Cursor::blocks`): sound to share when a
 // `&mut [B]` may be sent, that is when `B: Send`.
 unsafe impl<B: Send> Sync for SharedBlocks<'_, B> {}
+
+/// Each chunk's time, for simulating the stages on more cores than the
+/// machine has (`benches/stages.rs`); only with the `stage-timing`
+/// feature, which no release build needs.
+#[cfg(feature = "stage-timing")]
+pub mod timing {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{Mutex, PoisonError};
+    use std::time::Duration;
+
+    /// One launch (a substep): for each stage in order, the time each of
+    /// its chunks took, in the order they were claimed.
+    pub type Launch = Vec<Vec<Duration>>;
+
+    static RECORDING: AtomicBool = AtomicBool::new(false);
+    static LAUNCHES: Mutex<Vec<Launch>> = Mutex::new(Vec::new());
+
+    /// Starts recording (what was recorded before is dropped).
+    pub fn start() {
+        LAUNCHES
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clear();
+        RECORDING.store(true, Ordering::SeqCst);
+    }
+
+    /// Stops recording, and returns every launch since [`start`].
+    pub fn stop() -> Vec<Launch> {
+        RECORDING.store(false, Ordering::SeqCst);
+        core::mem::take(&mut *LAUNCHES.lock().unwrap_or_else(PoisonError::into_inner))
+    }
+
+    /// A launch begins.
+    pub(crate) fn launch() {
+        if RECORDING.load(Ordering::Relaxed) {
+            let mut launches = LAUNCHES.lock().unwrap_or_else(PoisonError::into_inner);
+            launches.push(Vec::new());
+        }
+    }
+
+    /// A chunk of stage `stage` of the current launch took `time`.
+    pub(crate) fn chunk(stage: usize, time: Duration) {
+        if RECORDING.load(Ordering::Relaxed) {
+            let mut launches = LAUNCHES.lock().unwrap_or_else(PoisonError::into_inner);
+            if let Some(launch) = launches.last_mut() {
+                if launch.len() <= stage {
+                    launch.resize(stage + 1, Vec::new());
+                }
+                launch[stage].push(time);
+            }
+        }
+    }
+}

@@ -462,7 +462,6 @@ impl Pass for Velocities {
     }
 }
 
-
 /// The most chunks a body pass is split into.
 const MAX_BODY_CHUNKS: usize = 64;
 
@@ -538,10 +537,13 @@ fn solve_substep(world: &mut World, h: f32) -> u64 {
     let config = &world.config;
     let b = &mut world.bodies;
     let n = b.capacity();
-    let size = n
-        .div_ceil(MAX_BODY_CHUNKS)
-        .max(n.div_ceil(workers.saturating_mul(CHUNKS_PER_WORKER)))
-        .max(1);
+    let size = if workers > 1 {
+        n.div_ceil(MAX_BODY_CHUNKS)
+            .max(n.div_ceil(workers.saturating_mul(CHUNKS_PER_WORKER)))
+    } else {
+        n
+    }
+    .max(1);
     let mut body_chunks: [Mutex<Option<BodyChunk>>; MAX_BODY_CHUNKS] =
         core::array::from_fn(|_| Mutex::new(None));
     let chunks = (b.linear_velocity.chunks_mut(size))
@@ -708,21 +710,25 @@ impl Substep<'_> {
             blocks
         };
         let rows = &self.rows;
-        // SAFETY (each `BlockChunks::new` below): the ranges of a group
-        // do not overlap (the layout lays each kind's blocks out one
-        // range after another), and the parts lend four different vectors.
+        // The parts of one stage lend blocks of four different vectors,
+        // and a group's ranges of one vector do not overlap (the layout
+        // lays each kind's blocks out one range after another).
         let sockets = socket_ranges.map(|(range, driven, shaped)| {
             let kind = SocketBlocks { driven, shaped };
             let run = move |c: &mut [SocketBlock]| pass.sockets(c, kind, rows.rows(), backend);
+            // SAFETY: no other part lends these blocks (above).
             unsafe { BlockChunks::new(&self.sockets, range.clone(), size, run) }
         });
         let hinges = hinge_ranges.map(|(range, driven)| {
             let run = move |c: &mut [HingeBlock]| pass.hinges(c, driven, rows.rows(), backend);
+            // SAFETY: no other part lends these blocks (above).
             unsafe { BlockChunks::new(&self.hinges, range.clone(), size, run) }
         });
         let run = |c: &mut [FixedBlock]| pass.fixed(c, rows.rows(), backend);
+        // SAFETY: no other part lends these blocks (above).
         let fixed = unsafe { BlockChunks::new(&self.fixed, group.fixed.clone(), size, run) };
         let run = |c: &mut [RodBlock]| pass.rods(c, rows.rows(), backend);
+        // SAFETY: no other part lends these blocks (above).
         let rods = unsafe { BlockChunks::new(&self.rods, group.rods.clone(), size, run) };
         let [s0, s1, s2, s3] = &sockets;
         let [h0, h1] = &hinges;

@@ -79,12 +79,9 @@ impl TaskSystem for RayonTasks {
 
     fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync)) {
         use rayon::prelude::*;
-        if count == self.pool.current_num_threads() {
-            // One item on each worker, each woken directly.
-            self.pool.broadcast(|context| task(context.index()));
-        } else {
-            self.pool
-                .install(|| (0..count).into_par_iter().for_each(task));
-        }
+        // One job into the pool (`install`, which allocates nothing but a
+        // slot of the pool's injector queue), split among the workers.
+        self.pool
+            .install(|| (0..count).into_par_iter().for_each(task));
     }
 }
