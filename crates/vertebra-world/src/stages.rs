@@ -333,3 +333,100 @@ pub mod timing {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    use super::*;
+
+    /// How a task system runs the items it is given.
+    #[derive(Clone, Copy, Debug)]
+    enum Runs {
+        /// Each on its own thread, at once.
+        AtOnce,
+        /// One after another on the caller, last first.
+        Reversed,
+        /// Each twice at once on two threads.
+        Twice,
+        /// None of them.
+        Nothing,
+    }
+
+    struct Tasks(Runs);
+
+    impl TaskSystem for Tasks {
+        fn workers(&self) -> usize {
+            4
+        }
+        fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync)) {
+            match self.0 {
+                Runs::AtOnce => std::thread::scope(|s| {
+                    for i in 0..count {
+                        s.spawn(move || task(i));
+                    }
+                }),
+                Runs::Reversed => (0..count).rev().for_each(task),
+                Runs::Twice => std::thread::scope(|s| {
+                    for i in 0..count {
+                        s.spawn(move || task(i));
+                        s.spawn(move || task(i));
+                    }
+                }),
+                Runs::Nothing => {}
+            }
+        }
+    }
+
+    const STAGES: usize = 40;
+    const CHUNKS: usize = 7;
+
+    #[test]
+    fn every_chunk_runs_once_after_every_chunk_of_the_stage_before() {
+        for runs in [Runs::AtOnce, Runs::Reversed, Runs::Twice, Runs::Nothing] {
+            let counts: Vec<AtomicUsize> =
+                (0..STAGES * CHUNKS).map(|_| AtomicUsize::new(0)).collect();
+            let out_of_order = AtomicUsize::new(0);
+            let walk = |cursor: &mut Cursor| {
+                for stage in 0..STAGES {
+                    // Stages of 1 to 7 chunks, in two parts.
+                    let first = stage % CHUNKS;
+                    let run = |chunk: usize| {
+                        let mut before = stage.saturating_sub(1) * CHUNKS..stage * CHUNKS;
+                        if before.any(|c| counts[c].load(Ordering::Acquire) != 1) {
+                            out_of_order.fetch_add(1, Ordering::Relaxed);
+                        }
+                        counts[stage * CHUNKS + chunk].fetch_add(1, Ordering::AcqRel);
+                    };
+                    let head = Chunks(first, run);
+                    let tail = Chunks(CHUNKS - first, |chunk: usize| run(first + chunk));
+                    cursor.stage(&[&head, &tail]);
+                }
+            };
+            Stages::default().run(&Tasks(runs), &walk);
+            assert!(
+                counts.iter().all(|c| c.load(Ordering::Relaxed) == 1),
+                "{runs:?}: every chunk once"
+            );
+            assert_eq!(out_of_order.load(Ordering::Relaxed), 0, "{runs:?}");
+        }
+    }
+
+    #[test]
+    fn counters_grow_to_the_longest_launch_and_are_reset_for_the_next() {
+        let mut stages = Stages::default();
+        for count in [3, 9, 5] {
+            let runs = AtomicUsize::new(0);
+            let walk = |cursor: &mut Cursor| {
+                for _ in 0..count {
+                    cursor.stage(&[&Chunks(2, |_| {
+                        runs.fetch_add(1, Ordering::Relaxed);
+                    })]);
+                }
+            };
+            stages.run(&Tasks(Runs::AtOnce), &walk);
+            assert_eq!(runs.load(Ordering::Relaxed), 2 * count);
+        }
+        assert_eq!(stages.counters.len(), 9);
+    }
+}

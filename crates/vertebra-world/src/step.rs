@@ -2,6 +2,10 @@
 //! passes, derive velocities, run the velocity pass, damp (XPBD for rigid
 //! bodies, Müller et al. 2020, algorithm 2).
 
+use core::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, PoisonError};
+
 use glam::{Quat, Vec3};
 use vertebra_kernels::body::BodyRows;
 use vertebra_kernels::contact::{self, ContactBlock};
@@ -13,10 +17,6 @@ use vertebra_kernels::rod::{self, RodBlock};
 use vertebra_kernels::socket::{PositionPass, SocketBlock};
 use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
-
-use core::ops::Range;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, PoisonError};
 
 use crate::World;
 use crate::joint::JointKind;
