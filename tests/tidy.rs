@@ -74,10 +74,16 @@ fn intrinsics_only_in_lane_types_and_gather_scatter() {
     }
 }
 
-/// Besides the intrinsics, `unsafe` has one other home: the one claim that
+/// Besides the intrinsics, `unsafe` has one other home: the claims that
 /// body rows (not `Sync`) may be shared by the threads solving a colour,
-/// with the check that makes it sound (docs/architecture.md, invariants).
-const SHARED_ROWS_FILE: &str = "crates/vertebra-world/src/parallel.rs";
+/// with the check that makes it sound (docs/architecture.md, invariants),
+/// and that a stage's blocks are lent to one worker at a time (the solver
+/// stages, and the step's colours made into stages).
+const SHARED_FILES: [&str; 3] = [
+    "crates/vertebra-world/src/parallel.rs",
+    "crates/vertebra-world/src/stages.rs",
+    "crates/vertebra-world/src/step.rs",
+];
 
 /// And a test's own global allocator, counting allocations on its way to
 /// the system's (the proof that a steady step allocates nothing).
@@ -100,7 +106,7 @@ fn every_unsafe_block_says_why_and_stays_where_intrinsics_are() {
             }
             assert!(
                 INTRINSIC_FILES.contains(&path.as_str())
-                    || path == SHARED_ROWS_FILE
+                    || SHARED_FILES.contains(&path.as_str())
                     || path == COUNTING_ALLOCATOR_FILE,
                 "{path}:{}: `unsafe` only where intrinsics need it",
                 n + 1

@@ -89,13 +89,13 @@ const FRAMES: usize = 126;
 /// One test (the count is global, and a second test building its scene
 /// at the same time would be counted too). On one thread: nothing. At two
 /// threads the world's code allocates nothing either; rayon does, and
-/// cannot be kept from it: each step enters the world's pool once
-/// (`ThreadPool::install` from outside the pool), which pushes one job onto
-/// the pool's injector queue (crossbeam-deque's `Injector`), and that queue
-/// allocates a new block of 63 slots every 63 pushes. So the bound there
-/// is one allocation per 63 steps; only a task interface whose workers'
-/// entry outlives the step would remove it (the colours' fork-joins inside
-/// the pool allocate nothing).
+/// cannot be kept from it: each substep (one here) launches the world's
+/// workers once (`ThreadPool::install` from outside the pool, in
+/// `RayonTasks::parallel_for`), which pushes one job onto the pool's
+/// injector queue (crossbeam-deque's `Injector`), and that queue allocates
+/// a new block of 63 slots every 63 pushes. So the bound there is one
+/// allocation per 63 steps; an engine's task system whose queue does not
+/// grow would have none (the solver stages inside allocate nothing).
 #[test]
 fn a_settled_drop_allocates_nothing_per_frame_but_rayons_queue_blocks() {
     for spine in [SpineMode::Rod, SpineMode::Sockets] {

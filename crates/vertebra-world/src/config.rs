@@ -54,8 +54,10 @@ pub struct SolverConfig {
     pub threads: usize,
     /// Gravity (m/s^2, world).
     pub gravity: Vec3,
-    /// A colour is split over threads when it has at least this many
-    /// blocks of eight constraints (smaller ones run on one thread).
+    /// A colour is split into chunks for the workers when it has at
+    /// least this many blocks of eight constraints (a smaller one is one
+    /// chunk per joint kind: its kinds may still run on different
+    /// workers).
     pub parallel_min_blocks: usize,
     /// The fastest (m/s) overlapping bodies are pushed apart: a step removes
     /// at most `max_push_out_speed * dt` of a contact's overlap (Box2D's

@@ -37,6 +37,7 @@ mod parallel;
 mod rod;
 mod sleep;
 mod snapshot;
+mod stages;
 mod step;
 mod tasks;
 
@@ -60,7 +61,9 @@ pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTw
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
 pub use snapshot::Snapshot;
-pub use tasks::{MAX_RANGES, RayonTasks, SingleThreaded, TaskSystem};
+#[cfg(feature = "stage-timing")]
+pub use stages::timing as stage_timing;
+pub use tasks::{RayonTasks, SingleThreaded, TaskSystem};
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
@@ -93,6 +96,11 @@ pub struct World {
     contact_layout: contact::ContactLayout,
     rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
+    /// Scratch of the step: which slots the body passes move (live and
+    /// not static).
+    moving: Vec<bool>,
+    /// Scratch of the step: the counters of a substep's stages.
+    stages: stages::Stages,
     residuals: Residuals,
     /// `residuals` holds the current poses' measurement (false after a step
     /// that did not measure).
@@ -138,6 +146,8 @@ impl World {
             contact_layout: contact::ContactLayout::default(),
             rows: parallel::Scratch::default(),
             previous: Vec::new(),
+            moving: Vec::new(),
+            stages: stages::Stages::default(),
             residuals: Residuals::default(),
             residuals_measured: false,
             residual_lanes: metrics::LaneResiduals::default(),
@@ -610,21 +620,9 @@ impl World {
         let asleep = self.islands.asleep();
         self.contact_layout
             .rebuild(&self.contacts, &self.bodies, asleep, max_depth);
-        // One entry into the task system per step: the colours' fork-joins
-        // then run among its workers (see step::for_each_colour).
-        // The step runs once whatever `enter` does: a second call does
-        // nothing, and a step `enter` never ran runs here.
-        let tasks = Arc::clone(&self.tasks);
-        let mut stepped = false;
-        let mut once = |world: &mut World| {
-            if !core::mem::replace(&mut stepped, true) {
-                // `enter` may move the step to one of its threads.
-                let _mode = DefaultFloatMode::enter();
-                step::step(world, dt)
-            }
-        };
-        tasks.enter(&mut || once(self));
-        once(self);
+        // Each substep launches the task system's workers once
+        // (step::solve_substep).
+        step::step(self, dt);
         if let Some(settings) = &self.config.sleep {
             let links = islands::links(&self.joints, &self.rods);
             self.layout_dirty |=

@@ -7,15 +7,12 @@
 //! read or written by another worker at the same time. The condition is not
 //! taken on trust from the colouring (a restored snapshot carries one): each
 //! layout checks it when it is built ([`colour_is_disjoint`]) and a layout
-//! that fails the check runs on one thread.
+//! that fails the check runs one chunk at a time (`step.rs`).
 
 use std::sync::{Mutex, PoisonError};
 
 use vertebra_kernels::body::{BodyPairs, BodyRows};
-use vertebra_math::DefaultFloatMode;
 use vertebra_math::row::NO_WRITE;
-
-use crate::tasks::{TaskSystem, for_each_range};
 
 /// The world's body rows: scratch of a step, reached only through
 /// `&mut World`. The mutex is never locked (`get_mut` takes no lock): it
@@ -30,53 +27,33 @@ impl Scratch {
     }
 }
 
-/// Rows handed to the workers of one colour.
-struct Shared<'a>(&'a BodyRows);
+/// Rows handed to the workers of a substep's stages (`stages.rs`).
+pub(crate) struct Shared<'a>(&'a BodyRows);
 
 impl<'a> Shared<'a> {
+    /// Lends `rows` to the workers of a substep. The stages that reach them
+    /// must keep this module's rule (see the `Sync` impl).
+    pub fn new(rows: &'a BodyRows) -> Self {
+        Self(rows)
+    }
+
     /// The rows, on a worker (a method, so closures capture `Shared`).
-    fn rows(&self) -> &'a BodyRows {
+    pub fn rows(&self) -> &'a BodyRows {
         self.0
     }
 }
 
-// `Shared` exists only inside `chunked`, and only for blocks whose layout
-// passed `colour_is_disjoint`: every row one block writes is read and
-// written by that block's lane alone, and rows nobody writes (static,
-// kinematic, the null row) are only read. `for_each_range` runs each range
-// of blocks once, whatever the task system does, and only while `chunked`
-// holds the rows' borrow.
-// SAFETY: so no two workers touch a row that one of them writes, and the
-// kernels' plain loads and stores of rows never race.
+// `Shared` lends the rows to the stages of one substep (`step.rs`), which
+// runs at once only: chunks of one colour's blocks of a layout that passed
+// `colour_is_disjoint` (every row one block writes is read and written by
+// that block's lane alone; rows nobody writes, static, kinematic and the
+// null row, are only read), and chunks of bodies, each touching the rows
+// of its own bodies only. Everything else (the scalar overflow set, a
+// layout that failed the check) is a stage of one chunk, and stages run
+// one after another (the stage counters' release and acquire order them).
+// SAFETY: so no two workers touch a row that one of them writes at the
+// same time, and the kernels' plain loads and stores of rows never race.
 unsafe impl Sync for Shared<'_> {}
-
-/// Runs `run` on all `blocks` and `rows`, split over the workers of
-/// `tasks` when it has more than one, there are at least `min_blocks`
-/// blocks and `disjoint` holds; else on this thread.
-///
-/// `disjoint` must be a layout's verdict from [`colour_is_disjoint`] on
-/// every colour, and `blocks` one colour's blocks of that layout (their
-/// body pairs unchanged since): that is what makes sharing `rows` sound.
-pub(crate) fn chunked<B: Send>(
-    tasks: Option<&dyn TaskSystem>,
-    min_blocks: usize,
-    disjoint: bool,
-    blocks: &mut [B],
-    rows: &BodyRows,
-    run: impl Fn(&mut [B], &BodyRows) + Sync,
-) {
-    match tasks {
-        Some(tasks) if tasks.workers() > 1 && disjoint && blocks.len() >= min_blocks => {
-            let shared = Shared(rows);
-            for_each_range(tasks, blocks, &|range| {
-                // A worker starts in whatever mode its creator had.
-                let _mode = DefaultFloatMode::enter();
-                run(range, shared.rows())
-            });
-        }
-        _ => run(blocks, rows),
-    }
-}
 
 /// Whether one colour's blocks may run on several threads at once: every
 /// lane writes only its own body's row (or nothing), and a row that is

@@ -5,45 +5,39 @@
 //! default for 1), or the engine's own, given with
 //! [`World::set_tasks`](crate::World::set_tasks).
 //!
-//! Results do not depend on the task system, bit for bit: the step splits
-//! a colour's blocks into ranges that share no dynamic body, so the ranges
-//! may run in any order, on any threads. Nor do they depend on it being
-//! right: each range is claimed before it runs (a range run twice runs
-//! once; one never run is run by the step itself afterwards), and the
-//! borrow the work is lent under ends when `parallel_for` returns, so a
-//! task system written in safe Rust cannot make the step race or lose
-//! work, only slow it down.
-
-use std::sync::{Mutex, PoisonError};
+//! Each substep is one call of [`TaskSystem::parallel_for`] with one item
+//! per worker; every item walks the substep's fixed list of stages
+//! (`stages.rs`, as Box2D v3's solver stages), claiming chunks of work
+//! from atomic counters and waiting only for chunks other running items
+//! have claimed. Results do not depend on the task system, bit for bit:
+//! a chunk's work does not depend on who runs it, and the stages run in a
+//! fixed order. Nor do they depend on it being right: items run one after
+//! another (in any order) or twice at once share the work out as they
+//! come, an item never run leaves its work to the others, and the step
+//! finishes what is left when `parallel_for` returns (the borrow the work
+//! is lent under ends there), so a task system written in safe Rust
+//! cannot make the step race, deadlock or lose work, only slow it down.
 
 /// A job system the world's step runs its parallel work on.
 ///
-/// The step calls [`enter`](Self::enter) once per step with the whole
-/// step, and inside it [`parallel_for`](Self::parallel_for) for each
-/// colour of constraints large enough to split (a few dozen calls per
-/// iteration): a fork-join, so an implementation that keeps its workers
-/// awake inside `enter` (as a rayon pool's `install` does) pays no wake-up
-/// per call.
+/// The step calls [`parallel_for`](Self::parallel_for) once per substep
+/// (when [`workers`](Self::workers) is above 1) with one item per worker;
+/// each item runs until the substep's work is done, waiting for other
+/// items between its stages, so the items are worth running at once
+/// (as Box2D v3's `enqueueTask` and `finishTask`, or one Jolt job per
+/// worker).
 pub trait TaskSystem: Send + Sync {
-    /// How many threads may run items at once, the caller's included (at
-    /// least 1). The step splits a colour into about twice as many ranges.
+    /// How many threads may run items at once (at least 1): the number of
+    /// items the step asks for. The calling thread waits in
+    /// `parallel_for` and finishes what is left afterwards.
     fn workers(&self) -> usize;
 
     /// Runs `task(i)` for every `i` in `0..count`, on whichever threads
     /// and in whichever order, and returns when all have run (the borrow
-    /// of `task` ends here: it cannot be kept). Each item should run once:
-    /// the step skips an item run again, and runs one left out itself.
+    /// of `task` ends here: it cannot be kept). Items should run at once
+    /// to gain anything, but need not: an item run after another, run
+    /// twice, or not run at all costs time, never a result.
     fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync));
-
-    /// Runs one whole step (`step`, which calls
-    /// [`parallel_for`](Self::parallel_for)); by default on the calling
-    /// thread. A pool runs it inside itself, so that the step's fork-joins
-    /// happen among its workers. The step runs once either way: calling
-    /// `step` again does nothing, and a step not run here runs on the
-    /// caller afterwards.
-    fn enter(&self, step: &mut (dyn FnMut() + Send)) {
-        step()
-    }
 }
 
 /// Every item on the calling thread, in order.
@@ -85,53 +79,9 @@ impl TaskSystem for RayonTasks {
 
     fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync)) {
         use rayon::prelude::*;
-        // Inside `enter` this thread is one of the pool's: `install` runs
-        // inline, and the items are a fork-join among the workers.
+        // One job into the pool (`install`, which allocates nothing but a
+        // slot of the pool's injector queue), split among the workers.
         self.pool
             .install(|| (0..count).into_par_iter().for_each(task));
-    }
-
-    fn enter(&self, step: &mut (dyn FnMut() + Send)) {
-        self.pool.install(step)
-    }
-}
-
-/// The most ranges a colour is split into: a colour of the 300-ragdoll
-/// drop has a few dozen blocks, so more ranges than this would hold a
-/// block or less each. Kept on the stack (no allocation per call).
-pub const MAX_RANGES: usize = 64;
-
-/// Runs `run` on `blocks` split into about twice as many ranges as
-/// `tasks` has workers (at most [`MAX_RANGES`]), through `tasks`; each
-/// range exactly once whatever `tasks` does: a range is taken out of its
-/// slot to run (a second run finds it gone), and the ranges still in their
-/// slots when `parallel_for` returns run here.
-pub(crate) fn for_each_range<B: Send>(
-    tasks: &dyn TaskSystem,
-    blocks: &mut [B],
-    run: &(dyn Fn(&mut [B]) + Sync),
-) {
-    let ranges = tasks.workers().saturating_mul(2).clamp(1, MAX_RANGES);
-    let chunk = blocks.len().div_ceil(ranges).max(1);
-    let slots: [Mutex<Option<&mut [B]>>; MAX_RANGES] = core::array::from_fn(|_| Mutex::new(None));
-    let mut count = 0;
-    for (slot, range) in slots.iter().zip(blocks.chunks_mut(chunk)) {
-        *slot.lock().unwrap_or_else(PoisonError::into_inner) = Some(range);
-        count += 1;
-    }
-    let take = |i: usize| {
-        slots
-            .get(i)
-            .and_then(|slot| slot.lock().unwrap_or_else(PoisonError::into_inner).take())
-    };
-    tasks.parallel_for(count, &|i| {
-        if let Some(range) = take(i) {
-            run(range);
-        }
-    });
-    for i in 0..count {
-        if let Some(range) = take(i) {
-            run(range);
-        }
     }
 }
