@@ -130,13 +130,12 @@ pub fn solve<L: Lane>(
     let f_b = kb11 * r22 - kb12 * r12;
     let p = (f_b * (one - f_b)).max(zero);
     let e = safe_ratio(four * sin, d + (d * d + four * p * (sin * sin)).sqrt());
-    // dlambda = -K^-1 (E, 0).
-    let (l1, l2) = (-e * r22, e * r12);
+    // dlambda = -K^-1 (E, 0) = E (-r22, r12).
     angle::apply_local(
         a,
         b,
-        sa1.scale(l1) + sa2.scale(l2),
-        sb1.scale(l1) + sb2.scale(l2),
+        (sa2.scale(r12) - sa1.scale(r22), sb2.scale(r12) - sb1.scale(r22)),
+        e,
     );
     sin
 }

@@ -3,7 +3,9 @@
 //!
 //! The relative rotation `r = (q_a F_a)* (q_b F_b)` splits as
 //! `r = swing twist` with `twist` about +X (`Quat::swing_twist`); the twist
-//! angle `phi` in [-pi, pi] is its angle. Outside `[lo, hi]` the error is
+//! angle `phi` in [-pi, pi] is its angle, `2 atan2(r_x, r_w)` with the sign
+//! of `r_w` taken out, which needs only those two components of `r`
+//! ([`angle`]). Outside `[lo, hi]` the error is
 //! `e = phi - clamp(phi, lo, hi)`, corrected about the world axis
 //! `t_b = q_b F_b x` with sign `sign(e)`: turning `b` by `x` about `t_b`
 //! multiplies `r` by a twist of `x` on the right, which adds exactly `x` to
@@ -29,10 +31,20 @@ pub fn measure<L: Lane>(
     frame_b: Quat<L>,
 ) -> (Vec3<L>, L) {
     let f = super::frames(a, b, frame_a, frame_b);
-    (
-        f.tb,
-        (f.fa.conjugate() * f.fb).twist_angle(Vec3::splat(crate::TWIST_AXIS)),
-    )
+    (f.tb, angle(f.fa, f.fb))
+}
+
+/// The twist angle (rad, in [-pi, pi]) about +X of `r = f_a* f_b`:
+/// `2 atan2(r_x, r_w)` with the sign of `r_w` taken out
+/// ([`Quat::twist_angle`] about +X), from the only two components of the
+/// product it needs, `r_x = aw bx - ax bw - ay bz + az by` and
+/// `r_w = f_a . f_b`.
+#[inline(always)]
+pub fn angle<L: Lane>(fa: Quat<L>, fb: Quat<L>) -> L {
+    let rx = fa.w * fb.x - fa.x * fb.w - fa.y * fb.z + fa.z * fb.y;
+    let rw = fa.dot(fb);
+    let sign = L::splat(1.0).copysign(rw);
+    L::splat(2.0) * poly::atan2(rx * sign, rw * sign)
 }
 
 /// `phi - clamp(phi, lo, hi)`: signed excess beyond the range (rad).
@@ -85,10 +97,7 @@ pub fn measure_local<L: Lane>(
 ) -> ([Vec3<L>; 2], L) {
     // b's joint frame in a's body frame, then relative to a's joint frame.
     let fb = (a.q.conjugate() * b.q) * frame_b;
-    let r = frame_a.conjugate() * fb;
-    let sign = L::splat(1.0).copysign(r.w);
-    let phi = L::splat(2.0) * poly::atan2(r.x * sign, r.w * sign);
-    ([super::axis_x(fb), super::axis_x(frame_b)], phi)
+    ([super::axis_x(fb), super::axis_x(frame_b)], angle(frame_a, fb))
 }
 
 /// As [`violation`], in the bodies' own frames ([`measure_local`]).
