@@ -38,22 +38,20 @@ impl<L: Lane> Softness<L> {
     }
 }
 
-/// Applies the correction with the same axis on both bodies; returns
-/// `dlambda`.
+/// Applies a hard correction with the axis given in each body's own frame,
+/// `[R_a^T n_a, R_b^T n_b]`: `w = n_a . S_a n_a + n_b . S_b n_b` from the
+/// same `S n` that turns the bodies ([`apply_local`]), with no rotation
+/// into or out of a body.
 #[inline(always)]
-pub fn correct<L: Lane>(
+pub fn correct_local<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    n: Vec3<L>,
+    [n_a, n_b]: [Vec3<L>; 2],
     c: L,
-    alpha_tilde: L,
-    lambda: L,
-) -> L {
-    let soft = Softness {
-        alpha_tilde,
-        relaxation: L::splat(1.0),
-    };
-    correct_axes(a, b, n, n, c, soft, lambda)
+) {
+    let (s_a, s_b) = (a.inv_inertia.mul_vec(n_a), b.inv_inertia.mul_vec(n_b));
+    let dlambda = safe_ratio(-c, n_a.dot(s_a) + n_b.dot(s_b));
+    apply_local(a, b, (s_a, s_b), dlambda);
 }
 
 /// Applies the correction with axis `n_a` on `a` and `n_b` on `b`; returns

@@ -134,7 +134,10 @@ pub fn solve<L: Lane>(
     angle::apply_local(
         a,
         b,
-        (sa2.scale(r12) - sa1.scale(r22), sb2.scale(r12) - sb1.scale(r22)),
+        (
+            sa2.scale(r12) - sa1.scale(r22),
+            sb2.scale(r12) - sb1.scale(r22),
+        ),
         e,
     );
     sin

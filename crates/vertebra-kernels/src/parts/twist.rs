@@ -11,12 +11,15 @@
 //! multiplies `r` by a twist of `x` on the right, which adds exactly `x` to
 //! `phi`. A range of `[-pi, pi]` never binds: a disabled limit.
 //!
-//! The hinge measures the same angle in the bodies' own frames
-//! ([`violation_local`]): from b's orientation relative to a,
+//! The kernels (the socket's, the hinge's) measure the same angle in the
+//! bodies' own frames ([`violation_local`]): from b's orientation relative
+//! to a,
 //! `R_a^T R_b` (one quaternion product), `r = F_a* (q_a* q_b F_b)`, whose
 //! twist about +X is `2 atan2(r_x, r_w)` (the sign of `r_w` taken out),
 //! and the axis `t_b` is `(q_a* q_b F_b) x` in a's frame and `F_b x` in
-//! b's, ready for [`super::limit::solve_local`].
+//! b's, ready for [`super::limit::solve_local`] and
+//! [`super::angle::correct_local`], which then need no rotation into or
+//! out of either body. [`measure`] (world) is the residual's.
 
 use vertebra_math::{Lane, Quat, Vec3, poly};
 
@@ -53,23 +56,9 @@ pub fn excess<L: Lane>(phi: L, lo: L, hi: L) -> L {
     phi - phi.max(lo).min(hi)
 }
 
-/// The violation `|e|` (rad) and the axis `sign(e) t_b` along which it
-/// grows.
-#[inline(always)]
-pub fn violation<L: Lane>(
-    a: &BodyLanes<L>,
-    b: &BodyLanes<L>,
-    frame_a: Quat<L>,
-    frame_b: Quat<L>,
-    lo: L,
-    hi: L,
-) -> (Vec3<L>, L) {
-    let (axis, phi) = measure(a, b, frame_a, frame_b);
-    let e = excess(phi, lo, hi);
-    (axis.scale(L::splat(1.0).copysign(e)), e.abs())
-}
-
 /// Enforces the range; returns the |excess| before the correction (rad).
+/// Measured and corrected in the bodies' own frames
+/// ([`violation_local`], [`super::angle::correct_local`]).
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
@@ -79,11 +68,9 @@ pub fn solve<L: Lane>(
     lo: L,
     hi: L,
 ) -> L {
-    let (axis, phi) = measure(a, b, frame_a, frame_b);
-    let e = excess(phi, lo, hi);
-    let n = axis.scale(L::splat(1.0).copysign(e));
-    super::angle::correct(a, b, n, e.abs(), L::splat(0.0), L::splat(0.0));
-    e.abs()
+    let (axes, c) = violation_local(a, b, frame_a, frame_b, lo, hi);
+    super::angle::correct_local(a, b, axes, c);
+    c
 }
 
 /// The twist angle `phi` (rad) and the axis `t_b` in each body's own frame
@@ -97,10 +84,14 @@ pub fn measure_local<L: Lane>(
 ) -> ([Vec3<L>; 2], L) {
     // b's joint frame in a's body frame, then relative to a's joint frame.
     let fb = (a.q.conjugate() * b.q) * frame_b;
-    ([super::axis_x(fb), super::axis_x(frame_b)], angle(frame_a, fb))
+    (
+        [super::axis_x(fb), super::axis_x(frame_b)],
+        angle(frame_a, fb),
+    )
 }
 
-/// As [`violation`], in the bodies' own frames ([`measure_local`]).
+/// The violation `|e|` (rad) and the axis `sign(e) t_b` along which it
+/// grows, in the bodies' own frames ([`measure_local`]).
 #[inline(always)]
 pub fn violation_local<L: Lane>(
     a: &BodyLanes<L>,

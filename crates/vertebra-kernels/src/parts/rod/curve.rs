@@ -30,8 +30,8 @@
 use vertebra_math::{Lane, Vec3, poly};
 
 use super::Frames;
-use crate::parts::angle;
 use crate::body::{BodyLanes, PairStart, safe_ratio};
+use crate::parts::angle;
 
 /// The curve error and its gradients.
 #[derive(Clone, Copy, Debug)]
