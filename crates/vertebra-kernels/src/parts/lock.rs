@@ -8,7 +8,10 @@
 //! in `tests/joint_gradients.rs`), and the XPBD step is
 //! `dlambda = -W^-1 C` with `W = I_a^-1 + I_b^-1` (world); b turns by
 //! `I_b^-1 dlambda`, a by `-I_a^-1 dlambda`. A singular `W` (no dynamic
-//! body) gives no correction.
+//! body) gives no correction. The kernel solves the same step in a's body
+//! frame (every vector and `W` turned by `R_a^T`, which leaves `W^-1 C`
+//! turned the same way): there `S_a` needs no rotation and `I_b^-1`
+//! becomes `R S_b R^T` with `R` b's rotation relative to a's.
 
 use vertebra_math::{Lane, Quat, Vec3};
 
