@@ -141,7 +141,20 @@ impl<L: Lane> Quat<L> {
             z + (w * v.z + x * v.y - y * v.x),
             w - (x * v.x + y * v.y + z * v.z),
         )
-        .normalize()
+        .normalize_turned()
+    }
+
+    /// [`Quat::normalize`] for a unit quaternion plus a perpendicular
+    /// step (as [`Quat::integrate_local`] makes): its length is at least
+    /// one, never zero, so only a non-finite length (an overflowing or NaN
+    /// step) needs the identity, and one comparison finds it.
+    #[inline(always)]
+    fn normalize_turned(self) -> Self {
+        let length = self.dot(self).sqrt();
+        let finite = length.lt(L::splat(f32::INFINITY));
+        let inv = L::splat(1.0) / length;
+        let unit = Self::new(self.x * inv, self.y * inv, self.z * inv, self.w * inv);
+        Self::select(finite, unit, Self::identity())
     }
 
     /// The rotation by `angle` radians about the unit vector `axis`.

@@ -50,9 +50,17 @@ pub fn axes<L: Lane>(f: &Frames<L>) -> (Vec3<L>, Vec3<L>) {
 /// The twist angle `tau` in [-pi, pi] (rad).
 #[inline(always)]
 pub fn measure<L: Lane>(f: &Frames<L>) -> L {
-    // M = normalize(1 + t_a . t_b, t_a x t_b): the half-way quaternion.
-    // Folded back (t_b = -t_a) it is zero and normalises to the identity.
-    let minimal = Quat::from_parts(f.ta.cross(f.tb), L::splat(1.0) + f.ta.dot(f.tb)).normalize();
+    // M = (t_a x t_b, 1 + t_a . t_b), the half-way quaternion, not
+    // normalised: the twist angle is an atan2 of two components of the
+    // product, which any positive multiple of M leaves as they are. Folded
+    // back (1 + t_a . t_b at most 1e-6, where `axes` drops k too) it is the
+    // identity.
+    let w = L::splat(1.0) + f.ta.dot(f.tb);
+    let minimal = Quat::select(
+        w.gt(L::splat(1e-6)),
+        Quat::from_parts(f.ta.cross(f.tb), w),
+        Quat::identity(),
+    );
     crate::parts::twist::angle(minimal * f.fa, f.fb)
 }
 
