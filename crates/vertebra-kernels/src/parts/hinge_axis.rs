@@ -22,8 +22,9 @@
 //! projection whenever the inertia is anisotropic; see the drive part).
 //!
 //! The error `E` on the `n` row is not the linearised `theta` but what
-//! the bodies' update makes exact. [`BodyLanes::rotate`] turns by `w` as
-//! `q + 1/2 (w, 0) q`, renormalised: exactly the rotation whose Gibbs
+//! the bodies' update makes exact. [`BodyLanes::turn_local`] turns by the
+//! world `w = R v` as `q + 1/2 q (v, 0) = q + 1/2 (w, 0) q`, renormalised:
+//! exactly the rotation whose Gibbs
 //! (Rodrigues) vector is `g = w / 2` (angle `2 atan(|w| / 2)` about `w`).
 //! A rotation with Gibbs vector `g` takes `t_b` to `t_a` if and only if
 //! `t_a - t_b = g x s` (Rodrigues' formula). Both sides are perpendicular
