@@ -71,7 +71,15 @@ fn ragdoll_drop_rod() {
 // variants). The bodies' bits are unchanged: with `max_torque` left out of
 // the serialisation the old hashes came back on every backend and thread
 // count (undriven rods take the old correction bit for bit).
-const GOLDEN_BENDING_SOCKETS: u64 = 0x72b8_cc15_033e_3505;
-const GOLDEN_BENDING_ROD: u64 = 0x91fc_ac92_3106_001f;
-const GOLDEN_DROP_SOCKETS: u64 = 0x554e_4f30_f575_bb42;
-const GOLDEN_DROP_ROD: u64 = 0x634e_2c17_abeb_9fa5;
+// All four updated 2026-11-30 by issue 17's cheaper kernels: a
+// correction's weight and turn now come from one rotation of its axis into
+// the body (`body::Response`), the turn is applied in the body frame
+// (`q + 1/2 q (S u dlambda, 0)`, the same turn as before in other
+// roundings), the socket's swing and twist are measured in the bodies'
+// frames, frames' axes are matrix columns, the fixed joint's lock is solved
+// in a's frame, and the rod's twist takes an unnormalised half-way
+// quaternion. Every backend and thread count still gives one hash.
+const GOLDEN_BENDING_SOCKETS: u64 = 0xc87f_d8ef_4872_0112;
+const GOLDEN_BENDING_ROD: u64 = 0xb252_50e4_8e94_7bc0;
+const GOLDEN_DROP_SOCKETS: u64 = 0x4e84_1023_bfe3_42f5;
+const GOLDEN_DROP_ROD: u64 = 0xd338_5466_37e7_ca5f;
