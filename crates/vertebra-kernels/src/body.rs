@@ -163,33 +163,86 @@ impl<L: Lane> BodyLanes<L> {
         self.inv_inertia.rotated(self.q)
     }
 
-    /// `n^T I^-1 n`: the generalised inverse mass of a rotation about `n`.
+    /// How this body answers a rotational correction about the world axis
+    /// `n`: `u = R^T n` (the axis in the body frame), `S u` and
+    /// `n^T I^-1 n = u . S u` (see [`Response`]).
     #[inline(always)]
-    pub fn angular_weight(&self, n: Vec3<L>) -> L {
-        self.inv_inertia.quadratic(self.q.inverse_rotate(n))
+    pub fn angular_response(&self, n: Vec3<L>) -> Response<L> {
+        let u = self.q.inverse_rotate(n);
+        let turn = self.inv_inertia.mul_vec(u);
+        Response {
+            weight: u.dot(turn),
+            turn,
+        }
     }
 
     /// `1/m + (r x n)^T I^-1 (r x n)`: the generalised inverse mass of a
     /// positional correction along `n` at lever arm `r`.
     #[inline(always)]
     pub fn positional_weight(&self, r: Vec3<L>, n: Vec3<L>) -> L {
-        self.inv_mass + self.angular_weight(r.cross(n))
+        self.positional_response(r, n).weight
+    }
+
+    /// How this body answers a positional correction along `n` at lever
+    /// arm `r`: the angular response to `r x n`, with the weight
+    /// `1/m + (r x n)^T I^-1 (r x n)`.
+    #[inline(always)]
+    pub fn positional_response(&self, r: Vec3<L>, n: Vec3<L>) -> Response<L> {
+        let angular = self.angular_response(r.cross(n));
+        Response {
+            weight: self.inv_mass + angular.weight,
+            ..angular
+        }
+    }
+
+    /// Applies the positional impulse `dlambda n` (kg m) whose
+    /// [`BodyLanes::positional_response`] is `response`:
+    /// `p += dlambda n / m`, turned by `R (S R^T (r x n)) dlambda`.
+    #[inline(always)]
+    pub fn push(&mut self, n: Vec3<L>, response: &Response<L>, dlambda: L) {
+        self.p += n.scale(dlambda * self.inv_mass);
+        self.turn_local(response.turn, dlambda);
     }
 
     /// Applies a positional impulse `impulse` (kg m) at lever arm `r`:
-    /// `p += impulse / m`, `q += 1/2 (I^-1 (r x impulse), 0) q`.
+    /// `p += impulse / m`, turned by `I^-1 (r x impulse)`.
     #[inline(always)]
     pub fn apply_impulse(&mut self, r: Vec3<L>, impulse: Vec3<L>) {
         self.p += impulse.scale(self.inv_mass);
-        self.rotate(self.inv_inertia_mul(r.cross(impulse)));
+        self.apply_angular_impulse(r.cross(impulse));
     }
 
-    /// Turns the body by the small rotation vector `theta` (rad, world):
-    /// `q += 1/2 (theta, 0) q`, renormalised.
+    /// Turns the body by `I^-1 l` for the angular impulse `l` (kg m^2,
+    /// world): `S R^T l` in its own frame ([`BodyLanes::turn_local`]).
     #[inline(always)]
-    pub fn rotate(&mut self, theta: Vec3<L>) {
-        self.q = self.q.integrate(theta, L::splat(1.0));
+    pub fn apply_angular_impulse(&mut self, l: Vec3<L>) {
+        let turn = self.inv_inertia.mul_vec(self.q.inverse_rotate(l));
+        self.turn_local(turn, L::splat(1.0));
     }
+
+    /// Turns the body by the small rotation vector `theta = axis angle`
+    /// (rad) given in its own frame: `q += 1/2 q (theta, 0)`,
+    /// renormalised, which is `q += 1/2 (R theta, 0) q`: the world turn
+    /// `R theta` ([`Quat::integrate_local`]).
+    #[inline(always)]
+    pub fn turn_local(&mut self, axis: Vec3<L>, angle: L) {
+        self.q = self.q.integrate_local(axis, angle);
+    }
+}
+
+/// One body's answer to a unit correction (Müller et al. 2020, eqs. 2-3):
+/// the generalised inverse mass `w` and the turn per unit `dlambda` in the
+/// body's own frame, `S R^T j` for the angular direction `j` (`n`, or
+/// `r x n` for a positional one). The weight is `j^T R S R^T j =
+/// (R^T j) . (S R^T j)`, so the one rotation of `j` into the body gives
+/// both the weight and the turn, and the turn is applied in the body frame
+/// (`q += 1/2 q (turn dlambda, 0)`), so it is never rotated back.
+#[derive(Clone, Copy, Debug)]
+pub struct Response<L> {
+    /// `w` (1/kg for a positional correction, 1/(kg m^2) for a rotation).
+    pub weight: L,
+    /// `S R^T j` (rad per unit `dlambda`, body frame).
+    pub turn: Vec3<L>,
 }
 
 /// One body per lane: velocities (for the velocity pass).

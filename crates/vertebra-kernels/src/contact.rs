@@ -221,9 +221,10 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
     let (ra, rb, d) = arms(block, start, &a, &b);
     let allowance = L::load(&block.allowance[start..]);
     let c = (d.dot(n) + allowance).min(zero);
-    let w = a.positional_weight(ra, n) + b.positional_weight(rb, n);
-    let dlambda_n = safe_ratio(-c, w);
-    push(&mut a, &mut b, ra, rb, n.scale(dlambda_n));
+    let (resp_a, resp_b) = (a.positional_response(ra, n), b.positional_response(rb, n));
+    let dlambda_n = safe_ratio(-c, resp_a.weight + resp_b.weight);
+    b.push(n, &resp_b, dlambda_n);
+    a.push(n, &resp_a, -dlambda_n);
     let lambda_n = L::load(&block.lambda_n[start..]) + dlambda_n;
     lambda_n.store(&mut block.lambda_n[start..]);
 

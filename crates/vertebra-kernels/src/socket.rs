@@ -306,8 +306,11 @@ fn solve_shaped<L: Lane>(
         L::load(&block.twist_min[start..]),
         L::load(&block.twist_max[start..]),
     );
-    let twist = twist::violation(a, b, frame_a, frame_b, lo, hi);
-    solve_limit(block, 3, start, a, b, twist, soft);
+    let (axes, c) = twist::violation_local(a, b, frame_a, frame_b, lo, hi);
+    let lambda = L::load(&block.limit_lambda[3][start..]);
+    let c0 = L::load(&block.limit_start[3][start..]);
+    limit::solve_local(a, b, axes, (c, c0), soft, lambda)
+        .store(&mut block.limit_lambda[3][start..]);
 }
 
 /// The shaped path's four violations (ellipse in swing sines, pyramid y
@@ -336,7 +339,7 @@ fn shaped_violations<L: Lane>(
         L::load(&block.twist_min[start..]),
         L::load(&block.twist_max[start..]),
     );
-    let (_, twist) = twist::violation(a, b, frame_a, frame_b, lo, hi);
+    let (_, twist) = twist::violation_local(a, b, frame_a, frame_b, lo, hi);
     [ellipse, y, z, twist]
 }
 

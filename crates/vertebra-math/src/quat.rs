@@ -123,6 +123,40 @@ impl<L: Lane> Quat<L> {
         .normalize()
     }
 
+    /// The orientation after turning by the small rotation vector
+    /// `theta = axis angle` (rad) given in the frame this quaternion rotates
+    /// *from* (a body's own frame): `q + 1/2 q (theta, 0)`, renormalised.
+    /// The same turn as [`Quat::integrate`] by the world vector `R theta`
+    /// over one second, since `(R theta, 0) q = q (theta, 0) q* q`, without
+    /// rotating `theta` into the world (and with a product whose real part
+    /// is known zero). `axis` need not be unit: the split only lets the
+    /// half be taken of the scalar.
+    #[inline(always)]
+    pub fn integrate_local(self, axis: Vec3<L>, angle: L) -> Self {
+        let v = axis.scale(angle * L::splat(0.5));
+        let (x, y, z, w) = (self.x, self.y, self.z, self.w);
+        Self::new(
+            x + (w * v.x + y * v.z - z * v.y),
+            y + (w * v.y + z * v.x - x * v.z),
+            z + (w * v.z + x * v.y - y * v.x),
+            w - (x * v.x + y * v.y + z * v.z),
+        )
+        .normalize_turned()
+    }
+
+    /// [`Quat::normalize`] for a unit quaternion plus a perpendicular
+    /// step (as [`Quat::integrate_local`] makes): its length is at least
+    /// one, never zero, so only a non-finite length (an overflowing or NaN
+    /// step) needs the identity, and one comparison finds it.
+    #[inline(always)]
+    fn normalize_turned(self) -> Self {
+        let length = self.dot(self).sqrt();
+        let finite = length.lt(L::splat(f32::INFINITY));
+        let inv = L::splat(1.0) / length;
+        let unit = Self::new(self.x * inv, self.y * inv, self.z * inv, self.w * inv);
+        Self::select(finite, unit, Self::identity())
+    }
+
     /// The rotation by `angle` radians about the unit vector `axis`.
     #[inline(always)]
     pub fn from_axis_angle(axis: Vec3<L>, angle: L) -> Self {

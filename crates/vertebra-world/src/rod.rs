@@ -413,17 +413,10 @@ pub fn arc_tangent(a: Vec3, m: Vec3, b: Vec3) -> Option<Vec3> {
 /// sees, to the bit.
 pub fn rod_twist(f0: Quat, f1: Quat) -> f32 {
     use vertebra_kernels::parts::rod::{Frames, twist};
-    let x = vertebra_math::Vec3::<f32>::from(vertebra_kernels::TWIST_AXIS);
-    let (fa, fb) = (
+    twist::measure(&Frames::new(
         vertebra_math::Quat::<f32>::from(f0),
         vertebra_math::Quat::<f32>::from(f1),
-    );
-    twist::measure(&Frames {
-        fa,
-        fb,
-        ta: fa.rotate(x),
-        tb: fb.rotate(x),
-    })
+    ))
 }
 
 /// `sin(x/2) / x`, through the math layer (the kernels' own definition).

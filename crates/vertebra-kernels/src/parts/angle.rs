@@ -15,7 +15,7 @@
 
 use vertebra_math::{Lane, Vec3};
 
-use crate::body::{BodyLanes, safe_ratio};
+use crate::body::{BodyLanes, Response, safe_ratio};
 
 /// How hard a correction pulls: XPBD compliance, or a PBD relaxation
 /// factor, per lane.
@@ -38,22 +38,20 @@ impl<L: Lane> Softness<L> {
     }
 }
 
-/// Applies the correction with the same axis on both bodies; returns
-/// `dlambda`.
+/// Applies a hard correction with the axis given in each body's own frame,
+/// `[R_a^T n_a, R_b^T n_b]`: `w = n_a . S_a n_a + n_b . S_b n_b` from the
+/// same `S n` that turns the bodies ([`apply_local`]), with no rotation
+/// into or out of a body.
 #[inline(always)]
-pub fn correct<L: Lane>(
+pub fn correct_local<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    n: Vec3<L>,
+    [n_a, n_b]: [Vec3<L>; 2],
     c: L,
-    alpha_tilde: L,
-    lambda: L,
-) -> L {
-    let soft = Softness {
-        alpha_tilde,
-        relaxation: L::splat(1.0),
-    };
-    correct_axes(a, b, n, n, c, soft, lambda)
+) {
+    let (s_a, s_b) = (a.inv_inertia.mul_vec(n_a), b.inv_inertia.mul_vec(n_b));
+    let dlambda = safe_ratio(-c, n_a.dot(s_a) + n_b.dot(s_b));
+    apply_local(a, b, (s_a, s_b), dlambda);
 }
 
 /// Applies the correction with axis `n_a` on `a` and `n_b` on `b`; returns
@@ -68,40 +66,42 @@ pub fn correct_axes<L: Lane>(
     soft: Softness<L>,
     lambda: L,
 ) -> L {
-    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
+    let (ra, rb) = (a.angular_response(n_a), b.angular_response(n_b));
     let dlambda = safe_ratio(
         -soft.relaxation * c - soft.alpha_tilde * lambda,
-        w + soft.alpha_tilde,
+        ra.weight + rb.weight + soft.alpha_tilde,
     );
-    apply(a, b, n_a, n_b, dlambda);
+    apply(a, b, (&ra, &rb), dlambda);
     dlambda
 }
 
-/// Turns `b` by `I_b^-1 n_b dlambda` and `a` by `-I_a^-1 n_a dlambda`.
+/// Turns `b` by `I_b^-1 n_b dlambda` and `a` by `-I_a^-1 n_a dlambda`,
+/// from their responses to `n_a` and `n_b` (`crate::body::Response`: the
+/// turns in the bodies' own frames).
 #[inline(always)]
 pub fn apply<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    n_a: Vec3<L>,
-    n_b: Vec3<L>,
+    (ra, rb): (&Response<L>, &Response<L>),
     dlambda: L,
 ) {
-    b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
-    a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
+    b.turn_local(rb.turn, dlambda);
+    a.turn_local(ra.turn, -dlambda);
 }
 
-/// Turns `b` by `R_b turn_b` and `a` by `-R_a turn_a`, each turn given in
-/// its body's own frame (`turn = S n dlambda` with the body-frame inverse
-/// inertia `S` and axis `n = R^T n_world`: the parts that measure in the
-/// bodies' frames form `w = n^T S n` from the same `S n`, and need no
-/// rotation into the body).
+/// Turns `b` by `R_b turn_b dlambda` and `a` by `-R_a turn_a dlambda`,
+/// each turn given in its body's own frame (`turn = S n` with the
+/// body-frame inverse inertia `S` and axis `n = R^T n_world`: the parts that
+/// measure in the bodies' frames form `w = n^T S n` from the same `S n`,
+/// and need no rotation into the body, nor out of it:
+/// `BodyLanes::turn_local`).
 #[inline(always)]
 pub fn apply_local<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    turn_a: Vec3<L>,
-    turn_b: Vec3<L>,
+    (turn_a, turn_b): (Vec3<L>, Vec3<L>),
+    dlambda: L,
 ) {
-    b.rotate(b.q.rotate(turn_b));
-    a.rotate(-a.q.rotate(turn_a));
+    b.turn_local(turn_b, dlambda);
+    a.turn_local(turn_a, -dlambda);
 }

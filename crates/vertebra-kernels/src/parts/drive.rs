@@ -162,8 +162,8 @@ pub fn solve<L: Lane>(
     let rhs = Vec3::select((spring + gamma).gt(L::splat(0.0)), sprung, rhs);
     let dlambda = -m.inverse_or_zero().mul_vec(rhs);
     let (lambda, dlambda) = cap(lambda, dlambda, d.max_torque / inv_h2);
-    b.rotate(b.inv_inertia_mul(dlambda));
-    a.rotate(a.inv_inertia_mul(-dlambda));
+    b.apply_angular_impulse(dlambda);
+    a.apply_angular_impulse(-dlambda);
     lambda
 }
 

@@ -22,8 +22,9 @@
 //! projection whenever the inertia is anisotropic; see the drive part).
 //!
 //! The error `E` on the `n` row is not the linearised `theta` but what
-//! the bodies' update makes exact. [`BodyLanes::rotate`] turns by `w` as
-//! `q + 1/2 (w, 0) q`, renormalised: exactly the rotation whose Gibbs
+//! the bodies' update makes exact. [`BodyLanes::turn_local`] turns by the
+//! world `w = R v` as `q + 1/2 q (v, 0) = q + 1/2 (w, 0) q`, renormalised:
+//! exactly the rotation whose Gibbs
 //! (Rodrigues) vector is `g = w / 2` (angle `2 atan(|w| / 2)` about `w`).
 //! A rotation with Gibbs vector `g` takes `t_b` to `t_a` if and only if
 //! `t_a - t_b = g x s` (Rodrigues' formula). Both sides are perpendicular
@@ -130,13 +131,15 @@ pub fn solve<L: Lane>(
     let f_b = kb11 * r22 - kb12 * r12;
     let p = (f_b * (one - f_b)).max(zero);
     let e = safe_ratio(four * sin, d + (d * d + four * p * (sin * sin)).sqrt());
-    // dlambda = -K^-1 (E, 0).
-    let (l1, l2) = (-e * r22, e * r12);
+    // dlambda = -K^-1 (E, 0) = E (-r22, r12).
     angle::apply_local(
         a,
         b,
-        sa1.scale(l1) + sa2.scale(l2),
-        sb1.scale(l1) + sb2.scale(l2),
+        (
+            sa2.scale(r12) - sa1.scale(r22),
+            sb2.scale(r12) - sb1.scale(r22),
+        ),
+        e,
     );
     sin
 }

@@ -80,9 +80,9 @@ pub fn solve<L: Lane>(
     soft: Softness<L>,
     lambda: L,
 ) -> L {
-    let w = a.angular_weight(n) + b.angular_weight(n);
-    let dlambda = step(w, (c, c0), soft, lambda);
-    angle::apply(a, b, n, n, dlambda);
+    let (ra, rb) = (a.angular_response(n), b.angular_response(n));
+    let dlambda = step(ra.weight + rb.weight, (c, c0), soft, lambda);
+    angle::apply(a, b, (&ra, &rb), dlambda);
     lambda + dlambda
 }
 
@@ -100,7 +100,7 @@ pub fn solve_local<L: Lane>(
 ) -> L {
     let (s_a, s_b) = (a.inv_inertia.mul_vec(n_a), b.inv_inertia.mul_vec(n_b));
     let dlambda = step(n_a.dot(s_a) + n_b.dot(s_b), (c, c0), soft, lambda);
-    angle::apply_local(a, b, s_a.scale(dlambda), s_b.scale(dlambda));
+    angle::apply_local(a, b, (s_a, s_b), dlambda);
     lambda + dlambda
 }
 

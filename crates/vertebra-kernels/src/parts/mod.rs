@@ -46,6 +46,20 @@ pub struct Frames<L> {
     pub tb: Vec3<L>,
 }
 
+impl<L: Lane> Frames<L> {
+    /// The frames `fa`, `fb` (unit, world) with their +X axes, each its
+    /// rotation matrix's first column ([`axis_x`]).
+    #[inline(always)]
+    pub fn new(fa: Quat<L>, fb: Quat<L>) -> Self {
+        Self {
+            fa,
+            fb,
+            ta: axis_x(fa),
+            tb: axis_x(fb),
+        }
+    }
+}
+
 /// Measures the frames at the bodies' current orientations.
 #[inline(always)]
 pub fn frames<L: Lane>(
@@ -54,19 +68,12 @@ pub fn frames<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> Frames<L> {
-    let x = Vec3::splat(crate::TWIST_AXIS);
-    let (fa, fb) = (a.q * frame_a, b.q * frame_b);
-    Frames {
-        fa,
-        fb,
-        ta: fa.rotate(x),
-        tb: fb.rotate(x),
-    }
+    Frames::new(a.q * frame_a, b.q * frame_b)
 }
 
 /// `q x`: the unit quaternion's rotation of +X, its matrix's first column
-/// (fewer operations than [`Quat::rotate`], and other roundings). The
-/// hinge's parts measure in the bodies' own frames with it.
+/// (fewer operations than [`Quat::rotate`], and other roundings). Every
+/// part takes a frame's twist axis or a rod's tangent this way.
 #[inline(always)]
 pub fn axis_x<L: Lane>(q: Quat<L>) -> Vec3<L> {
     let (one, two) = (L::splat(1.0), L::splat(2.0));

@@ -40,10 +40,9 @@ pub fn solve<L: Lane>(
 ) -> L {
     let (ra, rb, d) = separation(a, b, local_a, local_b, start);
     let (n, c) = d.normalize_or_zero();
-    let w = a.positional_weight(ra, n) + b.positional_weight(rb, n);
-    let dlambda = safe_ratio(-c, w);
-    let impulse = n.scale(dlambda);
-    b.apply_impulse(rb, impulse);
-    a.apply_impulse(ra, -impulse);
+    let (resp_a, resp_b) = (a.positional_response(ra, n), b.positional_response(rb, n));
+    let dlambda = safe_ratio(-c, resp_a.weight + resp_b.weight);
+    b.push(n, &resp_b, dlambda);
+    a.push(n, &resp_a, -dlambda);
     c
 }

@@ -41,7 +41,29 @@ pub fn overshoot<L: Lane>(theta: L, max_angle: L) -> L {
     (theta - max_angle).max(L::splat(0.0))
 }
 
+/// As [`measure`], in the bodies' own frames: the axis `[R_a^T n,
+/// R_b^T n]` and the angle, from b's orientation relative to a's
+/// (`t_a = F_a x` and `t_b = (q_a* q_b F_b) x` in a's frame; `n` turned
+/// into b's frame by the same relative rotation).
+#[inline(always)]
+pub fn measure_local<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    frame_a: Quat<L>,
+    frame_b: Quat<L>,
+) -> ([Vec3<L>; 2], L) {
+    let relative = a.q.conjugate() * b.q;
+    let (ta, tb) = (super::axis_x(frame_a), super::axis_x(relative * frame_b));
+    let (n, sin) = axis(ta, tb);
+    (
+        [n, relative.inverse_rotate(n)],
+        poly::atan2(sin, ta.dot(tb)),
+    )
+}
+
 /// Enforces the cone; returns the overshoot before the correction (rad).
+/// Measured and corrected in the bodies' own frames ([`measure_local`],
+/// [`super::angle::correct_local`]).
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
@@ -50,8 +72,8 @@ pub fn solve<L: Lane>(
     frame_b: Quat<L>,
     max_angle: L,
 ) -> L {
-    let (n, theta) = measure(a, b, frame_a, frame_b);
+    let (axes, theta) = measure_local(a, b, frame_a, frame_b);
     let c = overshoot(theta, max_angle);
-    super::angle::correct(a, b, n, c, L::splat(0.0), L::splat(0.0));
+    super::angle::correct_local(a, b, axes, c);
     c
 }

@@ -43,10 +43,9 @@ pub fn measure<L: Lane>(
     frame_b: Quat<L>,
 ) -> Direction<L> {
     let fa = a.q * frame_a;
-    let x = Vec3::splat(crate::TWIST_AXIS);
     Direction {
         frame_a: fa,
-        d: fa.inverse_rotate((b.q * frame_b).rotate(x)),
+        d: super::axis_x(fa.conjugate() * (b.q * frame_b)),
     }
 }
 

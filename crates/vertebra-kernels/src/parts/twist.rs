@@ -3,18 +3,23 @@
 //!
 //! The relative rotation `r = (q_a F_a)* (q_b F_b)` splits as
 //! `r = swing twist` with `twist` about +X (`Quat::swing_twist`); the twist
-//! angle `phi` in [-pi, pi] is its angle. Outside `[lo, hi]` the error is
+//! angle `phi` in [-pi, pi] is its angle, `2 atan2(r_x, r_w)` with the sign
+//! of `r_w` taken out, which needs only those two components of `r`
+//! ([`angle`]). Outside `[lo, hi]` the error is
 //! `e = phi - clamp(phi, lo, hi)`, corrected about the world axis
 //! `t_b = q_b F_b x` with sign `sign(e)`: turning `b` by `x` about `t_b`
 //! multiplies `r` by a twist of `x` on the right, which adds exactly `x` to
 //! `phi`. A range of `[-pi, pi]` never binds: a disabled limit.
 //!
-//! The hinge measures the same angle in the bodies' own frames
-//! ([`violation_local`]): from b's orientation relative to a,
+//! The kernels (the socket's, the hinge's) measure the same angle in the
+//! bodies' own frames ([`violation_local`]): from b's orientation relative
+//! to a,
 //! `R_a^T R_b` (one quaternion product), `r = F_a* (q_a* q_b F_b)`, whose
 //! twist about +X is `2 atan2(r_x, r_w)` (the sign of `r_w` taken out),
 //! and the axis `t_b` is `(q_a* q_b F_b) x` in a's frame and `F_b x` in
-//! b's, ready for [`super::limit::solve_local`].
+//! b's, ready for [`super::limit::solve_local`] and
+//! [`super::angle::correct_local`], which then need no rotation into or
+//! out of either body. [`measure`] (world) is the residual's.
 
 use vertebra_math::{Lane, Quat, Vec3, poly};
 
@@ -29,10 +34,20 @@ pub fn measure<L: Lane>(
     frame_b: Quat<L>,
 ) -> (Vec3<L>, L) {
     let f = super::frames(a, b, frame_a, frame_b);
-    (
-        f.tb,
-        (f.fa.conjugate() * f.fb).twist_angle(Vec3::splat(crate::TWIST_AXIS)),
-    )
+    (f.tb, angle(f.fa, f.fb))
+}
+
+/// The twist angle (rad, in [-pi, pi]) about +X of `r = f_a* f_b`:
+/// `2 atan2(r_x, r_w)` with the sign of `r_w` taken out
+/// ([`Quat::twist_angle`] about +X), from the only two components of the
+/// product it needs, `r_x = aw bx - ax bw - ay bz + az by` and
+/// `r_w = f_a . f_b`.
+#[inline(always)]
+pub fn angle<L: Lane>(fa: Quat<L>, fb: Quat<L>) -> L {
+    let rx = fa.w * fb.x - fa.x * fb.w - fa.y * fb.z + fa.z * fb.y;
+    let rw = fa.dot(fb);
+    let sign = L::splat(1.0).copysign(rw);
+    L::splat(2.0) * poly::atan2(rx * sign, rw * sign)
 }
 
 /// `phi - clamp(phi, lo, hi)`: signed excess beyond the range (rad).
@@ -41,23 +56,9 @@ pub fn excess<L: Lane>(phi: L, lo: L, hi: L) -> L {
     phi - phi.max(lo).min(hi)
 }
 
-/// The violation `|e|` (rad) and the axis `sign(e) t_b` along which it
-/// grows.
-#[inline(always)]
-pub fn violation<L: Lane>(
-    a: &BodyLanes<L>,
-    b: &BodyLanes<L>,
-    frame_a: Quat<L>,
-    frame_b: Quat<L>,
-    lo: L,
-    hi: L,
-) -> (Vec3<L>, L) {
-    let (axis, phi) = measure(a, b, frame_a, frame_b);
-    let e = excess(phi, lo, hi);
-    (axis.scale(L::splat(1.0).copysign(e)), e.abs())
-}
-
 /// Enforces the range; returns the |excess| before the correction (rad).
+/// Measured and corrected in the bodies' own frames
+/// ([`violation_local`], [`super::angle::correct_local`]).
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
@@ -67,11 +68,9 @@ pub fn solve<L: Lane>(
     lo: L,
     hi: L,
 ) -> L {
-    let (axis, phi) = measure(a, b, frame_a, frame_b);
-    let e = excess(phi, lo, hi);
-    let n = axis.scale(L::splat(1.0).copysign(e));
-    super::angle::correct(a, b, n, e.abs(), L::splat(0.0), L::splat(0.0));
-    e.abs()
+    let (axes, c) = violation_local(a, b, frame_a, frame_b, lo, hi);
+    super::angle::correct_local(a, b, axes, c);
+    c
 }
 
 /// The twist angle `phi` (rad) and the axis `t_b` in each body's own frame
@@ -85,13 +84,14 @@ pub fn measure_local<L: Lane>(
 ) -> ([Vec3<L>; 2], L) {
     // b's joint frame in a's body frame, then relative to a's joint frame.
     let fb = (a.q.conjugate() * b.q) * frame_b;
-    let r = frame_a.conjugate() * fb;
-    let sign = L::splat(1.0).copysign(r.w);
-    let phi = L::splat(2.0) * poly::atan2(r.x * sign, r.w * sign);
-    ([super::axis_x(fb), super::axis_x(frame_b)], phi)
+    (
+        [super::axis_x(fb), super::axis_x(frame_b)],
+        angle(frame_a, fb),
+    )
 }
 
-/// As [`violation`], in the bodies' own frames ([`measure_local`]).
+/// The violation `|e|` (rad) and the axis `sign(e) t_b` along which it
+/// grows, in the bodies' own frames ([`measure_local`]).
 #[inline(always)]
 pub fn violation_local<L: Lane>(
     a: &BodyLanes<L>,

@@ -2,7 +2,9 @@
 //!
 //! `wide` picks its instructions when it is compiled, not at run time, so
 //! inside a `#[target_feature(enable = "avx2")]` function its `f32x8` would
-//! still be two SSE halves; this type is raw intrinsics instead.
+//! still be two SSE halves; this type is raw intrinsics instead. What it
+//! shares with the SSE4.1 type is written once in `x86.rs`, invoked here
+//! with the AVX intrinsics.
 //!
 //! Soundness: `F32x8` and `M32x8` are private to this crate, and a value of
 //! either is only ever created inside a function that
@@ -35,106 +37,13 @@ macro_rules! avx {
     };
 }
 
-#[inline(always)]
-fn sign_bit() -> __m256 {
-    avx!(_mm256_set1_ps(-0.0))
-}
-
-impl F32x8 {
-    #[inline(always)]
-    fn to_array(self) -> [f32; 8] {
-        let mut out = [0.0; 8];
-        self.store(&mut out);
-        out
-    }
-}
-
-impl fmt::Debug for F32x8 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.to_array().fmt(f)
-    }
-}
-
-impl fmt::Debug for M32x8 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let bits = avx!(_mm256_movemask_ps(self.0));
-        f.debug_list()
-            .entries((0..8).map(|i| bits >> i & 1 == 1))
-            .finish()
-    }
-}
-
-impl BitAnd for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitand(self, rhs: Self) -> Self {
-        Self(avx!(_mm256_and_ps(self.0, rhs.0)))
-    }
-}
-
-impl BitOr for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitor(self, rhs: Self) -> Self {
-        Self(avx!(_mm256_or_ps(self.0, rhs.0)))
-    }
-}
-
-impl Not for M32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn not(self) -> Self {
-        Self(avx!(_mm256_xor_ps(
-            self.0,
-            _mm256_castsi256_ps(_mm256_set1_epi32(-1))
-        )))
-    }
-}
-
-impl Mask for M32x8 {
-    #[inline(always)]
-    fn and_not(self, other: Self) -> Self {
-        Self(avx!(_mm256_andnot_ps(other.0, self.0)))
-    }
-}
-
-macro_rules! binary_op {
-    ($trait:ident, $method:ident, $assign_trait:ident, $assign:ident, $intrinsic:ident) => {
-        impl $trait for F32x8 {
-            type Output = Self;
-            #[inline(always)]
-            fn $method(self, rhs: Self) -> Self {
-                Self(avx!($intrinsic(self.0, rhs.0)))
-            }
-        }
-        impl $assign_trait for F32x8 {
-            #[inline(always)]
-            fn $assign(&mut self, rhs: Self) {
-                *self = $trait::$method(*self, rhs);
-            }
-        }
-    };
-}
-
-binary_op!(Add, add, AddAssign, add_assign, _mm256_add_ps);
-binary_op!(Sub, sub, SubAssign, sub_assign, _mm256_sub_ps);
-binary_op!(Mul, mul, MulAssign, mul_assign, _mm256_mul_ps);
-
-impl Div for F32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn div(self, rhs: Self) -> Self {
-        Self(avx!(_mm256_div_ps(self.0, rhs.0)))
-    }
-}
-
-impl Neg for F32x8 {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Self(avx!(_mm256_xor_ps(self.0, sign_bit())))
-    }
-}
+x86_lane_types!(
+    F32x8, M32x8, __m256, 8, avx,
+    set1: _mm256_set1_ps, and: _mm256_and_ps, or: _mm256_or_ps, xor: _mm256_xor_ps,
+    andnot: _mm256_andnot_ps, all_ones: _mm256_castsi256_ps(_mm256_set1_epi32(-1)),
+    movemask: _mm256_movemask_ps,
+    add: _mm256_add_ps, sub: _mm256_sub_ps, mul: _mm256_mul_ps, div: _mm256_div_ps,
+);
 
 impl F32x8 {
     #[inline(always)]
@@ -145,59 +54,17 @@ impl F32x8 {
 
 impl Lane for F32x8 {
     type Mask = M32x8;
-    const WIDTH: usize = 8;
+    x86_lane_methods!(
+        8, avx,
+        set1: _mm256_set1_ps, loadu: _mm256_loadu_ps, storeu: _mm256_storeu_ps,
+        sqrt: _mm256_sqrt_ps, andnot: _mm256_andnot_ps, and: _mm256_and_ps, or: _mm256_or_ps,
+        round: _mm256_round_ps, min: _mm256_min_ps, max: _mm256_max_ps,
+        blendv: _mm256_blendv_ps,
+    );
 
-    #[inline(always)]
-    fn splat(value: f32) -> Self {
-        Self(avx!(_mm256_set1_ps(value)))
-    }
-    #[inline(always)]
-    fn load(src: &[f32]) -> Self {
-        let src: &[f32; 8] = src[..8].try_into().expect("eight lanes");
-        // SAFETY: `src` is eight readable floats, `loadu` takes any
-        // alignment, and AVX was detected (module documentation).
-        Self(unsafe { _mm256_loadu_ps(src.as_ptr()) })
-    }
-    #[inline(always)]
-    fn store(self, dst: &mut [f32]) {
-        let dst: &mut [f32; 8] = (&mut dst[..8]).try_into().expect("eight lanes");
-        // SAFETY: `dst` is eight writable floats, `storeu` takes any
-        // alignment, and AVX was detected (module documentation).
-        unsafe { _mm256_storeu_ps(dst.as_mut_ptr(), self.0) }
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        Self(avx!(_mm256_sqrt_ps(self.0)))
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        Self(avx!(_mm256_andnot_ps(sign_bit(), self.0)))
-    }
-    #[inline(always)]
-    fn round(self) -> Self {
-        Self(avx!(_mm256_round_ps::<
-            { _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC },
-        >(self.0)))
-    }
-    #[inline(always)]
-    fn min(self, other: Self) -> Self {
-        Self(avx!(_mm256_min_ps(self.0, other.0)))
-    }
-    #[inline(always)]
-    fn max(self, other: Self) -> Self {
-        Self(avx!(_mm256_max_ps(self.0, other.0)))
-    }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         Self(avx!(_mm256_fmadd_ps(self.0, a.0, b.0)))
-    }
-    #[inline(always)]
-    fn copysign(self, sign: Self) -> Self {
-        let s = sign_bit();
-        Self(avx!(_mm256_or_ps(
-            _mm256_andnot_ps(s, self.0),
-            _mm256_and_ps(s, sign.0)
-        )))
     }
     #[inline(always)]
     fn lt(self, other: Self) -> M32x8 {
@@ -222,10 +89,6 @@ impl Lane for F32x8 {
     #[inline(always)]
     fn ne(self, other: Self) -> M32x8 {
         self.compare::<_CMP_NEQ_UQ>(other)
-    }
-    #[inline(always)]
-    fn select(mask: M32x8, on_true: Self, on_false: Self) -> Self {
-        Self(avx!(_mm256_blendv_ps(on_false.0, on_true.0, mask.0)))
     }
     #[inline(always)]
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
@@ -255,15 +118,6 @@ impl Lane for F32x8 {
                 unsafe { _mm256_store_ps(p, lanes[lane]) };
             }
         }
-    }
-    #[inline(always)]
-    fn reduce_add(self) -> f32 {
-        let a = self.to_array();
-        let mut sum = a[0];
-        for x in &a[1..] {
-            sum += x;
-        }
-        sum
     }
 }
 

@@ -6,6 +6,8 @@
 //! confirmed SSE4.1. That is what each `// SAFETY:` below relies on. The
 //! same type also serves the 4-lane AVX2 backend: entered through an
 //! `avx2,fma` function, the same intrinsics are emitted with VEX encoding.
+//! What it shares with the AVX type is written once in `x86.rs`, invoked
+//! here with the SSE intrinsics.
 
 use core::arch::x86_64::*;
 use core::fmt;
@@ -33,149 +35,23 @@ macro_rules! sse41 {
     };
 }
 
-#[inline(always)]
-fn sign_bit() -> __m128 {
-    sse41!(_mm_set1_ps(-0.0))
-}
-
-impl F32x4 {
-    #[inline(always)]
-    fn to_array(self) -> [f32; 4] {
-        let mut out = [0.0; 4];
-        self.store(&mut out);
-        out
-    }
-}
-
-impl fmt::Debug for F32x4 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.to_array().fmt(f)
-    }
-}
-
-impl fmt::Debug for M32x4 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let bits = sse41!(_mm_movemask_ps(self.0));
-        f.debug_list()
-            .entries((0..4).map(|i| bits >> i & 1 == 1))
-            .finish()
-    }
-}
-
-impl BitAnd for M32x4 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitand(self, rhs: Self) -> Self {
-        Self(sse41!(_mm_and_ps(self.0, rhs.0)))
-    }
-}
-
-impl BitOr for M32x4 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitor(self, rhs: Self) -> Self {
-        Self(sse41!(_mm_or_ps(self.0, rhs.0)))
-    }
-}
-
-impl Not for M32x4 {
-    type Output = Self;
-    #[inline(always)]
-    fn not(self) -> Self {
-        Self(sse41!(_mm_xor_ps(
-            self.0,
-            _mm_castsi128_ps(_mm_set1_epi32(-1))
-        )))
-    }
-}
-
-impl Mask for M32x4 {
-    #[inline(always)]
-    fn and_not(self, other: Self) -> Self {
-        Self(sse41!(_mm_andnot_ps(other.0, self.0)))
-    }
-}
-
-macro_rules! binary_op {
-    ($trait:ident, $method:ident, $assign_trait:ident, $assign:ident, $intrinsic:ident) => {
-        impl $trait for F32x4 {
-            type Output = Self;
-            #[inline(always)]
-            fn $method(self, rhs: Self) -> Self {
-                Self(sse41!($intrinsic(self.0, rhs.0)))
-            }
-        }
-        impl $assign_trait for F32x4 {
-            #[inline(always)]
-            fn $assign(&mut self, rhs: Self) {
-                *self = $trait::$method(*self, rhs);
-            }
-        }
-    };
-}
-
-binary_op!(Add, add, AddAssign, add_assign, _mm_add_ps);
-binary_op!(Sub, sub, SubAssign, sub_assign, _mm_sub_ps);
-binary_op!(Mul, mul, MulAssign, mul_assign, _mm_mul_ps);
-
-impl Div for F32x4 {
-    type Output = Self;
-    #[inline(always)]
-    fn div(self, rhs: Self) -> Self {
-        Self(sse41!(_mm_div_ps(self.0, rhs.0)))
-    }
-}
-
-impl Neg for F32x4 {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Self(sse41!(_mm_xor_ps(self.0, sign_bit())))
-    }
-}
+x86_lane_types!(
+    F32x4, M32x4, __m128, 4, sse41,
+    set1: _mm_set1_ps, and: _mm_and_ps, or: _mm_or_ps, xor: _mm_xor_ps,
+    andnot: _mm_andnot_ps, all_ones: _mm_castsi128_ps(_mm_set1_epi32(-1)),
+    movemask: _mm_movemask_ps,
+    add: _mm_add_ps, sub: _mm_sub_ps, mul: _mm_mul_ps, div: _mm_div_ps,
+);
 
 impl Lane for F32x4 {
     type Mask = M32x4;
-    const WIDTH: usize = 4;
+    x86_lane_methods!(
+        4, sse41,
+        set1: _mm_set1_ps, loadu: _mm_loadu_ps, storeu: _mm_storeu_ps,
+        sqrt: _mm_sqrt_ps, andnot: _mm_andnot_ps, and: _mm_and_ps, or: _mm_or_ps,
+        round: _mm_round_ps, min: _mm_min_ps, max: _mm_max_ps, blendv: _mm_blendv_ps,
+    );
 
-    #[inline(always)]
-    fn splat(value: f32) -> Self {
-        Self(sse41!(_mm_set1_ps(value)))
-    }
-    #[inline(always)]
-    fn load(src: &[f32]) -> Self {
-        let src: &[f32; 4] = src[..4].try_into().expect("four lanes");
-        // SAFETY: `src` is four readable floats; `loadu` takes any alignment.
-        Self(unsafe { _mm_loadu_ps(src.as_ptr()) })
-    }
-    #[inline(always)]
-    fn store(self, dst: &mut [f32]) {
-        let dst: &mut [f32; 4] = (&mut dst[..4]).try_into().expect("four lanes");
-        // SAFETY: `dst` is four writable floats; `storeu` takes any alignment.
-        unsafe { _mm_storeu_ps(dst.as_mut_ptr(), self.0) }
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        Self(sse41!(_mm_sqrt_ps(self.0)))
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        Self(sse41!(_mm_andnot_ps(sign_bit(), self.0)))
-    }
-    #[inline(always)]
-    fn round(self) -> Self {
-        Self(sse41!(_mm_round_ps::<
-            { _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC },
-        >(self.0)))
-    }
-    #[inline(always)]
-    fn min(self, other: Self) -> Self {
-        Self(sse41!(_mm_min_ps(self.0, other.0)))
-    }
-    #[inline(always)]
-    fn max(self, other: Self) -> Self {
-        Self(sse41!(_mm_max_ps(self.0, other.0)))
-    }
     /// SSE4.1 has no fused multiply-add: lane by lane through `f32::mul_add`.
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
@@ -184,14 +60,6 @@ impl Lane for F32x4 {
             s[i] = s[i].mul_add(a[i], b[i]);
         }
         Self::load(&s)
-    }
-    #[inline(always)]
-    fn copysign(self, sign: Self) -> Self {
-        let s = sign_bit();
-        Self(sse41!(_mm_or_ps(
-            _mm_andnot_ps(s, self.0),
-            _mm_and_ps(s, sign.0)
-        )))
     }
     #[inline(always)]
     fn lt(self, other: Self) -> M32x4 {
@@ -216,10 +84,6 @@ impl Lane for F32x4 {
     #[inline(always)]
     fn ne(self, other: Self) -> M32x4 {
         M32x4(sse41!(_mm_cmpneq_ps(self.0, other.0)))
-    }
-    #[inline(always)]
-    fn select(mask: M32x4, on_true: Self, on_false: Self) -> Self {
-        Self(sse41!(_mm_blendv_ps(on_false.0, on_true.0, mask.0)))
     }
     #[inline(always)]
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
@@ -253,11 +117,6 @@ impl Lane for F32x4 {
                 }
             }
         }
-    }
-    #[inline(always)]
-    fn reduce_add(self) -> f32 {
-        let a = self.to_array();
-        ((a[0] + a[1]) + a[2]) + a[3]
     }
 }
 

@@ -56,8 +56,9 @@ pub fn solve<L: Lane>(
     lambda: L,
 ) -> L {
     let (n, c) = measure(f, rest_direction);
-    let w = bend_weight(a, b, n, rest_length);
-    drive::correct(a, b, n, n, c, c - start.dot(n), w, d, lambda)
+    let (ra, rb) = (a.angular_response(n), b.angular_response(n));
+    let w = bend_weight(a, b, (ra.weight, rb.weight), rest_length);
+    drive::correct(a, b, (&ra, &rb), c, c - start.dot(n), w, d, lambda)
 }
 
 /// How far `psi` exceeds the limit (rad, >= 0), and the bend axis.

@@ -31,6 +31,7 @@ use vertebra_math::{Lane, Vec3, poly};
 
 use super::Frames;
 use crate::body::{BodyLanes, PairStart, safe_ratio};
+use crate::parts::angle;
 
 /// The curve error and its gradients.
 #[derive(Clone, Copy, Debug)]
@@ -82,12 +83,10 @@ pub fn solve<L: Lane>(
     start: &PairStart<L>,
 ) -> L {
     let c = measure(a, b, f, start);
-    let w = a.angular_weight(c.n_a)
-        + b.angular_weight(c.n_b)
-        + c.g.length_squared() * (a.inv_mass + b.inv_mass);
+    let (ra, rb) = (a.angular_response(c.n_a), b.angular_response(c.n_b));
+    let w = ra.weight + rb.weight + c.g.length_squared() * (a.inv_mass + b.inv_mass);
     let dlambda = safe_ratio(-c.theta, w);
-    b.rotate(b.inv_inertia_mul(c.n_b.scale(dlambda)));
-    a.rotate(a.inv_inertia_mul(c.n_a.scale(-dlambda)));
+    angle::apply(a, b, (&ra, &rb), dlambda);
     b.p += c.g.scale(dlambda * b.inv_mass);
     a.p -= c.g.scale(dlambda * a.inv_mass);
     c.theta

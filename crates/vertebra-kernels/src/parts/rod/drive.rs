@@ -94,8 +94,8 @@
 
 use vertebra_math::{Lane, Vec3, poly};
 
-use crate::body::{BodyLanes, safe_ratio};
-use crate::parts::angle::Softness;
+use crate::body::{BodyLanes, Response, safe_ratio};
+use crate::parts::angle::{self, Softness};
 
 /// A soft part's drive settings for this substep, per lane.
 #[derive(Clone, Copy, Debug)]
@@ -112,10 +112,16 @@ pub struct Drive<L> {
 }
 
 /// The effective inverse inertia of bending about `n` (1/(kg m^2)): `w_J`
-/// of the module documentation, for a rod of length `rest_length` (m).
+/// of the module documentation, for a rod of length `rest_length` (m),
+/// from the bodies' responses to a turn about `n` (`ua = n^T I_a^-1 n`,
+/// `ub` the same for b).
 #[inline(always)]
-pub fn bend_weight<L: Lane>(a: &BodyLanes<L>, b: &BodyLanes<L>, n: Vec3<L>, rest_length: L) -> L {
-    let (ua, ub) = (a.angular_weight(n), b.angular_weight(n));
+pub fn bend_weight<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    (ua, ub): (L, L),
+    rest_length: L,
+) -> L {
     let v = a.inv_mass + b.inv_mass;
     let l2 = rest_length * rest_length;
     safe_ratio(
@@ -146,22 +152,22 @@ pub fn advance_twist<L: Lane>(rest: L, rate: L, h: L) -> L {
 }
 
 /// One damped, sprung, capped correction of the angle `c` (axes as in
-/// `parts::angle`); `rate` is `C - C_0` (rad) and `w_spring` the part's
-/// effective inverse inertia. Returns the new accumulated `lambda`.
+/// `parts::angle`, given as the bodies' responses to them); `rate` is
+/// `C - C_0` (rad) and `w_spring` the part's effective inverse inertia.
+/// Returns the new accumulated `lambda`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn correct<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    n_a: Vec3<L>,
-    n_b: Vec3<L>,
+    (ra, rb): (&Response<L>, &Response<L>),
     c: L,
     rate: L,
     w_spring: L,
     d: &Drive<L>,
     lambda: L,
 ) -> L {
-    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
+    let w = ra.weight + rb.weight;
     let s = d.soft;
     let plain = safe_ratio(
         -s.relaxation * c - s.alpha_tilde * lambda,
@@ -174,8 +180,7 @@ pub fn correct<L: Lane>(
     );
     let dlambda = L::select((d.spring + d.gamma).gt(L::splat(0.0)), damped, plain);
     let (lambda, dlambda) = cap(lambda, dlambda, d.limit);
-    b.rotate(b.inv_inertia_mul(n_b.scale(dlambda)));
-    a.rotate(a.inv_inertia_mul(n_a.scale(-dlambda)));
+    angle::apply(a, b, (ra, rb), dlambda);
     lambda
 }
 

@@ -4,7 +4,8 @@
 //! along the arc by its natural (parallel-transport) frame. For a circular
 //! arc that transport is the minimal rotation `M` taking `t_a` to `t_b`
 //! (about the bend axis, by `psi`), so `tau` is the angle of the rotation
-//! `(M F(0))* F(1)`, which turns about x only: `Quat::twist_angle`.
+//! `(M F(0))* F(1)`, which turns about x only: `Quat::twist_angle`, from
+//! the product's x and real components alone (`parts::twist::angle`).
 //! The paper's `tau = xi - psi` (eq. 12, `xi` the total angle between the
 //! frames) is not this: it cannot be negative, and a bend of `psi` with a
 //! twist of `tau` has `xi = 2 acos(cos(psi/2) cos(tau/2)) != psi + tau`.
@@ -49,11 +50,18 @@ pub fn axes<L: Lane>(f: &Frames<L>) -> (Vec3<L>, Vec3<L>) {
 /// The twist angle `tau` in [-pi, pi] (rad).
 #[inline(always)]
 pub fn measure<L: Lane>(f: &Frames<L>) -> L {
-    // M = normalize(1 + t_a . t_b, t_a x t_b): the half-way quaternion.
-    // Folded back (t_b = -t_a) it is zero and normalises to the identity.
-    let minimal = Quat::from_parts(f.ta.cross(f.tb), L::splat(1.0) + f.ta.dot(f.tb)).normalize();
-    let relative = (minimal * f.fa).conjugate() * f.fb;
-    relative.twist_angle(Vec3::splat(crate::TWIST_AXIS))
+    // M = (t_a x t_b, 1 + t_a . t_b), the half-way quaternion, not
+    // normalised: the twist angle is an atan2 of two components of the
+    // product, which any positive multiple of M leaves as they are. Folded
+    // back (1 + t_a . t_b at most 1e-6, where `axes` drops k too) it is the
+    // identity.
+    let w = L::splat(1.0) + f.ta.dot(f.tb);
+    let minimal = Quat::select(
+        w.gt(L::splat(1e-6)),
+        Quat::from_parts(f.ta.cross(f.tb), w),
+        Quat::identity(),
+    );
+    crate::parts::twist::angle(minimal * f.fa, f.fb)
 }
 
 /// The error `tau - rest`, wrapped to [-pi, pi]: a rod twisted past pi
@@ -79,9 +87,9 @@ pub fn solve<L: Lane>(
 ) -> L {
     let c = error(f, rest);
     let (n_a, n_b) = axes(f);
-    let w = a.angular_weight(n_a) + b.angular_weight(n_b);
+    let (ra, rb) = (a.angular_response(n_a), b.angular_response(n_b));
     let rate = poly::wrap_angle(c - start);
-    drive::correct(a, b, n_a, n_b, c, rate, w, d, lambda)
+    drive::correct(a, b, (&ra, &rb), c, rate, ra.weight + rb.weight, d, lambda)
 }
 
 /// Enforces `lo <= tau <= hi`; returns |excess| before the correction.
