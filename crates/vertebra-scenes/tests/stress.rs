@@ -208,10 +208,14 @@ fn ragdolls_teleported_into_each_other_separate() {
         end < 0.02 && limited_end < 0.02,
         "they separate: {end} m, {limited_end} m"
     );
-    // Removing 24 cm in a 60 Hz step is 14 m/s.
-    assert!(unlimited < 20.0, "no explosion: {unlimited} m/s");
+    // Removing 24 cm in a 60 Hz step is 14 m/s. Since issue 17 (contacts
+    // correct through the step's first lever arms; every correction turns
+    // the body in its own frame) the unlimited way out is 7.3 m/s where
+    // it was 15.9, and the limit (5.6 m/s where it was 7.9) calms it by
+    // less.
+    assert!(unlimited < 10.0, "no explosion: {unlimited} m/s");
     assert!(
-        limited < 0.7 * unlimited,
+        limited < 0.8 * unlimited,
         "the limit calms it: {limited} against {unlimited} m/s"
     );
 }
