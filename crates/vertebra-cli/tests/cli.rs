@@ -880,3 +880,29 @@ fn check_prints_what_a_generator_file_generates_or_its_problems() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--sleep` reaches the world: the anatomical drop (one ragdoll on the
+/// ground) stepped with sleeping on ends in another state than without,
+/// and says so in its JSON.
+#[test]
+fn sleep_turns_sleeping_on() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "scene",
+            "anatomical-drop",
+            "--spine",
+            "rod",
+            "--frames",
+            "90",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let (code, stdout, stderr) = vertebra(&args);
+        assert_eq!(code, 0, "{stderr}");
+        serde_json::from_str::<serde_json::Value>(stdout.trim()).expect("one JSON object")
+    };
+    let (asleep, awake) = (run(&["--sleep"]), run(&[]));
+    assert_eq!(asleep["sleep"], true);
+    assert_eq!(awake["sleep"], false);
+    assert_ne!(asleep["state_hash"], awake["state_hash"]);
+}
