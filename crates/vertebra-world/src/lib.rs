@@ -96,8 +96,8 @@ pub struct World {
     contact_layout: contact::ContactLayout,
     rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
-    /// Scratch of the step: which slots the body passes move (live and
-    /// not static).
+    /// Scratch of the step: which slots the body passes move (live, not
+    /// static, not asleep).
     moving: Vec<bool>,
     /// Scratch of the step: the counters of a substep's stages.
     stages: stages::Stages,
