@@ -91,8 +91,8 @@ enum Command {
         /// figure's median and spread over them.
         #[arg(long)]
         seeds: Option<u64>,
-        /// Let still islands sleep (the world's default thresholds: 0.05
-        /// m/s and 0.05 rad/s on average over 0.5 s). Off by default: the
+        /// Let still islands sleep (the world's default: a body's mass
+        /// moving at 0.05 m/s on average over 0.5 s). Off by default: the
         /// paper's figures step every body every frame.
         #[arg(long)]
         sleep: bool,

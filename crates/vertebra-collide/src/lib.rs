@@ -500,6 +500,12 @@ impl Collisions {
     ) -> Result<(), Error> {
         contacts.clear();
         vertebra_world::check_positive("time step", dt)?;
+        self.sleep_state(world, scratch)?;
+        if !scratch.acts.contains(&true) {
+            // Every body asleep or still (a settled pile): no pair has a
+            // body that moves, so no bounds, sweep or round is needed.
+            return Ok(());
+        }
         scratch.poses.clear();
         scratch.reach.clear();
         for (index, (c, shape)) in self.colliders.iter().enumerate() {
@@ -513,7 +519,6 @@ impl Collisions {
                 .reach
                 .push((s.linear_velocity.length() + s.angular_velocity.length() * extent) * dt);
         }
-        self.sleep_state(world, scratch)?;
         self.bounds(scratch);
         // Pairs where a body moves; then, round after round, the pairs of
         // the sleeping islands those contacts touch (the step wakes them,

@@ -402,3 +402,42 @@ fn sleeping_worlds_are_bit_identical_across_threads_and_backends() {
         }
     }
 }
+
+#[test]
+fn a_turn_counts_by_how_far_it_carries_the_mass() {
+    // Two capsules 0.5 m long spinning in free fall, one about its own axis
+    // (a limb twisting in place in a pile), one end over end, at the same
+    // rate. The mean speed of a body's mass spinning at `w` about a
+    // principal axis of inertia `I` is `w sqrt(I / m)`: a few cm/s for the
+    // twist, below the threshold, and more than it for the tumble. Sleeping
+    // judged by the turning rate (0.05 rad/s) kept both awake, and a pile
+    // of ragdolls, its limbs twisting back and forth at their limits, never
+    // slept.
+    let mut world = World::new(SolverConfig {
+        gravity: Vec3::ZERO,
+        ..sleeping()
+    })
+    .unwrap();
+    let shape = Shape::capsule(Vec3::new(0.0, -0.2, 0.0), Vec3::new(0.0, 0.2, 0.0), 0.05);
+    let mass = shape.mass_properties(1000.0).unwrap();
+    let w = 0.8;
+    let threshold = SleepSettings::default().speed;
+    let mass_speed = |axis: usize| w * (mass.inertia.col(axis)[axis] / mass.mass).sqrt();
+    assert!(mass_speed(1) < 0.7 * threshold && mass_speed(0) > 1.5 * threshold);
+    let spin = |world: &mut World, x: f32, axis: Vec3| {
+        let body = world
+            .add_body(BodyDesc::dynamic(mass).with_position(Vec3::new(x, 0.0, 0.0)))
+            .unwrap();
+        world.set_body_velocity(body, Vec3::ZERO, axis * w).unwrap();
+        body
+    };
+    let twisting = spin(&mut world, 0.0, Vec3::Y);
+    let tumbling = spin(&mut world, 2.0, Vec3::X);
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+    }
+    assert!(world.is_asleep(twisting).unwrap(), "the twisting capsule");
+    assert!(!world.is_asleep(tumbling).unwrap(), "the tumbling capsule");
+    let turning = world.body(tumbling).unwrap().angular_velocity;
+    assert!((turning - Vec3::X * w).length() < 1e-4, "{turning}");
+}

@@ -12,16 +12,20 @@
 //! contact's end is seen as a change of the sum of a hash of the island's
 //! touching body pairs from one step to the next.
 //!
-//! **Sleeping.** After each step, a dynamic body that has stayed within
-//! `linear_speed * time` (m) of where its stillness began, and turned by
-//! at most about `angular_speed * time` (rad) from there
-//! ([`SleepSettings`]), adds the step's time to its stillness; else it
-//! restarts from zero, from where it is. So a body is still when its
-//! *mean* speeds over the sleep time are below the thresholds, whatever
-//! it does in between: a limb jittering in place sleeps, one creeping
-//! away does not (a test of the speeds at each step, as Box2D's, kept a
-//! jittering pile awake); a small oscillation (of amplitude below half
-//! the reach) sleeps too, as it would under a speed test once it slowed.
+//! **Sleeping.** After each step, a dynamic body whose mass has moved less
+//! than `speed * time` ([`SleepSettings`]) from its anchor adds the step's
+//! time to its stillness; else its stillness restarts from zero, anchored
+//! where it is. Each time its stillness completes another `time`, the
+//! anchor moves on to where it is. So a body is still while the mean speed
+//! of its mass over each window of `time` stays below `speed`, whatever it
+//! does in between: a limb jittering in place sleeps (a test of the
+//! speeds at each step, as Box2D's, kept a jittering pile awake), and so
+//! does one creeping slower than `speed`, as under Box2D's speed test; an
+//! oscillation of amplitude below half the reach sleeps too (as Jolt's
+//! test of a body's points against a fixed radius lets it). The move is
+//! the root mean square over the body's mass of its points' moves (its
+//! centre's move and its turn weighted by its inertia): a limb twisting
+//! in place about its own axis barely moves, one swinging does.
 //! An island whose every body has been still for [`SleepSettings::time`],
 //! and that has no split pending, falls asleep: its velocities are zeroed,
 //! and until it wakes its bodies are not integrated, its joints and rods
@@ -49,24 +53,42 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error};
 
 use crate::{Contact, JointDesc, RodDesc};
 
+/// How far body `i`'s mass moved from `from` to `to`, squared: the mean
+/// over its mass of its points' squared moves (m^2). A point at `r` from
+/// the centre moves by `dx + (R - 1) r`; the mean of `r` is zero, and the
+/// mean of `|(R - 1) r|^2` is `v^T E[|r|^2 - r r^T] v = v^T (I / m) v` with
+/// `v = 2 sin(a / 2) axis`, twice the turn's vector part (in the body
+/// frame, where `I` is given).
+fn mass_moved_squared(bodies: &BodyStore, i: usize, from: (DVec3, Quat), to: (DVec3, Quat)) -> f64 {
+    let turn = from.1.inverse() * to.1;
+    let v = (2.0 * Vec3::new(turn.x, turn.y, turn.z)).as_dvec3();
+    let inertia = bodies.inertia[i].as_dmat3();
+    let spread = v.dot(inertia * v) / f64::from(bodies.mass[i]);
+    (to.0 - from.0).length_squared() + spread
+}
+
 /// A body in no island: free slot, static or kinematic.
 pub(crate) const NO_ISLAND: u32 = u32::MAX;
 
 /// When bodies fall asleep ([`SolverConfig::sleep`](crate::SolverConfig::sleep)):
-/// a body is still while its mean speeds since its stillness began stay
-/// below `linear_speed` and `angular_speed` over `time` (it stays within
-/// `linear_speed * time` of where it was, turned by about
-/// `angular_speed * time` at most); an island sleeps when all its bodies
-/// have been still for `time`. Defaults as Box2D's (0.05 m/s, 0.5 s) and
-/// an angular speed to match (0.05 rad/s: 2.5 cm/s at the end of a 0.5 m
-/// limb).
+/// a body is still while the mean speed of its mass over each window of
+/// `time` stays below `speed`, and an island sleeps when all its bodies
+/// have been still for `time`. Defaults as Box2D's (0.05 m/s, 0.5 s).
+///
+/// The speed is of the body's mass, not of its centre: how far its points
+/// have moved from where the window began, as the root mean square over
+/// its mass (`sqrt(|dx|^2 + v^T (I / m) v)`, `dx` the centre's move, `v`
+/// twice the vector part of the turn, `I` the body-frame inertia, `m` the
+/// mass; exact for any turn). So a turn counts by how far it carries the
+/// body's mass: a limb twisting by 2 degrees about its own axis moves its
+/// surface a millimetre and is still, a limb swinging by the same angle
+/// moves its far end a centimetre (as Jolt tests points on the body, and
+/// Box2D its extent times its angular speed).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SleepSettings {
-    /// The mean speed of a still body's centre of mass over `time` is
-    /// below this (m/s, at least 0)...
-    pub linear_speed: f32,
-    /// ...and its mean turning speed (rad/s, at least 0).
-    pub angular_speed: f32,
+    /// The mean speed of a still body's mass stays below this (m/s, at
+    /// least 0).
+    pub speed: f32,
     /// An island sleeps once every body in it has been still this long (s,
     /// positive, at most 1e6).
     pub time: f32,
@@ -75,8 +97,7 @@ pub struct SleepSettings {
 impl Default for SleepSettings {
     fn default() -> Self {
         Self {
-            linear_speed: 0.05,
-            angular_speed: 0.05,
+            speed: 0.05,
             time: 0.5,
         }
     }
@@ -85,15 +106,9 @@ impl Default for SleepSettings {
 impl SleepSettings {
     /// Checks every field; the error names it.
     pub fn validate(&self) -> Result<(), Error> {
-        let speed = |v: f32| v.is_finite() && v >= 0.0;
-        if !speed(self.linear_speed) {
+        if !(self.speed.is_finite() && self.speed >= 0.0) {
             return Err(Error::InvalidConfig(
-                "sleep.linear_speed must be finite and at least 0",
-            ));
-        }
-        if !speed(self.angular_speed) {
-            return Err(Error::InvalidConfig(
-                "sleep.angular_speed must be finite and at least 0",
+                "sleep.speed must be finite and at least 0",
             ));
         }
         if !(self.time > 0.0 && self.time <= 1.0e6) {
@@ -450,15 +465,12 @@ impl Islands {
         bodies: &BodyStore,
         links: impl Iterator<Item = Link>,
     ) {
-        // Within the drift for the whole time: the mean speeds below the
-        // thresholds, whatever a body does in between (a body jittering in
-        // place in a jammed pile is still; one creeping away is not).
-        // A turn by `a` from the anchor has `1 - dot^2 = sin^2(a / 2)`:
-        // held to `sin(a / 2) <= speed time / 2`, `a` about `speed time`
-        // (no trigonometry: every host decides alike).
-        let reach = f64::from(settings.linear_speed * settings.time);
-        let half = 0.5 * settings.angular_speed * settings.time;
-        let max_sin2 = half * half;
+        // The mean speed over each window of `time`, not the speed at each
+        // step: a limb jittering in place in a jammed pile is still (a test
+        // of the speeds at each step, as Box2D's, kept a jittering pile
+        // awake), and so is one creeping slower than `speed` (the anchor
+        // moves on to where the body is at the end of each window).
+        let reach = f64::from(settings.speed) * f64::from(settings.time);
         for i in 0..self.of.len() {
             if self.of[i] == NO_ISLAND || self.asleep[i] {
                 continue;
@@ -467,10 +479,12 @@ impl Islands {
             if self.still[i] == 0.0 {
                 self.anchor[i] = now;
             }
-            let (x, q) = self.anchor[i];
-            let dot = now.1.dot(q);
-            let drifted = (now.0 - x).length() > reach || 1.0 - dot * dot > max_sin2;
+            let drifted = mass_moved_squared(bodies, i, self.anchor[i], now) > reach * reach;
             if self.allowed[i] && !drifted {
+                let window = |still: f32| (still / settings.time).floor();
+                if window(self.still[i] + dt) > window(self.still[i]) {
+                    self.anchor[i] = now;
+                }
                 self.still[i] += dt;
             } else {
                 self.still[i] = 0.0;
