@@ -1,9 +1,11 @@
 //! The substepped pile comes to rest (issue 14; docs/contacts.md, "The
 //! jammed pile").
 
+use glam::Vec3;
+use vertebra_collide::{Collider, ColliderShape};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Scene, SceneConfig, build, run};
-use vertebra_world::SleepSettings;
+use vertebra_world::{BodyDesc, Shape, SleepSettings};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -78,5 +80,43 @@ fn the_pile_falls_asleep_and_stays_put() {
             scene.advance(config.scene, frame, DT).unwrap();
         }
         assert_eq!(poses(&scene), before, "{spine:?}: the sleeping pile moved");
+
+        // A ball dropped from 2 m wakes the pile (one island: its ragdolls
+        // all touch) in the frame its contacts reach it, and not before.
+        let props = Shape::Sphere { radius: 0.15 }
+            .mass_properties(1000.0)
+            .unwrap();
+        let ball = scene
+            .world
+            .add_body(BodyDesc::dynamic(props).with_position(Vec3::new(0.0, 2.0, 0.0)))
+            .unwrap();
+        let sphere = ColliderShape::Solid(Shape::Sphere { radius: 0.15 });
+        let collisions = scene.collisions.as_mut().unwrap();
+        collisions.add(Collider::new(ball, sphere)).unwrap();
+        let hips = scene.ragdolls[0].bodies[0].unwrap();
+        let mut woke = None;
+        for frame in frames + 120..frames + 240 {
+            scene.detect(DT).unwrap();
+            let contacts = scene.world.contacts().iter();
+            let touching = contacts
+                .filter(|c| c.body_a == ball || c.body_b == ball)
+                .count()
+                > 0;
+            scene.world.step(DT).unwrap();
+            if !scene.world.is_asleep(hips).unwrap() {
+                woke = Some((frame, touching));
+                break;
+            }
+        }
+        let (frame, touching) = woke.expect("the ball wakes the pile");
+        assert!(
+            touching,
+            "{spine:?}: the pile woke at frame {frame} before the ball reached it"
+        );
+        assert_eq!(
+            scene.world.island_count().1,
+            0,
+            "{spine:?}: the whole pile wakes"
+        );
     }
 }
