@@ -54,6 +54,7 @@ impl F32x8 {
 
 impl Lane for F32x8 {
     type Mask = M32x8;
+    type Narrow = crate::lane::sse41::F32x4;
     x86_lane_methods!(
         8, avx,
         set1: _mm256_set1_ps, loadu: _mm256_loadu_ps, storeu: _mm256_storeu_ps,
