@@ -14,7 +14,7 @@ use core::fmt;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
 use super::{Lane, Mask};
-use crate::row::{NO_WRITE, ROW_LEN, Row, check_reads, check_writes};
+use crate::row::{NO_WRITE, ROW_LEN, Row};
 
 /// Four `f32` lanes.
 #[derive(Clone, Copy)]
@@ -88,16 +88,13 @@ impl Lane for F32x4 {
     }
     #[inline(always)]
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
-        let indices = &indices[..4];
-        check_reads(rows, indices);
         let (mut lo, mut hi) = ([sse41!(_mm_setzero_ps()); 4], [sse41!(_mm_setzero_ps()); 4]);
-        for (lane, &index) in indices.iter().enumerate() {
-            // SAFETY: `index` names a row of `rows` (`check_reads`), a live,
-            // 32-byte aligned row of eight floats that no other thread
-            // writes now (`Row` is not `Sync`; shared rows are written
-            // disjointly: crate::row); SSE4.1 detected.
+        for lane in 0..4 {
+            let p = rows[indices[lane] as usize].as_ptr();
+            // SAFETY: `p` is a live, 32-byte aligned row of eight floats
+            // (bounds-checked) that no other thread writes now (`Row` is not
+            // `Sync`; shared rows are written disjointly: crate::row); SSE4.1 detected.
             unsafe {
-                let p = rows.get_unchecked(index as usize).as_ptr();
                 lo[lane] = _mm_load_ps(p);
                 hi[lane] = _mm_load_ps(p.add(4));
             }
@@ -109,16 +106,13 @@ impl Lane for F32x4 {
     fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]) {
         let lo = transpose4([values[0].0, values[1].0, values[2].0, values[3].0]);
         let hi = transpose4([values[4].0, values[5].0, values[6].0, values[7].0]);
-        let indices = &indices[..4];
-        check_writes(rows, indices);
-        for (lane, &index) in indices.iter().enumerate() {
+        for (lane, &index) in indices[..4].iter().enumerate() {
             if index != NO_WRITE {
-                // SAFETY: `index` names a row of `rows` (`check_writes`), a
-                // live, aligned row of eight floats that no other thread
-                // reads or writes now (`Row` is not `Sync`; shared rows are
-                // written disjointly: crate::row); SSE4.1 detected.
+                let p = rows[index as usize].as_ptr();
+                // SAFETY: `p` is a live, aligned row of eight floats that no
+                // other thread reads or writes now (`Row` is not `Sync`; shared
+                // rows are written disjointly: crate::row); SSE4.1 detected.
                 unsafe {
-                    let p = rows.get_unchecked(index as usize).as_ptr();
                     _mm_store_ps(p, lo[lane]);
                     _mm_store_ps(p.add(4), hi[lane]);
                 }
