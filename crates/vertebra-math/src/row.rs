@@ -81,7 +81,10 @@ pub(crate) fn check_reads(rows: &[Row], indices: &[u32]) {
     for &index in indices {
         largest = largest.max(index);
     }
-    assert!((largest as usize) < rows.len(), "a row index is out of range");
+    assert!(
+        (largest as usize) < rows.len(),
+        "a row index is out of range"
+    );
 }
 
 /// Panics unless every index of `indices` but [`NO_WRITE`] names a row of
@@ -94,7 +97,10 @@ pub(crate) fn check_writes(rows: &[Row], indices: &[u32]) {
     for &index in indices {
         largest = largest.max(index.wrapping_add(1));
     }
-    assert!((largest as usize) <= rows.len(), "a row index is out of range");
+    assert!(
+        (largest as usize) <= rows.len(),
+        "a row index is out of range"
+    );
 }
 
 /// The generic gather: lane `i` of output `k` is `rows[indices[i]][k]`.

@@ -91,7 +91,10 @@ fn start_drives(world: &mut World, h: f32) {
         // An empty range is not dispatched: a small world's groups hold
         // few kinds, and entering a backend is not free.
         let some = |range: &Range<usize>| !range.is_empty();
-        for range in [&group.driven, &group.shaped_driven].into_iter().filter(|r| some(r)) {
+        for range in [&group.driven, &group.shaped_driven]
+            .into_iter()
+            .filter(|r| some(r))
+        {
             world.backend.dispatch(StartPass {
                 blocks: &mut layout.sockets.blocks[range.clone()],
                 rows,
@@ -105,13 +108,19 @@ fn start_drives(world: &mut World, h: f32) {
                 h,
             });
         }
-        for range in [&group.shaped_driven, &group.shaped_plain].into_iter().filter(|r| some(r)) {
+        for range in [&group.shaped_driven, &group.shaped_plain]
+            .into_iter()
+            .filter(|r| some(r))
+        {
             world.backend.dispatch(limited::StartPass {
                 blocks: &mut layout.sockets.blocks[range.clone()],
                 rows,
             });
         }
-        for range in [&group.hinges_driven, &group.hinges_plain].into_iter().filter(|r| some(r)) {
+        for range in [&group.hinges_driven, &group.hinges_plain]
+            .into_iter()
+            .filter(|r| some(r))
+        {
             world.backend.dispatch(limited::StartPass {
                 blocks: &mut layout.hinges.blocks[range.clone()],
                 rows,

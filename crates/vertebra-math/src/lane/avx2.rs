@@ -120,7 +120,9 @@ impl Lane for F32x8 {
                 // live, aligned row of eight floats that no other thread
                 // reads or writes now (`Row` is not `Sync`; shared rows are
                 // written disjointly: crate::row); AVX detected.
-                unsafe { _mm256_store_ps(rows.get_unchecked(index as usize).as_ptr(), lanes[lane]) };
+                unsafe {
+                    _mm256_store_ps(rows.get_unchecked(index as usize).as_ptr(), lanes[lane])
+                };
             }
         }
     }
