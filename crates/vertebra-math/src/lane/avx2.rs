@@ -97,10 +97,9 @@ impl Lane for F32x8 {
         check_reads(rows, indices);
         let mut loaded = [avx!(_mm256_setzero_ps()); 8];
         for (lane, &index) in loaded.iter_mut().zip(indices) {
-            // SAFETY: `index` names a row of `rows` (`check_reads`), a live,
-            // 32-byte aligned row of eight floats that no other thread
-            // writes now (`Row` is not `Sync`; shared rows are written
-            // disjointly: crate::row); AVX detected.
+            // SAFETY: `index` < `rows.len()` (`check_reads`): a live, 32-byte
+            // aligned row that no other thread writes now (`Row` is not `Sync`;
+            // shared rows are written disjointly: crate::row); AVX detected.
             *lane = unsafe { _mm256_load_ps(rows.get_unchecked(index as usize).as_ptr()) };
         }
         transpose8(loaded).map(Self)
@@ -116,10 +115,9 @@ impl Lane for F32x8 {
         check_writes(rows, indices);
         for (lane, &index) in indices.iter().enumerate() {
             if index != NO_WRITE {
-                // SAFETY: `index` names a row of `rows` (`check_writes`), a
-                // live, aligned row of eight floats that no other thread
-                // reads or writes now (`Row` is not `Sync`; shared rows are
-                // written disjointly: crate::row); AVX detected.
+                // SAFETY: `index` < `rows.len()` (`check_writes`): a live,
+                // aligned row no other thread reaches now (`Row` is not `Sync`;
+                // shared rows are written disjointly: crate::row); AVX detected.
                 unsafe {
                     _mm256_store_ps(rows.get_unchecked(index as usize).as_ptr(), lanes[lane])
                 };
