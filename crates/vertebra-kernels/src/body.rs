@@ -307,6 +307,14 @@ pub struct BodyPairs {
     pub start_arm_a: Vec3Block,
     /// The world lever arm of b's point when the step began (m).
     pub start_arm_b: Vec3Block,
+    /// Bit `i` set: lane `i` is padding (reads the null row on both sides,
+    /// writes no row), kept by [`BodyPairs::set`]; kernels skip slices of
+    /// padding (`vertebra_math::block::for_live_slices`). Zero (a zeroed
+    /// header) runs every lane.
+    pub padding: u32,
+    /// Fills the header to its 32-byte alignment (`Pod` allows no implicit
+    /// padding bytes).
+    pub _align: [u32; 7],
 }
 
 /// Where a pair of body points stood when the step began: their separation
@@ -402,6 +410,12 @@ impl BodyPairs {
         self.body_b[lane] = b;
         self.write_a[lane] = if dynamic_a { a } else { NO_WRITE };
         self.write_b[lane] = if dynamic_b { b } else { NO_WRITE };
+        let bit = 1 << lane;
+        if a == 0 && b == 0 && !dynamic_a && !dynamic_b {
+            self.padding |= bit;
+        } else {
+            self.padding &= !bit;
+        }
     }
 
     /// Sets lane `lane`'s start of step.

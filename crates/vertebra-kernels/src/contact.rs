@@ -40,7 +40,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3 as GVec3;
-use vertebra_math::block::{BLOCK_LANES, Vec3Block};
+use vertebra_math::block::{BLOCK_LANES, LaneSlices, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel, Vec3};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows, StartLane, VelocityLanes, safe_ratio};
@@ -205,10 +205,26 @@ impl LaneKernel for PositionPass<'_> {
     #[inline(always)]
     fn run<L: Lane>(self) {
         for block in self.blocks.iter_mut() {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions::<L>(block, start, self.rows);
-            }
+            let padding = block.bodies.padding;
+            let mut positions = Positions {
+                block,
+                rows: self.rows,
+            };
+            for_live_slices::<L, _>(padding, &mut positions);
         }
+    }
+}
+
+/// One block of a [`PositionPass`].
+struct Positions<'a> {
+    block: &'a mut ContactBlock,
+    rows: &'a BodyRows,
+}
+
+impl LaneSlices for Positions<'_> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        solve_positions::<L>(self.block, start, self.rows);
     }
 }
 
@@ -263,16 +279,30 @@ impl LaneKernel for VelocityPass<'_> {
     #[inline(always)]
     fn run<L: Lane>(self) {
         for block in self.blocks {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_velocities::<L>(
-                    block,
-                    start,
-                    self.rows,
-                    L::splat(self.h),
-                    L::splat(self.resting_speed),
-                );
-            }
+            let mut velocities = Velocities {
+                block,
+                rows: self.rows,
+                h: self.h,
+                resting_speed: self.resting_speed,
+            };
+            for_live_slices::<L, _>(block.bodies.padding, &mut velocities);
         }
+    }
+}
+
+/// One block of a [`VelocityPass`].
+struct Velocities<'a> {
+    block: &'a ContactBlock,
+    rows: &'a BodyRows,
+    h: f32,
+    resting_speed: f32,
+}
+
+impl LaneSlices for Velocities<'_> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        let (h, resting_speed) = (L::splat(self.h), L::splat(self.resting_speed));
+        solve_velocities::<L>(self.block, start, self.rows, h, resting_speed);
     }
 }
 

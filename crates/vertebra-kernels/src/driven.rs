@@ -5,7 +5,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
-use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel, Quat};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows};
@@ -145,19 +145,38 @@ impl<B: Driven> LaneKernel for StartPass<'_, B> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let h = L::splat(self.h);
         for block in self.blocks.iter_mut() {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let (a, b) = block.bodies().gather::<L>(self.rows, start);
-                let (frame_a, frame_b) = block.frames::<L>(start);
-                let d = block.drive_mut();
-                let target = d.target.load::<L>(start);
-                let enabled = L::load(&d.enabled[start..]);
-                let error = drive::start(&a, &b, frame_a, frame_b, target, enabled);
-                d.start.store(start, error);
-                let velocity = d.velocity.load(start);
-                d.target.store(start, drive::advance(target, velocity, h));
-            }
+            let padding = block.bodies().padding;
+            let mut starts = Starts {
+                block,
+                rows: self.rows,
+                h: self.h,
+            };
+            for_live_slices::<L, _>(padding, &mut starts);
         }
+    }
+}
+
+/// One block of a [`StartPass`].
+struct Starts<'a, B> {
+    block: &'a mut B,
+    rows: &'a BodyRows,
+    h: f32,
+}
+
+impl<B: Driven> LaneSlices for Starts<'_, B> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        let block = &mut *self.block;
+        let (a, b) = block.bodies().gather::<L>(self.rows, start);
+        let (frame_a, frame_b) = block.frames::<L>(start);
+        let d = block.drive_mut();
+        let target = d.target.load::<L>(start);
+        let enabled = L::load(&d.enabled[start..]);
+        let error = drive::start(&a, &b, frame_a, frame_b, target, enabled);
+        d.start.store(start, error);
+        let velocity = d.velocity.load(start);
+        d.target
+            .store(start, drive::advance(target, velocity, L::splat(self.h)));
     }
 }

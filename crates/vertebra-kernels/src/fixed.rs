@@ -3,7 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
-use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
@@ -99,10 +99,26 @@ impl LaneKernel for PositionPass<'_> {
     #[inline(always)]
     fn run<L: Lane>(self) {
         for block in self.blocks.iter_mut() {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions::<L>(block, start, self.rows);
-            }
+            let padding = block.bodies.padding;
+            let mut positions = Positions {
+                block,
+                rows: self.rows,
+            };
+            for_live_slices::<L, _>(padding, &mut positions);
         }
+    }
+}
+
+/// One block of a [`PositionPass`].
+struct Positions<'a> {
+    block: &'a mut FixedBlock,
+    rows: &'a BodyRows,
+}
+
+impl LaneSlices for Positions<'_> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        solve_positions::<L>(self.block, start, self.rows);
     }
 }
 

@@ -14,7 +14,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
-use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel, Quat};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows};
@@ -180,12 +180,32 @@ impl<const DRIVE: bool> LaneKernel for PositionPass<'_, DRIVE> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
         for block in self.blocks.iter_mut() {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions::<L, DRIVE>(block, start, self.rows, inv_h, inv_h2);
-            }
+            let padding = block.bodies.padding;
+            let mut positions = Positions::<DRIVE> {
+                block,
+                rows: self.rows,
+                inv_h: self.inv_h,
+                inv_h2: self.inv_h2,
+            };
+            for_live_slices::<L, _>(padding, &mut positions);
         }
+    }
+}
+
+/// One block of a [`PositionPass`].
+struct Positions<'a, const DRIVE: bool> {
+    block: &'a mut HingeBlock,
+    rows: &'a BodyRows,
+    inv_h: f32,
+    inv_h2: f32,
+}
+
+impl<const DRIVE: bool> LaneSlices for Positions<'_, DRIVE> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
+        solve_positions::<L, DRIVE>(self.block, start, self.rows, inv_h, inv_h2);
     }
 }
 

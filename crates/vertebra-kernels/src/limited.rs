@@ -4,7 +4,7 @@
 //! (`parts::limit`) measures its rate against. Run on the blocks that can
 //! hold soft limits: the socket's shaped path and the hinge.
 
-use vertebra_math::block::BLOCK_LANES;
+use vertebra_math::block::{BLOCK_LANES, LaneSlices, for_live_slices};
 use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows};
@@ -96,10 +96,26 @@ impl<B: Limited> LaneKernel for StartPass<'_, B> {
     #[inline(always)]
     fn run<L: Lane>(self) {
         for block in self.blocks.iter_mut() {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let (a, b) = block.bodies().gather::<L>(self.rows, start);
-                block.start_limits(start, &a, &b);
-            }
+            let padding = block.bodies().padding;
+            let mut starts = Starts {
+                block,
+                rows: self.rows,
+            };
+            for_live_slices::<L, _>(padding, &mut starts);
         }
+    }
+}
+
+/// One block of a [`StartPass`].
+struct Starts<'a, B> {
+    block: &'a mut B,
+    rows: &'a BodyRows,
+}
+
+impl<B: Limited> LaneSlices for Starts<'_, B> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        let (a, b) = self.block.bodies().gather::<L>(self.rows, start);
+        self.block.start_limits(start, &a, &b);
     }
 }

@@ -17,7 +17,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
-use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
@@ -262,12 +262,32 @@ impl LaneKernel for PositionPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
         for block in self.blocks.iter_mut() {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                solve_positions(block, start, self.rows, inv_h, inv_h2);
-            }
+            let padding = block.bodies.padding;
+            let mut positions = Positions {
+                block,
+                rows: self.rows,
+                inv_h: self.inv_h,
+                inv_h2: self.inv_h2,
+            };
+            for_live_slices::<L, _>(padding, &mut positions);
         }
+    }
+}
+
+/// One block of a [`PositionPass`].
+struct Positions<'a> {
+    block: &'a mut RodBlock,
+    rows: &'a BodyRows,
+    inv_h: f32,
+    inv_h2: f32,
+}
+
+impl LaneSlices for Positions<'_> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
+        solve_positions(self.block, start, self.rows, inv_h, inv_h2);
     }
 }
 
@@ -288,23 +308,41 @@ impl LaneKernel for StartPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        let h = L::splat(self.h);
         for block in self.blocks.iter_mut() {
-            for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
-                let (a, b) = block.bodies.gather::<L>(self.rows, start);
-                let f = frames(&a, &b, block.frame_a.load(start), block.frame_b.load(start));
-                let bend_rest = block.bend_rest.load(start);
-                block.bend_start.store(start, bend::start(&f, bend_rest));
-                let twist_rest = L::load(&block.twist_rest[start..]);
-                twist::error(&f, twist_rest).store(&mut block.twist_start[start..]);
-                let velocity = block.bend_rest_velocity.load(start);
-                block
-                    .bend_rest
-                    .store(start, drive::advance_direction(bend_rest, velocity, h));
-                let rate = L::load(&block.twist_rest_velocity[start..]);
-                drive::advance_twist(twist_rest, rate, h).store(&mut block.twist_rest[start..]);
-            }
+            let padding = block.bodies.padding;
+            let mut starts = Starts {
+                block,
+                rows: self.rows,
+                h: self.h,
+            };
+            for_live_slices::<L, _>(padding, &mut starts);
         }
+    }
+}
+
+/// One block of a [`StartPass`].
+struct Starts<'a> {
+    block: &'a mut RodBlock,
+    rows: &'a BodyRows,
+    h: f32,
+}
+
+impl LaneSlices for Starts<'_> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        let (block, h) = (&mut *self.block, L::splat(self.h));
+        let (a, b) = block.bodies.gather::<L>(self.rows, start);
+        let f = frames(&a, &b, block.frame_a.load(start), block.frame_b.load(start));
+        let bend_rest = block.bend_rest.load(start);
+        block.bend_start.store(start, bend::start(&f, bend_rest));
+        let twist_rest = L::load(&block.twist_rest[start..]);
+        twist::error(&f, twist_rest).store(&mut block.twist_start[start..]);
+        let velocity = block.bend_rest_velocity.load(start);
+        block
+            .bend_rest
+            .store(start, drive::advance_direction(bend_rest, velocity, h));
+        let rate = L::load(&block.twist_rest_velocity[start..]);
+        drive::advance_twist(twist_rest, rate, h).store(&mut block.twist_rest[start..]);
     }
 }
 

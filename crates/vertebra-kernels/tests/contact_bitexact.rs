@@ -94,3 +94,13 @@ fn random_contacts_agree_on_every_backend() {
 fn adversarial_contacts_agree_on_every_backend_and_stay_finite() {
     agree_over_seeds(300..360, true, scene, run);
 }
+
+/// A padding lane as `ContactBlock::padding` makes it: null rows, no writes.
+fn clear(block: &mut ContactBlock, lane: usize) {
+    block.bodies.set(lane, 0, 0, false, false);
+}
+
+#[test]
+fn blocks_of_one_to_eight_contacts_agree_on_every_backend() {
+    common::padded_blocks_agree(400..406, scene, clear, run);
+}

@@ -290,3 +290,9 @@ fn random_fixed_joints_agree_on_every_backend() {
 fn adversarial_fixed_joints_agree_on_every_backend_and_stay_finite() {
     agree_over_seeds(100..160, true, fixed_joints, run_fixed);
 }
+
+#[test]
+fn blocks_of_one_to_eight_hinges_or_fixed_joints_agree_on_every_backend() {
+    common::padded_blocks_agree(400..406, hinges, HingeBlock::clear, run_hinges);
+    common::padded_blocks_agree(400..406, fixed_joints, FixedBlock::clear, run_fixed);
+}

@@ -218,3 +218,8 @@ fn random_rods_agree_on_every_backend() {
 fn adversarial_rods_agree_on_every_backend_and_stay_finite() {
     agree_over_seeds(200..280, true, scene, run);
 }
+
+#[test]
+fn blocks_of_one_to_eight_rods_agree_on_every_backend() {
+    common::padded_blocks_agree(400..406, scene, RodBlock::clear, run);
+}

@@ -241,3 +241,8 @@ fn random_joints_agree_on_every_backend() {
 fn adversarial_joints_agree_on_every_backend_and_stay_finite() {
     agree_over_seeds(100..160, true, scene, run);
 }
+
+#[test]
+fn blocks_of_one_to_eight_sockets_agree_on_every_backend() {
+    common::padded_blocks_agree(400..406, scene, SocketBlock::clear, run);
+}

@@ -100,3 +100,44 @@ impl QuatBlock {
         );
     }
 }
+
+/// What a kernel does to one block, a slice of lanes at a time.
+pub trait LaneSlices {
+    /// Solves lanes `start .. start + L::WIDTH` of the block.
+    fn slice<L: Lane>(&mut self, start: usize);
+}
+
+/// Runs `slices` over the lanes of one block that are not padding (bit
+/// `i` of `padding` set: lane `i` is padding), so that a block of few
+/// constraints is not paid for whole (a single ragdoll's colours hold two
+/// or three joints). A lane type as wide as the block runs it whole unless
+/// one half is all padding: then its [`Lane::Narrow`] type runs the other
+/// half alone; a narrower lane type walks the block slice by slice and
+/// skips a slice that is all padding. The choice reads the layout, never
+/// lane data, so the code stays branch-free inside a slice.
+///
+/// A padding lane reads the null row and writes no row, so skipping it
+/// changes no body: every backend gives the same rows as before and as
+/// each other. What a skipped padding lane keeps in its own block fields
+/// (multipliers, residuals) is left as it was: nothing reads it.
+#[inline(always)]
+pub fn for_live_slices<L: Lane, S: LaneSlices>(padding: u32, slices: &mut S) {
+    const HALF: usize = BLOCK_LANES / 2;
+    const LOW: u32 = (1 << HALF) - 1;
+    const HIGH: u32 = LOW << HALF;
+    if L::WIDTH == BLOCK_LANES && L::Narrow::WIDTH == HALF {
+        match (padding & LOW == LOW, padding & HIGH == HIGH) {
+            (false, false) => slices.slice::<L>(0),
+            (false, true) => slices.slice::<L::Narrow>(0),
+            (true, false) => slices.slice::<L::Narrow>(HALF),
+            (true, true) => {}
+        }
+    } else {
+        let all = (1u32 << L::WIDTH) - 1;
+        for start in (0..BLOCK_LANES).step_by(L::WIDTH) {
+            if (padding >> start) & all != all {
+                slices.slice::<L>(start);
+            }
+        }
+    }
+}

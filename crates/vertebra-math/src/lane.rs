@@ -102,6 +102,14 @@ pub trait Lane:
     /// The lane-wise boolean produced by comparisons.
     type Mask: Mask;
 
+    /// The lane type of at most half a block that runs in the same
+    /// instruction set: `F32x4` for `F32x8` (entered with AVX2 and FMA, it
+    /// is the VEX-encoded code of [`crate::Backend::Avx2x4`]), the type
+    /// itself for every other. A block whose other half is padding runs on
+    /// it ([`crate::block::for_live_slices`]); every lane type gives the
+    /// same bits per lane, so the narrower one changes no result.
+    type Narrow: Lane;
+
     /// How many `f32` values one lane value holds.
     const WIDTH: usize;
 

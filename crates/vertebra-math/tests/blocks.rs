@@ -1,6 +1,6 @@
 //! Lane blocks: bytemuck casts and per-backend loads and stores.
 
-use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Backend, Lane, LaneKernel};
 
 #[test]
@@ -82,4 +82,66 @@ fn backend_names_parse_and_unavailable_ones_are_refused() {
         err.to_string().contains("unknown backend `avx512`"),
         "{err}"
     );
+}
+
+/// Records every slice [`for_live_slices`] runs: (start, width).
+struct Recorder(Vec<(usize, usize)>);
+
+impl LaneSlices for Recorder {
+    fn slice<L: Lane>(&mut self, start: usize) {
+        self.0.push((start, L::WIDTH));
+    }
+}
+
+/// Walks one block with the padding mask `padding` on the backend.
+struct Walk(u32);
+
+impl LaneKernel for Walk {
+    type Output = Vec<(usize, usize)>;
+    #[inline(always)]
+    fn run<L: Lane>(self) -> Self::Output {
+        let mut recorder = Recorder(Vec::new());
+        for_live_slices::<L, _>(self.0, &mut recorder);
+        recorder.0
+    }
+}
+
+/// For every padding mask: each live lane is solved exactly once, no slice
+/// solved is all padding, and the 8-lane backend runs a block with a half
+/// of padding four lanes wide (the other backends at their own width).
+#[test]
+fn live_slices_cover_every_live_lane_once_and_skip_padding() {
+    for backend in Backend::available() {
+        for padding in 0..1u32 << BLOCK_LANES {
+            let slices = backend.dispatch(Walk(padding));
+            let mut solved = [0; BLOCK_LANES];
+            for &(start, width) in &slices {
+                assert!(start + width <= BLOCK_LANES, "{backend}: {slices:?}");
+                let lanes = start..start + width;
+                assert!(
+                    lanes.clone().any(|lane| padding & (1 << lane) == 0),
+                    "{backend}, padding {padding:08b}: slice {start}+{width} is all padding"
+                );
+                lanes.for_each(|lane| solved[lane] += 1);
+            }
+            for (lane, &count) in solved.iter().enumerate() {
+                let live = padding & (1 << lane) == 0;
+                assert!(
+                    !live || count == 1,
+                    "{backend}, padding {padding:08b}: lane {lane} solved {count} times"
+                );
+            }
+            let half = |mask: u32| padding & mask == mask;
+            let narrow = half(0x0F) || half(0xF0);
+            let widths: Vec<_> = slices.iter().map(|&(_, w)| w).collect();
+            let expected = match backend.lanes() {
+                8 if narrow => 4,
+                lanes => lanes,
+            };
+            assert!(
+                widths.iter().all(|&w| w == expected),
+                "{backend}, padding {padding:08b}: widths {widths:?}"
+            );
+        }
+    }
 }

@@ -119,3 +119,55 @@ fn gather_and_scatter_move_the_same_bits_on_every_backend() {
         }
     }
 }
+
+/// Whether [`Shift`] over four rows with these indices panics on `backend`.
+fn panics(backend: Backend, reads: [u32; 8], writes: [u32; 8]) -> bool {
+    let rows: Vec<Row> = (0..4).map(|_| Row::new([1.0; 8])).collect();
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        backend.dispatch(Shift {
+            rows: &rows,
+            reads: &reads,
+            writes: &writes,
+        })
+    }))
+    .is_err()
+}
+
+/// The AVX gather and scatter check a slice's indices once, by their
+/// maximum, and then index unchecked: an index past the rows must still
+/// panic on every backend, in any lane, and `NO_WRITE` must not.
+#[test]
+fn indices_past_the_rows_panic_on_every_backend() {
+    let inside = [3, 2, 1, 0, 0, 1, 2, 3];
+    let none = [NO_WRITE; 8];
+    let mut cases = Vec::new();
+    for lane in 0..8 {
+        let mut read_past = inside;
+        read_past[lane] = 4;
+        let (mut write_past, mut write_far) = (none, none);
+        write_past[lane] = 4;
+        write_far[lane] = u32::MAX - 1;
+        cases.extend([
+            (format!("lane {lane}: read past"), read_past, none, true),
+            (format!("lane {lane}: write past"), inside, write_past, true),
+            (format!("lane {lane}: write far"), inside, write_far, true),
+        ]);
+    }
+    cases.push(("in range, no writes".into(), inside, none, false));
+    cases.push(("in range, writes".into(), inside, inside, false));
+    // The expected panics stay quiet; the hook is back before asserting.
+    let prior = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let cases = &cases;
+    let outcomes: Vec<_> = Backend::available()
+        .flat_map(move |backend| {
+            cases.iter().map(move |(what, reads, writes, expected)| {
+                (backend, what, panics(backend, *reads, *writes), *expected)
+            })
+        })
+        .collect();
+    std::panic::set_hook(prior);
+    for (backend, what, panicked, expected) in outcomes {
+        assert_eq!(panicked, expected, "{backend}, {what}");
+    }
+}

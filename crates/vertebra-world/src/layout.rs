@@ -233,25 +233,25 @@ impl Layout {
     /// each rod's chord between centres of mass.
     pub fn start_step(&mut self, bodies: &BodyStore) {
         for block in &mut self.sockets.blocks {
-            for lane in 0..BLOCK_LANES {
+            for lane in live_lanes(&block.bodies) {
                 let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
                 start_lane(&mut block.bodies, lane, anchors, bodies);
             }
         }
         for block in &mut self.hinges.blocks {
-            for lane in 0..BLOCK_LANES {
+            for lane in live_lanes(&block.bodies) {
                 let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
                 start_lane(&mut block.bodies, lane, anchors, bodies);
             }
         }
         for block in &mut self.fixed.blocks {
-            for lane in 0..BLOCK_LANES {
+            for lane in live_lanes(&block.bodies) {
                 let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
                 start_lane(&mut block.bodies, lane, anchors, bodies);
             }
         }
         for block in &mut self.rods.blocks {
-            for lane in 0..BLOCK_LANES {
+            for lane in live_lanes(&block.bodies) {
                 let centres = (glam::Vec3::ZERO, glam::Vec3::ZERO);
                 start_lane(&mut block.bodies, lane, centres, bodies);
             }
@@ -347,6 +347,14 @@ impl Layout {
             rods,
         }
     }
+}
+
+/// The lanes of a block that hold a joint: a padding lane's start of step
+/// stays as laid out (zero: the null row at the origin, no anchors), which
+/// is what measuring it would give, and no kernel reads it into a row.
+fn live_lanes(pairs: &BodyPairs) -> impl Iterator<Item = usize> + use<> {
+    let padding = pairs.padding;
+    (0..BLOCK_LANES).filter(move |lane| padding & (1 << lane) == 0)
 }
 
 /// Sets `lane`'s start of step for points `local` (m, body frames) on its

@@ -88,35 +88,51 @@ fn start_drives(world: &mut World, h: f32) {
         .iter()
         .chain(core::iter::once(&layout.overflow))
     {
-        for range in [&group.driven, &group.shaped_driven] {
+        // An empty range is not dispatched: a small world's groups hold
+        // few kinds, and entering a backend is not free.
+        let some = |range: &Range<usize>| !range.is_empty();
+        for range in [&group.driven, &group.shaped_driven]
+            .into_iter()
+            .filter(|r| some(r))
+        {
             world.backend.dispatch(StartPass {
                 blocks: &mut layout.sockets.blocks[range.clone()],
                 rows,
                 h,
             });
         }
-        world.backend.dispatch(StartPass {
-            blocks: &mut layout.hinges.blocks[group.hinges_driven.clone()],
-            rows,
-            h,
-        });
-        for range in [&group.shaped_driven, &group.shaped_plain] {
+        if some(&group.hinges_driven) {
+            world.backend.dispatch(StartPass {
+                blocks: &mut layout.hinges.blocks[group.hinges_driven.clone()],
+                rows,
+                h,
+            });
+        }
+        for range in [&group.shaped_driven, &group.shaped_plain]
+            .into_iter()
+            .filter(|r| some(r))
+        {
             world.backend.dispatch(limited::StartPass {
                 blocks: &mut layout.sockets.blocks[range.clone()],
                 rows,
             });
         }
-        for range in [&group.hinges_driven, &group.hinges_plain] {
+        for range in [&group.hinges_driven, &group.hinges_plain]
+            .into_iter()
+            .filter(|r| some(r))
+        {
             world.backend.dispatch(limited::StartPass {
                 blocks: &mut layout.hinges.blocks[range.clone()],
                 rows,
             });
         }
-        world.backend.dispatch(rod::StartPass {
-            blocks: &mut layout.rods.blocks[group.rods.clone()],
-            rows,
-            h,
-        });
+        if some(&group.rods) {
+            world.backend.dispatch(rod::StartPass {
+                blocks: &mut layout.rods.blocks[group.rods.clone()],
+                rows,
+                h,
+            });
+        }
     }
 }
 
@@ -742,13 +758,32 @@ impl Substep<'_> {
         let rods = unsafe { BlockChunks::new(&self.rods, group.rods.clone(), size, run) };
         let [s0, s1, s2, s3] = &sockets;
         let [h0, h1] = &hinges;
-        let parts: [&dyn Part; 8] = [s0, s1, s2, s3, h0, h1, &fixed, &rods];
+        let mut parts: [&dyn Part; 8] = [s0, s1, s2, s3, h0, h1, &fixed, &rods];
+        // Only the kinds this colour holds, in order (a small world's
+        // colours hold one or two): a stage walks its parts per chunk.
+        let held = [
+            socket_ranges.map(|(r, ..)| !r.is_empty()),
+            [
+                !group.hinges_driven.is_empty(),
+                !group.hinges_plain.is_empty(),
+                !group.fixed.is_empty(),
+                !group.rods.is_empty(),
+            ],
+        ];
+        let mut kinds = 0;
+        for (k, held) in held.into_iter().flatten().enumerate() {
+            if held {
+                parts.swap(kinds, k);
+                kinds += 1;
+            }
+        }
+        let parts = &parts[..kinds];
         if split {
-            cursor.stage(&parts);
+            cursor.stage(parts);
         } else {
             // One stage each: the overflow set's constraints (or a crafted
             // colouring's) may share bodies across kinds.
-            for part in parts {
+            for &part in parts {
                 cursor.stage(&[part]);
             }
         }

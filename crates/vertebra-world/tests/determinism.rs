@@ -214,3 +214,62 @@ fn worlds_switching_kinds_mid_run_give_the_same_bits_everywhere() {
     }
     assert_ne!(reference, hash_after(Backend::Scalar, 1, 60).0);
 }
+
+/// `count` chains of three links hanging from static bodies: a socket with
+/// limits and a drive, a hinge, and a rod from the second link to the
+/// third, stepped `frames` times with a push now and then. Each colour
+/// then holds `count` joints of a kind, so 1 to 9 chains fill a kind's
+/// block from one lane to all eight (and one more block of one lane).
+fn small_world_hash(backend: Backend, count: usize, frames: usize) -> u64 {
+    let config = SolverConfig {
+        backend: BackendChoice::Forced(backend),
+        threads: 1,
+        ..SolverConfig::default()
+    };
+    let mut w = World::new(config).unwrap();
+    let mut links = Vec::new();
+    for chain in 0..count {
+        let top = Vec3::new(chain as f32 * 0.7, 2.0, 0.0);
+        let base = w.add_body(BodyDesc::fixed().with_position(top)).unwrap();
+        let tilt = Vec3::new(0.2, -1.0, 0.1 * chain as f32).normalize();
+        let knee = top + tilt * 0.4;
+        let upper = capsule(&mut w, top, knee, 2.0);
+        let lower = capsule(&mut w, knee, knee - Vec3::Y * 0.4, 1.0);
+        let foot = capsule(&mut w, knee - Vec3::Y * 0.45, knee - Vec3::Y * 0.6, 0.5);
+        let socket = JointDesc::socket_at_world_anchor(w.bodies(), base, upper, top, tilt)
+            .unwrap()
+            .with_swing_limit(0.3)
+            .with_twist_limit(-0.2, 0.2)
+            .with_drive(AngularDrive::spring(Quat::from_rotation_z(0.4), 2.0, 0.5));
+        w.add_joint(socket).unwrap();
+        let hinge =
+            JointDesc::hinge_at_world_anchor(w.bodies(), upper, lower, knee, Vec3::Z).unwrap();
+        w.add_joint(hinge).unwrap();
+        let bones = [knee - Vec3::new(0.01, 0.42, 0.0)];
+        let rod = RodDesc::from_pose(w.bodies(), lower, foot, &bones)
+            .unwrap()
+            .with_bend_limit(0.5);
+        w.add_rod(rod).unwrap();
+        links.extend([upper, lower, foot]);
+    }
+    for frame in 0..frames {
+        let body = links[(frame * 5) % links.len()];
+        w.add_force(body, Vec3::new(30.0, 10.0, -20.0)).unwrap();
+        w.step(1.0 / 60.0).unwrap();
+    }
+    w.state_hash()
+}
+
+#[test]
+fn worlds_of_one_to_nine_chains_give_the_same_bits_on_every_backend() {
+    for count in 1..=9 {
+        let reference = small_world_hash(Backend::Scalar, count, 40);
+        for backend in Backend::available() {
+            assert_eq!(
+                small_world_hash(backend, count, 40),
+                reference,
+                "{backend} differs from scalar with {count} chain(s)"
+            );
+        }
+    }
+}

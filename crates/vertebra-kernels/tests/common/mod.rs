@@ -7,6 +7,7 @@ use rand::rngs::StdRng;
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::limited::LimitLane;
 use vertebra_math::Backend;
+use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::check::same_bits;
 
 /// Body rows as plain floats: pose, inverse inertia, velocity.
@@ -188,5 +189,37 @@ pub fn limit_start(r: &mut StdRng) -> f32 {
         0 => 0.0,
         1 => r.random_range(0.0..0.1),
         _ => r.random_range(0.0..4.0),
+    }
+}
+
+/// Which lanes of a block hold joints in [`padded_blocks_agree`] (bit `i`:
+/// lane `i` live): the first 1 to 8 lanes (as the layout fills a colour's
+/// last block), the upper half alone, one lane of the upper half, every
+/// other lane.
+pub const LIVE_PATTERNS: [u32; 11] = [
+    0b1, 0b11, 0b111, 0xF, 0x1F, 0x3F, 0x7F, 0xFF, 0xF0, 0x20, 0x55,
+];
+
+/// A scene's blocks with only the lanes of each [`LIVE_PATTERNS`] entry
+/// kept (`clear` makes the others padding): every backend runs them to the
+/// scalar reference's bits, whichever slices and lane widths it skips or
+/// narrows to.
+pub fn padded_blocks_agree<B: Clone>(
+    seeds: core::ops::Range<u64>,
+    scene: fn(u64, usize, bool) -> (RawRows, Vec<B>),
+    clear: fn(&mut B, usize),
+    run: fn(Backend, &RawRows, &[B]) -> Vec<f32>,
+) {
+    for seed in seeds {
+        let (rows, blocks) = scene(seed, 3, seed % 2 == 1);
+        for live in LIVE_PATTERNS {
+            let mut padded = blocks.clone();
+            for block in &mut padded {
+                for lane in (0..BLOCK_LANES).filter(|lane| live & (1 << lane) == 0) {
+                    clear(block, lane);
+                }
+            }
+            assert_backends_agree(seed, |b| run(b, &rows, &padded));
+        }
     }
 }

@@ -16,7 +16,7 @@ use core::fmt;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
 use super::{Lane, Mask};
-use crate::row::{NO_WRITE, ROW_LEN, Row};
+use crate::row::{NO_WRITE, ROW_LEN, Row, check_reads, check_writes};
 
 /// Eight `f32` lanes.
 #[derive(Clone, Copy)]
@@ -54,6 +54,7 @@ impl F32x8 {
 
 impl Lane for F32x8 {
     type Mask = M32x8;
+    type Narrow = crate::lane::sse41::F32x4;
     x86_lane_methods!(
         8, avx,
         set1: _mm256_set1_ps, loadu: _mm256_loadu_ps, storeu: _mm256_storeu_ps,
@@ -92,13 +93,14 @@ impl Lane for F32x8 {
     }
     #[inline(always)]
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
+        let indices = &indices[..8];
+        check_reads(rows, indices);
         let mut loaded = [avx!(_mm256_setzero_ps()); 8];
-        for (lane, &index) in loaded.iter_mut().zip(&indices[..8]) {
-            let p = rows[index as usize].as_ptr();
-            // SAFETY: `p` is a live, 32-byte aligned row of eight floats
-            // (bounds-checked) that no other thread writes now (`Row` is not
-            // `Sync`; shared rows are written disjointly: crate::row); AVX detected.
-            *lane = unsafe { _mm256_load_ps(p) };
+        for (lane, &index) in loaded.iter_mut().zip(indices) {
+            // SAFETY: `index` < `rows.len()` (`check_reads`): a live, 32-byte
+            // aligned row that no other thread writes now (`Row` is not `Sync`;
+            // shared rows are written disjointly: crate::row); AVX detected.
+            *lane = unsafe { _mm256_load_ps(rows.get_unchecked(index as usize).as_ptr()) };
         }
         transpose8(loaded).map(Self)
     }
@@ -109,13 +111,16 @@ impl Lane for F32x8 {
             *column = value.0;
         }
         let lanes = transpose8(columns);
-        for (lane, &index) in indices[..8].iter().enumerate() {
+        let indices = &indices[..8];
+        check_writes(rows, indices);
+        for (lane, &index) in indices.iter().enumerate() {
             if index != NO_WRITE {
-                let p = rows[index as usize].as_ptr();
-                // SAFETY: `p` is a live, aligned row of eight floats that no
-                // other thread reads or writes now (`Row` is not `Sync`; shared
-                // rows are written disjointly: crate::row); AVX detected.
-                unsafe { _mm256_store_ps(p, lanes[lane]) };
+                // SAFETY: `index` < `rows.len()` (`check_writes`): a live,
+                // aligned row no other thread reaches now (`Row` is not `Sync`;
+                // shared rows are written disjointly: crate::row); AVX detected.
+                unsafe {
+                    _mm256_store_ps(rows.get_unchecked(index as usize).as_ptr(), lanes[lane])
+                };
             }
         }
     }

@@ -114,6 +114,7 @@ impl Neg for F32x4Portable {
 
 impl Lane for F32x4Portable {
     type Mask = M32x4Portable;
+    type Narrow = Self;
     const WIDTH: usize = 4;
 
     #[inline(always)]

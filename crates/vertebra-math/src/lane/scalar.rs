@@ -11,6 +11,7 @@ const ROUND_LIMIT: f32 = 8_388_608.0;
 
 impl Lane for f32 {
     type Mask = bool;
+    type Narrow = f32;
     const WIDTH: usize = 1;
 
     #[inline(always)]

@@ -45,6 +45,7 @@ x86_lane_types!(
 
 impl Lane for F32x4 {
     type Mask = M32x4;
+    type Narrow = Self;
     x86_lane_methods!(
         4, sse41,
         set1: _mm_set1_ps, loadu: _mm_loadu_ps, storeu: _mm_storeu_ps,
