@@ -13,7 +13,10 @@
 //! `parallel_for` returns is finished by the caller, who walks the stages
 //! last. Which worker runs a chunk changes no result (a chunk's work does
 //! not depend on who runs it, and the stage order is fixed), so results
-//! are bit-identical for any thread count and any task system.
+//! are bit-identical for any thread count and any task system. With one
+//! worker there is nothing to share: the caller walks the stages and runs
+//! every chunk in the order the lone worker would claim it, with no
+//! counters (the same bits, without the bookkeeping).
 
 use core::marker::PhantomData;
 use core::ops::Range;
@@ -56,8 +59,25 @@ impl Stages {
     /// stages every time it is called (it is called once to count them,
     /// then by each worker and by the caller).
     pub fn run(&mut self, tasks: &dyn TaskSystem, walk: &(dyn Fn(&mut Cursor) + Sync)) {
+        let workers = tasks.workers();
+        if workers <= 1 {
+            // One worker: every stage in order, every chunk in the order the
+            // lone worker would claim it, with no count, counter or wait (a
+            // single ragdoll's step walks about 50 stages a substep).
+            #[cfg(feature = "stage-timing")]
+            timing::launch();
+            let _mode = DefaultFloatMode::enter();
+            walk(&mut Cursor {
+                counters: None,
+                direct: true,
+                poisoned: &self.poisoned,
+                next: 0,
+            });
+            return;
+        }
         let mut counting = Cursor {
             counters: None,
+            direct: false,
             poisoned: &self.poisoned,
             next: 0,
         };
@@ -80,14 +100,12 @@ impl Stages {
             let _guard = PanicGuard(poisoned);
             walk(&mut Cursor {
                 counters: Some(counters),
+                direct: false,
                 poisoned,
                 next: 0,
             });
         };
-        let workers = tasks.workers();
-        if workers > 1 {
-            tasks.parallel_for(workers, &|_| worker());
-        }
+        tasks.parallel_for(workers, &|_| worker());
         // Every worker has returned: what is left (all of it, when the task
         // system ran nothing) is finished here.
         worker();
@@ -109,6 +127,8 @@ impl Drop for PanicGuard<'_> {
 /// number of stages seen).
 pub(crate) struct Cursor<'a> {
     counters: Option<&'a [Counters]>,
+    /// The only worker: it runs every chunk itself, in order.
+    direct: bool,
     poisoned: &'a AtomicBool,
     next: usize,
 }
@@ -126,6 +146,18 @@ impl Cursor<'_> {
         }
         let index = self.next;
         self.next += 1;
+        if self.direct {
+            for part in parts {
+                for chunk in 0..part.chunks() {
+                    #[cfg(feature = "stage-timing")]
+                    let started = std::time::Instant::now();
+                    part.run(chunk);
+                    #[cfg(feature = "stage-timing")]
+                    timing::chunk(index, started.elapsed());
+                }
+            }
+            return;
+        }
         let Some(counters) = self.counters else {
             return;
         };

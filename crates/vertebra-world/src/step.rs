@@ -738,44 +738,57 @@ impl Substep<'_> {
         let rows = &self.rows;
         // The parts of one stage lend blocks of four different vectors,
         // and a group's ranges of one vector do not overlap (the layout
-        // lays each kind's blocks out one range after another).
-        let sockets = socket_ranges.map(|(range, driven, shaped)| {
+        // lays each kind's blocks out one range after another). Only the
+        // kinds this colour holds become parts, in order (a small world's
+        // colours hold one or two).
+        let socket = |(range, driven, shaped): (&Range<usize>, bool, bool)| {
             let kind = SocketBlocks { driven, shaped };
             let run = move |c: &mut [SocketBlock]| pass.sockets(c, kind, rows.rows(), backend);
             // SAFETY: no other part lends these blocks (above).
-            unsafe { BlockChunks::new(&self.sockets, range.clone(), size, run) }
-        });
-        let hinges = hinge_ranges.map(|(range, driven)| {
+            (!range.is_empty())
+                .then(|| unsafe { BlockChunks::new(&self.sockets, range.clone(), size, run) })
+        };
+        let hinge = |(range, driven): (&Range<usize>, bool)| {
             let run = move |c: &mut [HingeBlock]| pass.hinges(c, driven, rows.rows(), backend);
             // SAFETY: no other part lends these blocks (above).
-            unsafe { BlockChunks::new(&self.hinges, range.clone(), size, run) }
-        });
+            (!range.is_empty())
+                .then(|| unsafe { BlockChunks::new(&self.hinges, range.clone(), size, run) })
+        };
+        let [r0, r1, r2, r3] = socket_ranges;
+        let (s0, s1, s2, s3) = (socket(r0), socket(r1), socket(r2), socket(r3));
+        let [r4, r5] = hinge_ranges;
+        let (h0, h1) = (hinge(r4), hinge(r5));
         let run = |c: &mut [FixedBlock]| pass.fixed(c, rows.rows(), backend);
         // SAFETY: no other part lends these blocks (above).
-        let fixed = unsafe { BlockChunks::new(&self.fixed, group.fixed.clone(), size, run) };
+        let fixed = (!group.fixed.is_empty())
+            .then(|| unsafe { BlockChunks::new(&self.fixed, group.fixed.clone(), size, run) });
         let run = |c: &mut [RodBlock]| pass.rods(c, rows.rows(), backend);
         // SAFETY: no other part lends these blocks (above).
-        let rods = unsafe { BlockChunks::new(&self.rods, group.rods.clone(), size, run) };
-        let [s0, s1, s2, s3] = &sockets;
-        let [h0, h1] = &hinges;
-        let mut parts: [&dyn Part; 8] = [s0, s1, s2, s3, h0, h1, &fixed, &rods];
-        // Only the kinds this colour holds, in order (a small world's
-        // colours hold one or two): a stage walks its parts per chunk.
-        let held = [
-            socket_ranges.map(|(r, ..)| !r.is_empty()),
-            [
-                !group.hinges_driven.is_empty(),
-                !group.hinges_plain.is_empty(),
-                !group.fixed.is_empty(),
-                !group.rods.is_empty(),
-            ],
-        ];
-        let mut kinds = 0;
-        for (k, held) in held.into_iter().flatten().enumerate() {
-            if held {
-                parts.swap(kinds, k);
-                kinds += 1;
-            }
+        let rods = (!group.rods.is_empty())
+            .then(|| unsafe { BlockChunks::new(&self.rods, group.rods.clone(), size, run) });
+        fn part<P: Part>(p: &Option<P>) -> Option<&dyn Part> {
+            p.as_ref().map(|p| p as &dyn Part)
+        }
+        let mut held = [
+            part(&s0),
+            part(&s1),
+            part(&s2),
+            part(&s3),
+            part(&h0),
+            part(&h1),
+            part(&fixed),
+            part(&rods),
+        ]
+        .into_iter()
+        .flatten();
+        let Some(first) = held.next() else {
+            return;
+        };
+        let mut parts = [first; 8];
+        let mut kinds = 1;
+        for p in held {
+            parts[kinds] = p;
+            kinds += 1;
         }
         let parts = &parts[..kinds];
         if split {
