@@ -5,9 +5,10 @@
 //! Each step, the awake dynamic bodies linked by awake joints and rods and
 //! by this step's contacts form islands (connected components, found
 //! afresh: the persistent islands of `islands.rs` only merge while
-//! sleeping is on, and split lazily). An island holding more than a share
-//! of the bodies is *large*: it goes to bin 0, whose constraints the
-//! workers solve together, colour by colour (one stage per colour). The
+//! sleeping is on, and split lazily). An island holding more than one
+//! worker's share of the bodies is *large*: it goes to bin 0, whose
+//! constraints the workers solve together, colour by colour (one stage
+//! per colour). The
 //! others are dealt to bins `1..`, the largest first, each to the bin with
 //! the fewest bodies so far (Graham's longest-processing-time rule), and a
 //! bin is solved whole (every iteration) by the one worker that claims it.
@@ -102,9 +103,10 @@ impl Bins {
             self.size[root as usize] += 1;
             total += 1;
         }
-        // Large: more than a quarter of one worker's share of the bodies
-        // (so never with one worker, where everything is bin 0).
-        let large = |size: u32| workers == 1 || 2 * workers * size as usize > total;
+        // Large: more than one worker's share of the bodies, so that one
+        // worker alone would take longer over it than the whole step
+        // should (every island is large with one worker: all in bin 0).
+        let large = |size: u32| workers == 1 || workers * size as usize > total;
         self.small.clear();
         self.small.extend(
             (0..n as u32).filter(|&r| self.size[r as usize] > 0 && !large(self.size[r as usize])),
@@ -264,7 +266,7 @@ mod tests {
         }
         assert!(!assign(&world, &[], 2, &mut bins), "the same again");
         // Contacts chaining the first five pairs: one island of 10 of the
-        // 16 bodies, more than a quarter of a worker's share: bin 0.
+        // 16 bodies, more than a worker's share (8): bin 0.
         let contacts: Vec<Contact> = (0..4)
             .map(|k| touching(pairs[k][1], pairs[k + 1][0]))
             .collect();
