@@ -5,8 +5,8 @@
 //! Each step, the awake dynamic bodies linked by awake joints and rods and
 //! by this step's contacts form islands (connected components, found
 //! afresh: the persistent islands of `islands.rs` only merge while
-//! sleeping is on, and split lazily). An island holding more than one
-//! worker's share of the bodies is *large*: it goes to bin 0, whose
+//! sleeping is on, and split lazily). An island holding at least two
+//! workers' share of the bodies is *large*: it goes to bin 0, whose
 //! constraints the workers solve together, colour by colour (one stage
 //! per colour). The
 //! others are dealt to bins `1..`, the largest first, each to the bin with
@@ -103,10 +103,12 @@ impl Bins {
             self.size[root as usize] += 1;
             total += 1;
         }
-        // Large: more than one worker's share of the bodies, so that one
-        // worker alone would take longer over it than the whole step
-        // should (every island is large with one worker: all in bin 0).
-        let large = |size: u32| workers == 1 || workers * size as usize > total;
+        // Large: at least two workers' share of the bodies. A bin holding
+        // a smaller island keeps its worker at most twice as long as the
+        // step's share, which costs less than a wait per colour (docs/
+        // threads.md); every island is large with one worker (all in bin
+        // 0), and so is a lone island.
+        let large = |size: u32| workers == 1 || workers * size as usize >= 2 * total;
         self.small.clear();
         self.small.extend(
             (0..n as u32).filter(|&r| self.size[r as usize] > 0 && !large(self.size[r as usize])),
@@ -265,20 +267,29 @@ mod tests {
             assert_eq!(held, 2, "bin {k}");
         }
         assert!(!assign(&world, &[], 2, &mut bins), "the same again");
-        // Contacts chaining the first five pairs: one island of 10 of the
-        // 16 bodies, more than a worker's share (8): bin 0.
-        let contacts: Vec<Contact> = (0..4)
-            .map(|k| touching(pairs[k][1], pairs[k + 1][0]))
-            .collect();
+        // Contacts chaining the first four pairs and the last four: two
+        // islands of half the bodies, below two workers' share: two bins.
+        fn chain(pairs: &[[BodyHandle; 2]]) -> impl Iterator<Item = Contact> + '_ {
+            pairs.windows(2).map(|w| touching(w[0][1], w[1][0]))
+        }
+        let contacts: Vec<Contact> = chain(&pairs[..4]).chain(chain(&pairs[4..])).collect();
         assert!(assign(&world, &contacts, 2, &mut bins));
-        assert!(pairs[..5].iter().flatten().all(|&h| bin(&bins, h) == 0));
-        assert!(pairs[5..].iter().flatten().all(|&h| bin(&bins, h) >= 1));
-        // The static ground links nothing: a contact with it joins no
-        // islands.
+        assert_eq!(bins.count, 3);
+        let (first, last) = (bin(&bins, pairs[0][0]), bin(&bins, pairs[7][0]));
+        assert!(first >= 1 && last >= 1 && first != last);
+        assert!(pairs[..4].iter().flatten().all(|&h| bin(&bins, h) == first));
+        assert!(pairs[4..].iter().flatten().all(|&h| bin(&bins, h) == last));
+        // The static ground links nothing: a lane with it is its
+        // dynamic body's.
         assert_eq!(
-            bins.of_rows(0, pairs[6][0].index() as u32 + 1),
-            bin(&bins, pairs[6][0])
+            bins.of_rows(0, pairs[7][0].index() as u32 + 1),
+            bin(&bins, pairs[7][0])
         );
+        // Chaining all eight: one island, solved colour by colour.
+        let contacts: Vec<Contact> = chain(&pairs).collect();
+        assert!(assign(&world, &contacts, 2, &mut bins));
+        assert_eq!(bins.count, 1);
+        assert!(pairs.iter().flatten().all(|&h| bin(&bins, h) == 0));
     }
 
     #[test]
