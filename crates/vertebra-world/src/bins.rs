@@ -63,8 +63,8 @@ impl Bins {
     /// This step's bins for `workers` workers: the islands of the awake
     /// dynamic bodies (`asleep` per slot) linked by `joints`, `rods` and
     /// `contacts`. True when a jointed body changed bin (`jointed` per
-    /// slot: its joint count), that is when the joints' layout must be
-    /// built again.
+    /// slot: its joint count) or the bin count changed, that is when the
+    /// joints' layout must be built again.
     #[allow(clippy::too_many_arguments)]
     pub fn assign(
         &mut self,
@@ -127,8 +127,10 @@ impl Bins {
             self.load[lightest] += self.size[root as usize];
             self.root_bin[root as usize] = lightest as u32 + 1;
         }
+        // A new bin count rebuilds the joints' layout too, so that it
+        // holds a (maybe empty) bin for every bin of the contacts'.
+        let mut changed = self.of.len() != n || self.count != bins + 1;
         self.count = bins + 1;
-        let mut changed = self.of.len() != n;
         self.of.resize(n, NO_BIN);
         for i in 0..n {
             let bin = if solved(i) {

@@ -690,7 +690,7 @@ impl Substep<'_> {
     /// while ragdolls met the floor less deeply (10 mm against 25 mm at
     /// impact, 1.4 mm against 0.5 mm at rest); see docs/contacts.md.
     fn for_each_colour(&self, cursor: &mut Cursor, bin: usize, pass: &impl Pass) {
-        let contact_bin = &self.contact_bins[bin];
+        let contact_bin = self.contact_bins.get(bin).cloned().unwrap_or_default();
         let colours = self.contact_colours[contact_bin.colours.clone()]
             .iter()
             .map(|r| (r, self.backend));
@@ -706,7 +706,9 @@ impl Substep<'_> {
         if !pass.joints() {
             return;
         }
-        let joints = &self.joint_bins[bin];
+        let Some(joints) = self.joint_bins.get(bin) else {
+            return;
+        };
         for group in &joints.colours {
             self.joint_colour(cursor, group, self.backend, self.joints_disjoint, pass);
         }
@@ -717,7 +719,9 @@ impl Substep<'_> {
     /// one worker (all of them in one chunk, one after another, unless
     /// the bins keep apart).
     fn bins_stage(&self, cursor: &mut Cursor, solve: impl Fn(usize) + Sync) {
-        let bins = self.joint_bins.len().min(self.contact_bins.len());
+        // Every bin of either layout (a world that never laid out a joint
+        // has no joints' bin at all).
+        let bins = self.joint_bins.len().max(self.contact_bins.len());
         let rest = 1..bins.max(1);
         if self.bins_apart {
             cursor.stage(&[&Chunks(rest.len(), |k| solve(1 + k))]);
@@ -732,7 +736,7 @@ impl Substep<'_> {
     /// [`Self::for_each_colour`] in order, with no stage between.
     fn solve_bin(&self, bin: usize, pass: &impl Pass) {
         let rows = &self.rows;
-        let contact_bin = &self.contact_bins[bin];
+        let contact_bin = self.contact_bins.get(bin).cloned().unwrap_or_default();
         let colours = self.contact_colours[contact_bin.colours.clone()]
             .iter()
             .map(|r| (r, self.backend));
@@ -746,7 +750,9 @@ impl Substep<'_> {
         if !pass.joints() {
             return;
         }
-        let joints = &self.joint_bins[bin];
+        let Some(joints) = self.joint_bins.get(bin) else {
+            return;
+        };
         let groups = (joints.colours.iter().map(|g| (g, self.backend)))
             .chain(core::iter::once((&joints.overflow, Backend::Scalar)));
         for (group, backend) in groups {
@@ -855,10 +861,9 @@ fn bins_apart(bins: &Bins, joints: &Layout, contacts: &ContactLayout) -> bool {
     };
     let joint_bins = joints.bins.iter().enumerate().skip(1);
     let contact_bins = contacts.bins.iter().enumerate().skip(1);
-    joints.bins.len() == contacts.bins.len()
-        && joint_bins
-            .clone()
-            .all(|(k, b)| joints.bin_pairs(b).all(|p| lanes_own(k as u32, p)))
+    joint_bins
+        .clone()
+        .all(|(k, b)| joints.bin_pairs(b).all(|p| lanes_own(k as u32, p)))
         && contact_bins
             .clone()
             .all(|(k, b)| contacts.bin_pairs(b).all(|p| lanes_own(k as u32, p)))

@@ -273,19 +273,20 @@ fn stepped_piles(
 
 #[test]
 fn islands_apart_and_one_pile_step_to_the_same_bits_on_every_task_system() {
-    // Six piles apart (six islands, dealt to the workers' bins), and the
-    // same six side by side (one island: solved colour by colour), with
-    // islands falling asleep and one woken by a push mid-run.
-    for (spacing, islands) in [(3.0, 6), (2.0 * R, 1)] {
+    // Six chains apart (six islands, dealt to the workers' bins), the
+    // same six side by side (one island: solved colour by colour), and
+    // six lone spheres (six islands without a joint), with islands
+    // falling asleep and one woken by a push mid-run.
+    for (links, spacing, islands) in [(3, 3.0, 6), (3, 2.0 * R, 1), (1, 3.0, 6)] {
         let sleepy = |threads| SolverConfig {
             sleep: Some(SleepSettings::default()),
             ..config(threads)
         };
         let run = |world: (World, BodyHandle, Vec<BodyHandle>)| {
             let (world, ground, spheres) = world;
-            stepped_piles(world, ground, &spheres, 3)
+            stepped_piles(world, ground, &spheres, spheres.len() / 2)
         };
-        let reference = run(piles(sleepy(1), 6, 3, spacing));
+        let reference = run(piles(sleepy(1), 6, links, spacing));
         let (_, before, after, found) = reference;
         assert_eq!(found, islands, "{spacing} m: {reference:?}");
         assert!(
@@ -298,7 +299,7 @@ fn islands_apart_and_one_pile_step_to_the_same_bits_on_every_task_system() {
             "{spacing} m: the push wakes one: {reference:?}"
         );
         for threads in [2, 3, 4] {
-            let world = piles(sleepy(threads), 6, 3, spacing);
+            let world = piles(sleepy(threads), 6, links, spacing);
             assert_eq!(run(world), reference, "{threads} threads, {spacing} m");
         }
         for behaviour in [
@@ -308,7 +309,7 @@ fn islands_apart_and_one_pile_step_to_the_same_bits_on_every_task_system() {
             Behaviour::Skipping,
             Behaviour::Nothing,
         ] {
-            let mut world = piles(sleepy(1), 6, 3, spacing);
+            let mut world = piles(sleepy(1), 6, links, spacing);
             world.0.set_tasks(Arc::new(Engine {
                 behaviour,
                 calls: AtomicUsize::new(0),
@@ -317,14 +318,61 @@ fn islands_apart_and_one_pile_step_to_the_same_bits_on_every_task_system() {
         }
         // Awake throughout: the islands of touching piles are found each
         // step, not kept.
-        let reference = run(piles(config(1), 6, 3, spacing));
+        let reference = run(piles(config(1), 6, links, spacing));
         for threads in [2, 3] {
-            let world = piles(config(threads), 6, 3, spacing);
+            let world = piles(config(threads), 6, links, spacing);
             assert_eq!(
                 run(world),
                 reference,
                 "awake, {threads} threads, {spacing} m"
             );
         }
+    }
+}
+
+#[test]
+fn islands_that_come_apart_step_to_the_same_bits_on_every_thread_count() {
+    // Three pairs of lone spheres (no joint) overlapping by 2 cm on the
+    // ground, 3 m apart: three islands that the overlap pushes apart into
+    // six, so that the bins grow in number mid-run.
+    let run = |threads: usize| {
+        let mut world = World::new(config(threads)).unwrap();
+        let ground = world.add_body(BodyDesc::fixed()).unwrap();
+        let mass = Shape::Sphere { radius: R }
+            .mass_properties_with_mass(1.0)
+            .unwrap();
+        let mut spheres = Vec::new();
+        for pair in 0..3 {
+            for side in [-1.0, 1.0] {
+                let at = Vec3::new(3.0 * pair as f32 + side * (R - 0.01), R, 0.0);
+                spheres.push(
+                    world
+                        .add_body(BodyDesc::dynamic(mass).with_position(at))
+                        .unwrap(),
+                );
+            }
+        }
+        let mut islands = Vec::new();
+        for _ in 0..60 {
+            let contacts = sphere_contacts(&world, ground, &spheres);
+            let touching = contacts.iter().filter(|c| c.body_a != ground).count();
+            islands.push(6 - touching.min(3));
+            world.set_contacts(&contacts).unwrap();
+            world.step(1.0 / 60.0).unwrap();
+        }
+        (
+            world.state_hash(),
+            islands.first().copied(),
+            islands.last().copied(),
+        )
+    };
+    let reference = run(1);
+    assert_eq!(
+        (reference.1, reference.2),
+        (Some(3), Some(6)),
+        "the pairs come apart"
+    );
+    for threads in [2, 3] {
+        assert_eq!(run(threads), reference, "{threads} threads");
     }
 }
