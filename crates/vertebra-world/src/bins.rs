@@ -26,9 +26,8 @@
 //! every lane of a bin `1..` touches only rows of its own bin or rows
 //! nobody writes ([`Bins::owns`], `step.rs`) before it solves bins at once.
 
-use vertebra_store::{BodyKind, BodyStore};
-
 use vertebra_math::row::NO_WRITE;
+use vertebra_store::{BodyKind, BodyStore};
 
 use crate::{Contact, JointDesc, RodDesc};
 
