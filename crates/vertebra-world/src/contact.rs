@@ -6,11 +6,13 @@
 use core::ops::Range;
 
 use glam::Vec3;
-use vertebra_kernels::body::StartLane;
+use vertebra_kernels::body::{BodyPairs, StartLane};
 use vertebra_kernels::contact::{ContactBlock, ContactLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::MAX_COLOURS;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_point, check_unit_vec};
+
+use crate::bins::Bins;
 
 /// A contact between two bodies for the next step.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -122,55 +124,87 @@ impl Contact {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ContactLayout {
     pub blocks: Vec<ContactBlock>,
-    /// Block ranges of the non-empty colours, in order.
+    /// Block ranges of the non-empty colours, bin by bin (`bins.rs`), in
+    /// colour order inside each bin.
     pub colours: Vec<Range<usize>>,
-    /// Block range of the overflow set.
-    pub overflow: Range<usize>,
+    /// Per solve bin (bin 0 first): its colours and its overflow set.
+    pub bins: Vec<ContactBin>,
     /// Every colour passed [`crate::parallel::colour_is_disjoint`].
     pub disjoint: bool,
-    /// Scratch: each contact's colour ([`OVERFLOW`] for the overflow set).
-    colour_of: Vec<u8>,
+    /// Scratch: each contact's bucket: its bin's colour (or overflow set),
+    /// or [`ASLEEP`].
+    colour_of: Vec<u32>,
     /// Scratch: per dynamic body, the bitset of colours its contacts use.
     body_colours: Vec<u32>,
-    /// Scratch: the contacts' indices in solve order (colour by colour,
-    /// the order given inside each).
+    /// Scratch: the contacts' indices in solve order (bin by bin, colour
+    /// by colour, the order given inside each).
     order: Vec<u32>,
+    /// Scratch: where each bucket starts in `order`.
+    starts: Vec<usize>,
+    /// Scratch: where the next contact of each bucket goes in `order`.
+    next: Vec<usize>,
     /// Scratch of the disjointness check.
     reads: Vec<u32>,
+}
+
+/// One solve bin's contacts.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ContactBin {
+    /// Its range of [`ContactLayout::colours`].
+    pub colours: Range<usize>,
+    /// Block range of its overflow set.
+    pub overflow: Range<usize>,
 }
 
 /// The colour index of the overflow set.
 const OVERFLOW: usize = MAX_COLOURS;
 
-/// The colour of a contact left out (its dynamic bodies sleep).
-const ASLEEP: usize = OVERFLOW + 1;
+/// Buckets per bin: its colours and its overflow set.
+const BUCKETS: usize = OVERFLOW + 1;
+
+/// The bucket of a contact left out (its dynamic bodies sleep): past every
+/// bin's.
+const ASLEEP: u32 = u32::MAX;
 
 impl ContactLayout {
     /// Colours `contacts` greedily in the order given (each takes the
     /// lowest colour free at both its dynamic bodies, after
     /// [`MAX_COLOURS`] the overflow set: `vertebra_scheduler::Colouring`'s
-    /// rule, with bitsets that live for one step) and lays them out, each
-    /// overlap capped at `max_depth` (m) for this step.
+    /// rule, with bitsets that live for one step) and lays them out bin by
+    /// bin (`bins`: a contact's is its awake dynamic body's), each overlap
+    /// capped at `max_depth` (m) for this step.
     pub fn rebuild(
         &mut self,
         contacts: &[Contact],
         bodies: &BodyStore,
         asleep: &[bool],
+        bins: &Bins,
         max_depth: f32,
     ) {
-        self.colour(contacts, bodies, asleep);
-        let starts = self.sort_by_colour();
+        self.colour(contacts, bodies, asleep, bins);
+        let buckets = bins.count.max(1) * BUCKETS;
+        self.sort_by_bucket(buckets);
         self.blocks.clear();
         self.colours.clear();
-        for colour in 0..=OVERFLOW {
-            let keys = &self.order[starts[colour]..starts[colour + 1]];
+        self.bins.clear();
+        for bucket in 0..buckets {
+            let keys = &self.order[self.starts[bucket]..self.starts[bucket + 1]];
             let start = self.blocks.len();
             append(&mut self.blocks, keys, contacts, bodies, max_depth);
             let range = start..self.blocks.len();
-            if colour == OVERFLOW {
-                self.overflow = range;
+            if bucket % BUCKETS == 0 {
+                let at = self.colours.len();
+                self.bins.push(ContactBin {
+                    colours: at..at,
+                    overflow: 0..0,
+                });
+            }
+            let bin = self.bins.last_mut().expect("pushed above");
+            if bucket % BUCKETS == OVERFLOW {
+                bin.overflow = range;
             } else if !range.is_empty() {
                 self.colours.push(range);
+                bin.colours.end = self.colours.len();
             }
         }
         let (blocks, reads) = (&self.blocks, &mut self.reads);
@@ -179,8 +213,18 @@ impl ContactLayout {
         });
     }
 
-    /// Each contact's colour into `colour_of`.
-    fn colour(&mut self, contacts: &[Contact], bodies: &BodyStore, asleep: &[bool]) {
+    /// The body pairs of every block of bin `bin`.
+    pub fn bin_pairs<'a>(
+        &'a self,
+        bin: &'a ContactBin,
+    ) -> impl Iterator<Item = &'a BodyPairs> + 'a {
+        let colours = self.colours[bin.colours.clone()].iter();
+        (colours.chain(core::iter::once(&bin.overflow)))
+            .flat_map(|r| self.blocks[r.clone()].iter().map(|b| &b.bodies))
+    }
+
+    /// Each contact's bucket into `colour_of`: its bin's colour.
+    fn colour(&mut self, contacts: &[Contact], bodies: &BodyStore, asleep: &[bool], bins: &Bins) {
         self.body_colours.clear();
         self.body_colours.resize(bodies.capacity(), 0);
         self.colour_of.clear();
@@ -190,7 +234,7 @@ impl ContactLayout {
             let ends = [dynamic(c.body_a), dynamic(c.body_b)];
             // Between sleeping (or sleeping and still) bodies: not solved.
             if ends.iter().flatten().all(|&b| asleep[b]) {
-                self.colour_of.push(ASLEEP as u8);
+                self.colour_of.push(ASLEEP);
                 continue;
             }
             let used = ends
@@ -198,35 +242,41 @@ impl ContactLayout {
                 .flatten()
                 .fold(0u32, |acc, &b| acc | self.body_colours[b]);
             let colour = (!used).trailing_zeros() as usize;
+            let bin = bins.of_rows(c.body_a.index() as u32 + 1, c.body_b.index() as u32 + 1);
+            let bin = (bin as usize).min(bins.count.max(1) - 1);
             if colour < MAX_COLOURS {
                 for &b in ends.iter().flatten() {
                     self.body_colours[b] |= 1 << colour;
                 }
-                self.colour_of.push(colour as u8);
+                self.colour_of.push((bin * BUCKETS + colour) as u32);
             } else {
-                self.colour_of.push(OVERFLOW as u8);
+                self.colour_of.push((bin * BUCKETS + OVERFLOW) as u32);
             }
         }
     }
 
-    /// `order` as the contacts sorted by colour, stably (a counting sort);
-    /// returns where each colour starts in it, and its end.
-    fn sort_by_colour(&mut self) -> [usize; ASLEEP + 2] {
-        let mut starts = [0usize; ASLEEP + 2];
+    /// `order` as the contacts sorted by bucket, stably (a counting sort
+    /// over `buckets` buckets, the left-out contacts last); `starts` where
+    /// each bucket starts in it, and its end.
+    fn sort_by_bucket(&mut self, buckets: usize) {
+        let bucket = |c: u32| if c == ASLEEP { buckets } else { c as usize };
+        self.starts.clear();
+        self.starts.resize(buckets + 2, 0);
         for &c in &self.colour_of {
-            starts[c as usize + 1] += 1;
+            self.starts[bucket(c) + 1] += 1;
         }
-        for c in 0..=ASLEEP {
-            starts[c + 1] += starts[c];
+        for b in 0..=buckets {
+            self.starts[b + 1] += self.starts[b];
         }
-        let mut next = starts;
         self.order.clear();
         self.order.resize(self.colour_of.len(), 0);
+        self.next.clear();
+        self.next.extend_from_slice(&self.starts);
         for (k, &c) in self.colour_of.iter().enumerate() {
-            self.order[next[c as usize]] = k as u32;
-            next[c as usize] += 1;
+            let at = &mut self.next[bucket(c)];
+            self.order[*at] = k as u32;
+            *at += 1;
         }
-        starts
     }
 }
 
@@ -330,7 +380,13 @@ mod tests {
                 })
                 .collect();
             let asleep = vec![false; world.bodies().capacity()];
-            layout.rebuild(&contacts, world.bodies(), &asleep, f32::INFINITY);
+            layout.rebuild(
+                &contacts,
+                world.bodies(),
+                &asleep,
+                &Bins::default(),
+                f32::INFINITY,
+            );
             let (order, sizes) = scheduler_order(&contacts, world.bodies());
             assert_eq!(layout.order, order, "seed {seed}");
             assert!(sizes[OVERFLOW] > 0, "seed {seed}: the overflow set is used");
@@ -342,7 +398,8 @@ mod tests {
                 .map(|&n| blocks(n))
                 .collect();
             assert_eq!(colours, expected, "seed {seed}");
-            assert_eq!(layout.overflow.len(), blocks(sizes[OVERFLOW]));
+            assert_eq!(layout.bins.len(), 1, "seed {seed}: one bin");
+            assert_eq!(layout.bins[0].overflow.len(), blocks(sizes[OVERFLOW]));
             assert!(layout.disjoint, "seed {seed}: every colour may be split");
         }
     }

@@ -26,6 +26,7 @@ use vertebra_math::poly;
 use vertebra_scheduler::{Colouring, MAX_COLOURS};
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 
+use crate::bins::Bins;
 use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
 use crate::rod::RodDesc;
 
@@ -118,16 +119,27 @@ impl<B: Copy> Blocks<B> {
     }
 }
 
+/// One solve bin's joints (`bins.rs`): its colours, then its overflow
+/// set.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Bin {
+    /// The bin's non-empty colours, in colour order.
+    pub colours: Vec<Group>,
+    /// The bin's part of the overflow set (solved by the scalar kernel).
+    pub overflow: Group,
+}
+
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Layout {
     pub sockets: Blocks<SocketBlock>,
     pub hinges: Blocks<HingeBlock>,
     pub fixed: Blocks<FixedBlock>,
     pub rods: Blocks<RodBlock>,
-    /// The non-empty colours, in colour order.
-    pub colours: Vec<Group>,
-    /// The overflow set (solved by the scalar kernel).
-    pub overflow: Group,
+    /// Per solve bin (bin 0 first), its blocks: each bin's blocks follow
+    /// the bin before's in every kind's vector.
+    pub bins: Vec<Bin>,
+    /// How many colours hold awake joints, in any bin.
+    pub colour_count: usize,
     /// Every colour passed [`crate::parallel::colour_is_disjoint`]: its
     /// blocks may run on several threads.
     pub disjoint: bool,
@@ -135,37 +147,58 @@ pub(crate) struct Layout {
 
 impl Layout {
     /// Lays out every coloured joint; `joints[slot]`, `rods[slot]` are
-    /// `Some` when live.
+    /// `Some` when live. The joints of bin `k` (their awake dynamic
+    /// body's, `bins`; all of them in bin 0 when `bins` is empty) go to
+    /// `bins[k]`, colour by colour.
     pub fn build(
         colouring: &Colouring,
         joints: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
         asleep: &[bool],
+        bins: &Bins,
     ) -> Self {
         let mut layout = Self::default();
         let awake = |a: BodyHandle, b: BodyHandle| !(asleep[a.index()] || asleep[b.index()]);
-        let joints: Vec<_> = joints
-            .iter()
-            .map(|d| d.filter(|d| awake(d.body_a, d.body_b)))
-            .collect();
-        let rods: Vec<_> = rods
-            .iter()
-            .map(|d| d.filter(|d| awake(d.body_a, d.body_b)))
-            .collect();
-        for c in 0..MAX_COLOURS {
-            let group = layout.append(colouring.colour(c), &joints, &rods, bodies);
-            if !group.is_empty() {
-                layout.colours.push(group);
+        let bin = |a: BodyHandle, b: BodyHandle| {
+            let row = |h: BodyHandle| h.index() as u32 + 1;
+            bins.of_rows(row(a), row(b))
+        };
+        let mut used = [false; MAX_COLOURS];
+        for k in 0..bins.count.max(1) as u32 {
+            let joints: Vec<_> = joints
+                .iter()
+                .map(|d| d.filter(|d| awake(d.body_a, d.body_b) && bin(d.body_a, d.body_b) == k))
+                .collect();
+            let rods: Vec<_> = rods
+                .iter()
+                .map(|d| d.filter(|d| awake(d.body_a, d.body_b) && bin(d.body_a, d.body_b) == k))
+                .collect();
+            let mut bin = Bin::default();
+            for (c, used) in used.iter_mut().enumerate() {
+                let group = layout.append(colouring.colour(c), &joints, &rods, bodies);
+                if !group.is_empty() {
+                    *used = true;
+                    bin.colours.push(group);
+                }
             }
+            bin.overflow = layout.append(colouring.overflow(), &joints, &rods, bodies);
+            layout.bins.push(bin);
         }
-        layout.overflow = layout.append(colouring.overflow(), &joints, &rods, bodies);
+        layout.colour_count = used.iter().filter(|&&u| u).count();
         let mut reads = Vec::new();
-        layout.disjoint = layout
-            .colours
-            .iter()
+        layout.disjoint = (layout.bins.iter())
+            .flat_map(|b| &b.colours)
             .all(|g| crate::parallel::colour_is_disjoint(layout.pairs(g), &mut reads));
         layout
+    }
+
+    /// The body pairs of every block of bin `bin` (its colours and its
+    /// overflow set).
+    pub fn bin_pairs<'a>(&'a self, bin: &'a Bin) -> impl Iterator<Item = &'a BodyPairs> + 'a {
+        (bin.colours.iter())
+            .chain(core::iter::once(&bin.overflow))
+            .flat_map(|g| self.pairs(g))
     }
 
     /// The body pairs of every block of `group`.

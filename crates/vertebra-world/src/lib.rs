@@ -22,6 +22,7 @@
 //! # Ok::<(), vertebra_world::Error>(())
 //! ```
 
+mod bins;
 mod checks;
 mod config;
 mod contact;
@@ -90,6 +91,8 @@ pub struct World {
     rods: Vec<Option<RodDesc>>,
     colouring: Colouring,
     islands: islands::Islands,
+    /// Scratch of the step: this step's solve bins (`bins.rs`).
+    bins: bins::Bins,
     layout: layout::Layout,
     layout_dirty: bool,
     contacts: Vec<Contact>,
@@ -140,6 +143,7 @@ impl World {
             rods: Vec::new(),
             colouring: Colouring::new(),
             islands: islands::Islands::default(),
+            bins: bins::Bins::default(),
             layout: layout::Layout::default(),
             layout_dirty: false,
             contacts: Vec::new(),
@@ -484,7 +488,7 @@ impl World {
 
     /// How many colours the joints use (after the last step's layout).
     pub fn colour_count(&self) -> usize {
-        self.layout.colours.len()
+        self.layout.colour_count
     }
 
     /// How many joints are in the overflow set (solved one at a time by
@@ -550,6 +554,7 @@ impl World {
                 &self.rods,
                 &self.bodies,
                 self.islands.asleep(),
+                &self.bins,
             );
             self.layout_dirty = false;
         }
@@ -612,6 +617,15 @@ impl World {
             Some(_) => self.islands.touch(&self.contacts, &self.bodies),
             None => self.islands.wake_all(),
         };
+        self.layout_dirty |= self.bins.assign(
+            &self.bodies,
+            self.islands.asleep(),
+            &self.joints,
+            &self.rods,
+            &self.contacts,
+            &self.joints_at,
+            self.tasks.workers(),
+        );
         self.refresh_layout();
         let (max_linear, max_angular) =
             (self.config.max_linear_speed, self.config.max_angular_speed);
@@ -619,7 +633,7 @@ impl World {
         let max_depth = self.config.max_push_out_speed * dt;
         let asleep = self.islands.asleep();
         self.contact_layout
-            .rebuild(&self.contacts, &self.bodies, asleep, max_depth);
+            .rebuild(&self.contacts, &self.bodies, asleep, &self.bins, max_depth);
         // Each substep launches the task system's workers once
         // (step::solve_substep).
         step::step(self, dt);

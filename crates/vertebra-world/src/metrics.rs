@@ -92,6 +92,7 @@ pub(crate) fn residuals(world: &mut World) {
             &world.rods,
             &world.bodies,
             &awake,
+            &crate::bins::Bins::default(),
         )
         .started(&world.bodies);
         &everything

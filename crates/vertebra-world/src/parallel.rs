@@ -47,10 +47,14 @@ impl<'a> Shared<'a> {
 // runs at once only: chunks of one colour's blocks of a layout that passed
 // `colour_is_disjoint` (every row one block writes is read and written by
 // that block's lane alone; rows nobody writes, static, kinematic and the
-// null row, are only read), and chunks of bodies, each touching the rows
-// of its own bodies only. Everything else (the scalar overflow set, a
-// layout that failed the check) is a stage of one chunk, and stages run
-// one after another (the stage counters' release and acquire order them).
+// null row, are only read); chunks of bodies, each touching the rows of
+// its own bodies only; and solve bins `1..` (`bins.rs`), each run whole by
+// one worker, once every lane of every bin was checked to read and write
+// only its own bin's rows and to read nothing else but rows nobody writes
+// (`step::bins_apart`, `Bins::owns`, every step). Everything else (the
+// scalar overflow set, a layout that failed a check) is a stage of one
+// chunk, and stages run one after another (the stage counters' release
+// and acquire order them).
 // SAFETY: so no two workers touch a row that one of them writes at the
 // same time, and the kernels' plain loads and stores of rows never race.
 unsafe impl Sync for Shared<'_> {}
@@ -119,8 +123,15 @@ mod tests {
         crafted.add(0, [None, None]);
         crafted.add(1, [None, None]);
         let asleep = world.islands.asleep();
-        let layout = Layout::build(&crafted, &world.joints, &world.rods, &world.bodies, asleep);
-        assert_eq!(layout.colours.len(), 1);
+        let layout = Layout::build(
+            &crafted,
+            &world.joints,
+            &world.rods,
+            &world.bodies,
+            asleep,
+            &crate::bins::Bins::default(),
+        );
+        assert_eq!(layout.bins[0].colours.len(), 1);
         assert!(!layout.disjoint);
     }
 

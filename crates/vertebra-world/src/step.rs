@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 use glam::{Quat, Vec3};
-use vertebra_kernels::body::BodyRows;
+use vertebra_kernels::body::{BodyPairs, BodyRows};
 use vertebra_kernels::contact::{self, ContactBlock};
 use vertebra_kernels::driven::StartPass;
 use vertebra_kernels::fixed::{self, FixedBlock};
@@ -19,9 +19,11 @@ use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
 
 use crate::World;
+use crate::bins::Bins;
+use crate::contact::{ContactBin, ContactLayout};
 use crate::islands::Islands;
 use crate::joint::JointKind;
-use crate::layout::Group;
+use crate::layout::{Bin, Group, Layout};
 use crate::parallel::Shared;
 use crate::stages::{BlockChunks, Chunks, Cursor, Part, SharedBlocks};
 
@@ -83,14 +85,14 @@ pub(crate) fn step(world: &mut World, dt: f32) {
 fn start_drives(world: &mut World, h: f32) {
     let rows = &*world.rows.get();
     let layout = &mut world.layout;
-    for group in layout
-        .colours
+    let bins = core::mem::take(&mut layout.bins);
+    let groups = bins
         .iter()
-        .chain(core::iter::once(&layout.overflow))
-    {
-        // An empty range is not dispatched: a small world's groups hold
-        // few kinds, and entering a backend is not free.
-        let some = |range: &Range<usize>| !range.is_empty();
+        .flat_map(|b| b.colours.iter().chain(core::iter::once(&b.overflow)));
+    // An empty range is not dispatched: a small world's groups hold few
+    // kinds, and entering a backend is not free.
+    let some = |range: &Range<usize>| !range.is_empty();
+    for group in groups {
         for range in [&group.driven, &group.shaped_driven]
             .into_iter()
             .filter(|r| some(r))
@@ -134,6 +136,7 @@ fn start_drives(world: &mut World, h: f32) {
             });
         }
     }
+    layout.bins = bins;
 }
 
 /// Writes each moving drive's advanced target (a nonzero
@@ -543,13 +546,15 @@ struct Substep<'a> {
     hinges: SharedBlocks<'a, HingeBlock>,
     fixed: SharedBlocks<'a, FixedBlock>,
     rods: SharedBlocks<'a, RodBlock>,
-    groups: &'a [Group],
-    overflow: &'a Group,
+    joint_bins: &'a [Bin],
     joints_disjoint: bool,
     contacts: SharedBlocks<'a, ContactBlock>,
     contact_colours: &'a [Range<usize>],
-    contact_overflow: Range<usize>,
+    contact_bins: &'a [ContactBin],
     contacts_disjoint: bool,
+    /// The bins `1..` keep to their own rows (`bins_apart`): each may be
+    /// solved by one worker while others solve the rest.
+    bins_apart: bool,
     /// Bodies put back by [`repair`] this substep.
     repaired: AtomicU64,
 }
@@ -589,6 +594,7 @@ fn solve_substep(world: &mut World, h: f32) -> u64 {
         });
         body_chunk_count += 1;
     }
+    let bins_apart = bins_apart(&world.bins, &world.layout, &world.contact_layout);
     let layout = &mut world.layout;
     let contacts = &mut world.contact_layout;
     let substep = Substep {
@@ -619,13 +625,13 @@ fn solve_substep(world: &mut World, h: f32) -> u64 {
         hinges: SharedBlocks::new(&mut layout.hinges.blocks),
         fixed: SharedBlocks::new(&mut layout.fixed.blocks),
         rods: SharedBlocks::new(&mut layout.rods.blocks),
-        groups: &layout.colours,
-        overflow: &layout.overflow,
+        joint_bins: &layout.bins,
         joints_disjoint: layout.disjoint,
         contacts: SharedBlocks::new(&mut contacts.blocks),
         contact_colours: &contacts.colours,
-        contact_overflow: contacts.overflow.clone(),
+        contact_bins: &contacts.bins,
         contacts_disjoint: contacts.disjoint,
+        bins_apart,
         repaired: AtomicU64::new(0),
     };
     world
@@ -645,11 +651,18 @@ impl Substep<'_> {
             inv_h2: 1.0 / (h * h),
         };
         for _ in 0..self.iterations {
-            self.for_each_colour(cursor, &positions);
+            self.for_each_colour(cursor, 0, &positions);
         }
+        self.bins_stage(cursor, |bin| {
+            for _ in 0..self.iterations {
+                self.solve_bin(bin, &positions);
+            }
+        });
         self.body_pass(cursor, |c, rows| derive_velocities(c, bodies, rows, h));
         let resting_speed = 2.0 * bodies.gravity.length() * h;
-        self.for_each_colour(cursor, &Velocities { h, resting_speed });
+        let velocities = Velocities { h, resting_speed };
+        self.for_each_colour(cursor, 0, &velocities);
+        self.bins_stage(cursor, |bin| self.solve_bin(bin, &velocities));
         self.body_pass(cursor, |c, rows| {
             read_velocities(c, bodies, rows);
             damp(c, bodies, h);
@@ -692,9 +705,12 @@ impl Substep<'_> {
     /// this order cut the mean joint error 2.4x (sockets) and 3.4x (rods),
     /// while ragdolls met the floor less deeply (10 mm against 25 mm at
     /// impact, 1.4 mm against 0.5 mm at rest); see docs/contacts.md.
-    fn for_each_colour(&self, cursor: &mut Cursor, pass: &impl Pass) {
-        let colours = self.contact_colours.iter().map(|r| (r, self.backend));
-        let overflow = core::iter::once((&self.contact_overflow, Backend::Scalar));
+    fn for_each_colour(&self, cursor: &mut Cursor, bin: usize, pass: &impl Pass) {
+        let contact_bin = self.contact_bins.get(bin).cloned().unwrap_or_default();
+        let colours = self.contact_colours[contact_bin.colours.clone()]
+            .iter()
+            .map(|r| (r, self.backend));
+        let overflow = core::iter::once((&contact_bin.overflow, Backend::Scalar));
         for (range, backend) in colours.chain(overflow) {
             let split = backend != Backend::Scalar && self.contacts_disjoint;
             let size = self.chunk_size(split, range.len());
@@ -706,10 +722,82 @@ impl Substep<'_> {
         if !pass.joints() {
             return;
         }
-        for group in self.groups {
+        let Some(joints) = self.joint_bins.get(bin) else {
+            return;
+        };
+        for group in &joints.colours {
             self.joint_colour(cursor, group, self.backend, self.joints_disjoint, pass);
         }
-        self.joint_colour(cursor, self.overflow, Backend::Scalar, false, pass);
+        self.joint_colour(cursor, &joints.overflow, Backend::Scalar, false, pass);
+    }
+
+    /// One stage whose chunks are the bins `1..`, each running `solve` on
+    /// one worker (all of them in one chunk, one after another, unless
+    /// the bins keep apart).
+    fn bins_stage(&self, cursor: &mut Cursor, solve: impl Fn(usize) + Sync) {
+        // Every bin of either layout (a world that never laid out a joint
+        // has no joints' bin at all).
+        let bins = self.joint_bins.len().max(self.contact_bins.len());
+        let rest = 1..bins.max(1);
+        if self.bins_apart {
+            cursor.stage(&[&Chunks(rest.len(), |k| solve(1 + k))]);
+        } else {
+            cursor.stage(&[&Chunks(usize::from(!rest.is_empty()), |_| {
+                rest.clone().for_each(&solve)
+            })]);
+        }
+    }
+
+    /// `pass` over bin `bin` (not 0), whole, on this worker: as
+    /// [`Self::for_each_colour`] in order, with no stage between.
+    fn solve_bin(&self, bin: usize, pass: &impl Pass) {
+        let rows = &self.rows;
+        let contact_bin = self.contact_bins.get(bin).cloned().unwrap_or_default();
+        let colours = self.contact_colours[contact_bin.colours.clone()]
+            .iter()
+            .map(|r| (r, self.backend));
+        let overflow = core::iter::once((&contact_bin.overflow, Backend::Scalar));
+        for (range, backend) in colours.chain(overflow) {
+            let run = |c: &mut [ContactBlock]| pass.contacts(c, rows.rows(), backend);
+            // SAFETY: a bin's blocks are its own (bins_stage hands each bin
+            // to one worker).
+            run_whole(unsafe { BlockChunks::new(&self.contacts, range.clone(), range.len(), run) });
+        }
+        if !pass.joints() {
+            return;
+        }
+        let Some(joints) = self.joint_bins.get(bin) else {
+            return;
+        };
+        let groups = (joints.colours.iter().map(|g| (g, self.backend)))
+            .chain(core::iter::once((&joints.overflow, Backend::Scalar)));
+        for (group, backend) in groups {
+            for (range, driven, shaped) in group.socket_ranges() {
+                let kind = SocketBlocks { driven, shaped };
+                let run = |c: &mut [SocketBlock]| pass.sockets(c, kind, rows.rows(), backend);
+                // SAFETY: as above.
+                run_whole(unsafe {
+                    BlockChunks::new(&self.sockets, range.clone(), range.len(), run)
+                });
+            }
+            for (range, driven) in group.hinge_ranges() {
+                let run = |c: &mut [HingeBlock]| pass.hinges(c, driven, rows.rows(), backend);
+                // SAFETY: as above.
+                run_whole(unsafe {
+                    BlockChunks::new(&self.hinges, range.clone(), range.len(), run)
+                });
+            }
+            let run = |c: &mut [FixedBlock]| pass.fixed(c, rows.rows(), backend);
+            // SAFETY: as above.
+            run_whole(unsafe {
+                BlockChunks::new(&self.fixed, group.fixed.clone(), group.fixed.len(), run)
+            });
+            let run = |c: &mut [RodBlock]| pass.rods(c, rows.rows(), backend);
+            // SAFETY: as above.
+            run_whole(unsafe {
+                BlockChunks::new(&self.rods, group.rods.clone(), group.rods.len(), run)
+            });
+        }
     }
 
     /// One colour's joints (or the overflow set's): one stage of every
@@ -801,6 +889,32 @@ impl Substep<'_> {
             }
         }
     }
+}
+
+/// Runs every chunk of `part` (a bin's blocks of one kind, one chunk) on
+/// this worker.
+fn run_whole(part: impl Part) {
+    (0..part.chunks()).for_each(|chunk| part.run(chunk));
+}
+
+/// Whether every lane of every bin `1..` keeps to its bin's rows
+/// ([`Bins::owns`]): then bins may be solved at once. Checked every step
+/// from the lanes themselves, not taken on trust from `bins.rs`.
+fn bins_apart(bins: &Bins, joints: &Layout, contacts: &ContactLayout) -> bool {
+    let lanes_own = |bin: u32, pairs: &BodyPairs| {
+        (0..pairs.body_a.len()).all(|l| {
+            bins.owns(bin, pairs.body_a[l], pairs.write_a[l])
+                && bins.owns(bin, pairs.body_b[l], pairs.write_b[l])
+        })
+    };
+    let joint_bins = joints.bins.iter().enumerate().skip(1);
+    let contact_bins = contacts.bins.iter().enumerate().skip(1);
+    joint_bins
+        .clone()
+        .all(|(k, b)| joints.bin_pairs(b).all(|p| lanes_own(k as u32, p)))
+        && contact_bins
+            .clone()
+            .all(|(k, b)| contacts.bin_pairs(b).all(|p| lanes_own(k as u32, p)))
 }
 
 /// Derives velocities from the solved motion: `v = (d - d0) / h` from the

@@ -9,7 +9,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, JointDesc, RayonTasks, Shape, SingleThreaded, SolverConfig, TaskSystem, World,
+    BodyDesc, BodyHandle, Contact, JointDesc, RayonTasks, Shape, SingleThreaded, SleepSettings,
+    SolverConfig, TaskSystem, World,
 };
 
 /// Chains of six capsules hanging from fixed anchors, swinging: enough
@@ -158,5 +159,220 @@ fn an_engines_job_system_runs_the_work_and_cannot_spoil_it() {
         let calls = engine.calls.load(Ordering::Relaxed);
         let substeps = config(1).substeps as usize;
         assert_eq!(calls, 30 * substeps, "{behaviour:?}");
+    }
+}
+
+/// Sphere radius in the piles (m).
+const R: f32 = 0.2;
+
+/// Piles of spheres on a static ground: `piles` chains of `links`
+/// spheres lying on the ground along z, each joined to the next by a
+/// socket where they touch, the chains `spacing` apart along x (closer
+/// than `2 R` they touch: one island; 3 m apart each is one of its own).
+/// Returns the world, the ground and the spheres.
+fn piles(
+    config: SolverConfig,
+    piles: usize,
+    links: usize,
+    spacing: f32,
+) -> (World, BodyHandle, Vec<BodyHandle>) {
+    let mut world = World::new(config).unwrap();
+    let ground = world.add_body(BodyDesc::fixed()).unwrap();
+    let mass = Shape::Sphere { radius: R }
+        .mass_properties_with_mass(1.0)
+        .unwrap();
+    let mut spheres = Vec::new();
+    for pile in 0..piles {
+        let mut last = None;
+        for link in 0..links {
+            let at = Vec3::new(spacing * pile as f32, R, 2.0 * R * link as f32);
+            let body = world
+                .add_body(BodyDesc::dynamic(mass).with_position(at))
+                .unwrap();
+            if let Some(last) = last {
+                let anchor = at - Vec3::Z * R;
+                let joint =
+                    JointDesc::socket_at_world_anchor(world.bodies(), last, body, anchor, Vec3::Z)
+                        .unwrap();
+                world.add_joint(joint).unwrap();
+            }
+            last = Some(body);
+            spheres.push(body);
+        }
+    }
+    (world, ground, spheres)
+}
+
+/// The contacts of the spheres with the ground (the plane y = 0) and with
+/// each other, from their poses now (a 5 mm margin).
+fn sphere_contacts(world: &World, ground: BodyHandle, spheres: &[BodyHandle]) -> Vec<Contact> {
+    let at = |h: BodyHandle| world.bodies().position[h.index()];
+    let contact = |body_a, body_b, point, normal, depth| Contact {
+        body_a,
+        body_b,
+        point,
+        normal,
+        depth,
+        friction: 0.5,
+        restitution: 0.0,
+    };
+    let mut contacts = Vec::new();
+    for (k, &a) in spheres.iter().enumerate() {
+        let p = at(a);
+        if p.y < R + 0.005 {
+            let point = Vec3::new(p.x, 0.5 * (p.y - R), p.z);
+            contacts.push(contact(ground, a, point, Vec3::Y, R - p.y));
+        }
+        for &b in &spheres[k + 1..] {
+            let d = at(b) - p;
+            let distance = d.length();
+            if distance < 2.0 * R + 0.005 && distance > 1e-6 {
+                let normal = d / distance;
+                let point = p + normal * (0.5 * distance);
+                contacts.push(contact(a, b, point, normal, 2.0 * R - distance));
+            }
+        }
+    }
+    contacts
+}
+
+/// What [`stepped_piles`] saw: the state hash at the end, the islands
+/// asleep just before and just after the push, and the spheres' distinct
+/// islands just before it.
+type PilesRun = (u64, usize, usize, usize);
+
+/// 160 steps of 1/60 s with the spheres' contacts, pushing sphere `push`
+/// up at step 100.
+fn stepped_piles(
+    mut world: World,
+    ground: BodyHandle,
+    spheres: &[BodyHandle],
+    push: usize,
+) -> PilesRun {
+    let (mut before, mut after, mut islands) = (0, 0, 0);
+    for step in 0..160 {
+        let contacts = sphere_contacts(&world, ground, spheres);
+        world.set_contacts(&contacts).unwrap();
+        if step == 100 {
+            before = world.island_count().1;
+            let mut ids: Vec<_> = spheres.iter().map(|&s| world.island(s).unwrap()).collect();
+            ids.sort();
+            ids.dedup();
+            islands = ids.len();
+            world
+                .apply_impulse(spheres[push], Vec3::new(0.3, 3.0, 0.0))
+                .unwrap();
+        }
+        world.step(1.0 / 60.0).unwrap();
+        if step == 100 {
+            after = world.island_count().1;
+        }
+    }
+    (world.state_hash(), before, after, islands)
+}
+
+#[test]
+fn islands_apart_and_one_pile_step_to_the_same_bits_on_every_task_system() {
+    // Six chains apart (six islands, dealt to the workers' bins), the
+    // same six side by side (one island: solved colour by colour), and
+    // six lone spheres (six islands without a joint), with islands
+    // falling asleep and one woken by a push mid-run.
+    for (links, spacing, islands) in [(3, 3.0, 6), (3, 2.0 * R, 1), (1, 3.0, 6)] {
+        let sleepy = |threads| SolverConfig {
+            sleep: Some(SleepSettings::default()),
+            ..config(threads)
+        };
+        let run = |world: (World, BodyHandle, Vec<BodyHandle>)| {
+            let (world, ground, spheres) = world;
+            stepped_piles(world, ground, &spheres, spheres.len() / 2)
+        };
+        let reference = run(piles(sleepy(1), 6, links, spacing));
+        let (_, before, after, found) = reference;
+        assert_eq!(found, islands, "{spacing} m: {reference:?}");
+        assert!(
+            before >= 1,
+            "{spacing} m: islands fall asleep: {reference:?}"
+        );
+        assert_eq!(
+            after,
+            before - 1,
+            "{spacing} m: the push wakes one: {reference:?}"
+        );
+        for threads in [2, 3, 4] {
+            let world = piles(sleepy(threads), 6, links, spacing);
+            assert_eq!(run(world), reference, "{threads} threads, {spacing} m");
+        }
+        for behaviour in [
+            Behaviour::Scoped,
+            Behaviour::Reversed,
+            Behaviour::Twice,
+            Behaviour::Skipping,
+            Behaviour::Nothing,
+        ] {
+            let mut world = piles(sleepy(1), 6, links, spacing);
+            world.0.set_tasks(Arc::new(Engine {
+                behaviour,
+                calls: AtomicUsize::new(0),
+            }));
+            assert_eq!(run(world), reference, "{behaviour:?}, {spacing} m");
+        }
+        // Awake throughout: the islands of touching piles are found each
+        // step, not kept.
+        let reference = run(piles(config(1), 6, links, spacing));
+        for threads in [2, 3] {
+            let world = piles(config(threads), 6, links, spacing);
+            assert_eq!(
+                run(world),
+                reference,
+                "awake, {threads} threads, {spacing} m"
+            );
+        }
+    }
+}
+
+#[test]
+fn islands_that_come_apart_step_to_the_same_bits_on_every_thread_count() {
+    // Three pairs of lone spheres (no joint) overlapping by 2 cm on the
+    // ground, 3 m apart: three islands that the overlap pushes apart into
+    // six, so that the bins grow in number mid-run.
+    let run = |threads: usize| {
+        let mut world = World::new(config(threads)).unwrap();
+        let ground = world.add_body(BodyDesc::fixed()).unwrap();
+        let mass = Shape::Sphere { radius: R }
+            .mass_properties_with_mass(1.0)
+            .unwrap();
+        let mut spheres = Vec::new();
+        for pair in 0..3 {
+            for side in [-1.0, 1.0] {
+                let at = Vec3::new(3.0 * pair as f32 + side * (R - 0.01), R, 0.0);
+                spheres.push(
+                    world
+                        .add_body(BodyDesc::dynamic(mass).with_position(at))
+                        .unwrap(),
+                );
+            }
+        }
+        let mut islands = Vec::new();
+        for _ in 0..60 {
+            let contacts = sphere_contacts(&world, ground, &spheres);
+            let touching = contacts.iter().filter(|c| c.body_a != ground).count();
+            islands.push(6 - touching.min(3));
+            world.set_contacts(&contacts).unwrap();
+            world.step(1.0 / 60.0).unwrap();
+        }
+        (
+            world.state_hash(),
+            islands.first().copied(),
+            islands.last().copied(),
+        )
+    };
+    let reference = run(1);
+    assert_eq!(
+        (reference.1, reference.2),
+        (Some(3), Some(6)),
+        "the pairs come apart"
+    );
+    for threads in [2, 3] {
+        assert_eq!(run(threads), reference, "{threads} threads");
     }
 }
