@@ -81,17 +81,18 @@ impl Bins {
                 && bodies.kind[i] == BodyKind::Dynamic
                 && !asleep.get(i).copied().unwrap_or(false)
         };
+        if workers <= 1 {
+            return self.all_in_bin_0(n, solved, jointed);
+        }
         self.parent.clear();
         self.parent.extend(0..n as u32);
-        if workers > 1 {
-            let links = (joints.iter().flatten().map(|d| (d.body_a, d.body_b)))
-                .chain(rods.iter().flatten().map(|d| (d.body_a, d.body_b)))
-                .chain(contacts.iter().map(|c| (c.body_a, c.body_b)));
-            for (a, b) in links {
-                let (a, b) = (a.index(), b.index());
-                if solved(a) && solved(b) {
-                    self.union(a, b);
-                }
+        let links = (joints.iter().flatten().map(|d| (d.body_a, d.body_b)))
+            .chain(rods.iter().flatten().map(|d| (d.body_a, d.body_b)))
+            .chain(contacts.iter().map(|c| (c.body_a, c.body_b)));
+        for (a, b) in links {
+            let (a, b) = (a.index(), b.index());
+            if solved(a) && solved(b) {
+                self.union(a, b);
             }
         }
         self.size.clear();
@@ -105,9 +106,8 @@ impl Bins {
         // Large: at least two workers' share of the bodies. A bin holding
         // a smaller island keeps its worker at most twice as long as the
         // step's share, which costs less than a wait per colour (docs/
-        // threads.md); every island is large with one worker (all in bin
-        // 0), and so is a lone island.
-        let large = |size: u32| workers == 1 || workers * size as usize >= 2 * total;
+        // threads.md); so is a lone island.
+        let large = |size: u32| workers * size as usize >= 2 * total;
         self.small.clear();
         self.small.extend(
             (0..n as u32).filter(|&r| self.size[r as usize] > 0 && !large(self.size[r as usize])),
@@ -138,6 +138,20 @@ impl Bins {
             } else {
                 NO_BIN
             };
+            changed |= self.of[i] != bin && jointed.get(i).is_some_and(|&j| j > 0);
+            self.of[i] = bin;
+        }
+        changed
+    }
+
+    /// One worker: every solved body in bin 0, no island search (the
+    /// bins `assign` would deal with every island large).
+    fn all_in_bin_0(&mut self, n: usize, solved: impl Fn(usize) -> bool, jointed: &[u32]) -> bool {
+        let mut changed = self.of.len() != n || self.count != 1;
+        self.count = 1;
+        self.of.resize(n, NO_BIN);
+        for i in 0..n {
+            let bin = if solved(i) { 0 } else { NO_BIN };
             changed |= self.of[i] != bin && jointed.get(i).is_some_and(|&j| j > 0);
             self.of[i] = bin;
         }

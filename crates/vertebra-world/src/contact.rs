@@ -181,12 +181,23 @@ impl ContactLayout {
         bins: &Bins,
         max_depth: f32,
     ) {
-        self.colour(contacts, bodies, asleep, bins);
-        let buckets = bins.count.max(1) * BUCKETS;
-        self.sort_by_bucket(buckets);
         self.blocks.clear();
         self.colours.clear();
         self.bins.clear();
+        if contacts.is_empty() {
+            // Every bin empty, as the buckets below would leave them,
+            // without walking them (a ragdoll alone has no contacts).
+            let empty = ContactBin {
+                colours: 0..0,
+                overflow: 0..0,
+            };
+            self.bins.resize(bins.count.max(1), empty);
+            self.disjoint = true;
+            return;
+        }
+        self.colour(contacts, bodies, asleep, bins);
+        let buckets = bins.count.max(1) * BUCKETS;
+        self.sort_by_bucket(buckets);
         for bucket in 0..buckets {
             let keys = &self.order[self.starts[bucket]..self.starts[bucket + 1]];
             let start = self.blocks.len();

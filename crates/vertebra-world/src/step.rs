@@ -818,6 +818,9 @@ impl Substep<'_> {
             + hinge_ranges.iter().map(|(r, _)| r.len()).sum::<usize>()
             + group.fixed.len()
             + group.rods.len();
+        if blocks == 0 {
+            return; // an empty overflow set: no stage
+        }
         let size = if split {
             self.chunk_size(true, blocks)
         } else {
