@@ -25,7 +25,7 @@ fn rig(mass: f32, drive: AngularDrive) -> (World, BodyHandle, JointHandle) {
         iterations: 4,
         gravity: Vec3::ZERO,
         // The drive's own response: a slow drive would sleep within
-        // `linear_speed / omega` of its target.
+        // `speed / omega` of its target.
         sleep: None,
         ..SolverConfig::default()
     })
