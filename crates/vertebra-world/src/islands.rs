@@ -16,10 +16,11 @@
 //! than `speed * time` ([`SleepSettings`]) from its anchor adds the step's
 //! time to its stillness; else its stillness restarts from zero, anchored
 //! where it is. Each time its stillness completes another `time`, the
-//! anchor moves on to where it is. So a body is still while the mean speed
-//! of its mass over each window of `time` stays below `speed`, whatever it
-//! does in between: a limb jittering in place sleeps (a test of the
-//! speeds at each step, as Box2D's, kept a jittering pile awake), and so
+//! anchor moves on to where it is. So a body is still while its mass stays
+//! within `speed * time` of where each window began (a mean speed below
+//! `speed` over each window), however fast it moves inside that reach: a
+//! limb jittering in place sleeps (a test of the speeds at each step, as
+//! Box2D's, kept a jittering pile awake), and so
 //! does one creeping slower than `speed`, as under Box2D's speed test; an
 //! oscillation of amplitude below half the reach sleeps too (as Jolt's
 //! test of a body's points against a fixed radius lets it). The move is
