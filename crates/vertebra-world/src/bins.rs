@@ -158,14 +158,9 @@ impl Bins {
         changed
     }
 
-    /// The root of `i`'s island (halving the path on the way).
-    fn root(&mut self, mut i: usize) -> u32 {
-        while self.parent[i] as usize != i {
-            let up = self.parent[self.parent[i] as usize];
-            self.parent[i] = up;
-            i = up as usize;
-        }
-        i as u32
+    /// The root of `i`'s island.
+    fn root(&mut self, i: usize) -> u32 {
+        crate::islands::root(&mut self.parent, i)
     }
 
     /// Joins `a`'s and `b`'s islands (the lower root stays the root).

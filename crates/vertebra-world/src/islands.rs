@@ -68,6 +68,18 @@ fn mass_moved_squared(bodies: &BodyStore, i: usize, from: (DVec3, Quat), to: (DV
     (to.0 - from.0).length_squared() + spread
 }
 
+/// The root of `i` in the union-find forest `parent` (each slot its
+/// parent, a root its own), halving the path on the way; islands and the
+/// step's solve bins both use it.
+pub(crate) fn root(parent: &mut [u32], mut i: usize) -> u32 {
+    while parent[i] as usize != i {
+        let up = parent[parent[i] as usize];
+        parent[i] = up;
+        i = up as usize;
+    }
+    i as u32
+}
+
 /// A body in no island: free slot, static or kinematic.
 pub(crate) const NO_ISLAND: u32 = u32::MAX;
 
@@ -578,14 +590,9 @@ impl Islands {
         }
     }
 
-    /// Body `i`'s union-find root (with path halving).
-    fn root(&mut self, mut i: usize) -> u32 {
-        while self.parent[i] as usize != i {
-            let up = self.parent[self.parent[i] as usize];
-            self.parent[i] = up;
-            i = up as usize;
-        }
-        i as u32
+    /// Body `i`'s union-find root.
+    fn root(&mut self, i: usize) -> u32 {
+        root(&mut self.parent, i)
     }
 
     /// Wakes every island (sleeping switched off).

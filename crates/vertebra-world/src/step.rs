@@ -706,12 +706,7 @@ impl Substep<'_> {
     /// while ragdolls met the floor less deeply (10 mm against 25 mm at
     /// impact, 1.4 mm against 0.5 mm at rest); see docs/contacts.md.
     fn for_each_colour(&self, cursor: &mut Cursor, bin: usize, pass: &impl Pass) {
-        let contact_bin = self.contact_bins.get(bin).cloned().unwrap_or_default();
-        let colours = self.contact_colours[contact_bin.colours.clone()]
-            .iter()
-            .map(|r| (r, self.backend));
-        let overflow = core::iter::once((&contact_bin.overflow, Backend::Scalar));
-        for (range, backend) in colours.chain(overflow) {
+        for (range, backend) in self.contact_groups(bin) {
             let split = backend != Backend::Scalar && self.contacts_disjoint;
             let size = self.chunk_size(split, range.len());
             let run = |c: &mut [ContactBlock]| pass.contacts(c, self.rows.rows(), backend);
@@ -729,6 +724,16 @@ impl Substep<'_> {
             self.joint_colour(cursor, group, self.backend, self.joints_disjoint, pass);
         }
         self.joint_colour(cursor, &joints.overflow, Backend::Scalar, false, pass);
+    }
+
+    /// Bin `bin`'s contact groups in solve order: each colour on the
+    /// world's backend, then the overflow set on the scalar one.
+    fn contact_groups(&self, bin: usize) -> impl Iterator<Item = (Range<usize>, Backend)> + '_ {
+        let contact_bin = self.contact_bins.get(bin).cloned().unwrap_or_default();
+        let colours = self.contact_colours[contact_bin.colours.clone()]
+            .iter()
+            .map(|r| (r.clone(), self.backend));
+        colours.chain(core::iter::once((contact_bin.overflow, Backend::Scalar)))
     }
 
     /// One stage whose chunks are the bins `1..`, each running `solve` on
@@ -752,12 +757,7 @@ impl Substep<'_> {
     /// [`Self::for_each_colour`] in order, with no stage between.
     fn solve_bin(&self, bin: usize, pass: &impl Pass) {
         let rows = &self.rows;
-        let contact_bin = self.contact_bins.get(bin).cloned().unwrap_or_default();
-        let colours = self.contact_colours[contact_bin.colours.clone()]
-            .iter()
-            .map(|r| (r, self.backend));
-        let overflow = core::iter::once((&contact_bin.overflow, Backend::Scalar));
-        for (range, backend) in colours.chain(overflow) {
+        for (range, backend) in self.contact_groups(bin) {
             let run = |c: &mut [ContactBlock]| pass.contacts(c, rows.rows(), backend);
             // SAFETY: a bin's blocks are its own (bins_stage hands each bin
             // to one worker).
