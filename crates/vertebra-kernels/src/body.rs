@@ -168,7 +168,13 @@ impl<L: Lane> BodyLanes<L> {
     /// `n^T I^-1 n = u . S u` (see [`Response`]).
     #[inline(always)]
     pub fn angular_response(&self, n: Vec3<L>) -> Response<L> {
-        let u = self.q.inverse_rotate(n);
+        self.local_response(self.q.inverse_rotate(n))
+    }
+
+    /// As [`BodyLanes::angular_response`], for an axis `u` already in the
+    /// body's own frame: `S u` and `u . S u`, with no rotation.
+    #[inline(always)]
+    pub fn local_response(&self, u: Vec3<L>) -> Response<L> {
         let turn = self.inv_inertia.mul_vec(u);
         Response {
             weight: u.dot(turn),

@@ -22,8 +22,9 @@ use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
 use crate::parts::angle::Softness;
+use crate::parts::axis_x;
 use crate::parts::rod::drive::{self, Drive};
-use crate::parts::rod::{bend, curve, frames, length, twist};
+use crate::parts::rod::{LocalFrames, bend, curve, frames, length, twist};
 use crate::residual::{Measured, Residual};
 
 /// Eight rods, field by field.
@@ -80,8 +81,8 @@ pub struct RodBlock {
     pub bend_lambda: [f32; BLOCK_LANES],
     /// Twisting's accumulated multiplier, reset every substep.
     pub twist_lambda: [f32; BLOCK_LANES],
-    /// The bend error `C n` as the substep began (rad, world), measured
-    /// by [`StartPass`].
+    /// The bend error `C n` as the substep began (rad, a's body frame, as
+    /// the position pass measures it), measured by [`StartPass`].
     pub bend_start: Vec3Block,
     /// The twist error as the substep began (rad), measured by
     /// [`StartPass`].
@@ -332,11 +333,12 @@ impl LaneSlices for Starts<'_> {
     fn slice<L: Lane>(&mut self, start: usize) {
         let (block, h) = (&mut *self.block, L::splat(self.h));
         let (a, b) = block.bodies.gather::<L>(self.rows, start);
-        let f = frames(&a, &b, block.frame_a.load(start), block.frame_b.load(start));
+        let frame_a = block.frame_a.load(start);
+        let m = LocalFrames::new(&a, &b, frame_a, block.frame_b.load(start), axis_x(frame_a));
         let bend_rest = block.bend_rest.load(start);
-        block.bend_start.store(start, bend::start(&f, bend_rest));
+        block.bend_start.store(start, bend::start(&m.f, bend_rest));
         let twist_rest = L::load(&block.twist_rest[start..]);
-        twist::error(&f, twist_rest).store(&mut block.twist_start[start..]);
+        twist::error(&m.f, twist_rest).store(&mut block.twist_start[start..]);
         let velocity = block.bend_rest_velocity.load(start);
         block
             .bend_rest
@@ -387,12 +389,13 @@ fn solve_positions<L: Lane>(
         inv_h,
         inv_h2,
     );
-    let f = frames(&a, &b, frame_a, frame_b);
+    let ta = axis_x(frame_a);
+    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
     let lambda = L::load(&block.bend_lambda[start..]);
     let lambda = bend::solve(
         &mut a,
         &mut b,
-        &f,
+        &m,
         block.bend_rest.load(start),
         rest_length,
         &bend_drive,
@@ -412,27 +415,29 @@ fn solve_positions<L: Lane>(
         inv_h,
         inv_h2,
     );
-    let f = frames(&a, &b, frame_a, frame_b);
+    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
     let lambda = L::load(&block.twist_lambda[start..]);
     let rest = L::load(&block.twist_rest[start..]);
     let start_twist = L::load(&block.twist_start[start..]);
-    let lambda = twist::solve(&mut a, &mut b, &f, rest, &twist_drive, start_twist, lambda);
+    let lambda = twist::solve(&mut a, &mut b, &m, rest, &twist_drive, start_twist, lambda);
     lambda.store(&mut block.twist_lambda[start..]);
 
-    let f = frames(&a, &b, frame_a, frame_b);
-    bend::limit(&mut a, &mut b, &f, L::load(&block.bend_max[start..]));
-    let f = frames(&a, &b, frame_a, frame_b);
+    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
+    bend::limit(&mut a, &mut b, &m, L::load(&block.bend_max[start..]));
+    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
     let (lo, hi) = (
         L::load(&block.twist_min[start..]),
         L::load(&block.twist_max[start..]),
     );
-    twist::limit(&mut a, &mut b, &f, lo, hi);
+    twist::limit(&mut a, &mut b, &m, lo, hi);
 
+    // The curve moves the bodies along a world gradient: its frames are
+    // the world's. The length needs only the bend angle.
     let chord = block.bodies.start(start);
     let f = frames(&a, &b, frame_a, frame_b);
     curve::solve(&mut a, &mut b, &f, &chord);
-    let f = frames(&a, &b, frame_a, frame_b);
-    length::solve(&mut a, &mut b, &f, rest_length, &chord);
+    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
+    length::solve(&mut a, &mut b, &m.f, rest_length, &chord);
 
     block.bodies.scatter(rows, start, &a, &b);
 }

@@ -27,17 +27,6 @@ pub struct Softness<L> {
     pub relaxation: L,
 }
 
-impl<L: Lane> Softness<L> {
-    /// A hard part.
-    #[inline(always)]
-    pub fn hard() -> Self {
-        Self {
-            alpha_tilde: L::splat(0.0),
-            relaxation: L::splat(1.0),
-        }
-    }
-}
-
 /// Applies a hard correction with the axis given in each body's own frame,
 /// `[R_a^T n_a, R_b^T n_b]`: `w = n_a . S_a n_a + n_b . S_b n_b` from the
 /// same `S n` that turns the bodies ([`apply_local`]), with no rotation
@@ -52,27 +41,6 @@ pub fn correct_local<L: Lane>(
     let (s_a, s_b) = (a.inv_inertia.mul_vec(n_a), b.inv_inertia.mul_vec(n_b));
     let dlambda = safe_ratio(-c, n_a.dot(s_a) + n_b.dot(s_b));
     apply_local(a, b, (s_a, s_b), dlambda);
-}
-
-/// Applies the correction with axis `n_a` on `a` and `n_b` on `b`; returns
-/// `dlambda`, to be added to the part's accumulated `lambda` by soft parts.
-#[inline(always)]
-pub fn correct_axes<L: Lane>(
-    a: &mut BodyLanes<L>,
-    b: &mut BodyLanes<L>,
-    n_a: Vec3<L>,
-    n_b: Vec3<L>,
-    c: L,
-    soft: Softness<L>,
-    lambda: L,
-) -> L {
-    let (ra, rb) = (a.angular_response(n_a), b.angular_response(n_b));
-    let dlambda = safe_ratio(
-        -soft.relaxation * c - soft.alpha_tilde * lambda,
-        ra.weight + rb.weight + soft.alpha_tilde,
-    );
-    apply(a, b, (&ra, &rb), dlambda);
-    dlambda
 }
 
 /// Turns `b` by `I_b^-1 n_b dlambda` and `a` by `-I_a^-1 n_a dlambda`,

@@ -21,9 +21,9 @@
 use vertebra_math::{Lane, Vec3, poly};
 
 use super::drive::{self, Drive, bend_weight};
-use super::{Frames, bend_angle};
+use super::{Frames, LocalFrames, bend_angle};
 use crate::body::BodyLanes;
-use crate::parts::angle::{self, Softness};
+use crate::parts::angle;
 
 /// The axis and angle from the rest direction to `t_b`.
 #[inline(always)]
@@ -48,15 +48,15 @@ pub fn start<L: Lane>(f: &Frames<L>, rest_direction: Vec3<L>) -> Vec3<L> {
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    f: &Frames<L>,
+    m: &LocalFrames<L>,
     rest_direction: Vec3<L>,
     rest_length: L,
     d: &Drive<L>,
     start: Vec3<L>,
     lambda: L,
 ) -> L {
-    let (n, c) = measure(f, rest_direction);
-    let (ra, rb) = (a.angular_response(n), b.angular_response(n));
+    let (n, c) = measure(&m.f, rest_direction);
+    let (ra, rb) = (a.local_response(n), b.local_response(m.in_b(n)));
     let w = bend_weight(a, b, (ra.weight, rb.weight), rest_length);
     drive::correct(a, b, (&ra, &rb), c, c - start.dot(n), w, d, lambda)
 }
@@ -70,8 +70,13 @@ pub fn overshoot<L: Lane>(f: &Frames<L>, max_bend: L) -> (Vec3<L>, L) {
 
 /// Enforces `psi <= max_bend`; returns the overshoot before the correction.
 #[inline(always)]
-pub fn limit<L: Lane>(a: &mut BodyLanes<L>, b: &mut BodyLanes<L>, f: &Frames<L>, max_bend: L) -> L {
-    let (n, c) = overshoot(f, max_bend);
-    angle::correct_axes(a, b, n, n, c, Softness::hard(), L::splat(0.0));
+pub fn limit<L: Lane>(
+    a: &mut BodyLanes<L>,
+    b: &mut BodyLanes<L>,
+    m: &LocalFrames<L>,
+    max_bend: L,
+) -> L {
+    let (n, c) = overshoot(&m.f, max_bend);
+    angle::correct_local(a, b, [n, m.in_b(n)], c);
     c
 }

@@ -15,9 +15,56 @@ pub mod drive;
 pub mod length;
 pub mod twist;
 
-use vertebra_math::{Lane, Vec3, poly};
+use vertebra_math::{Lane, Quat, Vec3, poly};
 
+use crate::body::BodyLanes;
 pub use crate::parts::{Frames, frames};
+
+/// The material frames measured in a's body frame: `F(0)` is `F_a` itself
+/// and `F(1)` is `(q_a* q_b) F_b`, one quaternion product where the world
+/// frames take two; `t_a = F_a x` is the same for every part of an
+/// iteration. The angles (bend, twist, their axes' relations) are the same
+/// in any frame, and an axis `n` found in a's frame is already the
+/// `R_a^T n` that a's inverse inertia needs; b's is `relative* n`
+/// ([`LocalFrames::in_b`]): one rotation per correction instead of two.
+#[derive(Clone, Copy, Debug)]
+pub struct LocalFrames<L> {
+    /// The frames and tangents, in a's body frame.
+    pub f: Frames<L>,
+    /// b's orientation relative to a's, `q_a* q_b`.
+    pub relative: Quat<L>,
+}
+
+impl<L: Lane> LocalFrames<L> {
+    /// Measures the frames at the bodies' current orientations; `ta` is
+    /// `F_a x` ([`crate::parts::axis_x`]), which the caller forms once.
+    #[inline(always)]
+    pub fn new(
+        a: &BodyLanes<L>,
+        b: &BodyLanes<L>,
+        frame_a: Quat<L>,
+        frame_b: Quat<L>,
+        ta: Vec3<L>,
+    ) -> Self {
+        let relative = a.q.conjugate() * b.q;
+        let fb = relative * frame_b;
+        Self {
+            f: Frames {
+                fa: frame_a,
+                fb,
+                ta,
+                tb: crate::parts::axis_x(fb),
+            },
+            relative,
+        }
+    }
+
+    /// The axis `n` (a's body frame) in b's body frame.
+    #[inline(always)]
+    pub fn in_b(&self, n: Vec3<L>) -> Vec3<L> {
+        self.relative.inverse_rotate(n)
+    }
+}
 
 /// The bend axis (unit, or zero when straight or folded back) and the bend
 /// angle `psi` in [0, pi].

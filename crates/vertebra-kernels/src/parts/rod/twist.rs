@@ -25,10 +25,10 @@
 
 use vertebra_math::{Lane, Quat, Vec3, poly};
 
-use super::Frames;
 use super::drive::{self, Drive};
+use super::{Frames, LocalFrames};
 use crate::body::{BodyLanes, safe_ratio};
-use crate::parts::angle::{self, Softness};
+use crate::parts::angle;
 use crate::parts::twist::excess;
 
 /// The axes `(n_a, n_b)` with `dtau/dtheta_a = -n_a`, `dtau/dtheta_b = n_b`.
@@ -79,15 +79,15 @@ pub fn error<L: Lane>(f: &Frames<L>, rest: L) -> L {
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    f: &Frames<L>,
+    m: &LocalFrames<L>,
     rest: L,
     d: &Drive<L>,
     start: L,
     lambda: L,
 ) -> L {
-    let c = error(f, rest);
-    let (n_a, n_b) = axes(f);
-    let (ra, rb) = (a.angular_response(n_a), b.angular_response(n_b));
+    let c = error(&m.f, rest);
+    let (n_a, n_b) = axes(&m.f);
+    let (ra, rb) = (a.local_response(n_a), b.local_response(m.in_b(n_b)));
     let rate = poly::wrap_angle(c - start);
     drive::correct(a, b, (&ra, &rb), c, rate, ra.weight + rb.weight, d, lambda)
 }
@@ -97,12 +97,12 @@ pub fn solve<L: Lane>(
 pub fn limit<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    f: &Frames<L>,
+    m: &LocalFrames<L>,
     lo: L,
     hi: L,
 ) -> L {
-    let e = excess(measure(f), lo, hi);
-    let (n_a, n_b) = axes(f);
-    angle::correct_axes(a, b, n_a, n_b, e, Softness::hard(), L::splat(0.0));
+    let e = excess(measure(&m.f), lo, hi);
+    let (n_a, n_b) = axes(&m.f);
+    angle::correct_local(a, b, [n_a, m.in_b(n_b)], e);
     e.abs()
 }
