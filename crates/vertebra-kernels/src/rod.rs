@@ -24,7 +24,7 @@ use crate::body::{BodyPairs, BodyRows};
 use crate::parts::angle::Softness;
 use crate::parts::axis_x;
 use crate::parts::rod::drive::{self, Drive};
-use crate::parts::rod::{LocalFrames, bend, curve, frames, length, twist};
+use crate::parts::rod::{LocalFrames, bend, curve, frames, length, twist, world_tangents};
 use crate::residual::{Measured, Residual};
 
 /// Eight rods, field by field.
@@ -389,8 +389,9 @@ fn solve_positions<L: Lane>(
         inv_h,
         inv_h2,
     );
-    let ta = axis_x(frame_a);
-    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
+    let (ta, tb) = (axis_x(frame_a), axis_x(frame_b));
+    let frames = (frame_a, frame_b);
+    let m = LocalFrames::tangents(&a, &b, frames, (ta, tb));
     let lambda = L::load(&block.bend_lambda[start..]);
     let lambda = bend::solve(
         &mut a,
@@ -422,7 +423,7 @@ fn solve_positions<L: Lane>(
     let lambda = twist::solve(&mut a, &mut b, &m, rest, &twist_drive, start_twist, lambda);
     lambda.store(&mut block.twist_lambda[start..]);
 
-    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
+    let m = LocalFrames::tangents(&a, &b, frames, (ta, tb));
     bend::limit(&mut a, &mut b, &m, L::load(&block.bend_max[start..]));
     let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
     let (lo, hi) = (
@@ -434,9 +435,9 @@ fn solve_positions<L: Lane>(
     // The curve moves the bodies along a world gradient: its frames are
     // the world's. The length needs only the bend angle.
     let chord = block.bodies.start(start);
-    let f = frames(&a, &b, frame_a, frame_b);
+    let f = world_tangents(&a, &b, frames, (ta, tb));
     curve::solve(&mut a, &mut b, &f, &chord);
-    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
+    let m = LocalFrames::tangents(&a, &b, frames, (ta, tb));
     length::solve(&mut a, &mut b, &m.f, rest_length, &chord);
 
     block.bodies.scatter(rows, start, &a, &b);

@@ -410,7 +410,9 @@ pub fn arc_tangent(a: Vec3, m: Vec3, b: Vec3) -> Option<Vec3> {
 /// `t_b`, to `f1`. It is the rod kernel's own measure
 /// (`vertebra_kernels::parts::rod::twist::measure`) run on one `f32` lane,
 /// so a rest twist or a mapping computed with it is the twist the solver
-/// sees, to the bit.
+/// sees: to the bit where a's body is unrotated (the bind pose, where the
+/// kernel's frames in a's body frame, `F_a` and `(q_a* q_b) F_b`, are
+/// these), to rounding elsewhere.
 pub fn rod_twist(f0: Quat, f1: Quat) -> f32 {
     use vertebra_kernels::parts::rod::{Frames, twist};
     twist::measure(&Frames::new(

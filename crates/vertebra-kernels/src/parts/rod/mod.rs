@@ -59,10 +59,53 @@ impl<L: Lane> LocalFrames<L> {
         }
     }
 
+    /// As [`LocalFrames::new`], with `t_b` the rotation of `F_b x`
+    /// (`tb`, which the caller forms once) by the relative orientation
+    /// rather than the column of `F(1)`: one rotation instead of a product
+    /// and a column, for the parts that read only the tangents (the bend,
+    /// its limit, the length), whose unread `F(1)` the compiler drops.
+    #[inline(always)]
+    pub fn tangents(
+        a: &BodyLanes<L>,
+        b: &BodyLanes<L>,
+        (frame_a, frame_b): (Quat<L>, Quat<L>),
+        (ta, tb): (Vec3<L>, Vec3<L>),
+    ) -> Self {
+        let relative = a.q.conjugate() * b.q;
+        Self {
+            f: Frames {
+                fa: frame_a,
+                fb: relative * frame_b,
+                ta,
+                tb: relative.rotate(tb),
+            },
+            relative,
+        }
+    }
+
     /// The axis `n` (a's body frame) in b's body frame.
     #[inline(always)]
     pub fn in_b(&self, n: Vec3<L>) -> Vec3<L> {
         self.relative.inverse_rotate(n)
+    }
+}
+
+/// The world frames with each tangent rotated from its body frame's
+/// (`ta = F_a x`, `tb = F_b x`, formed once by the caller): two rotations
+/// instead of two products and two columns, for the curve, which reads
+/// only the tangents (the unread frames the compiler drops).
+#[inline(always)]
+pub fn world_tangents<L: Lane>(
+    a: &BodyLanes<L>,
+    b: &BodyLanes<L>,
+    (frame_a, frame_b): (Quat<L>, Quat<L>),
+    (ta, tb): (Vec3<L>, Vec3<L>),
+) -> Frames<L> {
+    Frames {
+        fa: a.q * frame_a,
+        fb: b.q * frame_b,
+        ta: a.q.rotate(ta),
+        tb: b.q.rotate(tb),
     }
 }
 
