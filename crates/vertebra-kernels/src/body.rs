@@ -157,12 +157,6 @@ impl<L: Lane> BodyLanes<L> {
             .rotate(self.inv_inertia.mul_vec(self.q.inverse_rotate(v)))
     }
 
-    /// The world-space inverse inertia `R S R^T`.
-    #[inline(always)]
-    pub fn world_inv_inertia(&self) -> Sym3<L> {
-        self.inv_inertia.rotated(self.q)
-    }
-
     /// How this body answers a rotational correction about the world axis
     /// `n`: `u = R^T n` (the axis in the body frame), `S u` and
     /// `n^T I^-1 n = u . S u` (see [`Response`]).

@@ -12,6 +12,18 @@
 //! step is an oblique projection, removing only ~14% of the error per
 //! iteration for a capsule whose inertias differ 13:1.
 //!
+//! Frame. The kernel measures and solves in a's body frame: `C` turned by
+//! `R_a^T` is `log((q_a* q_b F_b) (F_a T)*)`, `W` turned is
+//! `S_a + R S_b R^T` with `R` b's rotation relative to a's, and each
+//! body's turn is applied in its own frame (`S_a dlambda`,
+//! `S_b R^T dlambda`), so one inertia is rotated instead of two and no
+//! turn is rotated back into the world (as the lock part, `lock.rs`). The
+//! start error `C_0` and the accumulated `lambda` are held in the same
+//! frame, so the damping's `C - C_0` is the change of the joint's own
+//! error: a pair that turns rigidly keeps its error in a's frame and is
+//! not damped, where in the world its error would turn with it and read
+//! as a rate.
+//!
 //! Moving target. `T` turns at the target angular velocity `w_T` (rad/s,
 //! in a's joint frame): substep `k` aims at `T_k = exp(w_T h) T_(k-1)`
 //! ([`advance`]). The error at the substep's start, `C_0`, is measured
@@ -83,25 +95,32 @@ pub struct Drive<L> {
     pub max_torque: L,
     /// 1 where the drive is on, 0 where off.
     pub enabled: L,
-    /// The error `C_0` at the substep's start (rad, world).
+    /// The error `C_0` at the substep's start (rad, a's body frame).
     pub start: Vec3<L>,
 }
 
-/// The error rotation vector `log(B D*)` (rad, world).
+/// The error rotation vector in a's body frame, `R_a^T log(B D*) =
+/// log((q_a* q_b F_b) (F_a T)*)` (rad; the conjugate by `q_a` of the
+/// world error rotation, whose rotation vector is the world one turned by
+/// `R_a^T`), and b's orientation relative to a's, `q_a* q_b`.
 #[inline(always)]
-pub fn measure<L: Lane>(
+pub fn measure_in_a<L: Lane>(
     a: &BodyLanes<L>,
     b: &BodyLanes<L>,
     frame_a: Quat<L>,
     frame_b: Quat<L>,
     target: Quat<L>,
-) -> Vec3<L> {
-    let desired = a.q * frame_a * target;
-    ((b.q * frame_b) * desired.conjugate()).to_rotation_vector()
+) -> (Vec3<L>, Quat<L>) {
+    let relative = a.q.conjugate() * b.q;
+    let desired = frame_a * target;
+    (
+        ((relative * frame_b) * desired.conjugate()).to_rotation_vector(),
+        relative,
+    )
 }
 
-/// The error at the substep's start, `C_0` (rad, world), against the
-/// previous substep's target, zero where the drive is off.
+/// The error at the substep's start, `C_0` (rad, a's body frame), against
+/// the previous substep's target, zero where the drive is off.
 #[inline(always)]
 pub fn start<L: Lane>(
     a: &BodyLanes<L>,
@@ -111,7 +130,9 @@ pub fn start<L: Lane>(
     target: Quat<L>,
     enabled: L,
 ) -> Vec3<L> {
-    measure(a, b, frame_a, frame_b, target).scale(enabled)
+    measure_in_a(a, b, frame_a, frame_b, target)
+        .0
+        .scale(enabled)
 }
 
 /// The turn `exp(velocity h)` that `h` seconds at `velocity` (rad/s) make,
@@ -137,7 +158,11 @@ pub fn advance<L: Lane>(target: Quat<L>, velocity: Vec3<L>, h: L) -> Quat<L> {
 }
 
 /// One XPBD iteration of the drive; returns the new accumulated `lambda`
-/// (N m s^2, world). `inv_h` and `inv_h2` are `1/h` and `1/h^2`.
+/// (N m s^2, a's body frame). `inv_h` and `inv_h2` are `1/h` and `1/h^2`.
+/// Solved in a's body frame, as the lock part (`lock.rs`): `W = S_a +
+/// R S_b R^T` (`R` b's rotation relative to a's), a turns by `-S_a dlambda`
+/// in its own frame and b by `S_b R^T dlambda` in its own: one inertia
+/// rotated instead of two, nothing rotated back into the world.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn solve<L: Lane>(
@@ -150,8 +175,9 @@ pub fn solve<L: Lane>(
     inv_h2: L,
     lambda: Vec3<L>,
 ) -> Vec3<L> {
-    let c = measure(a, b, frame_a, frame_b, d.target).scale(d.enabled);
-    let w = a.world_inv_inertia() + b.world_inv_inertia();
+    let (c, relative) = measure_in_a(a, b, frame_a, frame_b, d.target);
+    let c = c.scale(d.enabled);
+    let w = a.inv_inertia + b.inv_inertia.rotated(relative);
     let gamma = d.damping_time * inv_h;
     let spring = d.period2 * inv_h2;
     let alpha = d.compliance * inv_h2;
@@ -162,8 +188,9 @@ pub fn solve<L: Lane>(
     let rhs = Vec3::select((spring + gamma).gt(L::splat(0.0)), sprung, rhs);
     let dlambda = -m.inverse_or_zero().mul_vec(rhs);
     let (lambda, dlambda) = cap(lambda, dlambda, d.max_torque / inv_h2);
-    b.apply_angular_impulse(dlambda);
-    a.apply_angular_impulse(-dlambda);
+    let turn_b = b.inv_inertia.mul_vec(relative.inverse_rotate(dlambda));
+    b.turn_local(turn_b, L::splat(1.0));
+    a.turn_local(a.inv_inertia.mul_vec(dlambda), L::splat(-1.0));
     lambda
 }
 
