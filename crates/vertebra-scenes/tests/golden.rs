@@ -71,10 +71,10 @@ fn ragdoll_drop_rod() {
 // variants). The bodies' bits are unchanged: with `max_torque` left out of
 // the serialisation the old hashes came back on every backend and thread
 // count (undriven rods take the old correction bit for bit).
-const GOLDEN_BENDING_SOCKETS: u64 = 0xba45_2624_d2f6_d6b3;
-const GOLDEN_BENDING_ROD: u64 = 0xe98b_653e_d246_c735;
+const GOLDEN_BENDING_SOCKETS: u64 = 0xd058_d104_f861_b247;
+const GOLDEN_BENDING_ROD: u64 = 0x026b_981b_3467_eb81;
 const GOLDEN_DROP_SOCKETS: u64 = 0xb16f_5ecf_f1ec_b012;
-const GOLDEN_DROP_ROD: u64 = 0x0f2e_e7c8_ad79_1507;
+const GOLDEN_DROP_ROD: u64 = 0x2876_b9bc_0f6f_67fd;
 // The drop's two updated 2026-11-30 by the contact fix (issue 17): a
 // contact's corrections act through the step's first lever arms, not the
 // turned ones (a capsule lying on the ground spun up about its axis);
@@ -93,3 +93,12 @@ const GOLDEN_DROP_ROD: u64 = 0x0f2e_e7c8_ad79_1507;
 // in a's frame, and the rod's twist takes an unnormalised half-way
 // quaternion. Every backend and thread count still gives one hash (with
 // the contact fix and the islands: checked by this test at the merge).
+// Then three by issue 17's frames (kernels17c, 2026-11-30): the rod's
+// bend, twist, limits and length are measured in a's body frame (other
+// roundings of the same angles), and the angular drive is solved in a's
+// body frame, its start error and multiplier held there (the damping no
+// longer sees a rigid turn of the pair as a rate). The drop with sockets
+// has no drive and no rod: its hash is unchanged. They were
+// 0xba45_2624_d2f6_d6b3 (bending, sockets: the hips' pin is a drive),
+// 0xe98b_653e_d246_c735 (bending, rod) and 0x0f2e_e7c8_ad79_1507 (drop,
+// rod).
