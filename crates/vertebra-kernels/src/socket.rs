@@ -311,16 +311,16 @@ fn solve_shaped<L: Lane>(
         alpha_tilde: soft.alpha_tilde * L::splat(0.25),
         ..soft
     };
-    solve_limit(block, 0, start, a, b, (n, c), quarter);
+    solve_limit(block, 0, start, a, b, ([n, dir.in_b(n)], c), quarter);
 
     let dir = swing_direction::measure(a, b, frame_a, frame_b);
-    let [y, z] = pyramid::violations(
+    let [(y, cy), (z, cz)] = pyramid::violations(
         &dir,
         load_range(&block.pyramid_y, start),
         load_range(&block.pyramid_z, start),
     );
-    solve_limit(block, 1, start, a, b, y, soft);
-    solve_limit(block, 2, start, a, b, z, soft);
+    solve_limit(block, 1, start, a, b, ([y, dir.in_b(y)], cy), soft);
+    solve_limit(block, 2, start, a, b, ([z, dir.in_b(z)], cz), soft);
 
     let (lo, hi) = (
         L::load(&block.twist_min[start..]),
@@ -382,7 +382,8 @@ fn load_range<L: Lane>(range: &[[f32; BLOCK_LANES]; 2], start: usize) -> [L; 2] 
     [L::load(&range[0][start..]), L::load(&range[1][start..])]
 }
 
-/// One shaped limit (`k` its multiplier and start) through the limit part.
+/// One shaped limit (`k` its multiplier and start) through the limit part,
+/// its axis given in each body's own frame.
 #[inline(always)]
 fn solve_limit<L: Lane>(
     block: &mut SocketBlock,
@@ -390,12 +391,13 @@ fn solve_limit<L: Lane>(
     start: usize,
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
-    (n, c): (Vec3<L>, L),
+    (axes, c): ([Vec3<L>; 2], L),
     soft: limit::Softness<L>,
 ) {
     let lambda = L::load(&block.limit_lambda[k][start..]);
     let c0 = L::load(&block.limit_start[k][start..]);
-    limit::solve(a, b, n, (c, c0), soft, lambda).store(&mut block.limit_lambda[k][start..]);
+    limit::solve_local(a, b, axes, (c, c0), soft, lambda)
+        .store(&mut block.limit_lambda[k][start..]);
 }
 
 impl Driven for SocketBlock {

@@ -102,6 +102,8 @@ fn ellipse_gradients_match_finite_differences() {
         if violation < 0.02 {
             continue; // inside, or too close to the boundary for differences
         }
+        // The axis comes in a's body frame: the world gradient is R_a n.
+        let n = a.q.rotate(n);
         let value = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| c(a, b).1;
         check(
             "ellipse / b",
@@ -139,6 +141,7 @@ fn pyramid_gradients_match_finite_differences() {
             if violation < 0.02 {
                 continue;
             }
+            let n = a.q.rotate(n); // a's body frame to the world
             let value = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| c(a, b).1;
             check(
                 "pyramid / b",

@@ -69,26 +69,11 @@ impl<L: Lane> Softness<L> {
     }
 }
 
-/// Corrects a violation `c` (rad, >= 0) about `n`, `c0` the violation at
-/// the substep's start; returns the new accumulated `lambda` (N m s^2).
-#[inline(always)]
-pub fn solve<L: Lane>(
-    a: &mut BodyLanes<L>,
-    b: &mut BodyLanes<L>,
-    n: Vec3<L>,
-    (c, c0): (L, L),
-    soft: Softness<L>,
-    lambda: L,
-) -> L {
-    let (ra, rb) = (a.angular_response(n), b.angular_response(n));
-    let dlambda = step(ra.weight + rb.weight, (c, c0), soft, lambda);
-    angle::apply(a, b, (&ra, &rb), dlambda);
-    lambda + dlambda
-}
-
-/// As [`solve`], with the axis given in each body's own frame, `[R_a^T n,
-/// R_b^T n]` (as the hinge measures its range): `w` and the turns come
-/// from the same body-frame `S n` ([`angle::apply_local`]).
+/// Corrects a violation `c` (rad, >= 0) about the axis `n`, given in
+/// each body's own frame, `[R_a^T n, R_b^T n]` (as every limit measures
+/// it), `c0` the violation at the substep's start; returns the new
+/// accumulated `lambda` (N m s^2). `w` and the turns come from the same
+/// body-frame `S n` ([`angle::apply_local`]).
 #[inline(always)]
 pub fn solve_local<L: Lane>(
     a: &mut BodyLanes<L>,

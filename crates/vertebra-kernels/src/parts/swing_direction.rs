@@ -19,18 +19,25 @@
 //! (not unit), so each limit supplies only `C` and `g` (derived in its
 //! own header; checked against finite differences in
 //! `tests/joint_gradients.rs`). At `d = -x` (a swing of exactly pi) the
-//! swing axis is undefined: the gradients are 0 there, by selects.
+//! swing axis is undefined: the gradients are 0 there, by selects. The
+//! kernel takes `n` in a's body frame, `F_a (d x g)`, and in b's, where
+//! the limit part needs it with no further rotation.
 
 use vertebra_math::{Lane, Quat, Vec3};
 
 use crate::body::BodyLanes;
 
-/// b's twist axis in a's joint frame, and a's joint frame in the world.
+/// b's twist axis in a's joint frame, measured from b's orientation
+/// relative to a's (as the plain path's swing and twist): no product with
+/// either world orientation, and the limits' axes come out in the bodies'
+/// own frames.
 #[derive(Clone, Copy, Debug)]
 pub struct Direction<L> {
-    /// `q_a F_a`: a's joint frame in the world.
+    /// `F_a`: a's joint frame in a's body frame.
     pub frame_a: Quat<L>,
-    /// `d`, unit, in a's joint frame.
+    /// `q_a* q_b`: b's orientation relative to a's.
+    pub relative: Quat<L>,
+    /// `d = F_a* (q_a* q_b) F_b x`, unit, in a's joint frame.
     pub d: Vec3<L>,
 }
 
@@ -42,16 +49,28 @@ pub fn measure<L: Lane>(
     frame_a: Quat<L>,
     frame_b: Quat<L>,
 ) -> Direction<L> {
-    let fa = a.q * frame_a;
+    let relative = a.q.conjugate() * b.q;
     Direction {
-        frame_a: fa,
-        d: super::axis_x(fa.conjugate() * (b.q * frame_b)),
+        frame_a,
+        relative,
+        d: super::axis_x(frame_a.conjugate() * (relative * frame_b)),
     }
 }
 
-/// The world axis `n = q_a F_a (d x g)` for a limit of gradient `g` (a's
-/// joint frame): `dC/dtheta_b = n`, `dC/dtheta_a = -n`.
+/// The axis `F_a (d x g)` for a limit of gradient `g` (a's joint frame):
+/// `R_a^T n`, the world axis `n = q_a F_a (d x g)` (`dC/dtheta_b = n`,
+/// `dC/dtheta_a = -n`) in a's body frame, as
+/// [`crate::parts::limit::solve_local`] takes it ([`Direction::in_b`] gives
+/// b's).
 #[inline(always)]
 pub fn axis<L: Lane>(dir: &Direction<L>, g: Vec3<L>) -> Vec3<L> {
     dir.frame_a.rotate(dir.d.cross(g))
+}
+
+impl<L: Lane> Direction<L> {
+    /// The axis `n` (a's body frame) in b's body frame, `(q_a* q_b)* n`.
+    #[inline(always)]
+    pub fn in_b(&self, n: Vec3<L>) -> Vec3<L> {
+        self.relative.inverse_rotate(n)
+    }
 }
