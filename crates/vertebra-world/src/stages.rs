@@ -504,7 +504,6 @@ mod tests {
                 Stages::default().run(&Tasks(runs), &|cursor: &mut Cursor| {
                     cursor.stage(&[&chunks])
                 });
-                drop(chunks);
                 assert!(
                     seen.iter().enumerate().all(|(i, &v)| v == i),
                     "{runs:?}, {len} in {pieces}"
