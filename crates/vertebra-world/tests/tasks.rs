@@ -2,7 +2,8 @@
 //! system, the default ones and an engine's own, and on task systems that
 //! run items one after another (last first), run items twice at once,
 //! leave items out or all of them, or call with indices out of range; and
-//! each substep is one launch of the workers.
+//! each substep is one launch of the workers (and the step's start one
+//! more, when it has many contacts).
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
