@@ -145,6 +145,8 @@ pub(crate) struct ContactLayout {
     next: Vec<usize>,
     /// Scratch of the disjointness check.
     reads: Vec<u32>,
+    /// Scratch: per block, its contacts' range of `order`.
+    block_keys: Vec<Range<u32>>,
 }
 
 /// One solve bin's contacts.
@@ -172,7 +174,10 @@ impl ContactLayout {
     /// [`MAX_COLOURS`] the overflow set: `vertebra_scheduler::Colouring`'s
     /// rule, with bitsets that live for one step) and lays them out bin by
     /// bin (`bins`: a contact's is its awake dynamic body's), each overlap
-    /// capped at `max_depth` (m) for this step.
+    /// capped at `max_depth` (m) for this step: [`Self::plan`], every
+    /// block filled ([`ContactFill`]), [`Self::check`]. The step does the
+    /// same with the blocks filled in chunks on its workers.
+    #[cfg(test)]
     pub fn rebuild(
         &mut self,
         contacts: &[Contact],
@@ -181,9 +186,20 @@ impl ContactLayout {
         bins: &Bins,
         max_depth: f32,
     ) {
+        self.plan(contacts, bodies, asleep, bins);
+        let (fill, blocks) = self.fill(contacts, bodies, max_depth);
+        fill.blocks(0, blocks);
+        self.check();
+    }
+
+    /// Colours `contacts` and sorts them into bins and colours: the block
+    /// ranges of every colour and bin, and as many padding blocks as they
+    /// hold, each to be filled from its contacts ([`Self::fill`]).
+    pub fn plan(&mut self, contacts: &[Contact], bodies: &BodyStore, asleep: &[bool], bins: &Bins) {
         self.blocks.clear();
         self.colours.clear();
         self.bins.clear();
+        self.block_keys.clear();
         if contacts.is_empty() {
             // Every bin empty, as the buckets below would leave them,
             // without walking them (a ragdoll alone has no contacts).
@@ -192,17 +208,18 @@ impl ContactLayout {
                 overflow: 0..0,
             };
             self.bins.resize(bins.count.max(1), empty);
-            self.disjoint = true;
             return;
         }
         self.colour(contacts, bodies, asleep, bins);
         let buckets = bins.count.max(1) * BUCKETS;
         self.sort_by_bucket(buckets);
         for bucket in 0..buckets {
-            let keys = &self.order[self.starts[bucket]..self.starts[bucket + 1]];
-            let start = self.blocks.len();
-            append(&mut self.blocks, keys, contacts, bodies, max_depth);
-            let range = start..self.blocks.len();
+            let keys = self.starts[bucket]..self.starts[bucket + 1];
+            let start = self.block_keys.len();
+            let blocks = keys.clone().step_by(BLOCK_LANES);
+            self.block_keys
+                .extend(blocks.map(|k| k as u32..(k + BLOCK_LANES).min(keys.end) as u32));
+            let range = start..self.block_keys.len();
             if bucket % BUCKETS == 0 {
                 let at = self.colours.len();
                 self.bins.push(ContactBin {
@@ -218,6 +235,31 @@ impl ContactLayout {
                 bin.colours.end = self.colours.len();
             }
         }
+        self.blocks
+            .resize(self.block_keys.len(), ContactBlock::padding());
+    }
+
+    /// The planned blocks ([`Self::plan`]), to be filled by
+    /// [`ContactFill::blocks`] in any chunks on any threads.
+    pub fn fill<'a>(
+        &'a mut self,
+        contacts: &'a [Contact],
+        bodies: &'a BodyStore,
+        max_depth: f32,
+    ) -> (ContactFill<'a>, &'a mut [ContactBlock]) {
+        let fill = ContactFill {
+            block_keys: &self.block_keys,
+            order: &self.order,
+            contacts,
+            bodies,
+            max_depth,
+        };
+        (fill, &mut self.blocks)
+    }
+
+    /// Whether every colour may be split over threads, once the blocks are
+    /// filled ([`crate::parallel::colour_is_disjoint`]).
+    pub fn check(&mut self) {
         let (blocks, reads) = (&self.blocks, &mut self.reads);
         self.disjoint = self.colours.iter().all(|r| {
             crate::parallel::colour_is_disjoint(blocks[r.clone()].iter().map(|b| &b.bodies), reads)
@@ -291,24 +333,29 @@ impl ContactLayout {
     }
 }
 
-/// Lays out `keys` (indices into `contacts`) at the end of `blocks`, eight
-/// to a block.
-fn append(
-    blocks: &mut Vec<ContactBlock>,
-    keys: &[u32],
-    contacts: &[Contact],
-    bodies: &BodyStore,
+/// What filling the planned contact blocks reads: each block's contacts,
+/// and the bodies as the step begins. Each block is filled alone.
+pub(crate) struct ContactFill<'a> {
+    block_keys: &'a [Range<u32>],
+    order: &'a [u32],
+    contacts: &'a [Contact],
+    bodies: &'a BodyStore,
     max_depth: f32,
-) {
-    for (k, &key) in keys.iter().enumerate() {
-        if k % BLOCK_LANES == 0 {
-            blocks.push(ContactBlock::padding());
+}
+
+impl ContactFill<'_> {
+    /// Fills `blocks`, the planned blocks from block `first` on, each lane
+    /// from its contact (the lanes past a block's contacts stay padding).
+    pub fn blocks(&self, first: usize, blocks: &mut [ContactBlock]) {
+        for (block, keys) in blocks.iter_mut().zip(&self.block_keys[first..]) {
+            for (lane, &key) in self.order[keys.start as usize..keys.end as usize]
+                .iter()
+                .enumerate()
+            {
+                let contact = &self.contacts[key as usize];
+                block.set(lane, &contact.lane(self.bodies, self.max_depth));
+            }
         }
-        let block = blocks.len() - 1;
-        blocks[block].set(
-            k % BLOCK_LANES,
-            &contacts[key as usize].lane(bodies, max_depth),
-        );
     }
 }
 

@@ -263,32 +263,13 @@ impl Layout {
 
     /// Measures where every joint's bodies stand as the step begins (the
     /// rows then hold displacements from there): each socket's anchors,
-    /// each rod's chord between centres of mass.
+    /// each rod's chord between centres of mass. Each block alone
+    /// ([`StartBlock`]): the step does it in chunks on its workers.
     pub fn start_step(&mut self, bodies: &BodyStore) {
-        for block in &mut self.sockets.blocks {
-            for lane in live_lanes(&block.bodies) {
-                let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
-                start_lane(&mut block.bodies, lane, anchors, bodies);
-            }
-        }
-        for block in &mut self.hinges.blocks {
-            for lane in live_lanes(&block.bodies) {
-                let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
-                start_lane(&mut block.bodies, lane, anchors, bodies);
-            }
-        }
-        for block in &mut self.fixed.blocks {
-            for lane in live_lanes(&block.bodies) {
-                let anchors = (block.anchor_a.get(lane), block.anchor_b.get(lane));
-                start_lane(&mut block.bodies, lane, anchors, bodies);
-            }
-        }
-        for block in &mut self.rods.blocks {
-            for lane in live_lanes(&block.bodies) {
-                let centres = (glam::Vec3::ZERO, glam::Vec3::ZERO);
-                start_lane(&mut block.bodies, lane, centres, bodies);
-            }
-        }
+        start_blocks(&mut self.sockets.blocks, bodies);
+        start_blocks(&mut self.hinges.blocks, bodies);
+        start_blocks(&mut self.fixed.blocks, bodies);
+        start_blocks(&mut self.rods.blocks, bodies);
     }
 
     fn append(
@@ -388,6 +369,44 @@ impl Layout {
 fn live_lanes(pairs: &BodyPairs) -> impl Iterator<Item = usize> + use<> {
     let padding = pairs.padding;
     (0..BLOCK_LANES).filter(move |lane| padding & (1 << lane) == 0)
+}
+
+/// A joint block whose lanes measure where their bodies stand as the step
+/// begins, each block reading only the bodies and writing only itself.
+pub(crate) trait StartBlock: Send {
+    /// Every live lane's start of step, from `bodies`.
+    fn start(&mut self, bodies: &BodyStore);
+}
+
+/// Sockets, hinges and fixed joints: their anchors (m, body frames).
+macro_rules! start_at_anchors {
+    ($($block:ty),*) => {$(
+        impl StartBlock for $block {
+            fn start(&mut self, bodies: &BodyStore) {
+                for lane in live_lanes(&self.bodies) {
+                    let anchors = (self.anchor_a.get(lane), self.anchor_b.get(lane));
+                    start_lane(&mut self.bodies, lane, anchors, bodies);
+                }
+            }
+        }
+    )*};
+}
+
+start_at_anchors!(SocketBlock, HingeBlock, FixedBlock);
+
+/// Rods: the chord between the centres of mass.
+impl StartBlock for RodBlock {
+    fn start(&mut self, bodies: &BodyStore) {
+        for lane in live_lanes(&self.bodies) {
+            let centres = (glam::Vec3::ZERO, glam::Vec3::ZERO);
+            start_lane(&mut self.bodies, lane, centres, bodies);
+        }
+    }
+}
+
+/// Each of `blocks`' start of step ([`StartBlock`]).
+pub(crate) fn start_blocks<B: StartBlock>(blocks: &mut [B], bodies: &BodyStore) {
+    blocks.iter_mut().for_each(|b| b.start(bodies));
 }
 
 /// Sets `lane`'s start of step for points `local` (m, body frames) on its

@@ -633,7 +633,11 @@ impl World {
         let max_depth = self.config.max_push_out_speed * dt;
         let asleep = self.islands.asleep();
         self.contact_layout
-            .rebuild(&self.contacts, &self.bodies, asleep, &self.bins, max_depth);
+            .plan(&self.contacts, &self.bodies, asleep, &self.bins);
+        // The contacts' lanes and the joints' start of step, on the workers
+        // when there are many (step::start_blocks_all).
+        step::start_blocks_all(self, max_depth);
+        self.contact_layout.check();
         // Each substep launches the task system's workers once
         // (step::solve_substep).
         step::step(self, dt);

@@ -21,6 +21,7 @@
 use core::marker::PhantomData;
 use core::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 use vertebra_math::DefaultFloatMode;
 
@@ -221,6 +222,50 @@ impl<F: Fn(usize) + Sync> Part for Chunks<F> {
     }
     fn run(&self, chunk: usize) {
         (self.1)(chunk)
+    }
+}
+
+/// The most chunks a [`SliceChunks`] splits its slice into.
+const MAX_SLICE_CHUNKS: usize = 64;
+
+/// A slice in chunks, each lent whole (`&mut`, behind one uncontended
+/// mutex: safe code) to the worker that runs it; `run` gets the chunk's
+/// first index in the slice and its elements.
+pub(crate) struct SliceChunks<'a, T, F> {
+    chunks: [Mutex<(usize, &'a mut [T])>; MAX_SLICE_CHUNKS],
+    count: usize,
+    run: F,
+}
+
+impl<'a, T, F> SliceChunks<'a, T, F> {
+    /// `slice` in `pieces` chunks (1 to 64) of equal length, the last
+    /// maybe shorter.
+    pub fn new(slice: &'a mut [T], pieces: usize, run: F) -> Self {
+        let size = slice
+            .len()
+            .div_ceil(pieces.clamp(1, MAX_SLICE_CHUNKS))
+            .max(1);
+        let mut chunks: [Mutex<(usize, &'a mut [T])>; MAX_SLICE_CHUNKS] =
+            core::array::from_fn(|_| Mutex::new((0, Default::default())));
+        let mut count = 0;
+        for (slot, chunk) in chunks.iter_mut().zip(slice.chunks_mut(size)) {
+            *slot.get_mut().unwrap_or_else(PoisonError::into_inner) = (count * size, chunk);
+            count += 1;
+        }
+        Self { chunks, count, run }
+    }
+}
+
+impl<T: Send, F: Fn(usize, &mut [T]) + Sync> Part for SliceChunks<'_, T, F> {
+    fn chunks(&self) -> usize {
+        self.count
+    }
+    fn run(&self, chunk: usize) {
+        let mut held = self.chunks[chunk]
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        let (first, ref mut elements) = *held;
+        (self.run)(first, elements)
     }
 }
 
@@ -441,6 +486,29 @@ mod tests {
                 "{runs:?}: every chunk once"
             );
             assert_eq!(out_of_order.load(Ordering::Relaxed), 0, "{runs:?}");
+        }
+    }
+
+    #[test]
+    fn slice_chunks_lend_every_element_once_with_its_index() {
+        for runs in [Runs::AtOnce, Runs::Reversed, Runs::Twice, Runs::Nothing] {
+            for (len, pieces) in [(0, 8), (1, 8), (7, 3), (100, 16), (1000, 500)] {
+                let mut seen = vec![usize::MAX; len];
+                let chunks = SliceChunks::new(&mut seen, pieces, |first, part: &mut [usize]| {
+                    for (k, v) in part.iter_mut().enumerate() {
+                        assert_eq!(*v, usize::MAX, "{runs:?}: lent once");
+                        *v = first + k;
+                    }
+                });
+                assert!(chunks.chunks() <= pieces.clamp(1, MAX_SLICE_CHUNKS));
+                Stages::default().run(&Tasks(runs), &|cursor: &mut Cursor| {
+                    cursor.stage(&[&chunks])
+                });
+                assert!(
+                    seen.iter().enumerate().all(|(i, &v)| v == i),
+                    "{runs:?}, {len} in {pieces}"
+                );
+            }
         }
     }
 

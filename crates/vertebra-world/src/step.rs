@@ -23,14 +23,62 @@ use crate::bins::Bins;
 use crate::contact::{ContactBin, ContactLayout};
 use crate::islands::Islands;
 use crate::joint::JointKind;
+use crate::layout::start_blocks;
 use crate::layout::{Bin, Group, Layout};
 use crate::parallel::Shared;
-use crate::stages::{BlockChunks, Chunks, Cursor, Part, SharedBlocks};
+use crate::stages::{BlockChunks, Chunks, Cursor, Part, SharedBlocks, SliceChunks};
+use crate::tasks::{SingleThreaded, TaskSystem};
+
+/// Contacts from which the step's start ([`start_blocks_all`]) is a launch
+/// of the workers of its own: below, one launch costs about what it
+/// saves (about 60 ns a contact on this machine, docs/threads.md).
+const START_LAUNCH_CONTACTS: usize = 1024;
+
+/// The step's start, before its substeps: the contacts' blocks filled
+/// from this step's contacts (`ContactLayout::plan` placed them) and every
+/// joint block's start of step (`Layout::start_step`), each block alone
+/// from the bodies as they stand (capped at `max_depth`, m, for the
+/// contacts). With more than one worker and many contacts, one launch of
+/// the workers: one stage of every kind's blocks in chunks (each chunk
+/// writes only its own blocks, and reads only the bodies and the
+/// contacts); else all of it on the calling thread. The same bits either
+/// way.
+pub(crate) fn start_blocks_all(world: &mut World, max_depth: f32) {
+    let workers = world.tasks.workers();
+    let launch = workers > 1 && world.contacts.len() >= START_LAUNCH_CONTACTS;
+    let (tasks, pieces): (&dyn TaskSystem, usize) = if launch {
+        (&*world.tasks, workers.saturating_mul(CHUNKS_PER_WORKER))
+    } else {
+        (&SingleThreaded, 1)
+    };
+    let bodies = &world.bodies;
+    let (fill, blocks) = world
+        .contact_layout
+        .fill(&world.contacts, bodies, max_depth);
+    let contacts = SliceChunks::new(blocks, pieces, |first, b: &mut [ContactBlock]| {
+        fill.blocks(first, b)
+    });
+    let layout = &mut world.layout;
+    let sockets = SliceChunks::new(&mut layout.sockets.blocks, pieces, |_, b: &mut [_]| {
+        start_blocks::<SocketBlock>(b, bodies)
+    });
+    let hinges = SliceChunks::new(&mut layout.hinges.blocks, pieces, |_, b: &mut [_]| {
+        start_blocks::<HingeBlock>(b, bodies)
+    });
+    let fixed = SliceChunks::new(&mut layout.fixed.blocks, pieces, |_, b: &mut [_]| {
+        start_blocks::<FixedBlock>(b, bodies)
+    });
+    let rods = SliceChunks::new(&mut layout.rods.blocks, pieces, |_, b: &mut [_]| {
+        start_blocks::<RodBlock>(b, bodies)
+    });
+    world.stages.run(tasks, &|cursor: &mut Cursor| {
+        cursor.stage(&[&contacts, &sockets, &hinges, &fixed, &rods])
+    });
+}
 
 pub(crate) fn step(world: &mut World, dt: f32) {
     let h = dt / world.config.substeps as f32;
     upload(&world.bodies, world.rows.get());
-    world.layout.start_step(&world.bodies);
     world
         .previous
         .resize(world.bodies.capacity(), (Vec3::ZERO, Quat::IDENTITY));

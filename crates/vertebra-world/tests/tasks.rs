@@ -2,7 +2,8 @@
 //! system, the default ones and an engine's own, and on task systems that
 //! run items one after another (last first), run items twice at once,
 //! leave items out or all of them, or call with indices out of range; and
-//! each substep is one launch of the workers.
+//! each substep is one launch of the workers (and the step's start one
+//! more, when it has many contacts).
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -374,5 +375,58 @@ fn islands_that_come_apart_step_to_the_same_bits_on_every_thread_count() {
     );
     for threads in [2, 3] {
         assert_eq!(run(threads), reference, "{threads} threads");
+    }
+}
+
+#[test]
+fn many_contacts_are_laid_out_on_the_workers_to_the_same_bits() {
+    // Ten chains of 40 spheres side by side on the ground: one island
+    // with about 1,150 contacts, enough that the step's start (the
+    // contacts' lanes, the joints' start of step) is a launch of the
+    // workers of its own.
+    let steps = 20;
+    let run = |mut world: World, ground: BodyHandle, spheres: &[BodyHandle]| {
+        let mut counts = Vec::new();
+        for _ in 0..steps {
+            let contacts = sphere_contacts(&world, ground, spheres);
+            counts.push(contacts.len());
+            world.set_contacts(&contacts).unwrap();
+            world.step(1.0 / 60.0).unwrap();
+        }
+        (world.state_hash(), counts)
+    };
+    let (world, ground, spheres) = piles(config(1), 10, 40, 2.0 * R);
+    let (reference, counts) = run(world, ground, &spheres);
+    assert!(
+        counts.iter().all(|&n| n >= 1024),
+        "many contacts every step: {counts:?}"
+    );
+    for threads in [2, 3, 4] {
+        let (world, ground, spheres) = piles(config(threads), 10, 40, 2.0 * R);
+        assert_eq!(
+            run(world, ground, &spheres).0,
+            reference,
+            "{threads} threads"
+        );
+    }
+    for behaviour in [
+        Behaviour::Scoped,
+        Behaviour::Reversed,
+        Behaviour::Twice,
+        Behaviour::Skipping,
+        Behaviour::Nothing,
+        Behaviour::OutOfRange,
+    ] {
+        let engine = Arc::new(Engine {
+            behaviour,
+            calls: AtomicUsize::new(0),
+        });
+        let (mut world, ground, spheres) = piles(config(1), 10, 40, 2.0 * R);
+        world.set_tasks(engine.clone());
+        assert_eq!(run(world, ground, &spheres).0, reference, "{behaviour:?}");
+        // The step's start, then one launch per substep.
+        let substeps = config(1).substeps as usize;
+        let calls = engine.calls.load(Ordering::Relaxed);
+        assert_eq!(calls, steps * (1 + substeps), "{behaviour:?}");
     }
 }
