@@ -27,7 +27,6 @@ use crate::layout::start_blocks;
 use crate::layout::{Bin, Group, Layout};
 use crate::parallel::Shared;
 use crate::stages::{BlockChunks, Chunks, Cursor, Part, SharedBlocks, SliceChunks};
-use crate::tasks::{SingleThreaded, TaskSystem};
 
 /// Contacts from which the step's start ([`start_blocks_all`]) is a launch
 /// of the workers of its own: below, one launch costs about what it
@@ -45,16 +44,19 @@ const START_LAUNCH_CONTACTS: usize = 1024;
 /// way.
 pub(crate) fn start_blocks_all(world: &mut World, max_depth: f32) {
     let workers = world.tasks.workers();
-    let launch = workers > 1 && world.contacts.len() >= START_LAUNCH_CONTACTS;
-    let (tasks, pieces): (&dyn TaskSystem, usize) = if launch {
-        (&*world.tasks, workers.saturating_mul(CHUNKS_PER_WORKER))
-    } else {
-        (&SingleThreaded, 1)
-    };
     let bodies = &world.bodies;
     let (fill, blocks) = world
         .contact_layout
         .fill(&world.contacts, bodies, max_depth);
+    if workers <= 1 || world.contacts.len() < START_LAUNCH_CONTACTS {
+        // On the calling thread, block after block: no chunks to lend (a
+        // single ragdoll's step is a few tens of thousands of
+        // instructions, and lending five slices in chunks cost thousands).
+        fill.blocks(0, blocks);
+        world.layout.start_step(bodies);
+        return;
+    }
+    let pieces = workers.saturating_mul(CHUNKS_PER_WORKER);
     let contacts = SliceChunks::new(blocks, pieces, |first, b: &mut [ContactBlock]| {
         fill.blocks(first, b)
     });
@@ -71,7 +73,7 @@ pub(crate) fn start_blocks_all(world: &mut World, max_depth: f32) {
     let rods = SliceChunks::new(&mut layout.rods.blocks, pieces, |_, b: &mut [_]| {
         start_blocks::<RodBlock>(b, bodies)
     });
-    world.stages.run(tasks, &|cursor: &mut Cursor| {
+    world.stages.run(&*world.tasks, &|cursor: &mut Cursor| {
         cursor.stage(&[&contacts, &sockets, &hinges, &fixed, &rods])
     });
 }
