@@ -119,6 +119,13 @@ fn work(launches: &[Launch], timer: Duration) -> Duration {
     chunks.map(|d| d.saturating_sub(timer)).sum()
 }
 
+/// A run's work outside its stages: what a P-worker launch leaves on the
+/// calling thread (with more than one worker the step's start of a world
+/// with many contacts is a stage: docs/threads.md, "The step's start").
+fn outside(total: Duration, launches: &[Launch], timer: Duration) -> Duration {
+    total.saturating_sub(work(launches, timer))
+}
+
 fn ms(total: Duration) -> f64 {
     total.as_secs_f64() * 1e3 / FRAMES as f64
 }
@@ -138,11 +145,11 @@ fn main() {
 
 fn scene(name: &str, spine: SpineMode, count: usize, timer: Duration) {
     let (one, recorded) = run(spine, count, 1, Some(Arc::new(Recorder(1))));
-    let serial = one.saturating_sub(work(&recorded, timer));
+    let serial = outside(one, &recorded, timer);
     let stages: usize = recorded.iter().map(Vec::len).sum();
     let (two, _) = run(spine, count, 2, None);
-    let (_, split) = run(spine, count, 1, Some(Arc::new(Recorder(2))));
-    let ideal = serial + stage_time(&split, 2, timer, Duration::ZERO);
+    let (total, split) = run(spine, count, 1, Some(Arc::new(Recorder(2))));
+    let ideal = outside(total, &split, timer) + stage_time(&split, 2, timer, Duration::ZERO);
     // The waits of a 2-worker launch are its own stages' (islands apart
     // are one stage of bins there, one stage per colour with 1 worker).
     let stages_at_2: usize = split.iter().map(Vec::len).sum();
@@ -160,7 +167,8 @@ fn scene(name: &str, spine: SpineMode, count: usize, timer: Duration) {
     println!("| workers | no wait | speed-up | wait as at 2 | speed-up | wait x P/2 | speed-up |");
     let base = ms(serial + stage_time(&recorded, 1, timer, Duration::ZERO));
     for p in WORKERS {
-        let (_, split) = run(spine, count, 1, Some(Arc::new(Recorder(p))));
+        let (total, split) = run(spine, count, 1, Some(Arc::new(Recorder(p))));
+        let serial = outside(total, &split, timer);
         let at = |sync: Duration| ms(serial + stage_time(&split, p, timer, sync));
         let (free, flat, growing) = (
             at(Duration::ZERO),
