@@ -5,7 +5,7 @@
 # it. The figures in docs/performance.md come from one such run (its date is
 # given there), so that their ratios are of one build under one load.
 #
-#   ./benches/figures.sh            # everything (about 40 minutes on 2 cores)
+#   ./benches/figures.sh            # everything (about 20 minutes on 2 cores)
 #   ./benches/figures.sh step sleep # only these benches, same settings
 set -euo pipefail
 cd "$(dirname "$0")/.."
