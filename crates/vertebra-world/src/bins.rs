@@ -107,7 +107,7 @@ impl Bins {
         // a smaller island keeps its worker at most twice as long as the
         // step's share, which costs less than a wait per colour (docs/
         // threads.md); so is a lone island.
-        let large = |size: u32| workers * size as usize >= 2 * total;
+        let large = |size: u32| workers.saturating_mul(size as usize) >= 2 * total;
         self.small.clear();
         self.small.extend(
             (0..n as u32).filter(|&r| self.size[r as usize] > 0 && !large(self.size[r as usize])),
@@ -115,7 +115,10 @@ impl Bins {
         let size = &self.size;
         self.small
             .sort_unstable_by_key(|&r| (core::cmp::Reverse(size[r as usize]), r));
-        let bins = self.small.len().min(BINS_PER_WORKER * workers);
+        let bins = self
+            .small
+            .len()
+            .min(workers.saturating_mul(BINS_PER_WORKER));
         self.load.clear();
         self.load.resize(bins, 0);
         // Per root, its island's bin (0 for a large island).

@@ -737,7 +737,7 @@ impl Substep<'_> {
     /// (all of them, one chunk, when it may not or is too small to be).
     fn chunk_size(&self, split: bool, blocks: usize) -> usize {
         if split && self.workers > 1 && blocks >= self.min_blocks {
-            blocks.div_ceil(self.workers * CHUNKS_PER_WORKER)
+            blocks.div_ceil(self.workers.saturating_mul(CHUNKS_PER_WORKER))
         } else {
             blocks
         }

@@ -1,0 +1,475 @@
+//! Issue 17's promises tried as an outsider would: task systems that lie
+//! about their workers or panic, sleep settings out of range, every call
+//! that should wake a sleeping island, sleep far from the origin, snapshots
+//! taken asleep (and damaged), and contact lists that must be refused.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use glam::{Quat, Vec3};
+use vertebra_world::{
+    BodyDesc, BodyHandle, Contact, Error, JointDesc, Shape, SingleThreaded, SleepSettings,
+    Snapshot, SolverConfig, TaskSystem, World,
+};
+
+const DT: f32 = 1.0 / 60.0;
+
+fn ball() -> BodyDesc {
+    let mass = Shape::Sphere { radius: 0.1 }
+        .mass_properties_with_mass(1.0)
+        .unwrap();
+    BodyDesc::dynamic(mass)
+}
+
+/// Chains of four balls hanging from fixed anchors, swinging.
+fn chains(config: SolverConfig) -> World {
+    let mut world = World::new(config).unwrap();
+    for chain in 0..20 {
+        let x = chain as f32 * 0.5;
+        let mut parent = world
+            .add_body(BodyDesc::fixed().with_position(Vec3::new(x, 3.0, 0.0)))
+            .unwrap();
+        for link in 1..=4 {
+            let at = Vec3::new(x + 0.2 * link as f32, 3.0, 0.0);
+            let body = ball()
+                .with_position(at)
+                .with_velocity(Vec3::new(0.0, 0.0, 0.3 * link as f32), Vec3::ZERO);
+            let child = world.add_body(body).unwrap();
+            let joint = JointDesc::socket_at_world_anchor(
+                world.bodies(),
+                parent,
+                child,
+                at - Vec3::new(0.1, 0.0, 0.0),
+                Vec3::X,
+            )
+            .unwrap();
+            world.add_joint(joint).unwrap();
+            parent = child;
+        }
+    }
+    world
+}
+
+/// 1100 balls resting on the plane y = 0 (enough contacts that the step's
+/// start is lent to the workers too), fed their ground contacts each step.
+fn resting_balls(config: SolverConfig) -> (World, BodyHandle, Vec<BodyHandle>) {
+    let mut world = World::new(config).unwrap();
+    let ground = world.add_body(BodyDesc::fixed()).unwrap();
+    let balls = (0..1100)
+        .map(|k| {
+            let at = Vec3::new((k % 40) as f32 * 0.3, 0.11, (k / 40) as f32 * 0.3);
+            world.add_body(ball().with_position(at)).unwrap()
+        })
+        .collect();
+    (world, ground, balls)
+}
+
+fn ground_contacts(world: &World, ground: BodyHandle, balls: &[BodyHandle]) -> Vec<Contact> {
+    balls
+        .iter()
+        .map(|&b| {
+            let p = world.bodies().position[b.index()];
+            Contact {
+                body_a: ground,
+                body_b: b,
+                point: Vec3::new(p.x, 0.5 * (p.y - 0.1), p.z),
+                normal: Vec3::Y,
+                depth: 0.1 - p.y,
+                friction: 0.5,
+                restitution: 0.0,
+            }
+        })
+        .collect()
+}
+
+fn config(threads: usize) -> SolverConfig {
+    SolverConfig {
+        threads,
+        parallel_min_blocks: 1,
+        iterations: 4,
+        ..SolverConfig::default()
+    }
+}
+
+/// The state hash of the chains after 20 steps and of the resting balls
+/// after 3, on `tasks`.
+fn hashes(tasks: Arc<dyn TaskSystem>) -> (u64, u64) {
+    let mut world = chains(config(1));
+    world.set_tasks(tasks.clone());
+    for _ in 0..20 {
+        world.step(DT).unwrap();
+    }
+    let (mut pile, ground, balls) = resting_balls(config(1));
+    pile.set_tasks(tasks);
+    for _ in 0..3 {
+        let contacts = ground_contacts(&pile, ground, &balls);
+        pile.set_contacts(&contacts).unwrap();
+        pile.step(DT).unwrap();
+    }
+    (world.state_hash(), pile.state_hash())
+}
+
+/// A task system that lies about its workers: `counts` in turn, one per
+/// call of `workers()`; its `parallel_for` runs at most three items (the
+/// first ones) on scoped threads, whatever count it is asked for.
+struct Liar {
+    counts: Vec<usize>,
+    calls: AtomicUsize,
+}
+
+impl TaskSystem for Liar {
+    fn workers(&self) -> usize {
+        let k = self.calls.fetch_add(1, Ordering::Relaxed);
+        self.counts[k % self.counts.len()]
+    }
+
+    fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync)) {
+        std::thread::scope(|s| {
+            for i in 0..count.min(3) {
+                s.spawn(move || task(i));
+            }
+        });
+    }
+}
+
+#[test]
+fn workers_of_zero_huge_or_changing_step_to_the_single_threaded_bits() {
+    let expected = hashes(Arc::new(SingleThreaded));
+    for counts in [
+        vec![0],
+        vec![1],
+        vec![1 << 20],
+        vec![usize::MAX],
+        vec![0, 5, usize::MAX, 1, 2],
+        vec![usize::MAX, 0, 1 << 20, 1],
+    ] {
+        let liar = Liar {
+            counts: counts.clone(),
+            calls: AtomicUsize::new(0),
+        };
+        assert_eq!(hashes(Arc::new(liar)), expected, "workers {counts:?}");
+    }
+}
+
+/// A task system that panics: before running any item, or after running
+/// them all, or in one of its own threads while the others run.
+#[derive(Clone, Copy, Debug)]
+enum Panics {
+    Before,
+    After,
+    InAThread,
+}
+
+impl TaskSystem for Panics {
+    fn workers(&self) -> usize {
+        3
+    }
+
+    fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync)) {
+        match self {
+            Panics::Before => panic!("the engine's job system failed"),
+            Panics::After => {
+                (0..count).for_each(task);
+                panic!("the engine's job system failed");
+            }
+            Panics::InAThread => std::thread::scope(|s| {
+                for i in 0..count {
+                    s.spawn(move || {
+                        if i == 1 {
+                            panic!("the engine's job thread failed");
+                        }
+                        task(i)
+                    });
+                }
+            }),
+        }
+    }
+}
+
+#[test]
+fn a_task_system_that_panics_makes_the_step_panic_not_hang() {
+    for panics in [Panics::Before, Panics::After, Panics::InAThread] {
+        let mut world = chains(config(1));
+        world.set_tasks(Arc::new(panics));
+        let stepped = catch_unwind(AssertUnwindSafe(|| world.step(DT)));
+        assert!(stepped.is_err(), "{panics:?}: the panic surfaced");
+    }
+}
+
+#[test]
+fn sleep_settings_out_of_range_are_refused_naming_the_field() {
+    let speeds = [
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        -1.0,
+        -0.0 - 1e-30,
+    ];
+    for speed in speeds {
+        let sleep = Some(SleepSettings { speed, time: 0.5 });
+        let refused = World::new(SolverConfig {
+            sleep,
+            ..SolverConfig::default()
+        });
+        match refused {
+            Err(Error::InvalidConfig(what)) => assert!(what.contains("sleep.speed"), "{what}"),
+            other => panic!("speed {speed}: {:?}", other.map(|_| ())),
+        }
+    }
+    for time in [f32::NAN, f32::INFINITY, -1.0, 0.0, -0.0, 1.0e7, f32::MAX] {
+        let sleep = Some(SleepSettings { speed: 0.05, time });
+        let refused = World::new(SolverConfig {
+            sleep,
+            ..SolverConfig::default()
+        });
+        match refused {
+            Err(Error::InvalidConfig(what)) => assert!(what.contains("sleep.time"), "{what}"),
+            other => panic!("time {time}: {:?}", other.map(|_| ())),
+        }
+    }
+}
+
+#[test]
+fn extreme_but_valid_sleep_settings_step_finitely() {
+    for sleep in [
+        SleepSettings {
+            speed: f32::MAX,
+            time: 1.0e6,
+        },
+        SleepSettings {
+            speed: f32::MAX,
+            time: f32::MIN_POSITIVE,
+        },
+        SleepSettings {
+            speed: 0.0,
+            time: 1.0e-30,
+        },
+    ] {
+        let mut world = chains(SolverConfig {
+            sleep: Some(sleep),
+            ..config(1)
+        });
+        for _ in 0..40 {
+            world.step(DT).unwrap();
+        }
+        let b = world.bodies();
+        assert!(
+            b.position.iter().all(|p| p.is_finite()),
+            "{sleep:?}: finite poses"
+        );
+    }
+    // A window shorter than a step and any speed: the lone still ball sleeps
+    // after its first step.
+    let mut world = World::new(SolverConfig {
+        gravity: Vec3::ZERO,
+        sleep: Some(SleepSettings {
+            speed: f32::MAX,
+            time: f32::MIN_POSITIVE,
+        }),
+        ..SolverConfig::default()
+    })
+    .unwrap();
+    let b = world.add_body(ball()).unwrap();
+    world.step(DT).unwrap();
+    assert!(world.is_asleep(b).unwrap());
+}
+
+/// Without gravity, a ball at rest jointed to a fixed anchor (a socket at
+/// its top), and a second free ball at rest 5 m off; both asleep after a
+/// second.
+fn sleeping_pendulum(at: Vec3) -> (World, BodyHandle, BodyHandle, BodyHandle) {
+    let mut world = World::new(SolverConfig {
+        gravity: Vec3::ZERO,
+        ..SolverConfig::default()
+    })
+    .unwrap();
+    let anchor = world
+        .add_body(BodyDesc::fixed().with_position(at + Vec3::Y * 0.2))
+        .unwrap();
+    let bob = world.add_body(ball().with_position(at)).unwrap();
+    let joint =
+        JointDesc::socket_at_world_anchor(world.bodies(), anchor, bob, at + Vec3::Y * 0.1, Vec3::Y)
+            .unwrap();
+    world.add_joint(joint).unwrap();
+    let other = world
+        .add_body(ball().with_position(at + Vec3::new(5.0, 0.0, 0.0)))
+        .unwrap();
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    (world, anchor, bob, other)
+}
+
+#[test]
+fn every_call_that_should_wake_a_sleeping_island_wakes_it() {
+    type Poke = fn(&mut World, BodyHandle, BodyHandle, BodyHandle);
+    let pokes: [(&str, Poke); 9] = [
+        ("wake", |w, _, bob, _| w.wake(bob).unwrap()),
+        ("set_body_pose", |w, _, bob, _| {
+            let p = w.bodies().position[bob.index()];
+            w.set_body_pose(bob, p, Quat::IDENTITY).unwrap()
+        }),
+        ("set_body_velocity", |w, _, bob, _| {
+            w.set_body_velocity(bob, Vec3::ZERO, Vec3::ZERO).unwrap()
+        }),
+        ("apply_impulse", |w, _, bob, _| {
+            w.apply_impulse(bob, Vec3::X).unwrap()
+        }),
+        ("add_force", |w, _, bob, _| {
+            w.add_force(bob, Vec3::X).unwrap()
+        }),
+        ("add_torque", |w, _, bob, _| {
+            w.add_torque(bob, Vec3::X).unwrap()
+        }),
+        ("set_sleep_allowed(false)", |w, _, bob, _| {
+            w.set_sleep_allowed(bob, false).unwrap()
+        }),
+        ("add_joint", |w, _, bob, other| {
+            let at = w.bodies().position[bob.index()];
+            let joint =
+                JointDesc::socket_at_world_anchor(w.bodies(), bob, other, at, Vec3::Y).unwrap();
+            w.add_joint(joint).unwrap();
+        }),
+        ("remove_joint", |w, _, _, _| {
+            let (joint, _) = w.joints().next().unwrap();
+            w.remove_joint(joint).unwrap();
+        }),
+    ];
+    for (what, poke) in pokes {
+        let (mut world, anchor, bob, other) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+        assert!(world.is_asleep(bob).unwrap(), "{what}: asleep first");
+        assert!(world.is_asleep(other).unwrap(), "{what}: asleep first");
+        poke(&mut world, anchor, bob, other);
+        assert!(!world.is_asleep(bob).unwrap(), "{what} wakes the bob");
+        world.step(DT).unwrap();
+        let v = world.bodies().linear_velocity[bob.index()];
+        assert!(v.is_finite(), "{what}");
+    }
+}
+
+#[test]
+fn a_sleeping_body_at_1e5_m_keeps_its_bits_and_moves_when_woken() {
+    let at = Vec3::new(1.0e5, 1.0, -1.0e5);
+    let (mut world, _, bob, other) = sleeping_pendulum(at);
+    assert!(world.is_asleep(bob).unwrap());
+    let before = world.body(bob).unwrap();
+    for _ in 0..30 {
+        world.step(DT).unwrap();
+    }
+    let after = world.body(bob).unwrap();
+    assert_eq!(
+        before.position.to_array().map(f32::to_bits),
+        after.position.to_array().map(f32::to_bits)
+    );
+    world.wake(other).unwrap();
+    world
+        .apply_impulse(other, Vec3::new(1.0, 0.0, 0.0))
+        .unwrap();
+    let x0 = world.bodies().position[other.index()].x;
+    for _ in 0..6 {
+        world.step(DT).unwrap();
+    }
+    let x1 = world.bodies().position[other.index()].x;
+    // 1 m/s for 0.1 s: 0.1 m, to the f32 spacing at 1e5 m (8 mm).
+    assert!((x1 - x0 - 0.1).abs() < 0.02, "moved {}", x1 - x0);
+}
+
+#[test]
+fn a_snapshot_taken_asleep_restores_to_the_same_bits_and_sleep() {
+    let (mut world, _, bob, other) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+    let snapshot = world.snapshot();
+    let mut copy = World::new(*world.config()).unwrap();
+    copy.restore(&snapshot).unwrap();
+    assert!(copy.is_asleep(bob).unwrap() && copy.is_asleep(other).unwrap());
+    assert_eq!(copy.island_count(), world.island_count());
+    assert_eq!(copy.state_hash(), world.state_hash());
+    for w in [&mut world, &mut copy] {
+        w.step(DT).unwrap();
+        w.apply_impulse(other, Vec3::Y).unwrap();
+        for _ in 0..10 {
+            w.step(DT).unwrap();
+        }
+    }
+    assert_eq!(copy.state_hash(), world.state_hash());
+    assert_eq!(copy.is_asleep(bob).unwrap(), world.is_asleep(bob).unwrap());
+}
+
+#[test]
+fn a_damaged_sleeping_snapshot_is_refused_or_steps_without_panicking() {
+    let (world, ..) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+    let bytes = world.snapshot().as_bytes().to_vec();
+    let (mut accepted, mut refused) = (0, 0);
+    for at in 0..bytes.len() {
+        for flip in [0x01u8, 0x80, 0xff] {
+            let mut damaged = bytes.clone();
+            damaged[at] ^= flip;
+            let mut target = World::new(*world.config()).unwrap();
+            let hash = target.state_hash();
+            let outcome = catch_unwind(AssertUnwindSafe(|| {
+                match target.restore(&Snapshot::from_bytes(damaged)) {
+                    Ok(()) => {
+                        for _ in 0..3 {
+                            target.step(DT).unwrap();
+                        }
+                        true
+                    }
+                    Err(_) => {
+                        assert_eq!(target.state_hash(), hash, "refused: unchanged");
+                        false
+                    }
+                }
+            }));
+            match outcome {
+                Ok(true) => accepted += 1,
+                Ok(false) => refused += 1,
+                Err(_) => panic!("byte {at} ^ {flip:#x} panicked"),
+            }
+        }
+    }
+    assert!(refused > 0 && accepted + refused == 3 * bytes.len());
+}
+
+#[test]
+fn contacts_that_are_wrong_are_refused_and_the_lists_stay() {
+    let (mut world, ground, balls) = resting_balls(config(1));
+    let good = ground_contacts(&world, ground, &balls[..3]);
+    world.set_contacts(&good).unwrap();
+    let mut gone = World::new(SolverConfig::default()).unwrap();
+    let stranger = gone.add_body(ball()).unwrap();
+    let removed = world.add_body(ball()).unwrap();
+    world.remove_body(removed).unwrap();
+    let broken: [(&str, fn(&mut Contact, BodyHandle, BodyHandle)); 8] = [
+        ("nan normal", |c, _, _| c.normal = Vec3::NAN),
+        ("zero normal", |c, _, _| c.normal = Vec3::ZERO),
+        ("huge depth", |c, _, _| c.depth = 1.0e30),
+        ("nan depth", |c, _, _| c.depth = f32::NAN),
+        ("inf point", |c, _, _| c.point = Vec3::INFINITY),
+        ("removed body", |c, _, removed| c.body_b = removed),
+        ("other world's body", |c, stranger, _| c.body_b = stranger),
+        ("same body", |c, _, _| c.body_a = c.body_b),
+    ];
+    for (what, break_it) in broken {
+        let mut list = ground_contacts(&world, ground, &balls[3..6]);
+        break_it(&mut list[2], stranger, removed);
+        let before = list.clone();
+        assert!(world.set_contacts(&list).is_err(), "{what}: set refused");
+        assert!(
+            world.swap_contacts(&mut list).is_err(),
+            "{what}: swap refused"
+        );
+        assert_eq!(
+            world.contacts(),
+            &good[..],
+            "{what}: the world's list stays"
+        );
+        assert_eq!(list.len(), before.len(), "{what}: the caller's list stays");
+        for (a, b) in list.iter().zip(&before) {
+            assert_eq!(
+                (a.body_a, a.body_b, a.depth.to_bits(), a.normal.x.to_bits()),
+                (b.body_a, b.body_b, b.depth.to_bits(), b.normal.x.to_bits()),
+                "{what}"
+            );
+        }
+    }
+}
