@@ -48,12 +48,14 @@ impl World {
         Ok(self.islands.allowed(self.bodies.index(body)?))
     }
 
-    /// `body` was set or pushed: its island wakes; a kinematic body wakes
-    /// the islands jointed to it. `body` is live.
+    /// `body` was set or pushed: its island wakes; a static or kinematic
+    /// body (in no island) wakes the islands jointed to it, as
+    /// [`World::wake`] promises (a fixed anchor moved by hand drags its
+    /// sleeping chain along). `body` is live.
     pub(crate) fn stir(&mut self, body: BodyHandle) {
         let i = body.index();
         let mut woke = self.islands.wake(i);
-        if self.bodies.kind[i] == BodyKind::Kinematic && self.joints_at[i] > 0 {
+        if self.bodies.kind[i] != BodyKind::Dynamic && self.joints_at[i] > 0 {
             for link in links(&self.joints, &self.rods) {
                 let (a, b) = (link.a as usize, link.b as usize);
                 if a == i || b == i {

@@ -349,6 +349,34 @@ fn every_call_that_should_wake_a_sleeping_island_wakes_it() {
 }
 
 #[test]
+fn waking_or_moving_a_fixed_body_wakes_the_islands_jointed_to_it() {
+    let (mut world, anchor, bob, other) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+    world.wake(anchor).unwrap();
+    assert!(!world.is_asleep(bob).unwrap(), "wake");
+    assert!(
+        world.is_asleep(other).unwrap(),
+        "the other island sleeps on"
+    );
+    // A sleeping bob must follow its anchor when the anchor is moved.
+    let (mut world, anchor, bob, other) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+    let up = Vec3::new(0.0, 1.2 + 1.0, 0.0);
+    world.set_body_pose(anchor, up, Quat::IDENTITY).unwrap();
+    assert!(!world.is_asleep(bob).unwrap(), "set_body_pose");
+    assert!(
+        world.is_asleep(other).unwrap(),
+        "the other island sleeps on"
+    );
+    for _ in 0..30 {
+        world.step(DT).unwrap();
+    }
+    let y = world.bodies().position[bob.index()].y;
+    assert!(
+        (y - 2.0).abs() < 0.05,
+        "the bob followed its anchor to 2 m: {y}"
+    );
+}
+
+#[test]
 fn a_sleeping_body_at_1e5_m_keeps_its_bits_and_moves_when_woken() {
     let at = Vec3::new(1.0e5, 1.0, -1.0e5);
     let (mut world, _, bob, other) = sleeping_pendulum(at);
