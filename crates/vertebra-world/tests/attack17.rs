@@ -501,3 +501,73 @@ fn contacts_that_are_wrong_are_refused_and_the_lists_stay() {
         }
     }
 }
+
+/// A contact between `a` and `b` touching at `point` along +x.
+fn touching(a: BodyHandle, b: BodyHandle, point: Vec3) -> Contact {
+    Contact {
+        body_a: a,
+        body_b: b,
+        point,
+        normal: Vec3::X,
+        depth: 0.001,
+        friction: 0.5,
+        restitution: 0.0,
+    }
+}
+
+#[test]
+fn contacts_wake_a_sleeper_only_from_an_awake_body() {
+    // The free ball touched by the fixed anchor sleeps on.
+    let (mut world, anchor, bob, other) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+    let at = world.bodies().position[other.index()];
+    world.set_contacts(&[touching(anchor, other, at)]).unwrap();
+    world.step(DT).unwrap();
+    assert!(
+        world.is_asleep(other).unwrap(),
+        "a fixed body wakes nothing"
+    );
+    // Touched by the woken bob, it wakes, and joins the bob's island.
+    world.wake(bob).unwrap();
+    world.set_contacts(&[touching(bob, other, at)]).unwrap();
+    world.step(DT).unwrap();
+    assert!(!world.is_asleep(other).unwrap(), "an awake body wakes it");
+    assert_eq!(world.island(other).unwrap(), world.island(bob).unwrap());
+}
+
+#[test]
+fn a_sleeping_body_removed_or_made_kinematic_leaves_a_world_that_restores_to_the_same_bits() {
+    type Change = fn(&mut World, BodyHandle, BodyHandle);
+    let changes: [(&str, Change); 3] = [
+        ("remove the bob", |w, bob, _| {
+            let (joint, _) = w.joints().next().unwrap();
+            w.remove_joint(joint).unwrap();
+            w.remove_body(bob).unwrap()
+        }),
+        ("bob made kinematic", |w, bob, _| {
+            w.set_body_kind(bob, vertebra_world::BodyKind::Kinematic)
+                .unwrap()
+        }),
+        ("other made kinematic and back", |w, _, other| {
+            w.set_body_kind(other, vertebra_world::BodyKind::Kinematic)
+                .unwrap();
+            w.set_body_kind(other, vertebra_world::BodyKind::Dynamic)
+                .unwrap();
+        }),
+    ];
+    for (what, change) in changes {
+        let (mut world, _, bob, other) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+        change(&mut world, bob, other);
+        world.step(DT).unwrap();
+        let mut copy = World::new(*world.config()).unwrap();
+        copy.restore(&world.snapshot()).unwrap();
+        for w in [&mut world, &mut copy] {
+            w.wake(other).unwrap();
+            for _ in 0..60 {
+                w.step(DT).unwrap();
+            }
+        }
+        assert_eq!(copy.state_hash(), world.state_hash(), "{what}");
+        assert_eq!(copy.island_count(), world.island_count(), "{what}");
+        assert!(world.is_asleep(other).unwrap(), "{what}: sleeps again");
+    }
+}
