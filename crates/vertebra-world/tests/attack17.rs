@@ -93,7 +93,7 @@ fn config(threads: usize) -> SolverConfig {
 }
 
 /// The state hash of the chains after 20 steps and of the resting balls
-/// after 3, on `tasks`.
+/// after 45 (asleep at 40, when one is pushed awake), on `tasks`.
 fn hashes(tasks: Arc<dyn TaskSystem>) -> (u64, u64) {
     let mut world = chains(config(1));
     world.set_tasks(tasks.clone());
@@ -102,11 +102,16 @@ fn hashes(tasks: Arc<dyn TaskSystem>) -> (u64, u64) {
     }
     let (mut pile, ground, balls) = resting_balls(config(1));
     pile.set_tasks(tasks);
-    for _ in 0..3 {
+    for step in 0..45 {
         let contacts = ground_contacts(&pile, ground, &balls);
         pile.set_contacts(&contacts).unwrap();
+        if step == 40 {
+            assert_eq!(pile.island_count(), (1100, 1100), "the balls sleep");
+            pile.apply_impulse(balls[7], Vec3::X).unwrap();
+        }
         pile.step(DT).unwrap();
     }
+    assert_eq!(pile.island_count(), (1100, 1099), "one ball woke");
     (world.state_hash(), pile.state_hash())
 }
 
