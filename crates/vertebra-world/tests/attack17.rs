@@ -472,7 +472,8 @@ fn contacts_that_are_wrong_are_refused_and_the_lists_stay() {
     let stranger = gone.add_body(ball()).unwrap();
     let removed = world.add_body(ball()).unwrap();
     world.remove_body(removed).unwrap();
-    let broken: [(&str, fn(&mut Contact, BodyHandle, BodyHandle)); 8] = [
+    type Break = fn(&mut Contact, BodyHandle, BodyHandle);
+    let broken: [(&str, Break); 8] = [
         ("nan normal", |c, _, _| c.normal = Vec3::NAN),
         ("zero normal", |c, _, _| c.normal = Vec3::ZERO),
         ("huge depth", |c, _, _| c.depth = 1.0e30),
