@@ -1,4 +1,4 @@
-//! Issue 17's promises tried as an outsider would: task systems that lie
+//! The stepping API's promises tried as an outsider would: task systems that lie
 //! about their workers or panic, sleep settings out of range, every call
 //! that should wake a sleeping island, sleep far from the origin, snapshots
 //! taken asleep (and damaged), and contact lists that must be refused.
