@@ -73,7 +73,7 @@ struct Island {
 #[derive(Clone, Serialize, Deserialize)]
 struct Islands {
     of: Vec<u32>,
-    still: Vec<f32>,
+    still: Vec<f64>,
     anchor: Vec<(DVec3, Quat)>,
     allowed: Vec<bool>,
     islands: Vec<Island>,
@@ -414,7 +414,7 @@ fn islands(input: &mut Input, islands: &mut Islands) {
         }
         1 => {
             if let Some(still) = islands.still.get_mut(input.pick(n)) {
-                *still = value(input);
+                *still = f64::from(value(input));
             }
         }
         2 => {

@@ -150,8 +150,11 @@ pub(crate) struct Island {
 pub(crate) struct Islands {
     /// Per body slot: its island, or [`NO_ISLAND`].
     pub(crate) of: Vec<u32>,
-    /// Per body slot: how long (s) it has been still.
-    pub(crate) still: Vec<f32>,
+    /// Per body slot: how long (s) it has been still; double precision, so
+    /// that a step still adds to it after a million seconds (in single
+    /// precision a 1 ms step stops adding after about 17,000 s, so a long
+    /// `SleepSettings::time` could never be reached).
+    pub(crate) still: Vec<f64>,
     /// Per body slot: where it was when its stillness began (centre of
     /// mass, m, world; orientation).
     pub(crate) anchor: Vec<(DVec3, Quat)>,
@@ -456,7 +459,7 @@ impl Islands {
             let members = &self.members[id];
             if members
                 .iter()
-                .all(|&b| self.still[b as usize] >= settings.time)
+                .all(|&b| self.still[b as usize] >= f64::from(settings.time))
             {
                 self.islands[id].asleep = true;
                 for &b in members {
@@ -494,7 +497,8 @@ impl Islands {
             }
             let drifted = mass_moved_squared(bodies, i, self.anchor[i], now) > reach * reach;
             if self.allowed[i] && !drifted {
-                let window = |still: f32| (still / settings.time).floor();
+                let (dt, time) = (f64::from(dt), f64::from(settings.time));
+                let window = |still: f64| (still / time).floor();
                 if window(self.still[i] + dt) > window(self.still[i]) {
                     self.anchor[i] = now;
                 }
@@ -522,7 +526,7 @@ impl Islands {
     /// The awake island with a split pending that holds the stillest body
     /// still long enough to sleep (Box2D's choice); the lower id on a tie.
     fn split_candidate(&self, settings: &SleepSettings) -> Option<u32> {
-        let mut best: Option<(f32, u32)> = None;
+        let mut best: Option<(f64, u32)> = None;
         for (id, island) in self.islands.iter().enumerate() {
             if !(island.live && island.split && !island.asleep) {
                 continue;
@@ -530,8 +534,8 @@ impl Islands {
             let stillest = self.members[id]
                 .iter()
                 .map(|&b| self.still[b as usize])
-                .fold(0.0f32, f32::max);
-            if stillest >= settings.time && best.is_none_or(|(s, _)| stillest > s) {
+                .fold(0.0f64, f64::max);
+            if stillest >= f64::from(settings.time) && best.is_none_or(|(s, _)| stillest > s) {
                 best = Some((stillest, id as u32));
             }
         }

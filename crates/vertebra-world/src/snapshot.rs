@@ -45,7 +45,7 @@
 //! `Err(IncompatibleSnapshot)` for another build) and the world is
 //! unchanged.
 //!
-//! Bytes: `"VTBSNAP9"` (the format), the build id (u64 LE: a hash of the
+//! Bytes: `"VTBSNAPA"` (the format), the build id (u64 LE: a hash of the
 //! crate version and the format), the xxh3 hash of the payload (u64 LE),
 //! then the payload (postcard).
 
@@ -61,8 +61,9 @@ use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
 /// Bump with every change to [`State`] or anything in it.
 /// 8: rods' rest shapes gained their rates (`bend_rest_velocity`,
-/// `twist_rest_velocity`). 9: islands and sleep state.
-const FORMAT: u8 = b'9';
+/// `twist_rest_velocity`). 9: islands and sleep state. A: stillness in
+/// double precision.
+const FORMAT: u8 = b'A';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
 
@@ -631,7 +632,7 @@ mod tests {
                 "body 2: in island 1, which is not live",
             ),
             (
-                Box::new(|s| s.islands.still[3] = NAN),
+                Box::new(|s| s.islands.still[3] = f64::NAN),
                 "body 3: stillness NaN",
             ),
             (
