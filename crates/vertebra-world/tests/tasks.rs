@@ -81,10 +81,30 @@ enum Behaviour {
     OutOfRange,
 }
 
+impl Behaviour {
+    const EVERY: [Self; 6] = [
+        Self::Scoped,
+        Self::Reversed,
+        Self::Twice,
+        Self::Skipping,
+        Self::Nothing,
+        Self::OutOfRange,
+    ];
+}
+
 /// An engine's job system, counting the calls it gets.
 struct Engine {
     behaviour: Behaviour,
     calls: AtomicUsize,
+}
+
+impl Engine {
+    fn new(behaviour: Behaviour) -> Arc<Self> {
+        Arc::new(Self {
+            behaviour,
+            calls: AtomicUsize::new(0),
+        })
+    }
 }
 
 impl TaskSystem for Engine {
@@ -140,18 +160,8 @@ fn every_task_system_steps_to_the_same_bits() {
 #[test]
 fn an_engines_job_system_runs_the_work_and_cannot_spoil_it() {
     let reference = stepped(chains(config(1)));
-    for behaviour in [
-        Behaviour::Scoped,
-        Behaviour::Reversed,
-        Behaviour::Twice,
-        Behaviour::Skipping,
-        Behaviour::Nothing,
-        Behaviour::OutOfRange,
-    ] {
-        let engine = Arc::new(Engine {
-            behaviour,
-            calls: AtomicUsize::new(0),
-        });
+    for behaviour in Behaviour::EVERY {
+        let engine = Engine::new(behaviour);
         let mut world = chains(config(1));
         world.set_tasks(engine.clone());
         assert_eq!(stepped(world), reference, "{behaviour:?}");
@@ -303,18 +313,9 @@ fn islands_apart_and_one_pile_step_to_the_same_bits_on_every_task_system() {
             let world = piles(sleepy(threads), 6, links, spacing);
             assert_eq!(run(world), reference, "{threads} threads, {spacing} m");
         }
-        for behaviour in [
-            Behaviour::Scoped,
-            Behaviour::Reversed,
-            Behaviour::Twice,
-            Behaviour::Skipping,
-            Behaviour::Nothing,
-        ] {
+        for behaviour in Behaviour::EVERY {
             let mut world = piles(sleepy(1), 6, links, spacing);
-            world.0.set_tasks(Arc::new(Engine {
-                behaviour,
-                calls: AtomicUsize::new(0),
-            }));
+            world.0.set_tasks(Engine::new(behaviour));
             assert_eq!(run(world), reference, "{behaviour:?}, {spacing} m");
         }
         // Awake throughout: the islands of touching piles are found each
@@ -409,18 +410,8 @@ fn many_contacts_are_laid_out_on_the_workers_to_the_same_bits() {
             "{threads} threads"
         );
     }
-    for behaviour in [
-        Behaviour::Scoped,
-        Behaviour::Reversed,
-        Behaviour::Twice,
-        Behaviour::Skipping,
-        Behaviour::Nothing,
-        Behaviour::OutOfRange,
-    ] {
-        let engine = Arc::new(Engine {
-            behaviour,
-            calls: AtomicUsize::new(0),
-        });
+    for behaviour in Behaviour::EVERY {
+        let engine = Engine::new(behaviour);
         let (mut world, ground, spheres) = piles(config(1), 10, 40, 2.0 * R);
         world.set_tasks(engine.clone());
         assert_eq!(run(world, ground, &spheres).0, reference, "{behaviour:?}");
