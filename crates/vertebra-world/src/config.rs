@@ -33,6 +33,24 @@ pub const MAX_LINEAR_SPEED_LIMIT: f32 = MAX_COORDINATE / MAX_TIME_STEP;
 /// most 1 rad.
 pub const MAX_ANGULAR_SPEED_LIMIT: f32 = 1.0e6;
 
+/// How each position iteration solves the joints' equality parts (the
+/// points of sockets, hinges and fixed joints, the hinge's axis, the fixed
+/// joint's lock, the rod's curve and length).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum JointSolver {
+    /// Each joint on its own, colour by colour (Gauss-Seidel over the
+    /// joints, as the paper and most engines do): cheap per iteration,
+    /// slow to converge through long chains and across large mass ratios.
+    #[default]
+    Iterative,
+    /// Every joint of a tree of bodies at once, exactly for the
+    /// linearised rows (`docs/direct.md`): after each iteration the
+    /// linearised joint error is zero up to round-off, whatever the
+    /// chain's length or mass ratios. Limits, drives and soft parts stay
+    /// iterative; a joint that closes a loop stays iterative whole.
+    Direct,
+}
+
 /// How the world steps. Games use a fixed iteration count; so does the
 /// paper (20 iterations, 1 substep).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,6 +110,8 @@ pub struct SolverConfig {
     /// as in Box2D, Jolt and Rapier. The paper's scenes turn it off (their
     /// figures measure every joint at every step).
     pub sleep: Option<SleepSettings>,
+    /// How the joints' equality parts are solved ([`JointSolver`]).
+    pub joints: JointSolver,
 }
 
 impl Default for SolverConfig {
@@ -108,6 +128,7 @@ impl Default for SolverConfig {
             max_angular_speed: 100.0 * core::f32::consts::PI,
             measure_residuals: false,
             sleep: Some(SleepSettings::default()),
+            joints: JointSolver::Iterative,
         }
     }
 }

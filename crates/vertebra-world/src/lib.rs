@@ -50,7 +50,8 @@ use vertebra_scheduler::Colouring;
 use vertebra_store::Slots;
 
 pub use config::{
-    MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS, SolverConfig,
+    JointSolver, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS,
+    SolverConfig,
 };
 pub use contact::Contact;
 pub use drive::{

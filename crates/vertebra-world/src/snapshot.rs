@@ -18,7 +18,7 @@
 //! not the snapshot's). To step on bit for bit as the original would have,
 //! the settings that change results must match: `substeps`, `iterations`,
 //! `gravity`, `max_push_out_speed`, `max_linear_speed`,
-//! `max_angular_speed`, `sleep`; `backend`, `threads` and `parallel_min_blocks` may
+//! `max_angular_speed`, `sleep`, `joints`; `backend`, `threads` and `parallel_min_blocks` may
 //! differ (stepping is bit-identical across them). "The same build" is the
 //! same vertebra version and snapshot format; identity across compilers and
 //! targets is not promised (see `docs/robustness.md`).
