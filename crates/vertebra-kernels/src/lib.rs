@@ -24,6 +24,7 @@
 
 pub mod body;
 pub mod contact;
+pub mod direct;
 pub mod driven;
 pub mod fixed;
 pub mod hinge;

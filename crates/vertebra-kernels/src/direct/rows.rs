@@ -1,0 +1,217 @@
+//! Each joint's equality rows for the direct solve: the error `C` of every
+//! row and its Jacobian `J = dC/dx` for each body, with `x = (p, theta)`
+//! a body's displacement and rotation vector (world), so that the
+//! linearised error after a correction is `C + J_a dx_a + J_b dx_b`.
+//!
+//! | joint | rows |
+//! | --- | --- |
+//! | socket, hinge and fixed point (3) | `C = d`, the anchors' separation; `J_b = [1, -[r_b]x]`, `J_a = [-1, [r_a]x]` |
+//! | hinge axis (2) | `C = theta n` (the turn from `t_a` to `t_b`) along two axes `u` spanning the plane normal to `t_a + t_b`; `J_b = [0, u]`, `J_a = [0, -u]` |
+//! | fixed lock (3) | `C = log((q_b F_b)(q_a F_a)*)`; `J_b = [0, 1]`, `J_a = [0, -1]` |
+//! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b`; `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
+//! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, 0]`, `J_a = [-o, 0]` (the paper's "purely through linear motion") |
+//!
+//! The single angle the iterative parts correct (`hinge_axis`, `curve`)
+//! has no direction where the error is zero: a row along `n` would vanish
+//! exactly when the joint is right, and the solve would then leave other
+//! joints free to turn it. Two rows across the whole plane the error lives
+//! in keep it held at zero error too. Their Jacobians are exact at zero
+//! error and first-order beyond, which the next iteration's
+//! re-linearisation absorbs. Derivations in `docs/direct.md`; every row
+//! is checked against finite differences in `tests/direct.rs`.
+
+use vertebra_math::{Lane, Quat, Vec3, poly};
+
+use super::ldl::MAX;
+use crate::body::{BodyLanes, PairStart, safe_ratio};
+use crate::parts::rod::{curve, length};
+use crate::parts::{axis_x, frames, lock, point};
+
+/// What a joint holds equal, and so its rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum JointRows {
+    /// A socket: the point (3 rows).
+    Point,
+    /// A hinge: the point and the axis (5 rows).
+    Hinge,
+    /// A fixed joint: the point and the lock (6 rows).
+    Fixed,
+    /// A rod: the curve and the length (3 rows).
+    Rod,
+}
+
+impl JointRows {
+    /// How many rows.
+    pub const fn count(self) -> usize {
+        match self {
+            JointRows::Point | JointRows::Rod => 3,
+            JointRows::Hinge => 5,
+            JointRows::Fixed => 6,
+        }
+    }
+}
+
+/// A joint's rows: errors and both bodies' Jacobians (`[linear,
+/// angular]`, world).
+#[derive(Clone, Copy, Debug)]
+pub struct Rows<L> {
+    /// `dC/dx_a`, row by row.
+    pub ja: [[L; 6]; MAX],
+    /// `dC/dx_b`, row by row.
+    pub jb: [[L; 6]; MAX],
+    /// `C` (m for positional rows, rad for angular ones).
+    pub c: [L; MAX],
+}
+
+/// What a joint is measured from: its anchors (m, body frames), frames
+/// (body frames), the rod's rest length (m) and the pair's start of step.
+#[derive(Clone, Copy, Debug)]
+pub struct Geometry<L> {
+    /// Anchor on a.
+    pub anchor_a: Vec3<L>,
+    /// Anchor on b.
+    pub anchor_b: Vec3<L>,
+    /// Joint (or material) frame on a.
+    pub frame_a: Quat<L>,
+    /// Joint (or material) frame on b.
+    pub frame_b: Quat<L>,
+    /// The rod's rest length.
+    pub rest_length: L,
+    /// Where the pair's points (a rod's centres) stood as the step began.
+    pub start: PairStart<L>,
+}
+
+impl<L: Lane> Rows<L> {
+    /// Measures the rows of a joint of kind `kind` between `a` and `b`.
+    #[inline(always)]
+    pub fn measure(kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) -> Self {
+        let zero = L::splat(0.0);
+        let mut rows = Self {
+            ja: [[zero; 6]; MAX],
+            jb: [[zero; 6]; MAX],
+            c: [zero; MAX],
+        };
+        match kind {
+            JointRows::Point => rows.point(0, a, b, g),
+            JointRows::Hinge => {
+                rows.point(0, a, b, g);
+                rows.axis(3, a, b, g);
+            }
+            JointRows::Fixed => {
+                rows.point(0, a, b, g);
+                rows.lock(3, a, b, g);
+            }
+            JointRows::Rod => {
+                rows.curve(0, a, b, g);
+                rows.length(2, a, b, g);
+            }
+        }
+        rows
+    }
+
+    /// Row `k`: error `c`, `J_b = [lb, ab]`, `J_a = [-lb, -aa]`.
+    #[inline(always)]
+    fn set(&mut self, k: usize, c: L, (lb, ab): (Vec3<L>, Vec3<L>), aa: Vec3<L>) {
+        self.c[k] = c;
+        self.jb[k] = [lb.x, lb.y, lb.z, ab.x, ab.y, ab.z];
+        self.ja[k] = [-lb.x, -lb.y, -lb.z, -aa.x, -aa.y, -aa.z];
+    }
+
+    /// The point: `d` along the world axes; moving b along `e` moves its
+    /// anchor by `e`, turning it by `w` moves it by `w x r_b`, so
+    /// `dd_k/dtheta_b = r_b x e_k`.
+    #[inline(always)]
+    fn point(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let (ra, rb, d) = point::separation(a, b, g.anchor_a, g.anchor_b, &g.start);
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let axes = [
+            Vec3::new(one, zero, zero),
+            Vec3::new(zero, one, zero),
+            Vec3::new(zero, zero, one),
+        ];
+        let c = [d.x, d.y, d.z];
+        for k in 0..3 {
+            let e = axes[k];
+            self.set(at + k, c[k], (e, rb.cross(e)), ra.cross(e));
+        }
+    }
+
+    /// The hinge axis: `theta n` across the plane normal to `t_a + t_b`.
+    #[inline(always)]
+    fn axis(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let (fa, fb) = (a.q * g.frame_a, b.q * g.frame_b);
+        let (ta, tb) = (axis_x(fa), axis_x(fb));
+        let (n, sin) = ta.cross(tb).normalize_or_zero();
+        let turn = n.scale(poly::atan2(sin, ta.dot(tb)));
+        let zero = Vec3::zero();
+        for (k, u) in plane(ta + tb, axis_y(fa)).into_iter().enumerate() {
+            self.set(at + k, turn.dot(u), (zero, u), u);
+        }
+    }
+
+    /// The lock: the rotation vector between the joint frames.
+    #[inline(always)]
+    fn lock(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let c = lock::measure(a, b, g.frame_a, g.frame_b);
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let axes = [
+            Vec3::new(one, zero, zero),
+            Vec3::new(zero, one, zero),
+            Vec3::new(zero, zero, one),
+        ];
+        let c = [c.x, c.y, c.z];
+        for k in 0..3 {
+            self.set(at + k, c[k], (Vec3::zero(), axes[k]), axes[k]);
+        }
+    }
+
+    /// The rod's curve: the turn from `r` to `t_b` across the plane normal
+    /// to `r + t_b`, with the chord's turn as b moves (`curve.rs`'s `g`,
+    /// for any axis `u`: `e = u x r`).
+    #[inline(always)]
+    fn curve(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let f = frames(a, b, g.frame_a, g.frame_b);
+        let measured = curve::measure(a, b, &f, &g.start);
+        let turn = measured.n_b.scale(measured.theta);
+        let two = L::splat(2.0);
+        let (o, distance) = g.start.chord(a, b).normalize_or_zero();
+        let apart = distance.gt(L::splat(0.0));
+        let ta_o = f.ta.dot(o);
+        let r = o.scale(two * ta_o) - f.ta;
+        let scale = -safe_ratio(two, distance);
+        for (k, u) in plane(r + f.tb, axis_y(f.fa)).into_iter().enumerate() {
+            let e = u.cross(r);
+            let along = f.ta.scale(e.dot(o)) + e.scale(ta_o);
+            let across = (along - o.scale(along.dot(o))).scale(scale);
+            let across = Vec3::select(apart, across, Vec3::zero());
+            let reflected = o.scale(two * u.dot(o)) - u;
+            self.set(at + k, turn.dot(u), (across, u), reflected);
+        }
+    }
+
+    /// The rod's length, along the chord.
+    #[inline(always)]
+    fn length(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let f = frames(a, b, g.frame_a, g.frame_b);
+        let (o, c) = length::measure(a, b, &f, g.rest_length, &g.start);
+        self.set(at, c, (o, Vec3::zero()), Vec3::zero());
+    }
+}
+
+/// A frame's +Y axis (its rotation matrix's second column).
+#[inline(always)]
+fn axis_y<L: Lane>(q: Quat<L>) -> Vec3<L> {
+    q.rotate(Vec3::new(L::splat(0.0), L::splat(1.0), L::splat(0.0)))
+}
+
+/// Two orthonormal axes spanning the plane normal to `s`: `hint` with its
+/// part along `s` removed, and `s` crossed with that. Zero where they are
+/// undefined (`s = 0`: axes exactly opposed; `hint` along `s`), which
+/// drops the row ([`super::ldl`]).
+#[inline(always)]
+fn plane<L: Lane>(s: Vec3<L>, hint: Vec3<L>) -> [Vec3<L>; 2] {
+    let along = safe_ratio(hint.dot(s), s.dot(s));
+    let (u, _) = (hint - s.scale(along)).normalize_or_zero();
+    let (v, _) = s.cross(u).normalize_or_zero();
+    [u, v]
+}
