@@ -312,9 +312,16 @@ pub struct BodyPairs {
     /// padding (`vertebra_math::block::for_live_slices`). Zero (a zeroed
     /// header) runs every lane.
     pub padding: u32,
+    /// Nonzero: the direct solve (`crate::direct`) solves the equality
+    /// parts of every live lane (points, hinge axes, locks, the rod's curve
+    /// and length), so the block's position pass leaves them out and
+    /// solves only its limits, drives and soft parts. Zero (a zeroed
+    /// header) solves every part. One flag per block, not per lane, so that
+    /// every backend, whatever its slices, solves the same parts.
+    pub direct: u32,
     /// Fills the header to its 32-byte alignment (`Pod` allows no implicit
     /// padding bytes).
-    pub _align: [u32; 7],
+    pub _align: [u32; 6],
 }
 
 /// Where a pair of body points stood when the step began: their separation

@@ -98,7 +98,9 @@ impl LaneKernel for PositionPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
+        // A fixed joint is all equality: a block the direct solve holds
+        // has nothing left to iterate.
+        for block in self.blocks.iter_mut().filter(|b| b.bodies.direct == 0) {
             let padding = block.bodies.padding;
             let mut positions = Positions {
                 block,

@@ -228,7 +228,10 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
             .solve(start, a, b, frame_a, frame_b, inv_h, inv_h2);
     }
 
-    hinge_axis::solve(&mut a, &mut b, frame_a, frame_b);
+    let iterated = block.bodies.direct == 0;
+    if iterated {
+        hinge_axis::solve(&mut a, &mut b, frame_a, frame_b);
+    }
     let (lo, hi) = (
         L::load(&block.range_min[start..]),
         L::load(&block.range_max[start..]),
@@ -239,13 +242,15 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     let c0 = L::load(&block.limit_start[start..]);
     limit::solve_local(&mut a, &mut b, axes, (c, c0), soft, lambda)
         .store(&mut block.limit_lambda[start..]);
-    point::solve(
-        &mut a,
-        &mut b,
-        block.anchor_a.load(start),
-        block.anchor_b.load(start),
-        &block.bodies.start(start),
-    );
+    if iterated {
+        point::solve(
+            &mut a,
+            &mut b,
+            block.anchor_a.load(start),
+            block.anchor_b.load(start),
+            &block.bodies.start(start),
+        );
+    }
 
     block.bodies.scatter(rows, start, &a, &b);
 }

@@ -434,11 +434,13 @@ fn solve_positions<L: Lane>(
 
     // The curve moves the bodies along a world gradient: its frames are
     // the world's. The length needs only the bend angle.
-    let chord = block.bodies.start(start);
-    let f = world_tangents(&a, &b, frames, (ta, tb));
-    curve::solve(&mut a, &mut b, &f, &chord);
-    let m = LocalFrames::tangents(&a, &b, frames, (ta, tb));
-    length::solve(&mut a, &mut b, &m.f, rest_length, &chord);
+    if block.bodies.direct == 0 {
+        let chord = block.bodies.start(start);
+        let f = world_tangents(&a, &b, frames, (ta, tb));
+        curve::solve(&mut a, &mut b, &f, &chord);
+        let m = LocalFrames::tangents(&a, &b, frames, (ta, tb));
+        length::solve(&mut a, &mut b, &m.f, rest_length, &chord);
+    }
 
     block.bodies.scatter(rows, start, &a, &b);
 }

@@ -273,13 +273,15 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
         );
         twist::solve(&mut a, &mut b, frame_a, frame_b, lo, hi);
     }
-    point::solve(
-        &mut a,
-        &mut b,
-        block.anchor_a.load(start),
-        block.anchor_b.load(start),
-        &block.bodies.start(start),
-    );
+    if block.bodies.direct == 0 {
+        point::solve(
+            &mut a,
+            &mut b,
+            block.anchor_a.load(start),
+            block.anchor_b.load(start),
+            &block.bodies.start(start),
+        );
+    }
 
     block.bodies.scatter(rows, start, &a, &b);
 }

@@ -29,6 +29,7 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 use crate::bins::Bins;
 use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
 use crate::rod::RodDesc;
+use crate::trees::Trees;
 
 /// Added to a rod's slot to make its colouring key.
 pub(crate) const ROD_KEY: u64 = 1 << 32;
@@ -127,6 +128,9 @@ pub(crate) struct Bin {
     pub colours: Vec<Group>,
     /// The bin's part of the overflow set (solved by the scalar kernel).
     pub overflow: Group,
+    /// The bin's tree blocks (`Layout::trees`; none unless the direct
+    /// solve is on).
+    pub trees: Range<usize>,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -135,6 +139,8 @@ pub(crate) struct Layout {
     pub hinges: Blocks<HingeBlock>,
     pub fixed: Blocks<FixedBlock>,
     pub rods: Blocks<RodBlock>,
+    /// The direct solve's trees (empty for the iterative one).
+    pub trees: Trees,
     /// Per solve bin (bin 0 first), its blocks: each bin's blocks follow
     /// the bin before's in every kind's vector.
     pub bins: Vec<Bin>,
@@ -149,14 +155,16 @@ impl Layout {
     /// Lays out every coloured joint; `joints[slot]`, `rods[slot]` are
     /// `Some` when live. The joints of bin `k` (their awake dynamic
     /// body's, `bins`; all of them in bin 0 when `bins` is empty) go to
-    /// `bins[k]`, colour by colour.
+    /// `bins[k]`, colour by colour. With `direct`, each bin's trees too
+    /// (`trees.rs`), and every block whose joints they all hold is marked
+    /// so (`BodyPairs::direct`).
     pub fn build(
         colouring: &Colouring,
         joints: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
         asleep: &[bool],
-        bins: &Bins,
+        (bins, direct): (&Bins, bool),
     ) -> Self {
         let mut layout = Self::default();
         let awake = |a: BodyHandle, b: BodyHandle| !(asleep[a.index()] || asleep[b.index()]);
@@ -183,14 +191,61 @@ impl Layout {
                 }
             }
             bin.overflow = layout.append(colouring.overflow(), &joints, &rods, bodies);
+            if direct {
+                bin.trees = layout.trees.append(&joints, &rods, bodies);
+            }
             layout.bins.push(bin);
         }
+        layout.trees.check_disjoint();
+        layout.mark_direct(joints, rods);
         layout.colour_count = used.iter().filter(|&&u| u).count();
         let mut reads = Vec::new();
         layout.disjoint = (layout.bins.iter())
             .flat_map(|b| &b.colours)
             .all(|g| crate::parallel::colour_is_disjoint(layout.pairs(g), &mut reads));
         layout
+    }
+
+    /// Marks every block whose live lanes' equality parts the trees all
+    /// solve.
+    fn mark_direct(&mut self, joints: &[Option<JointDesc>], rods: &[Option<RodDesc>]) {
+        fn mark<B>(
+            blocks: &mut Blocks<B>,
+            slots: impl Iterator<Item = usize>,
+            pairs: impl Fn(&mut B) -> &mut BodyPairs,
+        ) {
+            let mut held = vec![0u32; blocks.blocks.len()];
+            for slot in slots {
+                let (block, lane) = blocks.place[slot];
+                held[block] |= 1 << lane;
+            }
+            for (block, held) in blocks.blocks.iter_mut().zip(held) {
+                let pairs = pairs(block);
+                let live = !pairs.padding & ((1 << BLOCK_LANES) - 1);
+                pairs.direct = u32::from(held == live);
+            }
+        }
+        let trees = &self.trees;
+        let held = |kind: fn(&JointKind) -> bool| {
+            (joints.iter().enumerate())
+                .filter(move |(s, d)| trees.has_joint(*s) && d.is_some_and(|d| kind(&d.kind)))
+                .map(|(s, _)| s)
+        };
+        mark(
+            &mut self.sockets,
+            held(|k| matches!(k, JointKind::Socket(_))),
+            |b| &mut b.bodies,
+        );
+        mark(
+            &mut self.hinges,
+            held(|k| matches!(k, JointKind::Hinge { .. })),
+            |b| &mut b.bodies,
+        );
+        mark(&mut self.fixed, held(|k| *k == JointKind::Fixed), |b| {
+            &mut b.bodies
+        });
+        let rod_slots = (0..rods.len()).filter(|&s| trees.has_rod(s));
+        mark(&mut self.rods, rod_slots, |b| &mut b.bodies);
     }
 
     /// The body pairs of every block of bin `bin` (its colours and its
@@ -223,6 +278,7 @@ impl Layout {
     /// drive presence unchanged, so its blocks are), keeping its drive's
     /// multiplier.
     pub fn update_joint(&mut self, slot: usize, desc: &JointDesc, bodies: &BodyStore) {
+        self.trees.update_joint(slot, desc);
         match desc.kind {
             JointKind::Socket(limits) => {
                 let (block, lane) = self.sockets.place[slot];
@@ -248,6 +304,7 @@ impl Layout {
     /// Writes a rod's new settings into its lane in place (its bodies
     /// unchanged), keeping its multipliers.
     pub fn update_rod(&mut self, slot: usize, desc: &RodDesc, bodies: &BodyStore) {
+        self.trees.update_rod(slot, desc);
         let (block, lane) = self.rods.place[slot];
         let block = &mut self.rods.blocks[block];
         let lambdas = (block.bend_lambda[lane], block.twist_lambda[lane]);
@@ -270,6 +327,7 @@ impl Layout {
         start_blocks(&mut self.hinges.blocks, bodies);
         start_blocks(&mut self.fixed.blocks, bodies);
         start_blocks(&mut self.rods.blocks, bodies);
+        start_blocks(&mut self.trees.blocks, bodies);
     }
 
     fn append(

@@ -41,6 +41,7 @@ mod snapshot;
 mod stages;
 mod step;
 mod tasks;
+mod trees;
 
 use std::sync::Arc;
 
@@ -555,7 +556,7 @@ impl World {
                 &self.rods,
                 &self.bodies,
                 self.islands.asleep(),
-                &self.bins,
+                (&self.bins, self.config.joints == JointSolver::Direct),
             );
             self.layout_dirty = false;
         }

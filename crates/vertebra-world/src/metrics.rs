@@ -92,7 +92,7 @@ pub(crate) fn residuals(world: &mut World) {
             &world.rods,
             &world.bodies,
             &awake,
-            &crate::bins::Bins::default(),
+            (&crate::bins::Bins::default(), false),
         )
         .started(&world.bodies);
         &everything

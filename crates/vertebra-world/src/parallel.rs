@@ -129,7 +129,7 @@ mod tests {
             &world.rods,
             &world.bodies,
             asleep,
-            &crate::bins::Bins::default(),
+            (&crate::bins::Bins::default(), false),
         );
         assert_eq!(layout.bins[0].colours.len(), 1);
         assert!(!layout.disjoint);

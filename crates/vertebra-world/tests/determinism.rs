@@ -7,7 +7,7 @@ use common::capsule;
 use glam::{Quat, Vec3};
 use vertebra_math::Backend;
 use vertebra_world::{
-    AngularDrive, BackendChoice, BodyDesc, BodyKind, JointDesc, RodDesc, RodStiffness,
+    AngularDrive, BackendChoice, BodyDesc, BodyKind, JointDesc, JointSolver, RodDesc, RodStiffness,
     SolverConfig, World,
 };
 
@@ -15,10 +15,16 @@ use vertebra_world::{
 /// plus a hub body with 30 sockets so that the overflow set is used, some
 /// limits and drives, stepped `frames` times.
 fn build(backend: Backend, threads: usize) -> World {
+    build_solved(backend, threads, JointSolver::Iterative)
+}
+
+/// [`build`]'s world with its joints solved by `joints`.
+fn build_solved(backend: Backend, threads: usize, joints: JointSolver) -> World {
     let config = SolverConfig {
         backend: BackendChoice::Forced(backend),
         threads,
         parallel_min_blocks: 1,
+        joints,
         ..SolverConfig::default()
     };
     let mut w = World::new(config).unwrap();
@@ -101,7 +107,16 @@ fn build(backend: Backend, threads: usize) -> World {
 }
 
 fn hash_after(backend: Backend, threads: usize, frames: usize) -> (u64, f32) {
-    let mut w = build(backend, threads);
+    hash_after_solved(backend, threads, frames, JointSolver::Iterative)
+}
+
+fn hash_after_solved(
+    backend: Backend,
+    threads: usize,
+    frames: usize,
+    joints: JointSolver,
+) -> (u64, f32) {
+    let mut w = build_solved(backend, threads, joints);
     let bodies: Vec<_> = (0..w.bodies().capacity())
         .filter_map(|i| w.bodies().handle_at(i))
         .collect();
@@ -137,6 +152,30 @@ fn every_backend_and_thread_count_gives_the_same_bits() {
     for backend in Backend::available() {
         for threads in [1, 2] {
             let (hash, _) = hash_after(backend, threads, 100);
+            assert_eq!(
+                hash, reference,
+                "{backend} with {threads} thread(s) differs from scalar"
+            );
+        }
+    }
+}
+
+/// The direct solve's trees (the hub's 30 spokes in one tree, rods with
+/// limits, drives, the overflow set) give the scalar reference's bits on
+/// every backend and thread count too, and hold the joints far tighter.
+#[test]
+fn direct_joints_give_the_same_bits_everywhere_and_tighter_joints() {
+    let direct = JointSolver::Direct;
+    let (reference, eps) = hash_after_solved(Backend::Scalar, 1, 100, direct);
+    let (iterative, iterative_eps) = hash_after(Backend::Scalar, 1, 100);
+    assert_ne!(reference, iterative, "the direct solve changed nothing");
+    assert!(
+        eps < iterative_eps / 10.0,
+        "direct {eps} cm against iterative {iterative_eps} cm"
+    );
+    for backend in Backend::available() {
+        for threads in [1, 2, 3] {
+            let (hash, _) = hash_after_solved(backend, threads, 100, direct);
             assert_eq!(
                 hash, reference,
                 "{backend} with {threads} thread(s) differs from scalar"

@@ -268,6 +268,13 @@ pub struct JointNode {
     pub frame_b: QuatBlock,
     /// A rod's rest length (m).
     pub rest_length: [f32; BLOCK_LANES],
+    /// The swing cone's half-angle (the rod's bend limit; rad; pi: none).
+    pub swing_max: [f32; BLOCK_LANES],
+    /// The twist range's low end (a hinge's range; the rod's twist
+    /// limit; rad).
+    pub twist_min: [f32; BLOCK_LANES],
+    /// The twist range's high end (rad).
+    pub twist_max: [f32; BLOCK_LANES],
 }
 
 /// A joint's geometry in one lane, as the world lays it out.
@@ -287,6 +294,12 @@ pub struct JointLane {
     pub frame_b: glam::Quat,
     /// A rod's rest length (m; 0 for a joint).
     pub rest_length: f32,
+    /// The hard swing cone's half-angle, or the rod's bend limit (rad; pi
+    /// for none).
+    pub swing_max: f32,
+    /// The hard twist range, a hinge's hard range or the rod's twist limit
+    /// (rad; `[-pi, pi]` for none).
+    pub twist: [f32; 2],
 }
 
 impl JointNode {
@@ -304,6 +317,8 @@ impl JointNode {
                     frame_a: glam::Quat::IDENTITY,
                     frame_b: glam::Quat::IDENTITY,
                     rest_length: 0.0,
+                    swing_max: core::f32::consts::PI,
+                    twist: [-core::f32::consts::PI, core::f32::consts::PI],
                 },
             );
         }
@@ -318,6 +333,8 @@ impl JointNode {
         self.frame_a.set(lane, j.frame_a);
         self.frame_b.set(lane, j.frame_b);
         self.rest_length[lane] = j.rest_length;
+        self.swing_max[lane] = j.swing_max;
+        (self.twist_min[lane], self.twist_max[lane]) = (j.twist[0], j.twist[1]);
     }
 
     #[inline(always)]
@@ -328,6 +345,11 @@ impl JointNode {
             frame_a: self.frame_a.load(start),
             frame_b: self.frame_b.load(start),
             rest_length: L::load(&self.rest_length[start..]),
+            swing_max: L::load(&self.swing_max[start..]),
+            twist: [
+                L::load(&self.twist_min[start..]),
+                L::load(&self.twist_max[start..]),
+            ],
             start: self.bodies.start(start),
         }
     }

@@ -10,6 +10,7 @@
 //! | fixed lock (3) | `C = log((q_b F_b)(q_a F_a)*)`; `J_b = [0, 1]`, `J_a = [0, -1]` |
 //! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b`; `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
 //! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, 0]`, `J_a = [-o, 0]` (the paper's "purely through linear motion") |
+//! | hard limits (socket cone and twist, hinge range, rod bend and twist: 1 each) | the violation, 0 within the limit; `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative part turns about; a zero row (dropped) while not violated |
 //!
 //! The single angle the iterative parts correct (`hinge_axis`, `curve`)
 //! has no direction where the error is zero: a row along `n` would vanish
@@ -24,19 +25,19 @@ use vertebra_math::{Lane, Quat, Vec3, poly};
 
 use super::ldl::MAX;
 use crate::body::{BodyLanes, PairStart, safe_ratio};
-use crate::parts::rod::{curve, length};
-use crate::parts::{axis_x, frames, lock, point};
+use crate::parts::rod::{bend, curve, length, twist as rod_twist};
+use crate::parts::{axis_x, frames, lock, point, swing, twist};
 
 /// What a joint holds equal, and so its rows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum JointRows {
-    /// A socket: the point (3 rows).
-    Point,
-    /// A hinge: the point and the axis (5 rows).
+    /// A socket: the point, the swing cone and the twist range (5 rows).
+    Socket,
+    /// A hinge: the point, the axis and the range (6 rows).
     Hinge,
     /// A fixed joint: the point and the lock (6 rows).
     Fixed,
-    /// A rod: the curve and the length (3 rows).
+    /// A rod: the curve, the length and the bend and twist limits (5 rows).
     Rod,
 }
 
@@ -44,9 +45,8 @@ impl JointRows {
     /// How many rows.
     pub const fn count(self) -> usize {
         match self {
-            JointRows::Point | JointRows::Rod => 3,
-            JointRows::Hinge => 5,
-            JointRows::Fixed => 6,
+            JointRows::Socket | JointRows::Rod => 5,
+            JointRows::Hinge | JointRows::Fixed => 6,
         }
     }
 }
@@ -77,6 +77,11 @@ pub struct Geometry<L> {
     pub frame_b: Quat<L>,
     /// The rod's rest length.
     pub rest_length: L,
+    /// The swing cone's half-angle (rad; the rod's bend limit; pi: none).
+    pub swing_max: L,
+    /// The twist range (rad; a hinge's range; the rod's twist limit;
+    /// `[-pi, pi]`: none).
+    pub twist: [L; 2],
     /// Where the pair's points (a rod's centres) stood as the step began.
     pub start: PairStart<L>,
 }
@@ -92,10 +97,15 @@ impl<L: Lane> Rows<L> {
             c: [zero; MAX],
         };
         match kind {
-            JointRows::Point => rows.point(0, a, b, g),
+            JointRows::Socket => {
+                rows.point(0, a, b, g);
+                rows.swing(3, a, b, g);
+                rows.twist(4, a, b, g);
+            }
             JointRows::Hinge => {
                 rows.point(0, a, b, g);
                 rows.axis(3, a, b, g);
+                rows.twist(5, a, b, g);
             }
             JointRows::Fixed => {
                 rows.point(0, a, b, g);
@@ -104,6 +114,7 @@ impl<L: Lane> Rows<L> {
             JointRows::Rod => {
                 rows.curve(0, a, b, g);
                 rows.length(2, a, b, g);
+                rows.rod_limits(3, a, b, g);
             }
         }
         rows
@@ -115,6 +126,52 @@ impl<L: Lane> Rows<L> {
         self.c[k] = c;
         self.jb[k] = [lb.x, lb.y, lb.z, ab.x, ab.y, ab.z];
         self.ja[k] = [-lb.x, -lb.y, -lb.z, -aa.x, -aa.y, -aa.z];
+    }
+
+    /// A limit's row: its violation `c` (0: not violated) grows as b turns
+    /// about `jb` and as a turns against `ja` (world). A limit not
+    /// violated has no row (a zero row, dropped), so the solve never holds
+    /// a joint inside its range: an active set chosen afresh each
+    /// iteration.
+    #[inline(always)]
+    fn limit(&mut self, k: usize, c: L, ja: Vec3<L>, jb: Vec3<L>) {
+        let active = c.ne(L::splat(0.0));
+        let zero = Vec3::zero();
+        let (ja, jb) = (
+            Vec3::select(active, ja, zero),
+            Vec3::select(active, jb, zero),
+        );
+        self.set(k, c, (zero, jb), ja);
+    }
+
+    /// The swing cone: the angle between the twist axes past its
+    /// half-angle, about `n = t_a x t_b / |t_a x t_b|` (`parts::swing`).
+    #[inline(always)]
+    fn swing(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let (n, theta) = swing::measure(a, b, g.frame_a, g.frame_b);
+        self.limit(at, swing::overshoot(theta, g.swing_max), n, n);
+    }
+
+    /// The twist range (a hinge's range): the signed excess about `t_b`
+    /// (`parts::twist`).
+    #[inline(always)]
+    fn twist(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let [lo, hi] = g.twist;
+        let ([axis_a, axis_b], c) = twist::violation_local(a, b, g.frame_a, g.frame_b, lo, hi);
+        self.limit(at, c, a.q.rotate(axis_a), b.q.rotate(axis_b));
+    }
+
+    /// The rod's bend limit and twist range (`parts::rod::bend`,
+    /// `parts::rod::twist`), in the world frames.
+    #[inline(always)]
+    fn rod_limits(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let f = frames(a, b, g.frame_a, g.frame_b);
+        let (n, c) = bend::overshoot(&f, g.swing_max);
+        self.limit(at, c, n, n);
+        let [lo, hi] = g.twist;
+        let e = twist::excess(rod_twist::measure(&f), lo, hi);
+        let (na, nb) = rod_twist::axes(&f);
+        self.limit(at + 1, e, na, nb);
     }
 
     /// The point: `d` along the world axes; moving b along `e` moves its
