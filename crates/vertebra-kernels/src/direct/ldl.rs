@@ -29,11 +29,12 @@ pub const fn at(i: usize, j: usize) -> usize {
     i * (i + 1) / 2 + j
 }
 
-/// Factors the leading `n x n` block of `a` in place: afterwards entry
+/// Factors the leading `N x N` block of `a` in place: afterwards entry
 /// `(i, j)`, `i > j`, holds `L_ij` and entry `(i, i)` holds `1 / D_i` (0
 /// for a dropped pivot).
 #[inline(always)]
-pub fn factor<L: Lane>(a: &mut [L; PACKED], n: usize) {
+pub fn factor<L: Lane, const N: usize>(a: &mut [L; PACKED]) {
+    let n = N;
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
     let tolerance = L::splat(PIVOT_TOLERANCE);
     let mut pivots = [zero; MAX];
@@ -62,7 +63,8 @@ pub fn factor<L: Lane>(a: &mut [L; PACKED], n: usize) {
 /// Solves `A x = x` in place with the factors from [`factor`]: forward
 /// through `L`, scaled by `D^-1`, back through `L^T`.
 #[inline(always)]
-pub fn solve<L: Lane>(f: &[L; PACKED], n: usize, x: &mut [L; MAX]) {
+pub fn solve<L: Lane, const N: usize>(f: &[L; PACKED], x: &mut [L; MAX]) {
+    let n = N;
     for i in 0..n {
         for k in 0..i {
             x[i] -= f[at(i, k)] * x[k];

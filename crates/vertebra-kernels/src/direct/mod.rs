@@ -31,16 +31,17 @@
 
 pub mod ldl;
 pub mod rows;
+mod solve;
 
 use bytemuck::{Pod, Zeroable};
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::row::NO_WRITE;
-use vertebra_math::{Lane, LaneKernel, Sym3, Vec3};
+use vertebra_math::{Lane, LaneKernel};
 
-use crate::body::{BodyLanes, BodyPairs, BodyRows};
-use ldl::{MAX, PACKED, at};
+use crate::body::{BodyPairs, BodyRows};
+use ldl::{MAX, PACKED};
+use rows::Geometry;
 pub use rows::JointRows;
-use rows::{Geometry, Rows};
 
 /// No node: the root's parent, or a joint's side on a static or kinematic
 /// body.
@@ -195,7 +196,7 @@ impl Topology {
     }
 
     /// A node's unknowns: 6 for a body, its rows for a joint.
-    fn size(&self, n: usize) -> usize {
+    pub fn size(&self, n: usize) -> usize {
         match self.nodes[n].kind {
             NodeKind::Body { .. } => 6,
             NodeKind::Joint { rows, .. } => rows.count(),
@@ -442,231 +443,9 @@ impl LaneSlices for Slices<'_> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
         let (topology, rows) = (self.topology, self.rows);
-        assemble::<L>(self.block, topology, rows, start);
-        eliminate::<L>(self.block, topology, start);
-        substitute::<L>(self.block, topology, start);
-        apply::<L>(self.block, topology, rows, start);
-    }
-}
-
-/// Loads `n` lanes-values from scratch arrays.
-#[inline(always)]
-fn load<L: Lane, const N: usize>(src: &[[f32; BLOCK_LANES]], start: usize) -> [L; N] {
-    let mut out = [L::splat(0.0); N];
-    for (o, s) in out.iter_mut().zip(src) {
-        *o = L::load(&s[start..]);
-    }
-    out
-}
-
-/// Stores lane values into scratch arrays.
-#[inline(always)]
-fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
-    for (v, d) in values.iter().zip(dst) {
-        v.store(&mut d[start..]);
-    }
-}
-
-/// Every node's starting block: a body's mass matrix (world), a joint's
-/// zero (hard rows) with its errors on the right, and each joint's
-/// Jacobians written where the tree couples it to each body.
-#[inline(always)]
-fn assemble<L: Lane>(block: &mut TreeBlock, topology: &Topology, rows: &BodyRows, start: usize) {
-    let zero = L::splat(0.0);
-    for (n, node) in topology.nodes.iter().enumerate() {
-        let mut diagonal = [zero; PACKED];
-        let mut rhs = [zero; MAX];
-        match node.kind {
-            NodeKind::Body { index } => {
-                let body = &block.bodies[index as usize];
-                let q = BodyLanes::<L>::gather(rows, &body.row[start..]).q;
-                let mass = L::load(&body.mass[start..]);
-                let [xx, yy, zz, xy, xz, yz] = load::<L, 6>(&body.inertia, start);
-                let inertia = Sym3 {
-                    xx,
-                    yy,
-                    zz,
-                    xy,
-                    xz,
-                    yz,
-                }
-                .rotated(q);
-                for k in 0..3 {
-                    diagonal[at(k, k)] = mass;
-                }
-                diagonal[at(3, 3)] = inertia.xx;
-                diagonal[at(4, 3)] = inertia.xy;
-                diagonal[at(5, 3)] = inertia.xz;
-                diagonal[at(4, 4)] = inertia.yy;
-                diagonal[at(5, 4)] = inertia.yz;
-                diagonal[at(5, 5)] = inertia.zz;
-            }
-            NodeKind::Joint {
-                index,
-                rows: kind,
-                a,
-                b,
-            } => {
-                let joint = &block.joints[index as usize];
-                let (body_a, body_b) = joint.bodies.gather::<L>(rows, start);
-                let measured = Rows::measure(kind, &body_a, &body_b, &joint.geometry(start));
-                let count = kind.count();
-                rhs[..count].copy_from_slice(&measured.c[..count]);
-                // The coupling to body `side` sits with whichever of the two
-                // is the other's child.
-                for (side, jacobian) in [(a, &measured.ja), (b, &measured.jb)] {
-                    if side == NONE {
-                        continue;
-                    }
-                    let holder = if node.parent == side {
-                        n
-                    } else {
-                        side as usize
-                    };
-                    let mut flat = [zero; MAX * 6];
-                    for (r, row) in jacobian.iter().take(count).enumerate() {
-                        flat[r * 6..r * 6 + 6].copy_from_slice(row);
-                    }
-                    store(
-                        &flat[..count * 6],
-                        &mut block.scratch[holder].coupling,
-                        start,
-                    );
-                }
-            }
-        }
-        let scratch = &mut block.scratch[n];
-        store(&diagonal, &mut scratch.diagonal, start);
-        store(&rhs, &mut scratch.rhs, start);
-    }
-}
-
-/// Leaves first: each node's block factored, its Schur complement and its
-/// right-hand side passed to its parent. For a joint child with rows `J`
-/// against its parent body, `D_p -= J^T D^-1 J` and `b_p += J^T D^-1 b`;
-/// for a body child against its parent joint's rows `J`,
-/// `D_p -= J D^-1 J^T` and `b_p += J D^-1 b` (the coupling block is `-J`).
-#[inline(always)]
-fn eliminate<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
-    let zero = L::splat(0.0);
-    for (n, node) in topology.nodes.iter().enumerate() {
-        let size = topology.size(n);
-        let mut factors = load::<L, PACKED>(&block.scratch[n].diagonal, start);
-        ldl::factor(&mut factors, size);
-        store(&factors, &mut block.scratch[n].diagonal, start);
-        if node.parent == NONE {
-            continue;
-        }
-        let p = node.parent as usize;
-        let mut y = load::<L, MAX>(&block.scratch[n].rhs, start);
-        ldl::solve(&factors, size, &mut y);
-        let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
-        let mut parent = load::<L, PACKED>(&block.scratch[p].diagonal, start);
-        let mut parent_rhs = load::<L, MAX>(&block.scratch[p].rhs, start);
-        match node.kind {
-            NodeKind::Joint { .. } => {
-                // X = D^-1 J, column by column (6 columns of `size` rows).
-                let mut x = [[zero; MAX]; 6];
-                for (c, column) in x.iter_mut().enumerate() {
-                    for r in 0..size {
-                        column[r] = j[r * 6 + c];
-                    }
-                    ldl::solve(&factors, size, column);
-                }
-                for r in 0..6 {
-                    for s in 0..=r {
-                        let mut sum = zero;
-                        for i in 0..size {
-                            sum += j[i * 6 + r] * x[s][i];
-                        }
-                        parent[at(r, s)] -= sum;
-                    }
-                    let mut sum = zero;
-                    for i in 0..size {
-                        sum += j[i * 6 + r] * y[i];
-                    }
-                    parent_rhs[r] += sum;
-                }
-            }
-            NodeKind::Body { .. } => {
-                let rows = topology.size(p);
-                // X = D^-1 J^T, row by row of J (each a 6-vector).
-                let mut x = [[zero; MAX]; MAX];
-                for (r, xr) in x.iter_mut().enumerate().take(rows) {
-                    xr.copy_from_slice(&j[r * 6..r * 6 + 6]);
-                    ldl::solve(&factors, 6, xr);
-                }
-                for r in 0..rows {
-                    for s in 0..=r {
-                        let mut sum = zero;
-                        for c in 0..6 {
-                            sum += j[r * 6 + c] * x[s][c];
-                        }
-                        parent[at(r, s)] -= sum;
-                    }
-                    let mut sum = zero;
-                    for c in 0..6 {
-                        sum += j[r * 6 + c] * y[c];
-                    }
-                    parent_rhs[r] += sum;
-                }
-            }
-        }
-        store(&parent, &mut block.scratch[p].diagonal, start);
-        store(&parent_rhs, &mut block.scratch[p].rhs, start);
-    }
-}
-
-/// Root first: each node's unknowns from its factored block, its
-/// right-hand side and its parent's unknowns (`x = D^-1 (b + J x_p)` for
-/// a joint, `D^-1 (b + J^T x_p)` for a body), kept in `rhs`.
-#[inline(always)]
-fn substitute<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
-    for (n, node) in topology.nodes.iter().enumerate().rev() {
-        let size = topology.size(n);
-        let factors = load::<L, PACKED>(&block.scratch[n].diagonal, start);
-        let mut x = load::<L, MAX>(&block.scratch[n].rhs, start);
-        if node.parent != NONE {
-            let p = node.parent as usize;
-            let xp = load::<L, MAX>(&block.scratch[p].rhs, start);
-            let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
-            match node.kind {
-                NodeKind::Joint { .. } => {
-                    for (r, xr) in x.iter_mut().enumerate().take(size) {
-                        for c in 0..6 {
-                            *xr += j[r * 6 + c] * xp[c];
-                        }
-                    }
-                }
-                NodeKind::Body { .. } => {
-                    for r in 0..topology.size(p) {
-                        for c in 0..6 {
-                            x[c] += j[r * 6 + c] * xp[r];
-                        }
-                    }
-                }
-            }
-        }
-        ldl::solve(&factors, size, &mut x);
-        store(&x[..size], &mut block.scratch[n].rhs, start);
-    }
-}
-
-/// Moves every body by its unknowns: `p += dp`, turned by the world
-/// rotation vector `dtheta` (`q += 1/2 (dtheta, 0) q`, renormalised, as
-/// every part turns a body).
-#[inline(always)]
-fn apply<L: Lane>(block: &mut TreeBlock, topology: &Topology, rows: &BodyRows, start: usize) {
-    for (n, node) in topology.nodes.iter().enumerate() {
-        let NodeKind::Body { index } = node.kind else {
-            continue;
-        };
-        let body = &block.bodies[index as usize];
-        let mut lanes = BodyLanes::<L>::gather(rows, &body.row[start..]);
-        let x = load::<L, MAX>(&block.scratch[n].rhs, start);
-        lanes.p += Vec3::new(x[0], x[1], x[2]);
-        let turn = lanes.q.inverse_rotate(Vec3::new(x[3], x[4], x[5]));
-        lanes.q = lanes.q.integrate_local(turn, L::splat(1.0));
-        lanes.scatter_pose(rows, &body.write[start..]);
+        solve::assemble::<L>(self.block, topology, rows, start);
+        solve::eliminate::<L>(self.block, topology, start);
+        solve::substitute::<L>(self.block, topology, start);
+        solve::apply::<L>(self.block, topology, rows, start);
     }
 }

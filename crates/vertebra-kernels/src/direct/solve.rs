@@ -1,0 +1,317 @@
+//! One direct solve of one slice of a [`TreeBlock`]: assemble every
+//! node's block, eliminate leaves first, substitute root first, move the
+//! bodies (the steps of `super`'s documentation).
+//!
+//! Every block size is a constant of its function (a body's 6, a joint's
+//! 5 or 6 rows: [`JointRows::count`]), chosen per node by a `match` on the
+//! topology (the same in every lane), so that the dense loops unroll and
+//! stay in registers.
+
+use vertebra_math::block::BLOCK_LANES;
+use vertebra_math::{Lane, Sym3, Vec3};
+
+use super::ldl::{self, MAX, PACKED, at};
+use super::rows::{JointRows, Rows};
+use super::{NONE, NodeKind, Topology, TreeBlock};
+use crate::body::{BodyLanes, BodyRows};
+
+/// Loads lane values from scratch arrays.
+#[inline(always)]
+fn load<L: Lane, const N: usize>(src: &[[f32; BLOCK_LANES]], start: usize) -> [L; N] {
+    let mut out = [L::splat(0.0); N];
+    for (o, s) in out.iter_mut().zip(src) {
+        *o = L::load(&s[start..]);
+    }
+    out
+}
+
+/// Stores lane values into scratch arrays.
+#[inline(always)]
+fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
+    for (v, d) in values.iter().zip(dst) {
+        v.store(&mut d[start..]);
+    }
+}
+
+/// Every node's starting block: a body's mass matrix (world), a joint's
+/// zero (hard rows) with its errors on the right, and each joint's
+/// Jacobians written where the tree couples it to each body.
+#[inline(always)]
+pub(super) fn assemble<L: Lane>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    rows: &BodyRows,
+    start: usize,
+) {
+    let zero = L::splat(0.0);
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let mut diagonal = [zero; PACKED];
+        let mut rhs = [zero; MAX];
+        match node.kind {
+            NodeKind::Body { index } => {
+                let body = &block.bodies[index as usize];
+                let q = BodyLanes::<L>::gather(rows, &body.row[start..]).q;
+                let mass = L::load(&body.mass[start..]);
+                let [xx, yy, zz, xy, xz, yz] = load::<L, 6>(&body.inertia, start);
+                let inertia = Sym3 {
+                    xx,
+                    yy,
+                    zz,
+                    xy,
+                    xz,
+                    yz,
+                }
+                .rotated(q);
+                for k in 0..3 {
+                    diagonal[at(k, k)] = mass;
+                }
+                diagonal[at(3, 3)] = inertia.xx;
+                diagonal[at(4, 3)] = inertia.xy;
+                diagonal[at(5, 3)] = inertia.xz;
+                diagonal[at(4, 4)] = inertia.yy;
+                diagonal[at(5, 4)] = inertia.yz;
+                diagonal[at(5, 5)] = inertia.zz;
+            }
+            NodeKind::Joint {
+                index,
+                rows: kind,
+                a,
+                b,
+            } => {
+                let joint = &block.joints[index as usize];
+                let (body_a, body_b) = joint.bodies.gather::<L>(rows, start);
+                let measured = Rows::measure(kind, &body_a, &body_b, &joint.geometry(start));
+                let count = kind.count();
+                rhs[..count].copy_from_slice(&measured.c[..count]);
+                // The coupling to body `side` sits with whichever of the two
+                // is the other's child.
+                for (side, jacobian) in [(a, &measured.ja), (b, &measured.jb)] {
+                    if side == NONE {
+                        continue;
+                    }
+                    let holder = if node.parent == side {
+                        n
+                    } else {
+                        side as usize
+                    };
+                    let mut flat = [zero; MAX * 6];
+                    for (r, row) in jacobian.iter().take(count).enumerate() {
+                        flat[r * 6..r * 6 + 6].copy_from_slice(row);
+                    }
+                    store(
+                        &flat[..count * 6],
+                        &mut block.scratch[holder].coupling,
+                        start,
+                    );
+                }
+            }
+        }
+        let scratch = &mut block.scratch[n];
+        store(&diagonal, &mut scratch.diagonal, start);
+        store(&rhs, &mut scratch.rhs, start);
+    }
+}
+
+/// Leaves first: each node's block factored, its Schur complement and its
+/// right-hand side passed to its parent. For a joint child with rows `J`
+/// against its parent body, `D_p -= J^T D^-1 J` and `b_p += J^T D^-1 b`;
+/// for a body child against its parent joint's rows `J`,
+/// `D_p -= J D^-1 J^T` and `b_p += J D^-1 b` (the coupling block is `-J`).
+#[inline(always)]
+pub(super) fn eliminate<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let parent = (node.parent != NONE).then_some(node.parent as usize);
+        match (node.kind, parent.map(|p| topology.size(p))) {
+            (NodeKind::Body { .. }, Some(5)) => body_child::<L, 5>(block, n, parent, start),
+            (NodeKind::Body { .. }, Some(6)) => body_child::<L, 6>(block, n, parent, start),
+            (NodeKind::Body { .. }, _) => body_child::<L, 6>(block, n, None, start),
+            (NodeKind::Joint { rows, .. }, _) if rows.count() == 5 => {
+                joint_child::<L, 5>(block, n, parent, start)
+            }
+            (NodeKind::Joint { .. }, _) => joint_child::<L, 6>(block, n, parent, start),
+        }
+    }
+}
+
+/// Factors node `n`'s `N x N` block in place; returns the factors and
+/// `D^-1 b`.
+#[inline(always)]
+fn factor<L: Lane, const N: usize>(
+    block: &mut TreeBlock,
+    n: usize,
+    start: usize,
+) -> ([L; PACKED], [L; MAX]) {
+    let mut factors = load::<L, PACKED>(&block.scratch[n].diagonal, start);
+    ldl::factor::<L, N>(&mut factors);
+    store(&factors, &mut block.scratch[n].diagonal, start);
+    let mut y = load::<L, MAX>(&block.scratch[n].rhs, start);
+    ldl::solve::<L, N>(&factors, &mut y);
+    (factors, y)
+}
+
+/// A joint node of `N` rows: factored, and its complement passed to its
+/// parent body.
+#[inline(always)]
+fn joint_child<L: Lane, const N: usize>(
+    block: &mut TreeBlock,
+    n: usize,
+    parent: Option<usize>,
+    start: usize,
+) {
+    let (factors, y) = factor::<L, N>(block, n, start);
+    let Some(p) = parent else {
+        return;
+    };
+    let zero = L::splat(0.0);
+    let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
+    // X = D^-1 J, column by column.
+    let mut x = [[zero; MAX]; 6];
+    for (c, column) in x.iter_mut().enumerate() {
+        for r in 0..N {
+            column[r] = j[r * 6 + c];
+        }
+        ldl::solve::<L, N>(&factors, column);
+    }
+    let mut d = load::<L, PACKED>(&block.scratch[p].diagonal, start);
+    let mut b = load::<L, MAX>(&block.scratch[p].rhs, start);
+    for r in 0..6 {
+        for s in 0..=r {
+            let mut sum = j[r] * x[s][0];
+            for i in 1..N {
+                sum += j[i * 6 + r] * x[s][i];
+            }
+            d[at(r, s)] -= sum;
+        }
+        let mut sum = j[r] * y[0];
+        for i in 1..N {
+            sum += j[i * 6 + r] * y[i];
+        }
+        b[r] += sum;
+    }
+    store(&d, &mut block.scratch[p].diagonal, start);
+    store(&b, &mut block.scratch[p].rhs, start);
+}
+
+/// A body node: factored, and its complement passed to its parent joint
+/// of `N` rows (none: the root).
+#[inline(always)]
+fn body_child<L: Lane, const N: usize>(
+    block: &mut TreeBlock,
+    n: usize,
+    parent: Option<usize>,
+    start: usize,
+) {
+    let (factors, y) = factor::<L, 6>(block, n, start);
+    let Some(p) = parent else {
+        return;
+    };
+    let zero = L::splat(0.0);
+    let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
+    // X = D^-1 J^T, one row of J at a time.
+    let mut x = [[zero; MAX]; N];
+    for (r, xr) in x.iter_mut().enumerate() {
+        xr.copy_from_slice(&j[r * 6..r * 6 + 6]);
+        ldl::solve::<L, 6>(&factors, xr);
+    }
+    let mut d = load::<L, PACKED>(&block.scratch[p].diagonal, start);
+    let mut b = load::<L, MAX>(&block.scratch[p].rhs, start);
+    for r in 0..N {
+        for s in 0..=r {
+            let mut sum = j[r * 6] * x[s][0];
+            for c in 1..6 {
+                sum += j[r * 6 + c] * x[s][c];
+            }
+            d[at(r, s)] -= sum;
+        }
+        let mut sum = j[r * 6] * y[0];
+        for c in 1..6 {
+            sum += j[r * 6 + c] * y[c];
+        }
+        b[r] += sum;
+    }
+    store(&d, &mut block.scratch[p].diagonal, start);
+    store(&b, &mut block.scratch[p].rhs, start);
+}
+
+/// Root first: each node's unknowns from its factored block, its
+/// right-hand side and its parent's unknowns (`x = D^-1 (b + J x_p)` for
+/// a joint, `D^-1 (b + J^T x_p)` for a body), kept in `rhs`.
+#[inline(always)]
+pub(super) fn substitute<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
+    for (n, node) in topology.nodes.iter().enumerate().rev() {
+        let parent = (node.parent != NONE).then_some(node.parent as usize);
+        match (node.kind, parent.map(|p| topology.size(p))) {
+            (NodeKind::Body { .. }, Some(5)) => unknowns::<L, 6, 5>(block, n, parent, false, start),
+            (NodeKind::Body { .. }, _) => unknowns::<L, 6, 6>(block, n, parent, false, start),
+            (NodeKind::Joint { rows, .. }, _) if rows.count() == 5 => {
+                unknowns::<L, 5, 6>(block, n, parent, true, start)
+            }
+            (NodeKind::Joint { .. }, _) => unknowns::<L, 6, 6>(block, n, parent, true, start),
+        }
+    }
+}
+
+/// Node `n`'s `N` unknowns, from its parent's `P` (`joint`: `n` holds the
+/// rows, else the parent does).
+#[inline(always)]
+fn unknowns<L: Lane, const N: usize, const P: usize>(
+    block: &mut TreeBlock,
+    n: usize,
+    parent: Option<usize>,
+    joint: bool,
+    start: usize,
+) {
+    let factors = load::<L, PACKED>(&block.scratch[n].diagonal, start);
+    let mut x = load::<L, MAX>(&block.scratch[n].rhs, start);
+    if let Some(p) = parent {
+        let xp = load::<L, MAX>(&block.scratch[p].rhs, start);
+        let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
+        if joint {
+            // x += J x_p: N rows against the body's 6.
+            for (r, xr) in x.iter_mut().enumerate().take(N) {
+                for c in 0..6 {
+                    *xr += j[r * 6 + c] * xp[c];
+                }
+            }
+        } else {
+            // x += J^T x_p: the parent's P rows against this body's 6.
+            for r in 0..P {
+                for c in 0..6 {
+                    x[c] += j[r * 6 + c] * xp[r];
+                }
+            }
+        }
+    }
+    ldl::solve::<L, N>(&factors, &mut x);
+    store(&x[..N], &mut block.scratch[n].rhs, start);
+}
+
+/// Moves every body by its unknowns: `p += dp`, turned by the world
+/// rotation vector `dtheta` (`q += 1/2 (dtheta, 0) q`, renormalised, as
+/// every part turns a body).
+#[inline(always)]
+pub(super) fn apply<L: Lane>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    rows: &BodyRows,
+    start: usize,
+) {
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let NodeKind::Body { index } = node.kind else {
+            continue;
+        };
+        let body = &block.bodies[index as usize];
+        let mut lanes = BodyLanes::<L>::gather(rows, &body.row[start..]);
+        let x = load::<L, MAX>(&block.scratch[n].rhs, start);
+        lanes.p += Vec3::new(x[0], x[1], x[2]);
+        let turn = lanes.q.inverse_rotate(Vec3::new(x[3], x[4], x[5]));
+        lanes.q = lanes.q.integrate_local(turn, L::splat(1.0));
+        lanes.scatter_pose(rows, &body.write[start..]);
+    }
+}
+
+/// Every joint's rows count is 5 or 6 (the sizes above).
+const _: () = {
+    assert!(JointRows::Socket.count() == 5 && JointRows::Rod.count() == 5);
+    assert!(JointRows::Hinge.count() == 6 && JointRows::Fixed.count() == 6);
+};
