@@ -3,8 +3,8 @@
 use glam::Vec3;
 use vertebra_world::{
     AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, Error, JointDesc, JointHandle,
-    JointKind, LimitSoftness, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, RodDesc, RodHandle,
-    RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
+    JointKind, JointSolver, LimitSoftness, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT,
+    RodDesc, RodHandle, RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
 };
 
 use crate::input::Input;
@@ -302,6 +302,7 @@ pub fn world_api(data: &[u8]) {
     let config = SolverConfig {
         iterations: 1 + input.pick(8) as u32,
         substeps: 1 + input.pick(3) as u32,
+        joints: joint_solver(&mut input),
         ..SolverConfig::default()
     };
     calls(World::new(config).expect("a valid config"), &mut input);
@@ -345,7 +346,17 @@ fn settings(input: &mut Input) -> SolverConfig {
         gravity: input.vec3(100.0),
         parallel_min_blocks: 1 + input.pick(8),
         measure_residuals: input.flag(),
+        joints: joint_solver(input),
         ..SolverConfig::default()
+    }
+}
+
+/// Either joint solver: every promise holds for both.
+fn joint_solver(input: &mut Input) -> JointSolver {
+    if input.flag() {
+        JointSolver::Direct
+    } else {
+        JointSolver::Iterative
     }
 }
 
