@@ -49,7 +49,13 @@ pub(crate) struct Trees {
     pub rods: Vec<Option<Place>>,
     /// No two lanes of any blocks write one row: blocks may run at once.
     pub disjoint: bool,
+    /// Each shape's place in `topologies`.
+    shapes: BTreeMap<Shape, usize>,
 }
+
+/// A tree's joints in key order: their rows and their bodies' places in
+/// the tree (`None`: static or kinematic).
+type Shape = Vec<(JointRows, Option<u32>, Option<u32>)>;
 
 /// An edge of the graph: a joint or a rod.
 #[derive(Clone, Copy, Debug)]
@@ -63,7 +69,7 @@ enum Edge {
 struct Found {
     edges: Vec<Edge>,
     bodies: Vec<usize>,
-    shape: Vec<(JointRows, Option<u32>, Option<u32>)>,
+    shape: Shape,
 }
 
 impl Trees {
@@ -78,13 +84,12 @@ impl Trees {
         let first = self.blocks.len();
         let mut by_shape: BTreeMap<usize, Vec<Found>> = BTreeMap::new();
         for found in find(joints, rods, bodies) {
-            let topology = match self.topologies.iter().position(|t| *t == found.topology()) {
-                Some(t) => t,
-                None => {
-                    self.topologies.push(found.topology());
-                    self.topologies.len() - 1
-                }
-            };
+            let next = self.topologies.len();
+            let topology = *self.shapes.entry(found.shape.clone()).or_insert(next);
+            if topology == next {
+                let shape = Topology::new(found.bodies.len(), &found.shape);
+                self.topologies.push(shape.expect("a found tree is a tree"));
+            }
             by_shape.entry(topology).or_default().push(found);
         }
         for (topology, trees) in by_shape {
@@ -170,12 +175,6 @@ impl Trees {
     /// Whether a rod's curve and length are solved here.
     pub fn has_rod(&self, slot: usize) -> bool {
         matches!(self.rods.get(slot), Some(Some(_)))
-    }
-}
-
-impl Found {
-    fn topology(&self) -> Topology {
-        Topology::new(self.bodies.len(), &self.shape).expect("a found tree is a tree")
     }
 }
 

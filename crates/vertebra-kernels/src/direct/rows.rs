@@ -29,7 +29,7 @@ use crate::parts::rod::{bend, curve, length, twist as rod_twist};
 use crate::parts::{axis_x, frames, lock, point, swing, twist};
 
 /// What a joint holds equal, and so its rows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum JointRows {
     /// A socket: the point, the swing cone and the twist range (5 rows).
     Socket,
