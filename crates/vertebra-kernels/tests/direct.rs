@@ -1120,3 +1120,214 @@ fn bent_rods_converge_linearly() {
         assert!(e[4] <= 1e-3 * e[0], "errors {}", show(&e));
     }
 }
+
+// ---------------------------------------------------------------------------
+// Every backend: the scalar reference's bits.
+// ---------------------------------------------------------------------------
+
+/// One block of trees and its topology.
+#[derive(Clone)]
+struct Trees {
+    block: TreeBlock,
+    topology: Topology,
+}
+
+const KINDS: [JointRows; 4] = [Point, Hinge, Fixed, Rod];
+
+/// Static bodies at the end of the rows, shared by every lane.
+const STATICS: usize = 2;
+
+/// A random tree shape of 1 to 7 bodies: each body after the first (in a
+/// random order) joined to one before it, either way round, by a random
+/// kind; sometimes one joint to a static body; the joints shuffled.
+fn random_shape(r: &mut StdRng) -> (usize, Vec<(JointRows, Option<u32>, Option<u32>)>) {
+    let n = r.random_range(1..=7);
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    shuffle(r, &mut order);
+    let kind = |r: &mut StdRng| KINDS[r.random_range(0..KINDS.len())];
+    let mut joints = Vec::new();
+    for k in 1..n {
+        let (parent, child) = (order[r.random_range(0..k)], order[k]);
+        let (a, b) = if r.random_bool(0.5) { (parent, child) } else { (child, parent) };
+        joints.push((kind(r), Some(a), Some(b)));
+    }
+    if r.random_bool(0.6) {
+        let body = Some(order[r.random_range(0..n)]);
+        joints.push(if r.random_bool(0.5) { (kind(r), None, body) } else { (kind(r), body, None) });
+    }
+    shuffle(r, &mut joints);
+    (n, joints)
+}
+
+fn shuffle<T>(r: &mut StdRng, items: &mut [T]) {
+    for i in (1..items.len()).rev() {
+        items.swap(i, r.random_range(0..=i));
+    }
+}
+
+/// Fills `lane` of `block` with a tree of its topology's shape at random
+/// (adversarial: all its bodies at one point, so rods' ends meet; anchors
+/// at the centres; hinge axes exactly opposed; frames exactly aligned;
+/// identity orientations; a vanishing rest length; a start of step of
+/// zero), its bodies' rows from `first_row`.
+fn random_lane(
+    r: &mut StdRng,
+    raw: &mut RawRows,
+    block: &mut TreeBlock,
+    shape: &[(JointRows, Option<u32>, Option<u32>)],
+    lane: usize,
+    first_row: usize,
+    adversarial: bool,
+) {
+    let chance = |r: &mut StdRng, p: f64| adversarial && r.random_bool(p);
+    let bodies = block.bodies.len();
+    let together = chance(r, 0.2);
+    // The offset from the start pose (m, rad): none, small or large.
+    let size = [0.0, 1e-3, 0.3][r.random_range(0..3)];
+    let offset = |r: &mut StdRng| if size > 0.0 { vec(r, size) } else { GVec3::ZERO };
+    let mut poses = Vec::new();
+    for (i, node) in block.bodies.iter_mut().enumerate() {
+        let x = if together { DVec3::ZERO } else { vec(r, 1.0).as_dvec3() };
+        let q = if chance(r, 0.3) { GQuat::IDENTITY } else { unit_quat(r) };
+        let mass = log_uniform(r, -3.0, 3.0);
+        let mut body = body_at(r, x, mass);
+        body.q = q;
+        let (dp, dtheta) = (offset(r), offset(r));
+        let row = first_row + i;
+        raw[row] = [
+            BodyRows::pose_row(dp, 1.0 / body.mass, GQuat::from_scaled_axis(dtheta) * q),
+            BodyRows::inertia_row(body.inertia.inverse()),
+            BodyRows::velocity_row(vec(r, 1.0), vec(r, 1.0)),
+        ];
+        node.set(lane, row as u32, true, body.mass, body.inertia);
+        poses.push((x, q));
+    }
+    let statics = raw.len() - STATICS;
+    for (node, &(kind, a, b)) in block.joints.iter_mut().zip(shape) {
+        let mut side = |r: &mut StdRng, side: Option<u32>| match side {
+            Some(i) => (first_row + i as usize, poses[i as usize]),
+            None => {
+                let row = statics + r.random_range(0..STATICS);
+                (row, (DVec3::ZERO, GQuat::from_slice(&raw[row][0][4..])))
+            }
+        };
+        let ((row_a, (xa, qa)), (row_b, (xb, qb))) = (side(r, a), side(r, b));
+        let centred = kind == Rod || chance(r, 0.3);
+        let anchor = |r: &mut StdRng| if centred { GVec3::ZERO } else { vec(r, 0.5) };
+        let (anchor_a, anchor_b) = (anchor(r), anchor(r));
+        let frame_a = unit_quat(r);
+        let frame_b = match r.random_range(0..if adversarial { 4 } else { 1 }) {
+            1 => qb.inverse() * qa * frame_a * GQuat::from_rotation_y(core::f32::consts::PI),
+            2 => qb.inverse() * qa * frame_a,
+            _ => unit_quat(r),
+        };
+        let start = if chance(r, 0.3) {
+            StartLane::default()
+        } else {
+            StartLane::new(xa, qa, anchor_a, xb, qb, anchor_b)
+        };
+        node.set(
+            lane,
+            &JointLane {
+                body_a: row_a as u32,
+                body_b: row_b as u32,
+                anchor_a,
+                anchor_b,
+                frame_a,
+                frame_b,
+                rest_length: if chance(r, 0.2) { 1e-6 } else { r.random_range(0.1..2.0) },
+            },
+        );
+        node.bodies.set_start(lane, &start);
+    }
+    block.padding &= !(1 << lane);
+    debug_assert_eq!(bodies, poses.len());
+}
+
+/// `blocks` blocks of random shapes, each lane (but one in ten, padding)
+/// a random tree of its block's shape.
+fn tree_scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<Trees>) {
+    let mut r = StdRng::seed_from_u64(seed);
+    let shapes: Vec<_> = (0..blocks).map(|_| random_shape(&mut r)).collect();
+    let rows: usize = shapes.iter().map(|(n, _)| n * BLOCK_LANES).sum();
+    let mut raw = vec![BodyRows::null_raw(); 1 + rows + STATICS];
+    for row in &mut raw[1 + rows..] {
+        row[0] = BodyRows::pose_row(GVec3::ZERO, 0.0, unit_quat(&mut r));
+    }
+    let mut out = Vec::new();
+    let mut first_row = 1;
+    for (index, (n, shape)) in shapes.iter().enumerate() {
+        let topology = Topology::new(*n, shape).expect("a tree");
+        let mut block = TreeBlock::padding(index as u32, &topology);
+        for lane in 0..BLOCK_LANES {
+            if !r.random_bool(0.1) {
+                random_lane(&mut r, &mut raw, &mut block, shape, lane, first_row + lane * n, adversarial);
+            }
+        }
+        first_row += n * BLOCK_LANES;
+        out.push(Trees { block, topology });
+    }
+    (raw, out)
+}
+
+/// Makes `lane` padding, as `TreeBlock::padding` lays it out: the null
+/// row, written nowhere, a unit mass; joints between null rows.
+fn clear_lane(trees: &mut Trees, lane: usize) {
+    let block = &mut trees.block;
+    block.padding |= 1 << lane;
+    for body in &mut block.bodies {
+        body.set(lane, 0, false, 1.0, Mat3::IDENTITY);
+    }
+    let empty = JointLane {
+        body_a: 0,
+        body_b: 0,
+        anchor_a: GVec3::ZERO,
+        anchor_b: GVec3::ZERO,
+        frame_a: GQuat::IDENTITY,
+        frame_b: GQuat::IDENTITY,
+        rest_length: 0.0,
+    };
+    for joint in &mut block.joints {
+        joint.set(lane, &empty);
+        joint.bodies.set_start(lane, &StartLane::default());
+    }
+}
+
+/// Two passes (the second re-linearised where the first left the bodies):
+/// every row, and every live lane's unknowns.
+fn run_trees(backend: Backend, raw: &RawRows, trees: &[Trees]) -> Vec<f32> {
+    let rows = to_rows(raw);
+    let topologies: Vec<Topology> = trees.iter().map(|t| t.topology.clone()).collect();
+    let mut blocks: Vec<TreeBlock> = trees.iter().map(|t| t.block.clone()).collect();
+    for _ in 0..2 {
+        pass(backend, &rows, &mut blocks, &topologies);
+    }
+    let mut out = flatten(&rows);
+    for (block, topology) in blocks.iter().zip(&topologies) {
+        for lane in (0..BLOCK_LANES).filter(|lane| block.padding & (1 << lane) == 0) {
+            for (node, scratch) in topology.nodes.iter().zip(&block.scratch) {
+                let size = match node.kind {
+                    NodeKind::Body { .. } => 6,
+                    NodeKind::Joint { rows, .. } => rows.count(),
+                };
+                out.extend(scratch.rhs[..size].iter().map(|v| v[lane]));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn random_trees_agree_on_every_backend() {
+    common::agree_over_seeds(0..40, false, tree_scene, run_trees);
+}
+
+#[test]
+fn adversarial_trees_agree_on_every_backend_and_stay_finite() {
+    common::agree_over_seeds(200..280, true, tree_scene, run_trees);
+}
+
+#[test]
+fn blocks_of_one_to_eight_trees_agree_on_every_backend() {
+    common::padded_blocks_agree(400..410, tree_scene, clear_lane, run_trees);
+}
