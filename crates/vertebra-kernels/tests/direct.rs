@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{RawRows, assert_backends_agree, flatten, to_rows, unit_quat, vec};
+use common::{RawRows, flatten, to_rows, unit_quat, vec};
 use glam::{DVec3, Mat3, Quat as GQuat, Vec3 as GVec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -14,8 +14,7 @@ use vertebra_kernels::body::{BodyLanes, BodyRows, PairStart, StartLane};
 use vertebra_kernels::direct::ldl::{self, MAX, PACKED, at};
 use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows};
 use vertebra_kernels::direct::{
-    BodyNode, JointLane, JointNode, NONE, NodeKind, PositionPass, Topology, TopologyError,
-    TreeBlock,
+    JointLane, NONE, NodeKind, PositionPass, Topology, TopologyError, TreeBlock,
 };
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Backend, Sym3, Vec3};
@@ -66,10 +65,11 @@ fn reference_solve(a: &Dense, b: &[f64]) -> Vec<f64> {
             .max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs()))
             .unwrap();
         m.swap(c, p);
-        for i in c + 1..n {
-            let f = m[i][c] / m[c][c];
-            for k in c..=n {
-                m[i][k] -= f * m[c][k];
+        let pivot = m[c].clone();
+        for row in &mut m[c + 1..] {
+            let f = row[c] / pivot[c];
+            for (v, p) in row.iter_mut().zip(&pivot).skip(c) {
+                *v -= f * p;
             }
         }
     }
@@ -137,9 +137,9 @@ fn ldl_drops_a_row_of_zeros_and_solves_the_others_exactly() {
     for n in 1..=MAX {
         for zero in 0..n {
             let mut a = gram(&random_matrix(&mut r, n), 0.3);
-            for k in 0..n {
-                a[zero][k] = 0.0;
-                a[k][zero] = 0.0;
+            a[zero].fill(0.0);
+            for row in &mut a {
+                row[zero] = 0.0;
             }
             let b: Vec<f64> = (0..n).map(|_| r.random_range(-1.0..1.0)).collect();
             let (f, x) = ldl_solve(&a, &b);
@@ -406,7 +406,8 @@ fn rod(r: &mut StdRng, distance: f32, bend: f32, misalignment: GQuat) -> Measure
     // a's tangent `bend` from o; b's the reflection of a's about o.
     let side = o.any_orthonormal_vector();
     let ta = GQuat::from_axis_angle(side, bend) * o;
-    let frame_a = GQuat::from_rotation_arc(GVec3::X, ta) * GQuat::from_rotation_x(r.random_range(-3.0..3.0));
+    let frame_a =
+        GQuat::from_rotation_arc(GVec3::X, ta) * GQuat::from_rotation_x(r.random_range(-3.0..3.0));
     let reflected = 2.0 * ta.dot(o) * o - ta;
     let frame_b = misalignment * GQuat::from_rotation_arc(ta, reflected) * frame_a;
     let psi = ta.angle_between(reflected);
@@ -446,7 +447,10 @@ fn point_rows_are_exact_gradients_everywhere() {
             let m = joint(&mut r, kind, misalignment);
             let all: Vec<usize> = (0..COORDINATES).collect();
             let deviation = m.deviation(0..3, &all);
-            assert!(deviation < 1e-3, "{kind:?} point rows: deviation {deviation:.2e}");
+            assert!(
+                deviation < 1e-3,
+                "{kind:?} point rows: deviation {deviation:.2e}"
+            );
         }
     }
 }
@@ -544,7 +548,8 @@ fn curve_rows_stay_gradients_for_a_rod_bent_a_right_angle_in_its_frame_plane() {
                 anchor_b: Vec3::zero(),
                 frame_a: GQuat::IDENTITY.into(),
                 frame_b: (GQuat::from(b.q).inverse() * frame_b).into(),
-                rest_length: d * core::f32::consts::FRAC_PI_2 / (2.0 * core::f32::consts::FRAC_PI_4.sin()),
+                rest_length: d * core::f32::consts::FRAC_PI_2
+                    / (2.0 * core::f32::consts::FRAC_PI_4.sin()),
                 start: pair_start(&StartLane::default()),
             },
         };
@@ -570,7 +575,10 @@ fn rod_length_row_is_the_gradient_of_its_linear_part_and_drops_the_bend() {
         let mut rod = rod(&mut r, d, bend, misalignment);
         rod.g.rest_length *= r.random_range(0.5..2.0);
         let deviation = rod.deviation(2..3, &LINEAR);
-        assert!(deviation < 1e-3, "length row / p: deviation {deviation:.2e}");
+        assert!(
+            deviation < 1e-3,
+            "length row / p: deviation {deviation:.2e}"
+        );
         let analytic = rod.analytic()[2];
         assert!(ANGULAR.iter().all(|&c| analytic[c] == 0.0));
     }
@@ -667,7 +675,14 @@ impl Tree {
     /// `point` with the world frame `frame`; a rod between the centres,
     /// a's tangent along `frame`'s +X, b's its reflection about the chord,
     /// its rest length the arc's (straight when `frame`'s +X is the chord).
-    fn join(&mut self, kind: JointRows, a: Option<usize>, b: Option<usize>, point: DVec3, frame: GQuat) {
+    fn join(
+        &mut self,
+        kind: JointRows,
+        a: Option<usize>,
+        b: Option<usize>,
+        point: DVec3,
+        frame: GQuat,
+    ) {
         let ((xa, qa), (xb, qb)) = (self.pose(a), self.pose(b));
         let (anchor_a, anchor_b, frame_b, rest_length) = if kind == JointRows::Rod {
             let chord = (xb - xa).as_vec3();
@@ -705,7 +720,8 @@ impl Tree {
         let ((xa, _), (xb, _)) = (self.pose(a), self.pose(b));
         let frame = if kind == JointRows::Rod {
             let o = (xb - xa).as_vec3().normalize();
-            GQuat::from_rotation_arc(GVec3::X, o) * GQuat::from_rotation_x(r.random_range(-3.0..3.0))
+            GQuat::from_rotation_arc(GVec3::X, o)
+                * GQuat::from_rotation_x(r.random_range(-3.0..3.0))
         } else {
             unit_quat(r)
         };
@@ -742,7 +758,12 @@ fn hanging_chain(r: &mut StdRng, kinds: &[JointRows]) -> Tree {
 /// A humanoid-like star, free: a 10 kg root and four chains of three
 /// bodies (0.01 to 10 kg), each chain's joints every kind in turn.
 fn star(r: &mut StdRng) -> Tree {
-    const KINDS: [JointRows; 4] = [JointRows::Hinge, JointRows::Fixed, JointRows::Rod, JointRows::Point];
+    const KINDS: [JointRows; 4] = [
+        JointRows::Hinge,
+        JointRows::Fixed,
+        JointRows::Rod,
+        JointRows::Point,
+    ];
     let mut tree = Tree::new();
     tree.bodies.push(body_at(r, DVec3::ZERO, 10.0));
     let directions = [DVec3::X, -DVec3::X, DVec3::NEG_Y, DVec3::Y];
@@ -792,11 +813,16 @@ impl Scene {
     }
 
     fn raw(&self, offsets: &[Offsets]) -> RawRows {
-        let mut raw = vec![BodyRows::null_raw(); 1 + self.trees.len() * (self.trees[0].bodies.len() + 1)];
+        let mut raw =
+            vec![BodyRows::null_raw(); 1 + self.trees.len() * (self.trees[0].bodies.len() + 1)];
         for (lane, (tree, offsets)) in self.trees.iter().zip(offsets).enumerate() {
             for (i, (body, &(dp, dtheta))) in tree.bodies.iter().zip(offsets).enumerate() {
                 raw[self.body_row(lane, i) as usize] = [
-                    BodyRows::pose_row(dp, 1.0 / body.mass, GQuat::from_scaled_axis(dtheta) * body.q),
+                    BodyRows::pose_row(
+                        dp,
+                        1.0 / body.mass,
+                        GQuat::from_scaled_axis(dtheta) * body.q,
+                    ),
                     BodyRows::inertia_row(body.inertia.inverse()),
                     BodyRows::velocity_row(GVec3::ZERO, GVec3::ZERO),
                 ];
@@ -868,7 +894,12 @@ fn unknowns(block: &TreeBlock, topology: &Topology, lane: usize, index: usize) -
     let node = topology
         .nodes
         .iter()
-        .position(|n| n.kind == NodeKind::Body { index: index as u32 })
+        .position(|n| {
+            n.kind
+                == NodeKind::Body {
+                    index: index as u32,
+                }
+        })
         .expect("every body is a node");
     let x = block.scratch[node].rhs.map(|v| v[lane]);
     (GVec3::new(x[0], x[1], x[2]), GVec3::new(x[3], x[4], x[5]))
@@ -966,7 +997,11 @@ fn one_pass(tree: &Tree, offsets: &Offsets) -> Pass {
     let rows = to_rows(&scene.raw(std::slice::from_ref(offsets)));
     let displacements = |rows: &BodyRows| -> Vec<GVec3> {
         (0..tree.bodies.len())
-            .map(|i| BodyLanes::<f32>::gather(rows, &[scene.body_row(0, i)]).p.into())
+            .map(|i| {
+                BodyLanes::<f32>::gather(rows, &[scene.body_row(0, i)])
+                    .p
+                    .into()
+            })
             .collect()
     };
     let before = (0..tree.joints.len())
@@ -974,7 +1009,12 @@ fn one_pass(tree: &Tree, offsets: &Offsets) -> Pass {
         .collect();
     let p_before = displacements(&rows);
     let mut blocks = vec![scene.block(0)];
-    pass(Backend::Scalar, &rows, &mut blocks, std::slice::from_ref(&scene.topology));
+    pass(
+        Backend::Scalar,
+        &rows,
+        &mut blocks,
+        std::slice::from_ref(&scene.topology),
+    );
     Pass {
         before,
         p_before,
@@ -1077,7 +1117,10 @@ fn a_free_tree_keeps_its_linear_momentum_and_its_angular_to_first_order() {
             }
             let linear = linear.length() / linear_scale;
             let angular = angular.length() / angular_scale;
-            assert!(linear <= 1e-5, "offsets {size}: linear momentum {linear:.2e}");
+            assert!(
+                linear <= 1e-5,
+                "offsets {size}: linear momentum {linear:.2e}"
+            );
             assert!(
                 angular <= 2.0 * size as f64,
                 "offsets {size}: angular momentum {angular:.2e}"
@@ -1125,6 +1168,9 @@ fn bent_rods_converge_linearly() {
 // Every backend: the scalar reference's bits.
 // ---------------------------------------------------------------------------
 
+/// A tree's joints as `Topology::new` takes them: rows and bodies.
+type Shape = Vec<(JointRows, Option<u32>, Option<u32>)>;
+
 /// One block of trees and its topology.
 #[derive(Clone)]
 struct Trees {
@@ -1140,7 +1186,7 @@ const STATICS: usize = 2;
 /// A random tree shape of 1 to 7 bodies: each body after the first (in a
 /// random order) joined to one before it, either way round, by a random
 /// kind; sometimes one joint to a static body; the joints shuffled.
-fn random_shape(r: &mut StdRng) -> (usize, Vec<(JointRows, Option<u32>, Option<u32>)>) {
+fn random_shape(r: &mut StdRng) -> (usize, Shape) {
     let n = r.random_range(1..=7);
     let mut order: Vec<u32> = (0..n as u32).collect();
     shuffle(r, &mut order);
@@ -1148,12 +1194,20 @@ fn random_shape(r: &mut StdRng) -> (usize, Vec<(JointRows, Option<u32>, Option<u
     let mut joints = Vec::new();
     for k in 1..n {
         let (parent, child) = (order[r.random_range(0..k)], order[k]);
-        let (a, b) = if r.random_bool(0.5) { (parent, child) } else { (child, parent) };
+        let (a, b) = if r.random_bool(0.5) {
+            (parent, child)
+        } else {
+            (child, parent)
+        };
         joints.push((kind(r), Some(a), Some(b)));
     }
     if r.random_bool(0.6) {
         let body = Some(order[r.random_range(0..n)]);
-        joints.push(if r.random_bool(0.5) { (kind(r), None, body) } else { (kind(r), body, None) });
+        joints.push(if r.random_bool(0.5) {
+            (kind(r), None, body)
+        } else {
+            (kind(r), body, None)
+        });
     }
     shuffle(r, &mut joints);
     (n, joints)
@@ -1180,15 +1234,28 @@ fn random_lane(
     adversarial: bool,
 ) {
     let chance = |r: &mut StdRng, p: f64| adversarial && r.random_bool(p);
-    let bodies = block.bodies.len();
     let together = chance(r, 0.2);
     // The offset from the start pose (m, rad): none, small or large.
     let size = [0.0, 1e-3, 0.3][r.random_range(0..3)];
-    let offset = |r: &mut StdRng| if size > 0.0 { vec(r, size) } else { GVec3::ZERO };
+    let offset = |r: &mut StdRng| {
+        if size > 0.0 {
+            vec(r, size)
+        } else {
+            GVec3::ZERO
+        }
+    };
     let mut poses = Vec::new();
     for (i, node) in block.bodies.iter_mut().enumerate() {
-        let x = if together { DVec3::ZERO } else { vec(r, 1.0).as_dvec3() };
-        let q = if chance(r, 0.3) { GQuat::IDENTITY } else { unit_quat(r) };
+        let x = if together {
+            DVec3::ZERO
+        } else {
+            vec(r, 1.0).as_dvec3()
+        };
+        let q = if chance(r, 0.3) {
+            GQuat::IDENTITY
+        } else {
+            unit_quat(r)
+        };
         let mass = log_uniform(r, -3.0, 3.0);
         let mut body = body_at(r, x, mass);
         body.q = q;
@@ -1204,7 +1271,7 @@ fn random_lane(
     }
     let statics = raw.len() - STATICS;
     for (node, &(kind, a, b)) in block.joints.iter_mut().zip(shape) {
-        let mut side = |r: &mut StdRng, side: Option<u32>| match side {
+        let side = |r: &mut StdRng, side: Option<u32>| match side {
             Some(i) => (first_row + i as usize, poses[i as usize]),
             None => {
                 let row = statics + r.random_range(0..STATICS);
@@ -1235,13 +1302,16 @@ fn random_lane(
                 anchor_b,
                 frame_a,
                 frame_b,
-                rest_length: if chance(r, 0.2) { 1e-6 } else { r.random_range(0.1..2.0) },
+                rest_length: if chance(r, 0.2) {
+                    1e-6
+                } else {
+                    r.random_range(0.1..2.0)
+                },
             },
         );
         node.bodies.set_start(lane, &start);
     }
     block.padding &= !(1 << lane);
-    debug_assert_eq!(bodies, poses.len());
 }
 
 /// `blocks` blocks of random shapes, each lane (but one in ten, padding)
@@ -1261,7 +1331,15 @@ fn tree_scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<Tree
         let mut block = TreeBlock::padding(index as u32, &topology);
         for lane in 0..BLOCK_LANES {
             if !r.random_bool(0.1) {
-                random_lane(&mut r, &mut raw, &mut block, shape, lane, first_row + lane * n, adversarial);
+                random_lane(
+                    &mut r,
+                    &mut raw,
+                    &mut block,
+                    shape,
+                    lane,
+                    first_row + lane * n,
+                    adversarial,
+                );
             }
         }
         first_row += n * BLOCK_LANES;
@@ -1330,4 +1408,192 @@ fn adversarial_trees_agree_on_every_backend_and_stay_finite() {
 #[test]
 fn blocks_of_one_to_eight_trees_agree_on_every_backend() {
     common::padded_blocks_agree(400..410, tree_scene, clear_lane, run_trees);
+}
+
+// ---------------------------------------------------------------------------
+// `Topology::new`: the elimination order, and what is not a tree.
+// ---------------------------------------------------------------------------
+
+/// Every body and joint is one node; every node's parent comes after it
+/// and the root, the only node without one, last (the grounded joint if
+/// there is one, else body 0); a joint's sides name its bodies' nodes
+/// (`NONE` for a static side) and its rows; a body's parent is a joint
+/// touching it, a joint's one of its sides; so every parent link is an
+/// edge of the tree, and every edge is a parent link.
+fn check_order(topology: &Topology, bodies: usize, joints: &Shape) {
+    let nodes = &topology.nodes;
+    assert_eq!((topology.bodies, topology.joints), (bodies, joints.len()));
+    assert_eq!(nodes.len(), bodies + joints.len());
+    let body_node = |i: u32| {
+        nodes
+            .iter()
+            .position(|n| n.kind == NodeKind::Body { index: i })
+            .expect("every body is a node") as u32
+    };
+    let root = nodes.last().expect("a node");
+    match joints
+        .iter()
+        .position(|&(_, a, b)| a.is_none() || b.is_none())
+    {
+        Some(j) => {
+            assert!(matches!(root.kind, NodeKind::Joint { index, .. } if index as usize == j))
+        }
+        None => assert_eq!(root.kind, NodeKind::Body { index: 0 }),
+    }
+    let mut joint_seen = vec![false; joints.len()];
+    for (n, node) in nodes.iter().enumerate() {
+        if n + 1 == nodes.len() {
+            assert_eq!(node.parent, NONE, "the root has a parent");
+        } else {
+            assert!(
+                node.parent != NONE && node.parent as usize > n,
+                "node {n} before its parent"
+            );
+        }
+        match node.kind {
+            NodeKind::Body { index } => {
+                assert_eq!(body_node(index), n as u32, "body {index} twice");
+                if node.parent != NONE {
+                    let NodeKind::Joint { a, b, .. } = nodes[node.parent as usize].kind else {
+                        panic!("body {index}'s parent is a body");
+                    };
+                    assert!(
+                        a == n as u32 || b == n as u32,
+                        "body {index}'s parent joint is not its"
+                    );
+                }
+            }
+            NodeKind::Joint { index, rows, a, b } => {
+                let (kind, ja, jb) = joints[index as usize];
+                assert!(!joint_seen[index as usize], "joint {index} twice");
+                joint_seen[index as usize] = true;
+                assert_eq!(rows, kind);
+                assert_eq!(a, ja.map_or(NONE, body_node));
+                assert_eq!(b, jb.map_or(NONE, body_node));
+                for side in [a, b].into_iter().filter(|&s| s != NONE) {
+                    let edge = node.parent == side || nodes[side as usize].parent == n as u32;
+                    assert!(
+                        edge,
+                        "joint {index}'s edge to node {side} is no parent link"
+                    );
+                }
+                if node.parent != NONE {
+                    assert!(
+                        node.parent == a || node.parent == b,
+                        "joint {index}'s parent is not its body"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn topology_orders_every_node_after_its_children_and_the_root_last() {
+    let mut r = StdRng::seed_from_u64(30);
+    for _ in 0..500 {
+        let (n, shape) = random_shape(&mut r);
+        let topology = Topology::new(n, &shape).expect("a tree");
+        check_order(&topology, n, &shape);
+    }
+    for tree in [hanging_chain(&mut r, &[Point]), star(&mut r)] {
+        let shape: Shape = tree
+            .joints
+            .iter()
+            .map(|j| (j.kind, j.a.map(|i| i as u32), j.b.map(|i| i as u32)))
+            .collect();
+        check_order(&tree.topology(), tree.bodies.len(), &shape);
+    }
+}
+
+#[test]
+fn topology_refuses_loops_disconnected_sets_and_bad_joints() {
+    use TopologyError::{BadJoint, Disconnected, Loop};
+    let cases: [(&str, usize, Shape, TopologyError); 11] = [
+        (
+            "a triangle",
+            3,
+            vec![
+                (Point, Some(0), Some(1)),
+                (Hinge, Some(1), Some(2)),
+                (Rod, Some(2), Some(0)),
+            ],
+            Loop,
+        ),
+        (
+            "two joints between one pair",
+            2,
+            vec![(Point, Some(0), Some(1)), (Fixed, Some(1), Some(0))],
+            Loop,
+        ),
+        (
+            "a body joined to itself",
+            2,
+            vec![(Point, Some(0), Some(1)), (Hinge, Some(1), Some(1))],
+            Loop,
+        ),
+        (
+            "two joints to static bodies",
+            2,
+            vec![
+                (Point, None, Some(0)),
+                (Point, Some(0), Some(1)),
+                (Point, Some(1), None),
+            ],
+            Loop,
+        ),
+        (
+            "two grounded pairs",
+            2,
+            vec![(Point, None, Some(0)), (Point, Some(1), None)],
+            Loop,
+        ),
+        ("two free bodies", 2, vec![], Disconnected),
+        (
+            "two pairs",
+            4,
+            vec![(Point, Some(0), Some(1)), (Rod, Some(2), Some(3))],
+            Disconnected,
+        ),
+        (
+            "a body left out",
+            2,
+            vec![(Point, None, Some(0))],
+            Disconnected,
+        ),
+        ("nothing", 0, vec![], Disconnected),
+        (
+            "a body past the count",
+            3,
+            vec![(Point, Some(0), Some(1)), (Point, Some(1), Some(3))],
+            BadJoint,
+        ),
+        (
+            "a joint to no body",
+            2,
+            vec![(Point, Some(0), Some(1)), (Point, None, None)],
+            BadJoint,
+        ),
+    ];
+    for (name, bodies, joints, expected) in cases {
+        assert_eq!(Topology::new(bodies, &joints), Err(expected), "{name}");
+    }
+    // Any random tree with one joint more closes a loop; with one of its
+    // joints between two bodies fewer, it falls apart.
+    let mut r = StdRng::seed_from_u64(31);
+    for _ in 0..300 {
+        let (n, mut shape) = random_shape(&mut r);
+        if n < 2 {
+            continue;
+        }
+        let mut fewer = shape.clone();
+        let inner = fewer
+            .iter()
+            .position(|&(_, a, b)| a.is_some() && b.is_some());
+        fewer.remove(inner.expect("n > 1 bodies are joined"));
+        assert_eq!(Topology::new(n, &fewer), Err(Disconnected), "{fewer:?}");
+        let (a, b) = (r.random_range(0..n as u32), r.random_range(0..n as u32));
+        shape.insert(r.random_range(0..=shape.len()), (Point, Some(a), Some(b)));
+        assert_eq!(Topology::new(n, &shape), Err(Loop), "{shape:?}");
+    }
 }
