@@ -792,77 +792,69 @@ fn offsets(r: &mut StdRng, tree: &Tree, size: f32) -> Offsets {
         .collect()
 }
 
-/// The rows of trees of one shape, one per lane: lane `l`'s body `i` at
-/// row `1 + l n + i`, its ground after every lane's bodies.
+/// One tree in lane 0 of a block: body `i` at row `1 + i`, the ground
+/// after the bodies.
 struct Scene {
-    trees: Vec<Tree>,
+    tree: Tree,
     topology: Topology,
 }
 
 impl Scene {
-    fn body_row(&self, lane: usize, i: usize) -> u32 {
-        (1 + lane * self.trees[0].bodies.len() + i) as u32
-    }
-
-    fn side_row(&self, lane: usize, side: Option<usize>) -> u32 {
-        side.map_or(self.ground_row(lane), |i| self.body_row(lane, i))
-    }
-
-    fn ground_row(&self, lane: usize) -> u32 {
-        (1 + self.trees.len() * self.trees[0].bodies.len() + lane) as u32
-    }
-
-    fn raw(&self, offsets: &[Offsets]) -> RawRows {
-        let mut raw =
-            vec![BodyRows::null_raw(); 1 + self.trees.len() * (self.trees[0].bodies.len() + 1)];
-        for (lane, (tree, offsets)) in self.trees.iter().zip(offsets).enumerate() {
-            for (i, (body, &(dp, dtheta))) in tree.bodies.iter().zip(offsets).enumerate() {
-                raw[self.body_row(lane, i) as usize] = [
-                    BodyRows::pose_row(
-                        dp,
-                        1.0 / body.mass,
-                        GQuat::from_scaled_axis(dtheta) * body.q,
-                    ),
-                    BodyRows::inertia_row(body.inertia.inverse()),
-                    BodyRows::velocity_row(GVec3::ZERO, GVec3::ZERO),
-                ];
-            }
-            raw[self.ground_row(lane) as usize][0] =
-                BodyRows::pose_row(GVec3::ZERO, 0.0, tree.ground.1);
+    fn new(tree: &Tree) -> Self {
+        Self {
+            tree: tree.clone(),
+            topology: tree.topology(),
         }
-        raw
     }
 
-    fn block(&self, topology: u32) -> TreeBlock {
-        let mut block = TreeBlock::padding(topology, &self.topology);
-        for (lane, tree) in self.trees.iter().enumerate() {
-            block.padding &= !(1 << lane);
-            for (i, body) in tree.bodies.iter().enumerate() {
-                block.bodies[i].set(lane, self.body_row(lane, i), true, body.mass, body.inertia);
-            }
-            for (node, j) in block.joints.iter_mut().zip(&tree.joints) {
-                node.set(
-                    lane,
-                    &JointLane {
-                        body_a: self.side_row(lane, j.a),
-                        body_b: self.side_row(lane, j.b),
-                        anchor_a: j.anchor_a,
-                        anchor_b: j.anchor_b,
-                        frame_a: j.frame_a,
-                        frame_b: j.frame_b,
-                        rest_length: j.rest_length,
-                    },
-                );
-                node.bodies.set_start(lane, &j.start);
-            }
+    fn side_row(&self, side: Option<usize>) -> u32 {
+        (1 + side.unwrap_or(self.tree.bodies.len())) as u32
+    }
+
+    /// The rows, each body offset from its start pose by `offsets`.
+    fn rows(&self, offsets: &Offsets) -> BodyRows {
+        let mut raw = vec![BodyRows::null_raw(); self.tree.bodies.len() + 2];
+        for (i, (body, &(dp, dtheta))) in self.tree.bodies.iter().zip(offsets).enumerate() {
+            let q = GQuat::from_scaled_axis(dtheta) * body.q;
+            raw[1 + i] = [
+                BodyRows::pose_row(dp, 1.0 / body.mass, q),
+                BodyRows::inertia_row(body.inertia.inverse()),
+                BodyRows::velocity_row(GVec3::ZERO, GVec3::ZERO),
+            ];
+        }
+        raw[self.side_row(None) as usize][0] =
+            BodyRows::pose_row(GVec3::ZERO, 0.0, self.tree.ground.1);
+        to_rows(&raw)
+    }
+
+    fn block(&self) -> TreeBlock {
+        let mut block = TreeBlock::padding(0, &self.topology);
+        block.padding &= !1;
+        for (i, body) in self.tree.bodies.iter().enumerate() {
+            block.bodies[i].set(0, self.side_row(Some(i)), true, body.mass, body.inertia);
+        }
+        for (node, j) in block.joints.iter_mut().zip(&self.tree.joints) {
+            node.set(
+                0,
+                &JointLane {
+                    body_a: self.side_row(j.a),
+                    body_b: self.side_row(j.b),
+                    anchor_a: j.anchor_a,
+                    anchor_b: j.anchor_b,
+                    frame_a: j.frame_a,
+                    frame_b: j.frame_b,
+                    rest_length: j.rest_length,
+                },
+            );
+            node.bodies.set_start(0, &j.start);
         }
         block
     }
 
-    /// Joint `j` of lane `lane` as the rows stand.
-    fn measured(&self, rows: &BodyRows, lane: usize, j: usize) -> Measured {
-        let joint = &self.trees[lane].joints[j];
-        let gather = |side| BodyLanes::<f32>::gather(rows, &[self.side_row(lane, side)]);
+    /// Joint `j` as the rows stand.
+    fn measured(&self, rows: &BodyRows, j: usize) -> Measured {
+        let joint = &self.tree.joints[j];
+        let gather = |side| BodyLanes::<f32>::gather(rows, &[self.side_row(side)]);
         Measured {
             kind: joint.kind,
             a: gather(joint.a),
@@ -878,31 +870,39 @@ impl Scene {
         }
     }
 
-    /// The largest joint error of lane `lane` (m or rad).
-    fn error(&self, rows: &BodyRows, lane: usize) -> f64 {
-        (0..self.trees[lane].joints.len())
+    /// The largest joint error (m or rad).
+    fn error(&self, rows: &BodyRows) -> f64 {
+        (0..self.tree.joints.len())
             .map(|j| {
-                let m = self.measured(rows, lane, j);
+                let m = self.measured(rows, j);
                 m.error(0..m.kind.count())
             })
             .fold(0.0, f64::max)
     }
-}
 
-/// Body `index`'s unknowns after a pass: `(dp, dtheta)` (m, rad, world).
-fn unknowns(block: &TreeBlock, topology: &Topology, lane: usize, index: usize) -> (GVec3, GVec3) {
-    let node = topology
-        .nodes
-        .iter()
-        .position(|n| {
-            n.kind
-                == NodeKind::Body {
-                    index: index as u32,
-                }
-        })
-        .expect("every body is a node");
-    let x = block.scratch[node].rhs.map(|v| v[lane]);
-    (GVec3::new(x[0], x[1], x[2]), GVec3::new(x[3], x[4], x[5]))
+    /// The bodies' displacements (m, world).
+    fn displacements(&self, rows: &BodyRows) -> Vec<GVec3> {
+        (0..self.tree.bodies.len())
+            .map(|i| {
+                BodyLanes::<f32>::gather(rows, &[self.side_row(Some(i))])
+                    .p
+                    .into()
+            })
+            .collect()
+    }
+
+    /// Body `index`'s unknowns after a pass: `(dp, dtheta)` (m, rad,
+    /// world).
+    fn unknowns(&self, block: &TreeBlock, index: usize) -> (GVec3, GVec3) {
+        let body = NodeKind::Body {
+            index: index as u32,
+        };
+        let node = self.topology.nodes.iter().position(|n| n.kind == body);
+        let x = block.scratch[node.expect("every body is a node")]
+            .rhs
+            .map(|v| v[0]);
+        (GVec3::new(x[0], x[1], x[2]), GVec3::new(x[3], x[4], x[5]))
+    }
 }
 
 fn pass(backend: Backend, rows: &BodyRows, blocks: &mut [TreeBlock], topologies: &[Topology]) {
@@ -913,35 +913,35 @@ fn pass(backend: Backend, rows: &BodyRows, blocks: &mut [TreeBlock], topologies:
     });
 }
 
-/// One tree in lane 0, offset by `offsets`: the errors before and after
-/// each of `passes` passes, and the block after the first.
-fn solve(tree: &Tree, offsets: &Offsets, passes: usize) -> (Vec<f64>, TreeBlock, BodyRows) {
-    let scene = Scene {
-        trees: vec![tree.clone()],
-        topology: tree.topology(),
-    };
-    let rows = to_rows(&scene.raw(std::slice::from_ref(offsets)));
-    let mut blocks = vec![scene.block(0)];
+/// A tree offset by `offsets`: its error before and after each of
+/// `passes` passes.
+fn errors(tree: &Tree, offsets: &Offsets, passes: usize) -> Vec<f64> {
+    let scene = Scene::new(tree);
+    let rows = scene.rows(offsets);
+    let mut blocks = vec![scene.block()];
     let topologies = [scene.topology.clone()];
-    let mut errors = vec![scene.error(&rows, 0)];
-    let mut first = None;
+    let mut errors = vec![scene.error(&rows)];
     for _ in 0..passes {
         pass(Backend::Scalar, &rows, &mut blocks, &topologies);
-        errors.push(scene.error(&rows, 0));
-        first.get_or_insert_with(|| blocks[0].clone());
+        errors.push(scene.error(&rows));
     }
-    (errors, first.expect("one pass"), rows)
+    errors
 }
 
 use JointRows::{Fixed, Hinge, Point, Rod};
 
 /// The trees of the first-order tests, by name: sockets hanging from a
-/// static anchor, every kind mixed (straight rods) likewise, and a free
-/// star.
+/// static anchor, every kind mixed (straight rods) likewise and with the
+/// static body on each joint's other side, and a free star.
 fn named_tree(r: &mut StdRng, name: &str) -> Tree {
     match name {
         "sockets" => hanging_chain(r, &[Point]),
         "mixed" => hanging_chain(r, &[Hinge, Fixed, Rod, Point, Hinge, Rod]),
+        "mixed, each joint's sides swapped" => {
+            let mut tree = hanging_chain(r, &[Fixed, Rod, Hinge, Point, Rod, Hinge]);
+            swap_sides(&mut tree);
+            tree
+        }
         _ => star(r),
     }
 }
@@ -951,14 +951,36 @@ fn show(errors: &[f64]) -> String {
     shown.join(", ")
 }
 
-const TREES: [&str; 3] = ["sockets", "mixed", "star"];
+const TREES: [&str; 4] = [
+    "sockets",
+    "mixed",
+    "mixed, each joint's sides swapped",
+    "star",
+];
+
+/// Swaps every joint's two sides (the static one now b): the same
+/// constraints, measured from the other body.
+fn swap_sides(tree: &mut Tree) {
+    let joints = std::mem::take(&mut tree.joints);
+    for j in joints {
+        let ((xa, _), (xb, qb)) = (tree.pose(j.a), tree.pose(j.b));
+        let point = xb + (qb * j.anchor_b).as_dvec3();
+        let frame = qb * j.frame_b;
+        if j.kind == Rod {
+            tree.join(Rod, j.b, j.a, xa, frame);
+        } else {
+            tree.join(j.kind, j.b, j.a, point, frame);
+        }
+    }
+}
 
 /// Offset by 1e-3 to 1e-2 m and rad from satisfied poses, one pass leaves
 /// an error of second order (measured: at most 2.4 e0^2, per metre or
 /// radian, over these trees; bound 4 e0^2), a second pass one of second
 /// order in that (measured 15 e1^2 + round-off; bound 20 e1^2 + 2e-6), and
-/// a third only round-off (measured 5e-7; bound 2e-6). At 1e-3 one pass takes off more
-/// than 99% of the error.
+/// a third only round-off (measured 8e-7; bound 2e-6). At offsets of 1e-3
+/// (errors to 1e-2: the rods' curve turns 2/|d| rad per metre) one pass
+/// takes off 98% of the error or more (bound 97%).
 #[test]
 fn one_pass_is_exact_to_first_order_and_a_second_to_round_off() {
     let mut r = StdRng::seed_from_u64(20);
@@ -967,13 +989,13 @@ fn one_pass_is_exact_to_first_order_and_a_second_to_round_off() {
             for _ in 0..10 {
                 let tree = named_tree(&mut r, name);
                 let offsets = offsets(&mut r, &tree, size);
-                let (e, _, _) = solve(&tree, &offsets, 3);
+                let e = errors(&tree, &offsets, 3);
                 let context = format!("{name}, offsets {size}: errors {}", show(&e));
                 assert!(e[1] <= 4.0 * e[0] * e[0] + 1e-6, "{context}");
                 assert!(e[2] <= 20.0 * e[1] * e[1] + 2e-6, "{context}");
                 assert!(e[3] <= 2e-6, "{context}");
                 if size <= 1e-3 {
-                    assert!(e[1] <= 1e-2 * e[0], "{context}");
+                    assert!(e[1] <= 3e-2 * e[0], "{context}");
                 }
             }
         }
@@ -990,25 +1012,13 @@ struct Pass {
 }
 
 fn one_pass(tree: &Tree, offsets: &Offsets) -> Pass {
-    let scene = Scene {
-        trees: vec![tree.clone()],
-        topology: tree.topology(),
-    };
-    let rows = to_rows(&scene.raw(std::slice::from_ref(offsets)));
-    let displacements = |rows: &BodyRows| -> Vec<GVec3> {
-        (0..tree.bodies.len())
-            .map(|i| {
-                BodyLanes::<f32>::gather(rows, &[scene.body_row(0, i)])
-                    .p
-                    .into()
-            })
-            .collect()
-    };
+    let scene = Scene::new(tree);
+    let rows = scene.rows(offsets);
     let before = (0..tree.joints.len())
-        .map(|j| scene.measured(&rows, 0, j))
+        .map(|j| scene.measured(&rows, j))
         .collect();
-    let p_before = displacements(&rows);
-    let mut blocks = vec![scene.block(0)];
+    let p_before = scene.displacements(&rows);
+    let mut blocks = vec![scene.block()];
     pass(
         Backend::Scalar,
         &rows,
@@ -1019,9 +1029,9 @@ fn one_pass(tree: &Tree, offsets: &Offsets) -> Pass {
         before,
         p_before,
         dx: (0..tree.bodies.len())
-            .map(|i| unknowns(&blocks[0], &scene.topology, 0, i))
+            .map(|i| scene.unknowns(&blocks[0], i))
             .collect(),
-        p_after: displacements(&rows),
+        p_after: scene.displacements(&rows),
     }
 }
 
@@ -1160,7 +1170,7 @@ fn bent_rods_converge_over_a_few_passes() {
     for _ in 0..10 {
         let tree = bent_rod_chain(&mut r);
         let offsets = offsets(&mut r, &tree, 1e-3);
-        let (e, _, _) = solve(&tree, &offsets, 4);
+        let e = errors(&tree, &offsets, 4);
         assert!(e[4] <= 1e-3 * e[0], "errors {}", show(&e));
     }
 }
