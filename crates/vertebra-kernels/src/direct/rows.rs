@@ -8,7 +8,7 @@
 //! | socket, hinge and fixed point (3) | `C = d`, the anchors' separation; `J_b = [1, -[r_b]x]`, `J_a = [-1, [r_a]x]` |
 //! | hinge axis (2) | `C = theta n` (the turn from `t_a` to `t_b`) along two axes `u` spanning the plane normal to `t_a + t_b`; `J_b = [0, u]`, `J_a = [0, -u]` |
 //! | fixed lock (3) | `C = log((q_b F_b)(q_a F_a)*)`; `J_b = [0, 1]`, `J_a = [0, -1]` |
-//! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b`; `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
+//! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b` (from a's +Y reflected likewise); `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
 //! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, 0]`, `J_a = [-o, 0]` (the paper's "purely through linear motion") |
 //! | hard limits (socket cone and twist, hinge range, rod bend and twist: 1 each) | the violation, 0 within the limit; `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative part turns about; a zero row (dropped) while not violated |
 //!
@@ -236,7 +236,12 @@ impl<L: Lane> Rows<L> {
         let ta_o = f.ta.dot(o);
         let r = o.scale(two * ta_o) - f.ta;
         let scale = -safe_ratio(two, distance);
-        for (k, u) in plane(r + f.tb, axis_y(f.fa)).into_iter().enumerate() {
+        // The hint is a's +Y reflected as t_a is: normal to r, as a's +Y is
+        // to t_a, so never along `r + t_b` near zero error (a's own +Y is
+        // along r for a rod bent 90 degrees in its XY plane).
+        let y = axis_y(f.fa);
+        let hint = o.scale(two * y.dot(o)) - y;
+        for (k, u) in plane(r + f.tb, hint).into_iter().enumerate() {
             let e = u.cross(r);
             let along = f.ta.scale(e.dot(o)) + e.scale(ta_o);
             let across = (along - o.scale(along.dot(o))).scale(scale);
