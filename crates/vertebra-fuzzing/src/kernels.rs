@@ -1,11 +1,12 @@
 //! Arbitrary lanes through the socket (plain and shaped), hinge, fixed,
-//! rod and contact kernels.
+//! rod and contact kernels, and the direct solve.
 
 use core::f32::consts::PI;
 
 use glam::{Mat3, Vec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
+use vertebra_kernels::direct::{self, JointLane, JointRows, Topology, TreeBlock};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
@@ -276,9 +277,71 @@ fn pad(input: &mut Input, blocks: &mut Blocks) {
     }
 }
 
+/// A block of direct-solve trees of one shape: each lane's own two rows
+/// joined by a joint of any kind, and now and then a second joint (any
+/// kind) from a static row to the first body, the tree's root; masses and
+/// inertias arbitrary, lanes padding at random.
+fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
+    let kinds = [
+        JointRows::Socket,
+        JointRows::Hinge,
+        JointRows::Fixed,
+        JointRows::Rod,
+    ];
+    let mut shape = vec![(kinds[input.pick(4)], Some(0), Some(1))];
+    let grounded = input.flag();
+    if grounded {
+        shape.push((kinds[input.pick(4)], None, Some(0)));
+    }
+    let topology = Topology::new(2, &shape).expect("a tree");
+    let mut block = TreeBlock::padding(0, &topology);
+    let fixed = (2 * BLOCK_LANES + 1) as u32;
+    for lane in 0..BLOCK_LANES {
+        if input.pick(8) == 0 {
+            continue; // a padding lane
+        }
+        block.padding &= !(1 << lane);
+        let own = |j: usize| (1 + 2 * lane + j) as u32;
+        for (k, node) in block.bodies.iter_mut().enumerate() {
+            let inertia = Mat3::from_diagonal(Vec3::new(
+                input.positive(5.0),
+                input.positive(5.0),
+                input.positive(5.0),
+            ));
+            node.set(lane, own(k), true, input.positive(50.0), inertia);
+        }
+        let sides = [(own(0), own(1)), (fixed, own(0))];
+        for (joint, &(a, b)) in block.joints.iter_mut().zip(&sides) {
+            let twist = sorted_range(input);
+            joint.set(
+                lane,
+                &JointLane {
+                    body_a: a,
+                    body_b: b,
+                    anchor_a: input.vec3(0.5),
+                    anchor_b: input.vec3(0.5),
+                    frame_a: input.quat(),
+                    frame_b: input.quat(),
+                    rest_length: input.positive(1.0),
+                    swing_max: input.float(PI).abs(),
+                    twist,
+                },
+            );
+            joint.bodies.set_start(lane, &start(input));
+        }
+    }
+    (topology, block)
+}
+
 /// One position pass of each kernel over the same rows, on `backend`:
 /// every row's pose afterwards.
-fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32> {
+fn run(
+    backend: Backend,
+    raw: &RawRows,
+    blocks: &Blocks,
+    (topology, tree): &(Topology, TreeBlock),
+    inv_h2: f32,
+) -> Vec<f32> {
     let rows = BodyRows::from_raw(raw);
     let (mut sockets, mut rods, mut contacts) = ([blocks.0], [blocks.1], [blocks.2]);
     let (mut hinges, mut fixed) = ([blocks.3], [blocks.4]);
@@ -340,6 +403,11 @@ fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32
         blocks: &mut contacts,
         rows: &rows,
     });
+    backend.dispatch(direct::PositionPass {
+        blocks: &mut [tree.clone()],
+        topologies: core::slice::from_ref(topology),
+        rows: &rows,
+    });
     (0..rows.pose.len())
         .flat_map(|i| rows.pose[i].get())
         .collect()
@@ -347,7 +415,8 @@ fn run(backend: Backend, raw: &RawRows, blocks: &Blocks, inv_h2: f32) -> Vec<f32
 
 /// Arbitrary bodies and lanes (unit or arbitrary quaternions, any floats one
 /// time in eight) through the socket (with drive, plain and shaped), hinge
-/// (with drive), fixed, rod and contact position passes: every backend gives the scalar reference's bits, and input with
+/// (with drive), fixed, rod and contact position passes and the direct
+/// solve of a block of trees: every backend gives the scalar reference's bits, and input with
 /// no wild value gives finite poses.
 pub fn kernels(data: &[u8]) {
     let mut input = Input::new(data);
@@ -362,9 +431,10 @@ pub fn kernels(data: &[u8]) {
     let inv_h2 = 1.0 / (input.positive(0.05) * input.positive(0.05));
     rest_rates(&mut input, &mut blocks.1);
     pad(&mut input, &mut blocks);
-    let expected = run(Backend::Scalar, &raw, &blocks, inv_h2);
+    let tree = tree_block(&mut input);
+    let expected = run(Backend::Scalar, &raw, &blocks, &tree, inv_h2);
     for backend in Backend::available() {
-        let actual = run(backend, &raw, &blocks, inv_h2);
+        let actual = run(backend, &raw, &blocks, &tree, inv_h2);
         if let Some(k) = (0..expected.len()).find(|&k| !same_bits(expected[k], actual[k])) {
             panic!(
                 "{backend} differs at float {k}: {:e} vs scalar {:e}",

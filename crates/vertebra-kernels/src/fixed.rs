@@ -100,7 +100,10 @@ impl LaneKernel for PositionPass<'_> {
     fn run<L: Lane>(self) {
         // A fixed joint is all equality: a block the direct solve holds
         // has nothing left to iterate.
-        for block in self.blocks.iter_mut().filter(|b| b.bodies.direct == 0) {
+        for block in self.blocks.iter_mut() {
+            if block.bodies.direct != 0 {
+                continue;
+            }
             let padding = block.bodies.padding;
             let mut positions = Positions {
                 block,

@@ -91,13 +91,37 @@ fn ldl_solve(a: &Dense, b: &[f64]) -> ([f32; PACKED], Vec<f32>) {
             f[at(i, j)] = a[i][j] as f32;
         }
     }
-    ldl::factor(&mut f, n);
+    factor_n(&mut f, n);
     let mut x = [0.0f32; MAX];
     for (x, b) in x.iter_mut().zip(b) {
         *x = *b as f32;
     }
-    ldl::solve(&f, n, &mut x);
+    solve_n(&f, n, &mut x);
     (f, x[..n].to_vec())
+}
+
+/// `ldl::factor` at a size known only at run time.
+fn factor_n(f: &mut [f32; PACKED], n: usize) {
+    match n {
+        1 => ldl::factor::<f32, 1>(f),
+        2 => ldl::factor::<f32, 2>(f),
+        3 => ldl::factor::<f32, 3>(f),
+        4 => ldl::factor::<f32, 4>(f),
+        5 => ldl::factor::<f32, 5>(f),
+        _ => ldl::factor::<f32, 6>(f),
+    }
+}
+
+/// `ldl::solve` at a size known only at run time.
+fn solve_n(f: &[f32; PACKED], n: usize, x: &mut [f32; MAX]) {
+    match n {
+        1 => ldl::solve::<f32, 1>(f, x),
+        2 => ldl::solve::<f32, 2>(f, x),
+        3 => ldl::solve::<f32, 3>(f, x),
+        4 => ldl::solve::<f32, 4>(f, x),
+        5 => ldl::solve::<f32, 5>(f, x),
+        _ => ldl::solve::<f32, 6>(f, x),
+    }
 }
 
 fn norm(x: impl IntoIterator<Item = f64>) -> f64 {
@@ -390,6 +414,8 @@ fn joint(r: &mut StdRng, kind: JointRows, misalignment: GQuat) -> Measured {
             frame_a: (qa.inverse() * frame).into(),
             frame_b: (qb.inverse() * misalignment * frame).into(),
             rest_length: 0.0,
+            swing_max: core::f32::consts::PI,
+            twist: [-core::f32::consts::PI, core::f32::consts::PI],
             start: pair_start(&start),
         },
     }
@@ -426,6 +452,8 @@ fn rod(r: &mut StdRng, distance: f32, bend: f32, misalignment: GQuat) -> Measure
             frame_a: (qa.inverse() * frame_a).into(),
             frame_b: (qb.inverse() * frame_b).into(),
             rest_length,
+            swing_max: core::f32::consts::PI,
+            twist: [-core::f32::consts::PI, core::f32::consts::PI],
             // The rows' displacements measured from the origin: no gap.
             start: pair_start(&StartLane::default()),
         },
@@ -440,7 +468,7 @@ fn turn(r: &mut StdRng, angle: f32) -> GQuat {
 #[test]
 fn point_rows_are_exact_gradients_everywhere() {
     let mut r = StdRng::seed_from_u64(10);
-    for kind in [JointRows::Point, JointRows::Hinge, JointRows::Fixed] {
+    for kind in [JointRows::Socket, JointRows::Hinge, JointRows::Fixed] {
         for _ in 0..200 {
             let angle = r.random_range(0.0..3.0);
             let misalignment = turn(&mut r, angle);
@@ -550,6 +578,8 @@ fn curve_rows_stay_gradients_for_a_rod_bent_a_right_angle_in_its_frame_plane() {
                 frame_b: (GQuat::from(b.q).inverse() * frame_b).into(),
                 rest_length: d * core::f32::consts::FRAC_PI_2
                     / (2.0 * core::f32::consts::FRAC_PI_4.sin()),
+                swing_max: core::f32::consts::PI,
+                twist: [-core::f32::consts::PI, core::f32::consts::PI],
                 start: pair_start(&StartLane::default()),
             },
         };
@@ -762,7 +792,7 @@ fn star(r: &mut StdRng) -> Tree {
         JointRows::Hinge,
         JointRows::Fixed,
         JointRows::Rod,
-        JointRows::Point,
+        JointRows::Socket,
     ];
     let mut tree = Tree::new();
     tree.bodies.push(body_at(r, DVec3::ZERO, 10.0));
@@ -844,6 +874,8 @@ impl Scene {
                     frame_a: j.frame_a,
                     frame_b: j.frame_b,
                     rest_length: j.rest_length,
+                    swing_max: core::f32::consts::PI,
+                    twist: [-core::f32::consts::PI, core::f32::consts::PI],
                 },
             );
             node.bodies.set_start(0, &j.start);
@@ -865,6 +897,8 @@ impl Scene {
                 frame_a: joint.frame_a.into(),
                 frame_b: joint.frame_b.into(),
                 rest_length: joint.rest_length,
+                swing_max: core::f32::consts::PI,
+                twist: [-core::f32::consts::PI, core::f32::consts::PI],
                 start: pair_start(&joint.start),
             },
         }
@@ -928,7 +962,7 @@ fn errors(tree: &Tree, offsets: &Offsets, passes: usize) -> Vec<f64> {
     errors
 }
 
-use JointRows::{Fixed, Hinge, Point, Rod};
+use JointRows::{Fixed, Hinge, Rod, Socket as Point};
 
 /// The trees of the first-order tests, by name: sockets hanging from a
 /// static anchor, every kind mixed (straight rods) likewise and with the
@@ -1318,6 +1352,12 @@ fn random_lane(
                 } else {
                     r.random_range(0.1..2.0)
                 },
+                // Limits that bind (active rows) as often as not.
+                swing_max: r.random_range(0.0..core::f32::consts::PI),
+                twist: {
+                    let lo = r.random_range(-core::f32::consts::PI..0.0);
+                    [lo, r.random_range(lo..core::f32::consts::PI)]
+                },
             },
         );
         node.bodies.set_start(lane, &start);
@@ -1375,6 +1415,8 @@ fn clear_lane(trees: &mut Trees, lane: usize) {
         frame_a: GQuat::IDENTITY,
         frame_b: GQuat::IDENTITY,
         rest_length: 0.0,
+        swing_max: core::f32::consts::PI,
+        twist: [-core::f32::consts::PI, core::f32::consts::PI],
     };
     for joint in &mut block.joints {
         joint.set(lane, &empty);

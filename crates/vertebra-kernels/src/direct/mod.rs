@@ -119,7 +119,8 @@ impl Topology {
         for (j, &(_, a, b)) in joints.iter().enumerate() {
             let node = (bodies + j) as u32;
             let sides = [a, b];
-            if sides.iter().flatten().any(|&i| i as usize >= bodies) || sides == [None, None] {
+            let past = sides.iter().flatten().max() >= Some(&(bodies as u32));
+            if past || sides == [None, None] {
                 return Err(TopologyError::BadJoint);
             }
             if sides.contains(&None) {
@@ -166,28 +167,26 @@ impl Topology {
         for (k, &n) in order.iter().enumerate() {
             place[n as usize] = k as u32;
         }
-        let node_of = |n: u32| if n == NONE { NONE } else { place[n as usize] };
-        let nodes = order
-            .iter()
-            .map(|&n| {
-                let kind = match (n as usize).checked_sub(bodies) {
-                    None => NodeKind::Body { index: n },
-                    Some(j) => {
-                        let (rows, a, b) = joints[j];
-                        NodeKind::Joint {
-                            index: j as u32,
-                            rows,
-                            a: a.map_or(NONE, node_of),
-                            b: b.map_or(NONE, node_of),
-                        }
+        let mut nodes = Vec::with_capacity(count);
+        for &n in &order {
+            let kind = match (n as usize).checked_sub(bodies) {
+                None => NodeKind::Body { index: n },
+                Some(j) => {
+                    let (rows, a, b) = joints[j];
+                    NodeKind::Joint {
+                        index: j as u32,
+                        rows,
+                        a: node_of(&place, a),
+                        b: node_of(&place, b),
                     }
-                };
-                Node {
-                    kind,
-                    parent: node_of(parent[n as usize]),
                 }
-            })
-            .collect();
+            };
+            let up = parent[n as usize];
+            nodes.push(Node {
+                kind,
+                parent: if up == NONE { NONE } else { place[up as usize] },
+            });
+        }
         Ok(Self {
             nodes,
             bodies,
@@ -201,6 +200,14 @@ impl Topology {
             NodeKind::Body { .. } => 6,
             NodeKind::Joint { rows, .. } => rows.count(),
         }
+    }
+}
+
+/// The node of body `i` (`NONE` for none: static or kinematic).
+fn node_of(place: &[u32], i: Option<u32>) -> u32 {
+    match i {
+        Some(i) => place[i as usize],
+        None => NONE,
     }
 }
 

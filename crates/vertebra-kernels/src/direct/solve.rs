@@ -121,7 +121,7 @@ pub(super) fn assemble<L: Lane>(
 pub(super) fn eliminate<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
     for (n, node) in topology.nodes.iter().enumerate() {
         let parent = (node.parent != NONE).then_some(node.parent as usize);
-        match (node.kind, parent.map(|p| topology.size(p))) {
+        match (node.kind, parent_size(topology, parent)) {
             (NodeKind::Body { .. }, Some(5)) => body_child::<L, 5>(block, n, parent, start),
             (NodeKind::Body { .. }, Some(6)) => body_child::<L, 6>(block, n, parent, start),
             (NodeKind::Body { .. }, _) => body_child::<L, 6>(block, n, None, start),
@@ -130,6 +130,17 @@ pub(super) fn eliminate<L: Lane>(block: &mut TreeBlock, topology: &Topology, sta
             }
             (NodeKind::Joint { .. }, _) => joint_child::<L, 6>(block, n, parent, start),
         }
+    }
+}
+
+/// The size of a node's parent's block (none for the root). A `match`,
+/// not `Option::map`: lane code has no closures (`tests/tidy.rs`).
+#[inline(always)]
+#[allow(clippy::manual_map)]
+fn parent_size(topology: &Topology, parent: Option<usize>) -> Option<usize> {
+    match parent {
+        Some(p) => Some(topology.size(p)),
+        None => None,
     }
 }
 
@@ -240,7 +251,7 @@ fn body_child<L: Lane, const N: usize>(
 pub(super) fn substitute<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
     for (n, node) in topology.nodes.iter().enumerate().rev() {
         let parent = (node.parent != NONE).then_some(node.parent as usize);
-        match (node.kind, parent.map(|p| topology.size(p))) {
+        match (node.kind, parent_size(topology, parent)) {
             (NodeKind::Body { .. }, Some(5)) => unknowns::<L, 6, 5>(block, n, parent, false, start),
             (NodeKind::Body { .. }, _) => unknowns::<L, 6, 6>(block, n, parent, false, start),
             (NodeKind::Joint { rows, .. }, _) if rows.count() == 5 => {
