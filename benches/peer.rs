@@ -24,7 +24,7 @@ use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Frame, Scene, SceneConfig, Spread, build, run};
 use vertebra_world::JointSolver;
 
-use peer_plot::Point;
+use peer_plot::{Point, Series};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -79,7 +79,7 @@ fn row(engine: &str, figures: &Figures) {
 }
 
 /// The plot's point of `series` at `split`: each figure's median.
-fn point(series: &'static str, split: String, figures: &Figures) -> Point {
+fn point(series: Series, split: String, figures: &Figures) -> Point {
     let [time, lin, ang] = spreads(figures);
     Point {
         series,
@@ -119,16 +119,6 @@ fn ours(
         .collect()
 }
 
-/// The plot's series name of vertebra with `joints` and `spine`.
-fn series(joints: JointSolver, spine: SpineMode) -> &'static str {
-    match (joints, spine) {
-        (JointSolver::Iterative, SpineMode::Rod) => "vertebra iterative, rod spine",
-        (JointSolver::Iterative, SpineMode::Sockets) => "vertebra iterative, socket spine",
-        (JointSolver::Direct, SpineMode::Rod) => "vertebra direct, rod spine",
-        (JointSolver::Direct, SpineMode::Sockets) => "vertebra direct, socket spine",
-    }
-}
-
 /// Whole runs of both scenes from seeds 0 .. SEEDS: time per step and
 /// residual error, each as the median [10th, 90th percentile] over the
 /// seeds; then each scene's error-versus-cost plot.
@@ -163,14 +153,14 @@ fn whole_runs() {
                 .collect();
             row(&format!("{settings}, socket spine"), &peer);
             let split = format!("{}x{}", settings.solver_iterations, settings.pgs_iterations);
-            points.push(point("rapier, socket spine", split, &peer));
+            points.push(point(Series::Rapier, split, &peer));
         }
         for (_, joints) in JOINTS {
             for (_, spine) in SPINES {
                 for split @ (substeps, iterations) in SWEEP {
                     let runs = ours(scene, spine, joints, split, SWEEP_SEEDS);
                     let name = format!("{substeps}x{iterations}");
-                    points.push(point(series(joints, spine), name, &runs));
+                    points.push(point(Series::Vertebra(joints, spine), name, &runs));
                 }
             }
         }

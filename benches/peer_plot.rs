@@ -8,14 +8,76 @@ use std::path::{Path, PathBuf};
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::Scene;
+use vertebra_world::JointSolver;
 
-/// One engine and setting: its series (engine, joint solve, spine), its
-/// split (`substeps x iterations`, rapier's `solver x pgs`), and its
-/// figures, each the median over `seeds` seeded runs.
+/// An engine and setting's series: vertebra with a joint solve and a
+/// spine, or rapier (socket spines: it has no rod).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Series {
+    /// vertebra, its joints solved by the [`JointSolver`], with the spine.
+    Vertebra(JointSolver, SpineMode),
+    /// rapier3d.
+    Rapier,
+}
+
+impl Series {
+    /// In drawing order.
+    const ALL: [Series; 5] = [
+        Series::Vertebra(JointSolver::Iterative, SpineMode::Rod),
+        Series::Vertebra(JointSolver::Iterative, SpineMode::Sockets),
+        Series::Vertebra(JointSolver::Direct, SpineMode::Rod),
+        Series::Vertebra(JointSolver::Direct, SpineMode::Sockets),
+        Series::Rapier,
+    ];
+
+    /// The CSV's engine, joints and spine columns (rapier's joints: its
+    /// own solver).
+    fn columns(self) -> [&'static str; 3] {
+        let spine = |s| match s {
+            SpineMode::Rod => "rod",
+            SpineMode::Sockets => "socket",
+        };
+        match self {
+            Series::Vertebra(JointSolver::Iterative, s) => ["vertebra", "iterative", spine(s)],
+            Series::Vertebra(JointSolver::Direct, s) => ["vertebra", "direct", spine(s)],
+            Series::Rapier => ["rapier", "rapier", "socket"],
+        }
+    }
+
+    /// The legend's name: `vertebra direct, rod spine`, `rapier, socket
+    /// spine`.
+    fn label(self) -> String {
+        match self.columns() {
+            ["rapier", _, spine] => format!("rapier, {spine} spine"),
+            [engine, joints, spine] => format!("{engine} {joints}, {spine} spine"),
+        }
+    }
+
+    /// Rod red, sockets blue, rapier black; iterative hollow and larger,
+    /// direct filled, so a direct point on top of its iterative one shows
+    /// both. The marker's radius in pixels.
+    fn style(self) -> (ShapeStyle, u32) {
+        match self {
+            Series::Vertebra(joints, spine) => {
+                let colour = if spine == SpineMode::Rod { RED } else { BLUE };
+                match joints {
+                    JointSolver::Iterative => (colour.stroke_width(2), 7),
+                    JointSolver::Direct => (colour.filled(), 4),
+                }
+            }
+            Series::Rapier => (BLACK.filled(), 4),
+        }
+    }
+}
+
+/// One engine and setting: its series, its split (`substeps x
+/// iterations`, rapier's `solver x pgs`), and its figures, each the median
+/// over `seeds` seeded runs.
 pub struct Point {
-    /// e.g. `vertebra direct, rod spine` or `rapier, socket spine`.
-    pub series: &'static str,
+    /// Which engine, joint solve and spine.
+    pub series: Series,
     /// e.g. `1x20`.
     pub split: String,
     /// Seeded runs the medians are over.
@@ -28,22 +90,14 @@ pub struct Point {
     pub eps_ang_rad: f64,
 }
 
-/// The series in drawing order, with their colours: rod red, sockets
-/// blue, rapier black; iterative hollow and larger, direct filled, so a
-/// direct point on top of its iterative one shows both.
-const SERIES: [(&str, RGBColor, bool); 5] = [
-    ("vertebra iterative, rod spine", RED, false),
-    ("vertebra iterative, socket spine", BLUE, false),
-    ("vertebra direct, rod spine", RED, true),
-    ("vertebra direct, socket spine", BLUE, true),
-    ("rapier, socket spine", BLACK, true),
-];
-
 /// Where the plots and CSV go: `target/figures/peer/` at the workspace's
 /// root, whatever `CARGO_TARGET_DIR` says (`benches/figures.sh` copies it
 /// into its dated run).
 pub fn out_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/figures/peer")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the benches sit in the workspace")
+        .join("target/figures/peer")
 }
 
 /// Writes `error_vs_cost_<scene>.svg` and `.csv` under [`out_dir`] and
@@ -55,6 +109,22 @@ pub fn write(scene: Scene, points: &[Point]) -> Result<PathBuf, Box<dyn std::err
     std::fs::write(svg.with_extension("csv"), csv(scene, points))?;
     draw(&svg, scene, points)?;
     Ok(svg)
+}
+
+fn csv(scene: Scene, points: &[Point]) -> String {
+    let mut out = String::from(
+        "scene,engine,joints,spine,split,seeds,ms_per_step,mean_eps_lin_cm,mean_eps_ang_rad\n",
+    );
+    for p in points {
+        let [engine, joints, spine] = p.series.columns();
+        writeln!(
+            out,
+            "{scene},{engine},{joints},{spine},{},{},{},{},{}",
+            p.split, p.seeds, p.ms_per_step, p.eps_lin_cm, p.eps_ang_rad
+        )
+        .ok();
+    }
+    out
 }
 
 /// The two panels, one above the other: separation, angular violation.
@@ -74,20 +144,6 @@ fn draw(svg: &Path, scene: Scene, points: &[Point]) -> Result<(), Box<dyn std::e
     )?;
     root.present()?;
     Ok(())
-}
-
-fn csv(scene: Scene, points: &[Point]) -> String {
-    let mut out =
-        String::from("scene,series,split,seeds,ms_per_step,mean_eps_lin_cm,mean_eps_ang_rad\n");
-    for p in points {
-        writeln!(
-            out,
-            "{scene},{},{},{},{},{},{}",
-            p.series, p.split, p.seeds, p.ms_per_step, p.eps_lin_cm, p.eps_ang_rad
-        )
-        .ok();
-    }
-    out
 }
 
 /// One panel: every point's `error` against its time, each labelled with
@@ -114,21 +170,16 @@ fn panel(
         .x_desc("ms per step (wall time, collision detection included)")
         .y_desc(what)
         .draw()?;
-    for (series, colour, filled) in SERIES {
+    for series in Series::ALL {
         let at: Vec<(f64, f64, &str)> = points
             .iter()
             .filter(|p| p.series == series)
             .map(|p| (p.ms_per_step, error(p).max(low), p.split.as_str()))
             .collect();
-        let size = if filled { 4 } else { 7 };
-        let style = if filled {
-            colour.filled()
-        } else {
-            colour.stroke_width(2)
-        };
+        let (style, size) = series.style();
         chart
             .draw_series(at.iter().map(|&(x, y, _)| Circle::new((x, y), size, style)))?
-            .label(series)
+            .label(series.label())
             .legend(move |(x, y)| Circle::new((x + 10, y), size, style));
         chart.draw_series(at.iter().map(|&(x, y, split)| {
             EmptyElement::at((x, y))
