@@ -3,7 +3,9 @@
 # in a fixed order with fixed settings, each bench's output kept in
 # target/figures/<date>/<bench>.txt with the machine's load before and after
 # it. The figures in docs/performance.md come from one such run (its date is
-# given there), so that their ratios are of one build under one load.
+# given there), so that their ratios are of one build under one load. The
+# peer bench's error-versus-cost plots and their CSV (written to
+# target/figures/peer/) are copied into target/figures/<date>/peer/.
 #
 #   ./benches/figures.sh            # everything (about 20 minutes on 2 cores)
 #   ./benches/figures.sh step sleep # only these benches, same settings
@@ -36,8 +38,11 @@ for name in "${chosen[@]}"; do
     case $name in
     *_instructions) run "$name" --bench "$name" ;;
     stages) run "$name" --bench stages --features stage-timing ;;
-    math | joints | step | single_ragdoll | sleep | collisions | mapper | peer)
+    math | joints | step | single_ragdoll | sleep | collisions | mapper)
         run "$name" --bench "$name" -- "${criterion[@]}" ;;
+    peer)
+        run "$name" --bench "$name" -- "${criterion[@]}"
+        cp -r target/figures/peer "$out/" ;;
     *)
         echo "no bench named $name (one of: ${all[*]})" >&2
         exit 1

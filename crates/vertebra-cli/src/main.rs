@@ -17,7 +17,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
 use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, Seeded};
-use vertebra_world::SleepSettings;
+use vertebra_world::{JointSolver, SleepSettings};
 
 use skeleton_csv::{Failed, SkeletonCsv};
 
@@ -37,22 +37,32 @@ struct Cli {
 enum Command {
     /// Runs every scene both ways and writes tables, plots and pictures.
     Reproduce {
-        /// Where to write the results.
-        #[arg(long, default_value = "out")]
-        out: PathBuf,
+        /// Where to write the results (default: out, or out-direct with
+        /// --joints direct, so that the two runs sit side by side).
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// Seeded starts per scene and spine (0 .. K): every figure is
         /// given as its median and spread over them.
         #[arg(long, default_value_t = reproduce::DEFAULT_SEEDS)]
         seeds: u64,
+        /// How the joints are solved: iterative (each joint on its own, as
+        /// the paper) or direct (every joint of a ragdoll at once).
+        #[arg(long, value_enum, default_value_t = Joints::Iterative)]
+        joints: Joints,
     },
     /// Runs one scene.
     Scene {
-        /// passive-bending, ragdoll-drop, controllability (the paper's), or
-        /// hit-reaction, anatomical-drop (the anatomical humanoid).
+        /// passive-bending, ragdoll-drop, controllability (the paper's),
+        /// hit-reaction, anatomical-drop (the anatomical humanoid), or
+        /// heavy-chain (1 kg links holding a 1000 kg body).
         name: String,
         /// rod (simplified) or sockets (standard).
         #[arg(long)]
         spine: Spine,
+        /// How the joints are solved: iterative (each joint on its own, as
+        /// the paper) or direct (every joint of a ragdoll at once).
+        #[arg(long, value_enum, default_value_t = Joints::Iterative)]
+        joints: Joints,
         /// Position iterations per substep (substeps x iterations at most
         /// 10000).
         #[arg(long, default_value_t = 20)]
@@ -126,6 +136,21 @@ enum Spine {
     Sockets,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum Joints {
+    Iterative,
+    Direct,
+}
+
+impl From<Joints> for JointSolver {
+    fn from(j: Joints) -> Self {
+        match j {
+            Joints::Iterative => JointSolver::Iterative,
+            Joints::Direct => JointSolver::Direct,
+        }
+    }
+}
+
 impl From<Spine> for SpineMode {
     fn from(s: Spine) -> Self {
         match s {
@@ -172,7 +197,11 @@ fn main() -> ExitCode {
 
 fn execute(command: Command) -> Result<(), String> {
     match command {
-        Command::Reproduce { out, seeds } => reproduce::reproduce(&out, seeds),
+        Command::Reproduce { out, seeds, joints } => {
+            let joints = joints.into();
+            let out = out.unwrap_or_else(|| reproduce::default_out(joints));
+            reproduce::reproduce(&out, seeds, joints)
+        }
         Command::Check { file, skeleton } => {
             print!("{}", check::check(&file, skeleton.as_deref())?);
             Ok(())
@@ -180,6 +209,7 @@ fn execute(command: Command) -> Result<(), String> {
         Command::Scene {
             name,
             spine,
+            joints,
             iterations,
             substeps,
             frames,
@@ -212,6 +242,7 @@ fn execute(command: Command) -> Result<(), String> {
             let mut config = SceneConfig::new(scene, spine.into());
             config.iterations = iterations;
             config.substeps = substeps;
+            config.joints = joints.into();
             config.frames = frames;
             config.backend = backend;
             config.threads = threads;

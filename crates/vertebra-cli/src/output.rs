@@ -7,12 +7,21 @@ use std::path::Path;
 use serde_json::{Value, json};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Quantity, SceneConfig, SceneRun, Seeded, Spread};
+use vertebra_world::JointSolver;
 
 /// `rod` or `sockets`.
 pub fn spine_name(spine: SpineMode) -> &'static str {
     match spine {
         SpineMode::Rod => "rod",
         SpineMode::Sockets => "sockets",
+    }
+}
+
+/// `iterative` or `direct`, as `--joints` takes it.
+pub fn joints_name(joints: JointSolver) -> &'static str {
+    match joints {
+        JointSolver::Iterative => "iterative",
+        JointSolver::Direct => "direct",
     }
 }
 
@@ -53,6 +62,7 @@ fn setting_json(config: &SceneConfig, run: &SceneRun) -> serde_json::Map<String,
     let Value::Object(map) = json!({
         "scene": config.scene.name(),
         "spine": spine_name(config.spine),
+        "joints": joints_name(config.joints),
         "iterations": config.iterations,
         "substeps": config.substeps,
         "backend": run.backend.name(),
@@ -159,9 +169,10 @@ pub fn seeded_json(config: &SceneConfig, seeded: &Seeded) -> Value {
 pub fn print_summary(config: &SceneConfig, run: &SceneRun) {
     let (lin, ang) = (run.stats(Quantity::EpsLin), run.stats(Quantity::EpsAng));
     println!(
-        "{} ({}): mean eps_lin {:.4} cm, max {:.4} cm; mean eps_ang {:.5} rad, max {:.5} rad; {:.3} ms/step on {}; state {:016x}",
+        "{} ({}, {} joints): mean eps_lin {:.4} cm, max {:.4} cm; mean eps_ang {:.5} rad, max {:.5} rad; {:.3} ms/step on {}; state {:016x}",
         config.scene,
         spine_name(config.spine),
+        joints_name(config.joints),
         lin.mean,
         lin.max,
         ang.mean,
@@ -196,9 +207,10 @@ pub fn print_seeded_summary(config: &SceneConfig, seeded: &Seeded) {
     let spreads = spreads(seeded);
     let band = spreads[0].1.range_name();
     println!(
-        "{} ({}), seeds {}..{}: median [{band}] over {} runs on {}",
+        "{} ({}, {} joints), seeds {}..{}: median [{band}] over {} runs on {}",
         config.scene,
         spine_name(config.spine),
+        joints_name(config.joints),
         seeded.first,
         seeded.first + seeded.runs.len() as u64 - 1,
         seeded.runs.len(),

@@ -4,15 +4,16 @@
 
 use std::fmt::Write as _;
 use std::io::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{
     Comparison, Quantity, Scene, SceneConfig, Seeded, Spread, compare, kinematics,
 };
+use vertebra_world::JointSolver;
 
-use crate::output::{io, spine_name, spreads, write_csv};
+use crate::output::{io, joints_name, spine_name, spreads, write_csv};
 use crate::plots::{font_options, picture, plot, plot_locus, to_png};
 
 /// Seeds `reproduce` runs each scene from unless told: enough for the 10th
@@ -20,17 +21,28 @@ use crate::plots::{font_options, picture, plot, plot_locus, to_png};
 /// two cores (`docs/reproduction.md`).
 pub const DEFAULT_SEEDS: u64 = 16;
 
-/// Runs every scene both ways from seeds `0 .. seeds` and writes everything
-/// under `out`.
-pub fn reproduce(out: &Path, seeds: u64) -> Result<(), String> {
+/// Where `reproduce` writes unless told: `out` for the paper's iterative
+/// joints, `out-direct` for the direct solve, so that one run does not
+/// overwrite the other.
+pub fn default_out(joints: JointSolver) -> PathBuf {
+    match joints {
+        JointSolver::Iterative => PathBuf::from("out"),
+        JointSolver::Direct => PathBuf::from("out-direct"),
+    }
+}
+
+/// Runs every scene both ways from seeds `0 .. seeds`, the joints solved
+/// by `joints`, and writes everything under `out`.
+pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), String> {
     std::fs::create_dir_all(out).map_err(|e| io(format!("{}: {e}", out.display())))?;
     let fonts = font_options();
     let mut document = Vec::new();
-    let mut table = String::new();
+    let mut table = format!("joints: {}\n\n", joints_name(joints));
     for scene in Scene::PAPER {
         let mut runs = Vec::new();
         for spine in [SpineMode::Sockets, SpineMode::Rod] {
-            let config = SceneConfig::new(scene, spine);
+            let mut config = SceneConfig::new(scene, spine);
+            config.joints = joints;
             let label = format!("{scene} ({})", spine_name(spine));
             let seeded = Seeded::run(&config, seeds, |done, count| progress(&label, done, count))
                 .map_err(|e| e.to_string())?;
@@ -61,6 +73,7 @@ pub fn reproduce(out: &Path, seeds: u64) -> Result<(), String> {
     }
     std::fs::write(out.join("kinematics.csv"), csv).map_err(io)?;
     let document = json!({
+        "joints": joints_name(joints),
         "seeds": { "first": 0, "count": seeds, "band": Spread::band_name(seeds as usize) },
         "scenes": document,
         "kinematics": locus.chains.iter().map(|(n, _, g)| json!({"chain": n, "largest_gap_m": g})).collect::<Vec<_>>(),

@@ -906,3 +906,95 @@ fn sleep_turns_sleeping_on() {
     assert_eq!(awake["sleep"], false);
     assert_ne!(asleep["state_hash"], awake["state_hash"]);
 }
+
+/// `--joints` reaches the scene and is reported: in the JSON, in the
+/// one-line summary and over seeds; iterative unless told.
+#[test]
+fn joints_choose_the_solver_and_are_reported() {
+    let scene = |extra: &[&str]| {
+        let mut args = vec![
+            "scene",
+            "heavy-chain",
+            "--spine",
+            "sockets",
+            "--frames",
+            "3",
+        ];
+        args.extend_from_slice(extra);
+        let (code, stdout, stderr) = vertebra(&args);
+        assert_eq!(code, 0, "{stderr}");
+        stdout
+    };
+    let json = |extra: &[&str]| {
+        let stdout = scene(&[extra, &["--json"]].concat());
+        serde_json::from_str::<serde_json::Value>(stdout.trim()).expect("one JSON object")
+    };
+    assert_eq!(json(&[])["joints"], "iterative");
+    assert_eq!(json(&["--joints", "iterative"])["joints"], "iterative");
+    assert_eq!(json(&["--joints", "direct"])["joints"], "direct");
+    assert_eq!(
+        json(&["--joints", "direct", "--seeds", "2"])["joints"],
+        "direct"
+    );
+    let line = scene(&["--joints", "direct"]);
+    assert!(
+        line.starts_with("heavy-chain (sockets, direct joints):"),
+        "{line}"
+    );
+    let seeded = scene(&["--seeds", "2"]);
+    assert!(
+        seeded.starts_with("heavy-chain (sockets, iterative joints), seeds 0..1"),
+        "{seeded}"
+    );
+}
+
+/// A `--joints` that is neither value is refused, naming the flag and the
+/// values it takes, by both commands.
+#[test]
+fn a_bad_joints_value_names_the_flag_and_its_values() {
+    let scene = [
+        "scene",
+        "heavy-chain",
+        "--spine",
+        "rod",
+        "--joints",
+        "exact",
+    ];
+    let reproduce = ["reproduce", "--joints", "Direct"];
+    for args in [&scene[..], &reproduce[..]] {
+        for expected in ["--joints", "iterative", "direct"] {
+            fails_with(args, expected);
+        }
+    }
+}
+
+/// `reproduce --joints direct` writes to `out-direct` unless told, beside
+/// the iterative run's `out`: here a file in its way is named.
+#[test]
+fn reproduce_with_direct_joints_writes_beside_the_iterative_run() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-direct-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in ["out", "out-direct"] {
+        std::fs::write(dir.join(name), "in the way").unwrap();
+    }
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_vertebra"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .expect("the binary runs");
+        assert_ne!(out.status.code(), Some(0), "{args:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let direct = run(&["reproduce", "--joints", "direct"]);
+    assert!(
+        direct.contains("cannot write the results: out-direct: "),
+        "{direct}"
+    );
+    let iterative = run(&["reproduce"]);
+    assert!(
+        iterative.contains("cannot write the results: out: "),
+        "{iterative}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -6,12 +6,13 @@ use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, S
 use vertebra_world::{AngularDrive, BodyDesc, BodyHandle, JointDesc, World};
 
 use crate::{
-    Scene, SceneConfig, SceneWorld, controllability, hit_reaction, passive_bending, ragdoll_drop,
+    Scene, SceneConfig, SceneWorld, controllability, heavy_chain, hit_reaction, passive_bending,
+    ragdoll_drop,
 };
 
 /// Builds `config`'s scene at its first frame.
 pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
-    let desc = config.description();
+    let desc = config.description()?;
     let drive = config.drive()?;
     let world = config.world()?;
     match config.scene {
@@ -19,6 +20,7 @@ pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
         Scene::Controllability => controllability::build(world, &desc, config),
         Scene::RagdollDrop | Scene::AnatomicalDrop => ragdoll_drop::build(world, &desc, config),
         Scene::HitReaction => hit_reaction::build(world, &desc, config, &drive),
+        Scene::HeavyChain => heavy_chain::build(world, &desc, config),
     }
 }
 

@@ -1,7 +1,7 @@
 //! How to run a scene: spine, solver settings, ragdoll, seed.
 
 use vertebra_ragdoll::{DriveSettings, RagdollDesc, RagdollError, SpineMode, Strength};
-use vertebra_world::{BackendChoice, SleepSettings, SolverConfig, World};
+use vertebra_world::{BackendChoice, JointSolver, SleepSettings, SolverConfig, World};
 
 use crate::Scene;
 
@@ -16,6 +16,9 @@ pub struct SceneConfig {
     pub iterations: u32,
     /// Substeps per frame.
     pub substeps: u32,
+    /// How the joints are solved (`SolverConfig::joints`): iterative, as
+    /// the paper, or direct.
+    pub joints: JointSolver,
     /// Frames to run (the scene's default when `None`).
     pub frames: Option<usize>,
     /// Kernel backend.
@@ -23,7 +26,9 @@ pub struct SceneConfig {
     /// Worker threads.
     pub threads: usize,
     /// The ragdoll (when `None`, the reference humanoid in the paper's
-    /// scenes, the anatomical humanoid in the others).
+    /// scenes, the anatomical humanoid in the hit reaction and the
+    /// anatomical drop, [`heavy_chain`](crate::heavy_chain) in the heavy
+    /// chain, which refuses any other).
     pub ragdoll: Option<RagdollDesc>,
     /// Ragdolls dropped in the ragdoll-drop scene (the paper's 30; see
     /// [`ragdoll_drop`](crate::ragdoll_drop) for more).
@@ -61,6 +66,7 @@ impl SceneConfig {
             spine,
             iterations: 20,
             substeps: 1,
+            joints: JointSolver::Iterative,
             frames: None,
             backend: BackendChoice::Auto,
             threads: 1,
@@ -112,6 +118,7 @@ impl SceneConfig {
         let config = SolverConfig {
             iterations: self.iterations,
             substeps: self.substeps,
+            joints: self.joints,
             backend: self.backend,
             threads: self.threads,
             measure_residuals: self.measure_residuals,
@@ -121,13 +128,17 @@ impl SceneConfig {
         Ok(World::new(config)?)
     }
 
-    pub(crate) fn description(&self) -> RagdollDesc {
-        self.ragdoll.clone().unwrap_or_else(|| {
-            if self.scene.is_paper() {
-                RagdollDesc::reference_humanoid()
-            } else {
-                RagdollDesc::anatomical_humanoid()
-            }
-        })
+    pub(crate) fn description(&self) -> Result<RagdollDesc, RagdollError> {
+        match (self.scene, &self.ragdoll) {
+            (Scene::HeavyChain, None) => crate::heavy_chain(),
+            (Scene::HeavyChain, Some(_)) => Err(RagdollError::OutOfRange {
+                context: "scene".to_owned(),
+                field: "ragdoll",
+                reason: "is given; the heavy chain hangs its own chain of bodies".to_owned(),
+            }),
+            (_, Some(desc)) => Ok(desc.clone()),
+            (scene, None) if scene.is_paper() => Ok(RagdollDesc::reference_humanoid()),
+            (_, None) => Ok(RagdollDesc::anatomical_humanoid()),
+        }
     }
 }

@@ -1,5 +1,6 @@
 //! The paper's scenes (figures 1, 2, 6, 7, 8), on the reference humanoid,
-//! and two on the anatomical humanoid (a hit reaction, the drop), at 60 Hz
+//! two on the anatomical humanoid (a hit reaction, the drop), and a chain
+//! with a 1:1000 mass ratio across a joint, at 60 Hz
 //! with gravity (0, -9.81, 0), 1 substep and 20 iterations unless told
 //! otherwise, each with a rod spine (simplified) or a socket spine
 //! (standard). Used by the `vertebra` command, the benches and the tests.
@@ -7,6 +8,7 @@
 mod builder;
 mod config;
 mod controllability;
+mod heavy_chain;
 mod hit_reaction;
 mod kinematics;
 mod passive_bending;
@@ -23,6 +25,7 @@ mod spread;
 
 pub use builder::build;
 pub use config::SceneConfig;
+pub use heavy_chain::{HEAVY_MASS, LINK_MASS, LINKS, heavy_chain};
 pub use hit_reaction::HIT_FRAMES;
 pub use kinematics::{Locus, kinematics};
 pub use quantity::{Quantity, Stats};

@@ -3,7 +3,8 @@
 use core::fmt;
 use core::str::FromStr;
 
-/// A scene: the paper's three, and two on the anatomical humanoid.
+/// A scene: the paper's three, two on the anatomical humanoid, and a
+/// chain with a large mass ratio.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Scene {
     /// Figures 2 and 8 (left): the hips fixed, the upper body slumps.
@@ -19,6 +20,10 @@ pub enum Scene {
     HitReaction,
     /// The ragdoll drop with the anatomical humanoid.
     AnatomicalDrop,
+    /// A chain of 1 kg links hanging from a fixed anchor with a 1000 kg
+    /// body at its end ([`crate::heavy_chain`]): a 1:1000 mass ratio
+    /// across a joint. No spine, so both spines build the same chain.
+    HeavyChain,
 }
 
 impl Scene {
@@ -30,12 +35,13 @@ impl Scene {
     ];
 
     /// Every simulated scene.
-    pub const ALL: [Scene; 5] = [
+    pub const ALL: [Scene; 6] = [
         Scene::PassiveBending,
         Scene::RagdollDrop,
         Scene::Controllability,
         Scene::HitReaction,
         Scene::AnatomicalDrop,
+        Scene::HeavyChain,
     ];
 
     /// The name on the command line.
@@ -46,6 +52,7 @@ impl Scene {
             Scene::Controllability => "controllability",
             Scene::HitReaction => "hit-reaction",
             Scene::AnatomicalDrop => "anatomical-drop",
+            Scene::HeavyChain => "heavy-chain",
         }
     }
 
@@ -55,7 +62,7 @@ impl Scene {
         Scene::PAPER.contains(&self)
     }
 
-    /// Frames the paper's figure runs (the new scenes: 4 s and 10 s).
+    /// Frames the paper's figure runs (the new scenes: 4 s, 10 s and 5 s).
     pub fn default_frames(self) -> usize {
         match self {
             Scene::PassiveBending => 300,
@@ -63,6 +70,7 @@ impl Scene {
             Scene::Controllability => 240,
             Scene::HitReaction => 240,
             Scene::AnatomicalDrop => 600,
+            Scene::HeavyChain => 300,
         }
     }
 }
@@ -77,7 +85,7 @@ impl FromStr for Scene {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         Scene::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| {
-            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability, hit-reaction or anatomical-drop)")
+            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability, hit-reaction, anatomical-drop or heavy-chain)")
         })
     }
 }

@@ -28,8 +28,9 @@ pub struct SceneWorld {
     /// Impulses: (frame, body, impulse in N s through its centre of mass),
     /// applied before that frame's step (the hit reaction).
     pub hits: Vec<(usize, BodyHandle, Vec3)>,
-    /// The ragdolls' joints: the residual error counts these (not the pins
-    /// holding hips in place).
+    /// The joints the residual error counts: the ragdolls' own (not the
+    /// pins holding hips in place) and any the scene adds
+    /// ([`Self::with_joints`]).
     joints: HashSet<JointHandle>,
     rods: HashSet<RodHandle>,
     /// The contact list the detection fills and swaps into the world.
@@ -60,6 +61,13 @@ impl SceneWorld {
             rods,
             contacts: Vec::new(),
         }
+    }
+
+    /// Also counting `joints` (not the ragdolls' own) in the residual
+    /// error: the heavy chain's hanging socket.
+    pub(crate) fn with_joints(mut self, joints: impl IntoIterator<Item = JointHandle>) -> Self {
+        self.joints.extend(joints);
+        self
     }
 
     /// With `hits` ([`Self::hits`]).
