@@ -14,22 +14,27 @@
 use vertebra_math::Backend;
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Scene, SceneConfig, run};
-use vertebra_world::BackendChoice;
+use vertebra_world::{BackendChoice, JointSolver};
 
 /// Frames each scene runs for its hash: two seconds at 60 Hz.
 const FRAMES: usize = 120;
 
 fn check(scene: Scene, spine: SpineMode, golden: u64) {
+    check_solved(scene, spine, JointSolver::Iterative, golden);
+}
+
+fn check_solved(scene: Scene, spine: SpineMode, joints: JointSolver, golden: u64) {
     for backend in Backend::available() {
         for threads in [1, 2] {
             let mut config = SceneConfig::new(scene, spine);
+            config.joints = joints;
             config.frames = Some(FRAMES);
             config.backend = BackendChoice::Forced(backend);
             config.threads = threads;
             let hash = run(&config, |_, _| {}).expect("the scene runs").state_hash;
             assert_eq!(
                 hash, golden,
-                "{scene} ({spine:?}) on {backend} with {threads} threads: {hash:#018x}"
+                "{scene} ({spine:?}, {joints:?}) on {backend} with {threads} threads: {hash:#018x}"
             );
         }
     }
@@ -58,6 +63,41 @@ fn ragdoll_drop_sockets() {
 fn ragdoll_drop_rod() {
     check(Scene::RagdollDrop, SpineMode::Rod, GOLDEN_DROP_ROD);
 }
+
+#[test]
+fn passive_bending_direct() {
+    let (scene, direct) = (Scene::PassiveBending, JointSolver::Direct);
+    check_solved(
+        scene,
+        SpineMode::Sockets,
+        direct,
+        GOLDEN_BENDING_SOCKETS_DIRECT,
+    );
+    check_solved(scene, SpineMode::Rod, direct, GOLDEN_BENDING_ROD_DIRECT);
+}
+
+#[test]
+fn ragdoll_drop_sockets_direct() {
+    let (scene, direct) = (Scene::RagdollDrop, JointSolver::Direct);
+    check_solved(
+        scene,
+        SpineMode::Sockets,
+        direct,
+        GOLDEN_DROP_SOCKETS_DIRECT,
+    );
+}
+
+#[test]
+fn ragdoll_drop_rod_direct() {
+    let (scene, direct) = (Scene::RagdollDrop, JointSolver::Direct);
+    check_solved(scene, SpineMode::Rod, direct, GOLDEN_DROP_ROD_DIRECT);
+}
+
+// The direct solve's (issue 18), set by the commit that introduced them.
+const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x2d9f_e5a8_b349_f6a8;
+const GOLDEN_BENDING_ROD_DIRECT: u64 = 0xcead_d528_664e_36fc;
+const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x051a_b093_7a68_03cf;
+const GOLDEN_DROP_ROD_DIRECT: u64 = 0x8ca6_8dbe_7040_0965;
 
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision
