@@ -14,6 +14,7 @@ use vertebra_math::map::{LaneMap, map_arrays};
 use vertebra_math::{Backend, BackendChoice, Lane, Quat, Vec3, poly};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Scene, SceneConfig, SceneWorld, build};
+use vertebra_world::JointSolver;
 
 /// The backends the instruction-count benches measure, by argument index:
 /// 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
@@ -555,8 +556,18 @@ fn drop_scene_with(
 /// (60 frames) in, on `backend`, its residuals not measured. No colliders,
 /// so a frame is the step.
 pub fn single_ragdoll(spine: SpineMode, backend: BackendChoice) -> SceneWorld {
+    single_ragdoll_solved(spine, backend, JointSolver::Iterative)
+}
+
+/// [`single_ragdoll`] with its joints solved by `joints`.
+pub fn single_ragdoll_solved(
+    spine: SpineMode,
+    backend: BackendChoice,
+    joints: JointSolver,
+) -> SceneWorld {
     let mut config = SceneConfig::new(Scene::PassiveBending, spine);
     (config.substeps, config.iterations, config.backend) = (1, 4, backend);
+    config.joints = joints;
     config.measure_residuals = false;
     let mut scene = build(&config).expect("the passive-bending scene");
     for frame in 0..60 {
