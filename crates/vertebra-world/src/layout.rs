@@ -412,9 +412,11 @@ impl Layout {
             .map(|&k| (k - ROD_KEY) as usize)
             .filter(|&s| rods[s].is_some());
         let rod_held = |s: usize| trees.has_rod(s);
-        let rods = self
-            .rods
-            .append(rod_slots, rod_held, RodBlock::padding(), |block, lane, slot| {
+        let rods = self.rods.append(
+            rod_slots,
+            rod_held,
+            RodBlock::padding(),
+            |block, lane, slot| {
                 block.set(
                     lane,
                     &rod_lane(
@@ -422,7 +424,8 @@ impl Layout {
                         bodies,
                     ),
                 );
-            });
+            },
+        );
         Group {
             driven,
             plain,
