@@ -97,13 +97,33 @@ impl<B> Default for Blocks<B> {
 }
 
 impl<B: Copy> Blocks<B> {
+    /// Lays out `slots` in blocks of eight: first those `held` (whose
+    /// equality parts the direct solve holds), then the rest, never two
+    /// of these in one block. So a block is `BodyPairs::direct` exactly
+    /// when its joints are held, whatever else shares its colour (which
+    /// depends on the solve bins, so on the worker count): which parts a
+    /// joint gets never depends on its neighbours in a block.
     fn append(
         &mut self,
-        slots: impl Iterator<Item = usize>,
+        slots: impl Iterator<Item = usize> + Clone,
+        held: impl Fn(usize) -> bool,
         padding: B,
         mut set: impl FnMut(&mut B, usize, usize),
     ) -> Range<usize> {
         let start = self.blocks.len();
+        let apart = slots.clone().filter(|&s| held(s));
+        self.append_packed(apart, padding, &mut set);
+        self.append_packed(slots.filter(|&s| !held(s)), padding, set);
+        start..self.blocks.len()
+    }
+
+    /// Lays out `slots` in blocks of eight, in order.
+    fn append_packed(
+        &mut self,
+        slots: impl Iterator<Item = usize>,
+        padding: B,
+        mut set: impl FnMut(&mut B, usize, usize),
+    ) {
         for (k, slot) in slots.enumerate() {
             let lane = k % BLOCK_LANES;
             if lane == 0 {
@@ -116,7 +136,6 @@ impl<B: Copy> Blocks<B> {
             }
             self.place[slot] = (block, lane);
         }
-        start..self.blocks.len()
     }
 }
 
@@ -156,8 +175,8 @@ impl Layout {
     /// `Some` when live. The joints of bin `k` (their awake dynamic
     /// body's, `bins`; all of them in bin 0 when `bins` is empty) go to
     /// `bins[k]`, colour by colour. With `direct`, each bin's trees too
-    /// (`trees.rs`), and every block whose joints they all hold is marked
-    /// so (`BodyPairs::direct`).
+    /// (`trees.rs`), laid out first so that the joints they hold take
+    /// blocks of their own, which are marked so (`BodyPairs::direct`).
     pub fn build(
         colouring: &Colouring,
         joints: &[Option<JointDesc>],
@@ -183,6 +202,10 @@ impl Layout {
                 .map(|d| d.filter(|d| awake(d.body_a, d.body_b) && bin(d.body_a, d.body_b) == k))
                 .collect();
             let mut bin = Bin::default();
+            // The trees first: their joints take blocks of their own.
+            if direct {
+                bin.trees = layout.trees.append(&joints, &rods, bodies);
+            }
             for (c, used) in used.iter_mut().enumerate() {
                 let group = layout.append(colouring.colour(c), &joints, &rods, bodies);
                 if !group.is_empty() {
@@ -191,9 +214,6 @@ impl Layout {
                 }
             }
             bin.overflow = layout.append(colouring.overflow(), &joints, &rods, bodies);
-            if direct {
-                bin.trees = layout.trees.append(&joints, &rods, bodies);
-            }
             layout.bins.push(bin);
         }
         layout.trees.check_disjoint();
@@ -359,18 +379,12 @@ impl Layout {
             }
         };
         let padding = SocketBlock::padding();
-        let driven = self
-            .sockets
-            .append(sockets(true, false), padding, set_socket);
-        let plain = self
-            .sockets
-            .append(sockets(false, false), padding, set_socket);
-        let shaped_driven = self
-            .sockets
-            .append(sockets(true, true), padding, set_socket);
-        let shaped_plain = self
-            .sockets
-            .append(sockets(false, true), padding, set_socket);
+        let trees = &self.trees;
+        let held = |s: usize| trees.has_joint(s);
+        let driven = (self.sockets).append(sockets(true, false), held, padding, set_socket);
+        let plain = (self.sockets).append(sockets(false, false), held, padding, set_socket);
+        let shaped_driven = (self.sockets).append(sockets(true, true), held, padding, set_socket);
+        let shaped_plain = (self.sockets).append(sockets(false, true), held, padding, set_socket);
         let hinges = |driven: bool| {
             joint_slots().filter(move |&s| {
                 let d = joint(s);
@@ -384,12 +398,12 @@ impl Layout {
             }
         };
         let padding = HingeBlock::padding();
-        let hinges_driven = self.hinges.append(hinges(true), padding, set_hinge);
-        let hinges_plain = self.hinges.append(hinges(false), padding, set_hinge);
+        let hinges_driven = self.hinges.append(hinges(true), held, padding, set_hinge);
+        let hinges_plain = self.hinges.append(hinges(false), held, padding, set_hinge);
         let fixed = joint_slots().filter(|&s| joint(s).kind == JointKind::Fixed);
         let fixed = self
             .fixed
-            .append(fixed, FixedBlock::padding(), |block, lane, slot| {
+            .append(fixed, held, FixedBlock::padding(), |block, lane, slot| {
                 block.set(lane, &fixed_lane(joint(slot), bodies));
             });
         let rod_slots = keys
@@ -397,9 +411,12 @@ impl Layout {
             .filter(|&&k| k >= ROD_KEY)
             .map(|&k| (k - ROD_KEY) as usize)
             .filter(|&s| rods[s].is_some());
-        let rods = self
-            .rods
-            .append(rod_slots, RodBlock::padding(), |block, lane, slot| {
+        let rod_held = |s: usize| trees.has_rod(s);
+        let rods = self.rods.append(
+            rod_slots,
+            rod_held,
+            RodBlock::padding(),
+            |block, lane, slot| {
                 block.set(
                     lane,
                     &rod_lane(
@@ -407,7 +424,8 @@ impl Layout {
                         bodies,
                     ),
                 );
-            });
+            },
+        );
         Group {
             driven,
             plain,
