@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Scene, SceneConfig, SceneWorld, build};
+use vertebra_world::JointSolver;
 
 /// The system allocator, counting allocations (and reallocations).
 struct Counting;
@@ -54,10 +55,11 @@ static COUNTING: Counting = Counting;
 
 const DT: f32 = 1.0 / 60.0;
 
-/// The drop with `threads` threads, `frames` frames in.
-fn settled(spine: SpineMode, threads: usize, frames: usize) -> SceneWorld {
+/// The drop with `threads` threads and its joints solved by `joints`,
+/// `frames` frames in.
+fn settled(spine: SpineMode, joints: JointSolver, threads: usize, frames: usize) -> SceneWorld {
     let mut config = SceneConfig::new(Scene::RagdollDrop, spine);
-    config.threads = threads;
+    (config.threads, config.joints) = (threads, joints);
     let mut scene = build(&config).expect("the drop");
     for _ in 0..frames {
         frame(&mut scene);
@@ -98,17 +100,24 @@ const FRAMES: usize = 126;
 /// grow would have none (the solver stages inside allocate nothing).
 #[test]
 fn a_settled_drop_allocates_nothing_per_frame_but_rayons_queue_blocks() {
-    for spine in [SpineMode::Rod, SpineMode::Sockets] {
-        let mut scene = settled(spine, 1, SETTLE);
+    let solves = [JointSolver::Iterative, JointSolver::Direct];
+    for (spine, joints) in [SpineMode::Rod, SpineMode::Sockets]
+        .into_iter()
+        .flat_map(|spine| solves.map(|joints| (spine, joints)))
+    {
+        let mut scene = settled(spine, joints, 1, SETTLE);
         let (allocations, fewest) = allocations_over(&mut scene, FRAMES);
         assert!(fewest > 500, "{spine:?}: the pile has its contacts");
-        assert_eq!(allocations, 0, "{spine:?}, 1 thread: {FRAMES} frames");
-        let mut scene = settled(spine, 2, SETTLE);
+        assert_eq!(
+            allocations, 0,
+            "{spine:?}, {joints:?}, 1 thread: {FRAMES} frames"
+        );
+        let mut scene = settled(spine, joints, 2, SETTLE);
         let (allocations, fewest) = allocations_over(&mut scene, FRAMES);
         assert!(fewest > 500, "{spine:?}: the pile has its contacts");
         assert!(
             allocations <= FRAMES.div_ceil(63),
-            "{spine:?}, 2 threads: {allocations} allocations in {FRAMES} frames"
+            "{spine:?}, {joints:?}, 2 threads: {allocations} allocations in {FRAMES} frames"
         );
     }
 }
