@@ -59,12 +59,12 @@ const TABLE: [(JointSolver, &[(u32, u32)]); 2] = [
 ];
 
 /// The plot's splits (substeps x iterations): the paper's 1x20, fewer
-/// iterations (1x10, 1x4), the same 20 sweeps in more substeps (2x5...
+/// iterations (1x10, 1x8, 1x4), the same 20 sweeps in more substeps (2x5...
 /// 4x5), and many substeps of few iterations (10x2).
 const SWEEP: [(u32, u32); 7] = [(1, 20), (1, 10), (1, 8), (1, 4), (2, 5), (4, 5), (10, 2)];
 
 /// Seeded starts per point of the plot: three (the median of three), to
-/// keep the sweep's 24 settings per scene to about a minute and a half.
+/// keep the sweep's 28 settings per scene to about two minutes.
 const SWEEP_SEEDS: u64 = 3;
 
 /// Per seed: ms per step, mean eps_lin (cm), mean eps_ang (rad).
