@@ -16,9 +16,10 @@
 //! has no direction where the error is zero: a row along `n` would vanish
 //! exactly when the joint is right, and the solve would then leave other
 //! joints free to turn it. Two rows across the whole plane the error lives
-//! in keep it held at zero error too. Their Jacobians are exact at zero
-//! error and first-order beyond, which the next iteration's
-//! re-linearisation absorbs. Derivations in `docs/direct.md`; every row
+//! in keep it held at zero error too. Their Jacobians, and the lock's
+//! (the identity: the rotation vector's derivative at zero), are exact
+//! at zero error and first-order beyond, which the next iteration's
+//! re-linearisation absorbs; the point's are exact everywhere. Derivations in `docs/direct.md`; every row
 //! is checked against finite differences in `tests/direct.rs`.
 
 use vertebra_math::{Lane, Quat, Vec3, poly};
