@@ -5,22 +5,22 @@
 //! (`vertebra_kernels::direct`).
 //!
 //! Joints are taken in key order (joints by slot, then rods by slot) and
-//! join their bodies' sets; static and kinematic bodies are one node, the
-//! ground. A joint whose two sides are already joined closes a loop (two
-//! hands on one pole, or a second joint to the ground) and stays
+//! join their dynamic bodies' sets; a set holds at most one joint to a
+//! static or kinematic body (its tree's root). A joint whose two sides are
+//! already joined, or that would give a set a second such joint, closes a
+//! loop (two hands on one pole, a body between two anchors) and stays
 //! iterative, whole. A tree's shape is its joints' kinds and bodies,
 //! numbered in the order the joints name them, so two ragdolls built by
 //! the same code share one (a crowd of one humanoid is one topology).
 //! Built with the layout, never per step.
 
+use core::f32::consts::PI;
 use std::collections::BTreeMap;
 
 use vertebra_kernels::body::StartLane;
 use vertebra_kernels::direct::{BodyNode, JointLane, JointNode, JointRows, Topology, TreeBlock};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
-
-use core::f32::consts::PI;
 
 use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing};
 use crate::rod::RodDesc;
