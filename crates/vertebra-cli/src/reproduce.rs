@@ -3,9 +3,9 @@
 //! CSV, plots, pictures and `summary.json`.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{Value, json};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{
@@ -44,9 +44,10 @@ pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), Stri
             let mut config = SceneConfig::new(scene, spine);
             config.joints = joints;
             let label = format!("{scene} ({})", spine_name(spine));
-            let seeded = Seeded::run(&config, seeds, |done, count| progress(&label, done, count))
+            let bar = progress(label, seeds);
+            let seeded = Seeded::run(&config, seeds, |done, _| bar.set_position(done as u64))
                 .map_err(|e| e.to_string())?;
-            eprintln!();
+            bar.finish();
             write_csv(
                 &out.join(format!("{scene}-{}.csv", spine_name(spine))),
                 &seeded,
@@ -186,13 +187,14 @@ fn scene_json(scene: Scene, runs: &[(SpineMode, Seeded)]) -> Value {
     json!({ "scene": scene.name(), "spines": spines, "rod_vs_sockets": comparison })
 }
 
-fn progress(label: &str, done: usize, count: usize) {
-    let width = 30;
-    let bar = width * done / count.max(1);
-    eprint!(
-        "\r{label:<28} [{}{}] {done}/{count} seeds",
-        "#".repeat(bar),
-        ".".repeat(width - bar)
-    );
-    std::io::stderr().flush().ok();
+/// A scene's progress over its seeds, on stderr: drawn only when stderr is
+/// a terminal (indicatif hides it otherwise), so a log file gets no
+/// carriage returns.
+fn progress(label: String, seeds: u64) -> ProgressBar {
+    let style = ProgressStyle::with_template("{prefix:<28} [{bar:30}] {pos}/{len} seeds")
+        .expect("a valid template")
+        .progress_chars("#>.");
+    let bar = ProgressBar::new(seeds).with_style(style).with_prefix(label);
+    bar.tick();
+    bar
 }

@@ -998,3 +998,17 @@ fn reproduce_with_direct_joints_writes_beside_the_iterative_run() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `reproduce`'s progress is drawn only on a terminal: run with stderr
+/// into a pipe (a log file, CI), it writes no carriage returns and no bar
+/// (the hand-written bar it replaced wrote one `\r` line per seed).
+#[test]
+fn reproduce_writes_no_progress_into_a_pipe() {
+    let out = std::env::temp_dir().join(format!("vertebra-progress-{}", std::process::id()));
+    let (code, _, stderr) =
+        vertebra(&["reproduce", "--seeds", "1", "--out", out.to_str().unwrap()]);
+    std::fs::remove_dir_all(&out).ok();
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains('\r'), "{stderr:?}");
+    assert!(!stderr.contains("seeds"), "{stderr:?}");
+}
