@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{RawRows, flatten, to_rows, unit_quat, vec};
+use common::{RawRows, flatten, moved, to_rows, turned, unit_quat, vec};
 use glam::{DVec3, Mat3, Quat as GQuat, Vec3 as GVec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -267,19 +267,6 @@ fn lanes(p: GVec3, q: GQuat) -> BodyLanes<f32> {
         q: q.into(),
         inv_inertia: Sym3::diagonal(Vec3::splat(GVec3::ONE)),
     }
-}
-
-/// Turns a body by the world rotation vector `v`, exactly.
-fn turned(mut b: BodyLanes<f32>, v: GVec3) -> BodyLanes<f32> {
-    b.q = (GQuat::from_scaled_axis(v) * GQuat::from(b.q))
-        .normalize()
-        .into();
-    b
-}
-
-fn moved(mut b: BodyLanes<f32>, v: GVec3) -> BodyLanes<f32> {
-    b.p = (GVec3::from(b.p) + v).into();
-    b
 }
 
 fn pair_start(s: &StartLane) -> PairStart<f32> {

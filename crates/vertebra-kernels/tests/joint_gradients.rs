@@ -3,6 +3,9 @@
 //! own measurement at random configurations; the hinge axis part's
 //! one-step alignment and the hinge range measured in the bodies' frames;
 //! and the ellipse's nearest point against its defining conditions.
+mod common;
+
+use common::turned;
 
 use glam::{Quat as GQuat, Vec3 as GVec3};
 use rand::rngs::StdRng;
@@ -43,14 +46,6 @@ fn configuration(
     let relative = GQuat::from_scaled_axis(unit(r) * r.random_range(0.0..max_angle));
     let fb = qb.inverse() * qa * fa * relative;
     (body(qa), body(qb), fa.into(), fb.into())
-}
-
-/// Turns a body by the small world rotation vector `v` (exactly).
-fn turned(mut b: BodyLanes<f32>, v: GVec3) -> BodyLanes<f32> {
-    b.q = (GQuat::from_scaled_axis(v) * GQuat::from(b.q))
-        .normalize()
-        .into();
-    b
 }
 
 /// Central difference of `c` for rotations of b (`of_b`) or a about each

@@ -1,6 +1,9 @@
 //! Every gradient a rod part uses, against central finite differences of
 //! the part's own measurement, at random configurations.
 
+mod common;
+
+use common::{moved, turned};
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -49,19 +52,6 @@ fn configuration(r: &mut StdRng) -> (BodyLanes<f32>, BodyLanes<f32>, Quat<f32>, 
     let pa = unit(r) * r.random_range(0.0..2.0);
     let pb = pa + unit(r) * r.random_range(0.2..1.0);
     (body(pa, qa), body(pb, qb), fa.into(), fb.into())
-}
-
-/// Turns a body by the small world rotation vector `v` (exactly).
-fn turned(mut b: BodyLanes<f32>, v: GVec3) -> BodyLanes<f32> {
-    b.q = (GQuat::from_scaled_axis(v) * GQuat::from(b.q))
-        .normalize()
-        .into();
-    b
-}
-
-fn moved(mut b: BodyLanes<f32>, v: GVec3) -> BodyLanes<f32> {
-    b.p = (GVec3::from(b.p) + v).into();
-    b
 }
 
 /// Central difference of `c` along each world axis, for rotations of one

@@ -181,16 +181,8 @@ impl<L: Lane> Rows<L> {
     #[inline(always)]
     fn point(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         let (ra, rb, d) = point::separation(a, b, g.anchor_a, g.anchor_b, &g.start);
-        let (zero, one) = (L::splat(0.0), L::splat(1.0));
-        let axes = [
-            Vec3::new(one, zero, zero),
-            Vec3::new(zero, one, zero),
-            Vec3::new(zero, zero, one),
-        ];
-        let c = [d.x, d.y, d.z];
-        for k in 0..3 {
-            let e = axes[k];
-            self.set(at + k, c[k], (e, rb.cross(e)), ra.cross(e));
+        for (k, (e, c)) in world_axes().into_iter().zip([d.x, d.y, d.z]).enumerate() {
+            self.set(at + k, c, (e, rb.cross(e)), ra.cross(e));
         }
     }
 
@@ -211,15 +203,8 @@ impl<L: Lane> Rows<L> {
     #[inline(always)]
     fn lock(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         let c = lock::measure(a, b, g.frame_a, g.frame_b);
-        let (zero, one) = (L::splat(0.0), L::splat(1.0));
-        let axes = [
-            Vec3::new(one, zero, zero),
-            Vec3::new(zero, one, zero),
-            Vec3::new(zero, zero, one),
-        ];
-        let c = [c.x, c.y, c.z];
-        for k in 0..3 {
-            self.set(at + k, c[k], (Vec3::zero(), axes[k]), axes[k]);
+        for (k, (e, c)) in world_axes().into_iter().zip([c.x, c.y, c.z]).enumerate() {
+            self.set(at + k, c, (Vec3::zero(), e), e);
         }
     }
 
@@ -259,6 +244,18 @@ impl<L: Lane> Rows<L> {
         let (o, c) = length::measure(a, b, &f, g.rest_length, &g.start);
         self.set(at, c, (o, Vec3::zero()), Vec3::zero());
     }
+}
+
+/// The world's axes: the rows of a vector error measured along them (the
+/// point's separation, the lock's rotation vector).
+#[inline(always)]
+fn world_axes<L: Lane>() -> [Vec3<L>; 3] {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    [
+        Vec3::new(one, zero, zero),
+        Vec3::new(zero, one, zero),
+        Vec3::new(zero, zero, one),
+    ]
 }
 
 /// A frame's +Y axis (its rotation matrix's second column).

@@ -223,3 +223,24 @@ pub fn padded_blocks_agree<B: Clone>(
         }
     }
 }
+
+/// Turns a body by the world rotation vector `v`, exactly (the gradient
+/// tests' finite differences).
+pub fn turned(
+    mut b: vertebra_kernels::body::BodyLanes<f32>,
+    v: Vec3,
+) -> vertebra_kernels::body::BodyLanes<f32> {
+    b.q = (Quat::from_scaled_axis(v) * Quat::from(b.q))
+        .normalize()
+        .into();
+    b
+}
+
+/// Moves a body by `v` (m, world).
+pub fn moved(
+    mut b: vertebra_kernels::body::BodyLanes<f32>,
+    v: Vec3,
+) -> vertebra_kernels::body::BodyLanes<f32> {
+    b.p = (Vec3::from(b.p) + v).into();
+    b
+}
