@@ -92,6 +92,37 @@ const SHARED_FILES: [&str; 3] = [
 /// the system's (the proof that a steady step allocates nothing).
 const COUNTING_ALLOCATOR_FILE: &str = "crates/vertebra-scenes/tests/allocation.rs";
 
+/// And the C ABI, whose callers hand it raw pointers: its functions are
+/// `unsafe extern "C"` with a `# Safety` section (what the pointers must
+/// be), their bodies turn pointers into references through `ffi.rs`'s
+/// checks; and the Rust programs that call them as C would (the crate's
+/// tests and the overhead benchmark).
+const C_ABI_PATHS: [&str; 3] = [
+    "crates/vertebra-capi/src/",
+    "crates/vertebra-capi/tests/",
+    "benches/capi.rs",
+];
+
+/// Whether `code` declares an unsafe function (not a function pointer
+/// type: `unsafe extern "C" fn(`).
+fn declares_unsafe_fn(code: &str) -> bool {
+    code.split("unsafe ").skip(1).any(|rest| {
+        let rest = rest.strip_prefix("extern \"C\" ").unwrap_or(rest);
+        rest.strip_prefix("fn ").is_some()
+    })
+}
+
+/// Whether the `unsafe fn` declared at line `n` has a `# Safety` section
+/// in the doc comment above it.
+fn says_its_safety_contract(lines: &[&str], n: usize) -> bool {
+    lines[..n]
+        .iter()
+        .rev()
+        .skip_while(|l| l.trim_start().starts_with("#["))
+        .take_while(|l| l.trim_start().starts_with("///"))
+        .any(|l| l.contains("# Safety"))
+}
+
 #[test]
 fn every_unsafe_block_says_why_and_stays_where_intrinsics_are() {
     for (path, text) in sources() {
@@ -107,13 +138,27 @@ fn every_unsafe_block_says_why_and_stays_where_intrinsics_are() {
             if code.contains("unsafe_op_in_unsafe_fn") {
                 continue;
             }
+            let c_abi = C_ABI_PATHS.iter().any(|p| path.starts_with(p));
             assert!(
                 INTRINSIC_FILES.contains(&path.as_str())
                     || SHARED_FILES.contains(&path.as_str())
-                    || path == COUNTING_ALLOCATOR_FILE,
+                    || path == COUNTING_ALLOCATOR_FILE
+                    || c_abi,
                 "{path}:{}: `unsafe` only where intrinsics need it",
                 n + 1
             );
+            if c_abi && code.contains("unsafe extern \"C\" fn(") {
+                // A function pointer's type: what C hands in, not a block.
+                continue;
+            }
+            if c_abi && declares_unsafe_fn(code) {
+                assert!(
+                    says_its_safety_contract(&lines, n),
+                    "{path}:{}: an unsafe fn without a `# Safety` section",
+                    n + 1
+                );
+                continue;
+            }
             let start = n.saturating_sub(3);
             let said = lines[start..=n].iter().any(|l| l.contains("// SAFETY:"))
                 || (start..n).any(|k| {

@@ -82,6 +82,24 @@ impl<T> Handle<T> {
         self.index as usize
     }
 
+    /// The handle as three plain numbers (slot index, the issuing
+    /// world's lineage, generation), for a C ABI or a message;
+    /// [`Handle::from_raw`] takes them back. Any three numbers make a
+    /// handle: a world refuses one it did not issue, as stale or foreign.
+    pub fn to_raw(self) -> (u32, u32, u64) {
+        self.key()
+    }
+
+    /// The handle of [`Handle::to_raw`]'s numbers.
+    pub fn from_raw(index: u32, lineage: u32, generation: u64) -> Self {
+        Self {
+            index,
+            lineage,
+            generation,
+            _kind: PhantomData,
+        }
+    }
+
     fn key(self) -> (u32, u32, u64) {
         (self.index, self.lineage, self.generation)
     }

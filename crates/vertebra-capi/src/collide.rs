@@ -1,0 +1,348 @@
+//! The collision layer (`vertebra-collide`, on parry3d): colliders on
+//! bodies, filtering, and the contacts it finds handed to the world
+//! (`docs/contacts.md`).
+
+use vertebra_collide::{Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions};
+use vertebra_world::Contact;
+
+use crate::body::VtShape;
+use crate::error::{Failure, VtResult};
+use crate::ffi::{Object, boxed, call, enter, free, out, read, slice};
+use crate::ragdoll::VtRagdoll;
+use crate::snapshot::VtBytes;
+use crate::types::{VtBody, VtVec3, flag, pick};
+use crate::world::VtWorld;
+
+/// Colliders and the contacts they make (opaque; `vt_collisions_create`,
+/// `vt_collisions_destroy`).
+pub struct VtCollisions {
+    pub(crate) collisions: Collisions,
+    /// The contact list handed to the world and back each update, kept so
+    /// that a steady update allocates nothing.
+    contacts: Vec<Contact>,
+    poisoned: bool,
+}
+
+impl Object for VtCollisions {
+    const NAME: &'static str = "collisions";
+    fn poisoned(&mut self) -> &mut bool {
+        &mut self.poisoned
+    }
+}
+
+/// A collider's geometry kind.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VtColliderKind {
+    /// A body shape (`shape`).
+    Solid = 0,
+    /// The half space below the plane through the body's origin with the
+    /// outward unit normal `plane_normal` (body frame): the ground.
+    Plane = 1,
+}
+
+/// A collider on a body.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct VtCollider {
+    /// The body it moves with.
+    pub body: VtBody,
+    /// A `VtColliderKind`.
+    pub kind: u32,
+    /// Solid: the shape (body frame, centred on the centre of mass).
+    pub shape: VtShape,
+    /// Plane: the outward unit normal (body frame).
+    pub plane_normal: VtVec3,
+    /// Friction coefficient (a pair uses the geometric mean), >= 0.
+    pub friction: f32,
+    /// Restitution (a pair uses the larger), in [0, 1].
+    pub restitution: f32,
+    /// The groups it is in (a bit set).
+    pub membership: u32,
+    /// The groups it collides with: a pair is tested when each one's
+    /// membership meets the other's filter.
+    pub filter: u32,
+}
+
+impl TryFrom<VtCollider> for Collider {
+    type Error = Failure;
+    fn try_from(c: VtCollider) -> Result<Self, Failure> {
+        let shape = match pick(c.kind, "collider.kind", &[0, 1])? {
+            0 => ColliderShape::Solid(c.shape.try_into()?),
+            _ => ColliderShape::Plane(c.plane_normal.into()),
+        };
+        Ok(Collider {
+            body: c.body.into(),
+            shape,
+            friction: c.friction,
+            restitution: c.restitution,
+            groups: CollisionGroups {
+                membership: c.membership,
+                filter: c.filter,
+            },
+        })
+    }
+}
+
+/// Runs `body` on the layer at `collisions` inside [`call`].
+///
+/// # Safety
+/// `collisions` is null or live, used by no other call at once.
+unsafe fn with_layer(
+    collisions: *mut VtCollisions,
+    body: impl FnOnce(&mut VtCollisions) -> Result<(), Failure>,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let mut layer = unsafe { enter(collisions) }?;
+        body(&mut layer)
+    })
+}
+
+/// Makes an empty collision layer (free it with `vt_collisions_destroy`).
+///
+/// # Safety
+/// `collisions` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_create(collisions: *mut *mut VtCollisions) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        unsafe { out(collisions, "collisions") }?.set(boxed(VtCollisions {
+            collisions: Collisions::new(),
+            contacts: Vec::new(),
+            poisoned: false,
+        }));
+        Ok(())
+    })
+}
+
+/// Frees a collision layer (null does nothing).
+///
+/// # Safety
+/// `collisions` is null or live, and not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_destroy(collisions: *mut VtCollisions) {
+    // SAFETY: the function's contract.
+    unsafe { free(collisions) }
+}
+
+/// Adds a collider and writes its index into `index` (null: not wanted).
+/// Refused, naming the collider, for a degenerate shape, a non-unit plane
+/// normal, or friction or restitution out of range.
+///
+/// # Safety
+/// `collisions` is live; `collider` is readable; `index` is null or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_add(
+    collisions: *mut VtCollisions,
+    collider: *const VtCollider,
+    index: *mut usize,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    let collider = unsafe { read(collider, "collider") };
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let added = layer.collisions.add(collider?.try_into()?)?;
+            if !index.is_null() {
+                out(index, "index")?.set(added);
+            }
+            Ok(())
+        })
+    }
+}
+
+/// Never lets two bodies collide.
+///
+/// # Safety
+/// `collisions` is live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_exclude(
+    collisions: *mut VtCollisions,
+    a: VtBody,
+    b: VtBody,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            layer.collisions.exclude(a.into(), b.into());
+            Ok(())
+        })
+    }
+}
+
+/// Sets the groups of every collider on `body`.
+///
+/// # Safety
+/// `collisions` is live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_set_body_groups(
+    collisions: *mut VtCollisions,
+    body: VtBody,
+    membership: u32,
+    filter: u32,
+) -> VtResult {
+    let groups = CollisionGroups { membership, filter };
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            Ok(layer.collisions.set_body_groups(body.into(), groups)?)
+        })
+    }
+}
+
+/// Sets the groups of every collider of a ragdoll.
+///
+/// # Safety
+/// `collisions` and `ragdoll` are live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_set_ragdoll_groups(
+    collisions: *mut VtCollisions,
+    ragdoll: *mut VtRagdoll,
+    membership: u32,
+    filter: u32,
+) -> VtResult {
+    let groups = CollisionGroups { membership, filter };
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let ragdoll = enter(ragdoll)?;
+            Ok(layer
+                .collisions
+                .set_ragdoll_groups(&ragdoll.ragdoll, groups)?)
+        })
+    }
+}
+
+/// Lets a ragdoll's bodies collide with each other (non-zero; its jointed
+/// pairs never do) or not (0).
+///
+/// # Safety
+/// `collisions` and `ragdoll` are live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_set_ragdoll_self_collision(
+    collisions: *mut VtCollisions,
+    ragdoll: *mut VtRagdoll,
+    collide: u32,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let ragdoll = enter(ragdoll)?;
+            let layer = &mut layer.collisions;
+            Ok(layer.set_ragdoll_self_collision(&ragdoll.ragdoll, flag(collide))?)
+        })
+    }
+}
+
+/// Removes every collider on `body` (and its exclusions).
+///
+/// # Safety
+/// `collisions` is live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_remove_body(
+    collisions: *mut VtCollisions,
+    body: VtBody,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            layer.collisions.remove_body(body.into());
+            Ok(())
+        })
+    }
+}
+
+/// Sets the speculative margin (m, finite, not negative): pairs closer
+/// than it make contacts before they touch.
+///
+/// # Safety
+/// `collisions` is live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_set_prediction(
+    collisions: *mut VtCollisions,
+    margin: f32,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            Ok(layer.collisions.set_prediction(margin)?)
+        })
+    }
+}
+
+/// Finds the contacts of the world's current poses for a step of `dt`
+/// seconds and hands them to the world for its next step (in place of
+/// `vt_world_set_contacts`). A steady update allocates nothing.
+///
+/// # Safety
+/// `collisions` and `world` are live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_update(
+    collisions: *mut VtCollisions,
+    world: *mut VtWorld,
+    dt: f32,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let mut world = enter(world)?;
+            let VtCollisions {
+                collisions,
+                contacts,
+                ..
+            } = layer;
+            collisions.find_contacts_into(&world.world, dt, contacts)?;
+            Ok(world.world.swap_contacts(contacts)?)
+        })
+    }
+}
+
+/// Writes a snapshot of the layer (colliders, groups, exclusions) into
+/// `snapshot`, owned by the caller (`vt_bytes_destroy`).
+///
+/// # Safety
+/// `collisions` is live; `snapshot` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_snapshot(
+    collisions: *mut VtCollisions,
+    snapshot: *mut *mut VtBytes,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    let snapshot = unsafe { out(snapshot, "snapshot") };
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let bytes = layer.collisions.snapshot().as_bytes().to_vec();
+            snapshot?.set(boxed(VtBytes { bytes }));
+            Ok(())
+        })
+    }
+}
+
+/// Restores the layer from `length` bytes of its snapshot, checked against
+/// `world` (restore the world first): refused, unchanged, for a collider
+/// on a body the world lacks or damaged bytes.
+///
+/// # Safety
+/// `collisions` and `world` are live; `data` points to `length` readable
+/// bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_restore(
+    collisions: *mut VtCollisions,
+    world: *mut VtWorld,
+    data: *const u8,
+    length: usize,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    let data = unsafe { slice(data, length, "data") };
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let world = enter(world)?;
+            let snapshot = CollisionSnapshot::from_bytes(data?.to_vec());
+            Ok(layer.collisions.restore(&snapshot, &world.world)?)
+        })
+    }
+}

@@ -1,0 +1,249 @@
+//! The boundary: the only place raw pointers become references, and the
+//! catch that keeps a panic from crossing into C.
+//!
+//! Every exported function runs its body in [`call`]. An object a call
+//! works on is [`enter`]ed: poisoned while the call runs and cleared when
+//! it returns, so a panic (a bug; never a caller's input) leaves it
+//! poisoned and every later call on it refused with
+//! [`VtResult::Poisoned`], not run on a half-updated state.
+
+use std::ffi::{CStr, c_char};
+use std::ops::{Deref, DerefMut};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use crate::error::{Failure, VtResult, remember};
+
+/// Runs a function's body: its result, or its refusal's code with the
+/// message kept for `vt_last_error_message`; a panic becomes
+/// [`VtResult::Panic`].
+pub(crate) fn call(body: impl FnOnce() -> Result<(), Failure>) -> VtResult {
+    let failure = match catch_unwind(AssertUnwindSafe(body)) {
+        Ok(Ok(())) => return VtResult::Ok,
+        Ok(Err(failure)) => failure,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Failure::new(VtResult::Panic, format!("vertebra panicked: {what}"))
+        }
+    };
+    remember(&failure.message);
+    failure.code
+}
+
+/// An object C holds by pointer that a panic can poison.
+pub(crate) trait Object {
+    /// Its name in messages, e.g. `world`.
+    const NAME: &'static str;
+    /// Its poison flag.
+    fn poisoned(&mut self) -> &mut bool;
+}
+
+/// An object lent to one call: poisoned until the call returns normally.
+pub(crate) struct Entered<'a, T: Object>(&'a mut T);
+
+impl<T: Object> Deref for Entered<'_, T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        self.0
+    }
+}
+
+impl<T: Object> DerefMut for Entered<'_, T> {
+    fn deref_mut(&mut self) -> &mut T {
+        self.0
+    }
+}
+
+impl<T: Object> Drop for Entered<'_, T> {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            *self.0.poisoned() = false;
+        }
+    }
+}
+
+/// Refuses a null or misaligned pointer, naming `what`.
+fn check<T>(ptr: *const T, what: &str) -> Result<(), Failure> {
+    if ptr.is_null() {
+        return Err(Failure::new(
+            VtResult::NullPointer,
+            format!("{what} is null"),
+        ));
+    }
+    if !ptr.is_aligned() {
+        return Err(Failure::new(
+            VtResult::NullPointer,
+            format!("{what} is not aligned for its type"),
+        ));
+    }
+    Ok(())
+}
+
+/// The object at `ptr`, lent to this call and poisoned while it runs.
+///
+/// # Safety
+/// `ptr` is null or points to a live object of this type made by its
+/// create function and not destroyed, used by no other call at once.
+pub(crate) unsafe fn enter<'a, T: Object>(ptr: *mut T) -> Result<Entered<'a, T>, Failure> {
+    check(ptr, T::NAME)?;
+    // SAFETY: checked non-null and aligned; live and unshared by the
+    // caller's contract.
+    let object = unsafe { &mut *ptr };
+    if *object.poisoned() {
+        return Err(Failure::new(
+            VtResult::Poisoned,
+            format!("the {} was poisoned by an earlier panic", T::NAME),
+        ));
+    }
+    *object.poisoned() = true;
+    Ok(Entered(object))
+}
+
+/// A read-only object (a description, skeleton or mapper).
+///
+/// # Safety
+/// `ptr` is null or points to a live object of this type made by its
+/// create function and not destroyed.
+pub(crate) unsafe fn shared<'a, T>(ptr: *const T, what: &str) -> Result<&'a T, Failure> {
+    check(ptr, what)?;
+    // SAFETY: checked non-null and aligned; live by the caller's contract.
+    Ok(unsafe { &*ptr })
+}
+
+/// A copy of the input struct at `ptr`.
+///
+/// # Safety
+/// `ptr` is null or points to a readable, initialised `T`.
+pub(crate) unsafe fn read<T: Copy>(ptr: *const T, what: &str) -> Result<T, Failure> {
+    check(ptr, what)?;
+    // SAFETY: checked non-null and aligned; readable by the contract. Every
+    // input struct is plain numbers, so any bits are a valid `T`.
+    Ok(unsafe { ptr.read() })
+}
+
+/// An output place, checked before the call computes anything, written
+/// only when it succeeds.
+pub(crate) struct Out<T>(*mut T);
+
+impl<T> Out<T> {
+    /// Writes the result.
+    pub(crate) fn set(self, value: T) {
+        // SAFETY: checked non-null and aligned in `out`; writable by the
+        // caller's contract.
+        unsafe { self.0.write(value) }
+    }
+
+    /// Writes the result, as a call's last step.
+    pub(crate) fn done(self, value: T) -> Result<(), Failure> {
+        self.set(value);
+        Ok(())
+    }
+}
+
+/// The output place `ptr`.
+///
+/// # Safety
+/// `ptr` is null or points to writable memory for a `T`.
+pub(crate) unsafe fn out<T>(ptr: *mut T, what: &str) -> Result<Out<T>, Failure> {
+    check(ptr, what)?;
+    Ok(Out(ptr))
+}
+
+/// `len` items at `ptr` (any pointer when `len` is 0).
+///
+/// # Safety
+/// `ptr` points to `len` readable, initialised items (or `len` is 0).
+pub(crate) unsafe fn slice<'a, T>(
+    ptr: *const T,
+    len: usize,
+    what: &str,
+) -> Result<&'a [T], Failure> {
+    if len == 0 {
+        return Ok(&[]);
+    }
+    check(ptr, what)?;
+    // SAFETY: checked non-null and aligned; `len` readable items by the
+    // contract. Every item type is plain numbers.
+    Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
+}
+
+/// `len` writable items at `ptr` (any pointer when `len` is 0).
+///
+/// # Safety
+/// `ptr` points to `len` writable items (or `len` is 0), which no other
+/// argument of the call points into.
+pub(crate) unsafe fn slice_mut<'a, T>(
+    ptr: *mut T,
+    len: usize,
+    what: &str,
+) -> Result<&'a mut [T], Failure> {
+    if len == 0 {
+        return Ok(&mut []);
+    }
+    check(ptr, what)?;
+    // SAFETY: checked non-null and aligned; `len` writable items, not
+    // aliased, by the contract. Every item type is plain numbers.
+    Ok(unsafe { std::slice::from_raw_parts_mut(ptr, len) })
+}
+
+/// The NUL-terminated UTF-8 string at `ptr`.
+///
+/// # Safety
+/// `ptr` is null or points to a NUL-terminated string.
+pub(crate) unsafe fn text<'a>(ptr: *const c_char, what: &str) -> Result<&'a str, Failure> {
+    check(ptr, what)?;
+    // SAFETY: checked non-null; NUL-terminated by the contract.
+    let text = unsafe { CStr::from_ptr(ptr) };
+    text.to_str()
+        .map_err(|e| Failure::new(VtResult::NotUtf8, format!("{what} is not UTF-8: {e}")))
+}
+
+/// Writes `text` with its NUL into `buffer` of `capacity` bytes and its
+/// length with the NUL into `length`; refused (`BufferTooSmall`, nothing
+/// but `length` written) when it does not fit. `buffer` may be null when
+/// `capacity` is 0, to ask the length.
+///
+/// # Safety
+/// `buffer` points to `capacity` writable bytes; `length` is writable.
+pub(crate) unsafe fn copy_text(
+    text: &str,
+    buffer: *mut c_char,
+    capacity: usize,
+    length: *mut usize,
+) -> Result<(), Failure> {
+    // SAFETY: the caller's contract.
+    let length = unsafe { out(length, "length") }?;
+    let needed = text.len() + 1;
+    length.set(needed);
+    if capacity < needed {
+        return Err(Failure::new(
+            VtResult::BufferTooSmall,
+            format!("the buffer holds {capacity} bytes; the text needs {needed}"),
+        ));
+    }
+    // SAFETY: the caller's contract: `capacity` >= `needed` writable bytes.
+    let bytes = unsafe { slice_mut(buffer.cast::<u8>(), needed, "buffer") }?;
+    bytes[..text.len()].copy_from_slice(text.as_bytes());
+    bytes[text.len()] = 0;
+    Ok(())
+}
+
+/// A new object for C to own (freed by its destroy function).
+pub(crate) fn boxed<T>(value: T) -> *mut T {
+    Box::into_raw(Box::new(value))
+}
+
+/// Frees an object made by [`boxed`]; null does nothing.
+///
+/// # Safety
+/// `ptr` is null or came from [`boxed`] for this type and was not freed.
+pub(crate) unsafe fn free<T>(ptr: *mut T) {
+    if !ptr.is_null() {
+        // SAFETY: made by `boxed` (Box::into_raw) and not yet freed, by
+        // the contract.
+        drop(unsafe { Box::from_raw(ptr) });
+    }
+}
