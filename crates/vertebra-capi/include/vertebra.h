@@ -399,6 +399,10 @@ typedef struct VtSkeleton VtSkeleton;
 // bones (opaque; read-only; `vt_skeleton_mapper_destroy`).
 typedef struct VtSkeletonMapper VtSkeletonMapper;
 
+// The switch from animation (opaque; read-only;
+// `vt_transition_destroy`).
+typedef struct VtTransition VtTransition;
+
 // Bodies, joints, rods and contacts, and the solver that steps them
 // (opaque; `vt_world_create`, `vt_world_destroy`).
 typedef struct VtWorld VtWorld;
@@ -1469,6 +1473,62 @@ enum VtResult vt_world_snapshot(struct VtWorld *world, struct VtBytes **snapshot
 // # Safety
 // `world` is a live world; `data` points to `length` readable bytes.
 enum VtResult vt_world_restore(struct VtWorld *world, const uint8_t *data, size_t length);
+
+// Takes a local pose (`count` parent-local transforms) to the model frame
+// (`count` transforms into `model`): what
+// `vt_skeleton_mapper_map_to_ragdoll` takes.
+//
+// # Safety
+// `skeleton` is live; `local` points to `count` readable transforms,
+// `model` to `count` writable ones.
+enum VtResult vt_skeleton_to_model(const struct VtSkeleton *skeleton,
+                                   const struct VtTransform *local,
+                                   struct VtTransform *model,
+                                   size_t count);
+
+// Starts the switch for a ragdoll just built at the animation's pose
+// (`vt_ragdoll_build` with `at_switch`): the offsets between the
+// animation (`count` parent-local transforms, placed by
+// `model_to_world`) and what `mapping` (a `VtSpineMapping`) gives from
+// the bodies, faded out over `fade` seconds (>= 0; infinity: kept).
+// Writes the transition into `transition` (`vt_transition_destroy`).
+//
+// # Safety
+// `mapper`, `ragdoll` and `world` are live; `animation` points to `count`
+// readable transforms; `transition` is writable.
+enum VtResult vt_transition_create(const struct VtSkeletonMapper *mapper,
+                                   struct VtRagdoll *ragdoll,
+                                   struct VtWorld *world,
+                                   const struct VtTransform *animation,
+                                   size_t count,
+                                   struct VtTransform model_to_world,
+                                   uint32_t mapping,
+                                   float fade,
+                                   struct VtTransition **transition);
+
+// Frees a transition (null does nothing).
+//
+// # Safety
+// `transition` is null or live, and not used afterwards.
+void vt_transition_destroy(struct VtTransition *transition);
+
+// Every bone of the skeleton `since_switch` seconds after the switch
+// (>= 0): the mapping of the simulated ragdoll with the switch's offsets
+// faded in; written into `bones` (`count` world transforms; `animation`
+// as `vt_skeleton_mapper_map_to_skeleton` takes it).
+//
+// # Safety
+// `transition`, `mapper`, `ragdoll` and `world` are live; `animation`
+// points to `count` readable transforms, `bones` to `count` writable ones.
+enum VtResult vt_transition_skeleton_pose(const struct VtTransition *transition,
+                                          const struct VtSkeletonMapper *mapper,
+                                          struct VtRagdoll *ragdoll,
+                                          struct VtWorld *world,
+                                          const struct VtTransform *animation,
+                                          struct VtTransform model_to_world,
+                                          float since_switch,
+                                          struct VtTransform *bones,
+                                          size_t count);
 
 // Writes the default settings (1 substep, 20 iterations, the best
 // backend, one thread, gravity -9.81 m/s^2 along y, sleeping on) into

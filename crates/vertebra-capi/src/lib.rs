@@ -2,7 +2,7 @@
 //! these sources): worlds, bodies, joints of every kind with their limits
 //! and drives, rods, impulses, contacts, snapshots, ragdolls (loaded from a
 //! file or a string, built at a pose, driven, mapped onto an animation
-//! skeleton), the engine's job system and the collision layer.
+//! skeleton, switched to from animation without a pop), the engine's job system and the collision layer.
 //!
 //! # Conventions
 //! - Every function returns a `VtResult`: `VT_RESULT_OK` (0) or the reason
@@ -14,7 +14,7 @@
 //!   `VT_RESULT_PANIC` and poisons the object it was working on (every
 //!   later call on it but its destroy returns `VT_RESULT_POISONED`).
 //! - Objects (`VtWorld`, `VtCollisions`, `VtRagdollDesc`, `VtRagdoll`,
-//!   `VtSkeleton`, `VtSkeletonMapper`, `VtBytes`) are opaque. The caller
+//!   `VtSkeleton`, `VtSkeletonMapper`, `VtTransition`, `VtBytes`) are opaque. The caller
 //!   owns every object a function writes to a `T**` and frees it with that
 //!   type's `_destroy` (null does nothing), exactly once. vertebra never
 //!   keeps a caller's pointer beyond the call (but the job system's
@@ -42,6 +42,7 @@ mod rod;
 mod skeleton;
 mod snapshot;
 mod tasks;
+mod transition;
 mod types;
 mod world;
 
@@ -55,5 +56,6 @@ pub use rod::*;
 pub use skeleton::*;
 pub use snapshot::*;
 pub use tasks::{VtParallelFor, VtTaskFn, VtTaskSystem};
+pub use transition::*;
 pub use types::{VtBody, VtJoint, VtQuat, VtRod, VtTransform, VtVec3};
 pub use world::*;

@@ -16,13 +16,13 @@ use crate::world::VtWorld;
 
 /// An animation skeleton (opaque; read-only; `vt_skeleton_destroy`).
 pub struct VtSkeleton {
-    skeleton: Skeleton,
+    pub(crate) skeleton: Skeleton,
 }
 
 /// A mapper between one ragdoll description's bodies and one skeleton's
 /// bones (opaque; read-only; `vt_skeleton_mapper_destroy`).
 pub struct VtSkeletonMapper {
-    mapper: SkeletonMapper,
+    pub(crate) mapper: SkeletonMapper,
 }
 
 /// How a chain of bones without bodies (the spine's, under a rod) is
@@ -48,6 +48,16 @@ impl From<Transform> for VtTransform {
     fn from(t: Transform) -> Self {
         (t.translation, t.rotation).into()
     }
+}
+
+/// The mapping a `VtSpineMapping` names.
+pub(crate) fn spine_mapping(mapping: u32) -> Result<SpineMapping, Failure> {
+    let all = [
+        SpineMapping::Orientation,
+        SpineMapping::PositionOrientation,
+        SpineMapping::Arc,
+    ];
+    pick(mapping, "mapping", &all)
 }
 
 /// Hands a loaded skeleton to C.
@@ -219,7 +229,7 @@ pub unsafe extern "C" fn vt_skeleton_bind_pose(
 }
 
 /// Copies bones into `place`, which must be as long.
-fn write_bones(bones: &[Transform], place: &mut [VtTransform]) -> Result<(), Failure> {
+pub(crate) fn write_bones(bones: &[Transform], place: &mut [VtTransform]) -> Result<(), Failure> {
     if place.len() != bones.len() {
         return Err(Failure::new(
             VtResult::BufferTooSmall,
@@ -345,15 +355,7 @@ pub unsafe extern "C" fn vt_skeleton_mapper_map_to_skeleton(
         let (ragdoll, world) = unsafe { (enter(ragdoll)?, enter(world)?) };
         // SAFETY: the function's contract.
         let place = unsafe { slice_mut(bones, count, "bones") }?;
-        let mapping = pick(
-            mapping,
-            "mapping",
-            &[
-                SpineMapping::Orientation,
-                SpineMapping::PositionOrientation,
-                SpineMapping::Arc,
-            ],
-        )?;
+        let mapping = spine_mapping(mapping)?;
         let animation = LocalPose {
             bones: animation.iter().map(|&t| t.into()).collect(),
         };
