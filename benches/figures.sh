@@ -28,7 +28,7 @@ run() {
 }
 
 all=(math_instructions joints_instructions step_instructions single_ragdoll_instructions
-    math joints step single_ragdoll sleep collisions mapper stages peer)
+    capi_instructions math joints step single_ragdoll sleep collisions mapper capi stages peer)
 chosen=("${@:-${all[@]}}")
 
 if printf '%s\n' "${chosen[@]}" | grep -q '_instructions$'; then
@@ -36,9 +36,18 @@ if printf '%s\n' "${chosen[@]}" | grep -q '_instructions$'; then
 fi
 for name in "${chosen[@]}"; do
     case $name in
+    capi_instructions)
+        run "$name" --bench "$name"
+        # The C layer's own instructions: each wrapper's inclusive count
+        # beside the Rust calls it makes.
+        for f in target/iai/vertebra-benches/capi_instructions/capi_30/c_frame.*/callgrind.*.out; do
+            echo "# $f"
+            callgrind_annotate --inclusive=yes "$f" 2>/dev/null | grep -E "(vt_world_step|vt_collisions_update|World::step|find_contacts_into|World::swap_contacts)$" |
+                grep -v "^ *[0-9,]* .*\[" | tee -a "$out/$name.txt"
+        done ;;
     *_instructions) run "$name" --bench "$name" ;;
     stages) run "$name" --bench stages --features stage-timing ;;
-    math | joints | step | single_ragdoll | sleep | collisions | mapper)
+    math | joints | step | single_ragdoll | sleep | collisions | mapper | capi)
         run "$name" --bench "$name" -- "${criterion[@]}" ;;
     peer)
         run "$name" --bench "$name" -- "${criterion[@]}"
