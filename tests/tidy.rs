@@ -96,11 +96,13 @@ const COUNTING_ALLOCATOR_FILE: &str = "crates/vertebra-scenes/tests/allocation.r
 /// `unsafe extern "C"` with a `# Safety` section (what the pointers must
 /// be), their bodies turn pointers into references through `ffi.rs`'s
 /// checks; and the Rust programs that call them as C would (the crate's
-/// tests and the overhead benchmarks, `benches/capi*.rs`).
-const C_ABI_PATHS: [&str; 3] = [
+/// tests, the overhead benchmarks `benches/capi*.rs`, and its fuzz
+/// target).
+const C_ABI_PATHS: [&str; 4] = [
     "crates/vertebra-capi/src/",
     "crates/vertebra-capi/tests/",
     "benches/capi",
+    "crates/vertebra-fuzzing/src/capi.rs",
 ];
 
 /// Whether `code` declares an unsafe function (not a function pointer

@@ -23,10 +23,15 @@
 //!   world and the collision set saved and restored (also from crafted
 //!   bytes), steps with detection: a refused call changes nothing, no
 //!   collider or contact outlives its body.
+//! - [`capi`]: arbitrary call sequences through the C ABI, structs filled
+//!   as a C caller may (any enum value, any float bits, made-up handles):
+//!   no call panics, a refused call leaves the world and the collision
+//!   layer as they were, every body stays finite.
 //! - [`snapshot`]: a valid world's snapshot with its decoded state changed
 //!   (or its payload's bytes) and a correct checksum: refused by name with
 //!   the world unchanged, or accepted and stepped with every body finite.
 
+mod capi;
 mod collisions;
 mod input;
 mod kernels;
@@ -35,6 +40,7 @@ mod math;
 mod snapshot;
 mod world;
 
+pub use capi::capi;
 pub use collisions::collisions;
 pub use kernels::kernels;
 pub use loader::ragdoll_loader;
@@ -46,7 +52,7 @@ pub use world::{world_api, world_settings};
 pub type Target = fn(&[u8]);
 
 /// Every target, by its cargo-fuzz name.
-pub const TARGETS: [(&str, Target); 7] = [
+pub const TARGETS: [(&str, Target); 8] = [
     ("math_backends", math_backends),
     ("kernels", kernels),
     ("world_api", world_api),
@@ -54,4 +60,5 @@ pub const TARGETS: [(&str, Target); 7] = [
     ("ragdoll_loader", ragdoll_loader),
     ("collisions", collisions),
     ("snapshot", snapshot),
+    ("capi", capi),
 ];
