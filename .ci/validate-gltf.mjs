@@ -1,6 +1,7 @@
 // Runs the Khronos glTF validator (the npm package `gltf-validator`) on
 // each file given: prints its counts and every message, and exits 1 if
-// any file has an error (severity 0) or the validator cannot read it.
+// any file has an error (severity 0) or a warning (1), or the validator
+// cannot read it. Infos and hints are printed only.
 //
 // usage: node .ci/validate-gltf.mjs VALIDATOR_DIR FILE...
 //   VALIDATOR_DIR: where `npm install --prefix` put the package.
@@ -32,7 +33,7 @@ for (const file of files) {
     for (const m of messages) {
       console.log(`  ${severities[m.severity]} ${m.code} at ${m.pointer ?? m.offset ?? ""}: ${m.message}`);
     }
-    failed ||= numErrors > 0;
+    failed ||= numErrors > 0 || numWarnings > 0;
   } catch (e) {
     console.log(`${file}: the validator could not read it: ${e}`);
     failed = true;
