@@ -313,7 +313,9 @@ fn run_writing(
     let run = match run {
         Ok(run) => run,
         Err(Failed(e)) => {
-            gltf.map(GltfOut::discard);
+            if let Some(gltf) = gltf {
+                gltf.discard();
+            }
             return Err(e);
         }
     };

@@ -89,12 +89,15 @@ fn load(path: &Path) -> Loaded {
     loaded
 }
 
+/// A body's name, shape, and pose (position, m; orientation) each frame.
+type BodyRun = (String, Shape, Vec<(Vec3, Quat)>);
+
 /// What the scenes API gives for the same run: per ragdoll, each built
 /// body's name, shape and pose every frame; every frame's mapped skeleton
 /// poses (if the ragdolls map); the bodies with colliders outside the
 /// ragdolls, with their pose.
 struct Expected {
-    bodies: Vec<Vec<(String, Shape, Vec<(Vec3, Quat)>)>>,
+    bodies: Vec<Vec<BodyRun>>,
     skeletons: Option<Vec<Vec<ModelPose>>>,
     scenery: Vec<(ColliderShape, Vec3, Quat)>,
 }

@@ -46,10 +46,11 @@ pub fn skins(
         })
         .collect();
     let inverse_binds = doc.floats(&inverse_binds, Type::Mat4, None, false);
-    let (data, skinning) = bones_mesh(skeleton, &bind.bones);
+    let (data, joints) = bones_mesh(skeleton, &bind.bones);
+    let weights = vec![[1.0, 0.0, 0.0, 0.0]; joints.len()];
     let skinning = Skinning {
-        joints: &skinning.0,
-        weights: &skinning.1,
+        joints: &joints,
+        weights: &weights,
     };
     let drawn_mesh = mesh(doc, "bones".to_owned(), &data, material, Some(skinning));
     Ok(skeletons
@@ -142,12 +143,9 @@ fn bone_node(
 
 /// One octahedron per bone but the roots (the model frame's placement,
 /// not a part of the body), from its origin to its first child's, in the
-/// bind pose (`bind`: model frame), each vertex bound to its bone with
-/// weight 1.
-fn bones_mesh(
-    skeleton: &Skeleton,
-    bind: &[Transform],
-) -> (MeshData, (Vec<[u16; 4]>, Vec<[f32; 4]>)) {
+/// bind pose (`bind`: model frame), with each vertex's bone (to be
+/// bound to it alone, weight 1).
+fn bones_mesh(skeleton: &Skeleton, bind: &[Transform]) -> (MeshData, Vec<[u16; 4]>) {
     let bones = skeleton.bones();
     let mut data = MeshData::default();
     let mut joints = Vec::new();
@@ -167,6 +165,5 @@ fn bones_mesh(
         data.indices.extend(shape.indices.iter().map(|i| first + i));
         joints.extend(shape.positions.iter().map(|_| [index as u16, 0, 0, 0]));
     }
-    let weights = vec![[1.0, 0.0, 0.0, 0.0]; joints.len()];
-    (data, (joints, weights))
+    (data, joints)
 }
