@@ -4,21 +4,23 @@
 //! skeleton file (`vertebra check FILE`).
 
 mod check;
+mod gltf_out;
 mod output;
 mod plots;
 mod reproduce;
 mod skeleton_csv;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, SpineMode};
-use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, Seeded};
+use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, SceneRun, Seeded};
 use vertebra_world::{JointSolver, SleepSettings};
 
+use gltf_out::GltfOut;
 use skeleton_csv::{Failed, SkeletonCsv};
 
 #[derive(Parser)]
@@ -114,6 +116,11 @@ enum Command {
         /// frame,ragdoll,bone,x,y,z,qx,qy,qz,qw (m, world).
         #[arg(long)]
         skeleton_out: Option<PathBuf>,
+        /// Writes the run as an animated glTF 2.0 file: FILE.glb (binary)
+        /// or FILE.gltf (JSON, buffer embedded); every body with its shape,
+        /// each ragdoll's reference skeleton as a skin (docs/gltf.md).
+        #[arg(long, value_name = "FILE")]
+        gltf: Option<PathBuf>,
     },
     /// Checks a ragdoll file (with its skeleton), a ragdoll generator file
     /// or a skeleton file and prints what it holds (or generates), or
@@ -224,6 +231,7 @@ fn execute(command: Command) -> Result<(), String> {
             sleep,
             json,
             skeleton_out,
+            gltf,
         } => {
             let scene: Scene = name.parse()?;
             let backend: BackendChoice = backend.parse().map_err(|e| format!("{e}"))?;
@@ -255,6 +263,9 @@ fn execute(command: Command) -> Result<(), String> {
             if let (Some(_), Some(_)) = (seeds, &skeleton_out) {
                 return Err("--skeleton-out writes one run; not with --seeds".to_owned());
             }
+            if let (Some(_), Some(_)) = (seeds, &gltf) {
+                return Err("--gltf writes one run; not with --seeds".to_owned());
+            }
             if let Some(count) = seeds {
                 let seeded = Seeded::run(&config, count, |_, _| {}).map_err(|e| e.to_string())?;
                 if json {
@@ -264,20 +275,7 @@ fn execute(command: Command) -> Result<(), String> {
                 }
                 return Ok(());
             }
-            let run = match skeleton_out {
-                Some(path) => {
-                    let mut csv = SkeletonCsv::new(&path);
-                    let run = vertebra_scenes::run_observed(
-                        &config,
-                        |_, _| {},
-                        |frame, scene| csv.frame(frame, scene),
-                    )
-                    .map_err(|Failed(e)| e)?;
-                    csv.finish()?;
-                    run
-                }
-                None => vertebra_scenes::run(&config, |_, _| {}).map_err(|e| e.to_string())?,
-            };
+            let run = run_writing(&config, skeleton_out.as_deref(), gltf.as_deref())?;
             if json {
                 println!("{}", output::run_json(&config, &run));
             } else {
@@ -286,4 +284,46 @@ fn execute(command: Command) -> Result<(), String> {
             Ok(())
         }
     }
+}
+
+/// Runs `config` once, writing every frame's skeleton poses as CSV to
+/// `skeleton_out` and the run as glTF to `gltf`, where given (the glTF
+/// file is created before the run and removed if the run fails).
+fn run_writing(
+    config: &SceneConfig,
+    skeleton_out: Option<&Path>,
+    gltf: Option<&Path>,
+) -> Result<SceneRun, String> {
+    let frames = config.frames.unwrap_or(config.scene.default_frames());
+    let mut csv = skeleton_out.map(SkeletonCsv::new);
+    let mut gltf = gltf.map(|p| GltfOut::create(p, frames)).transpose()?;
+    let run = vertebra_scenes::run_observed(
+        config,
+        |_, _| {},
+        |frame, scene| {
+            if let Some(csv) = &mut csv {
+                csv.frame(frame, scene)?;
+            }
+            if let Some(gltf) = &mut gltf {
+                gltf.frame(scene)?;
+            }
+            Ok(())
+        },
+    );
+    let run = match run {
+        Ok(run) => run,
+        Err(Failed(e)) => {
+            if let Some(gltf) = gltf {
+                gltf.discard();
+            }
+            return Err(e);
+        }
+    };
+    if let Some(csv) = csv {
+        csv.finish()?;
+    }
+    if let Some(note) = gltf.map(GltfOut::finish).transpose()?.flatten() {
+        eprintln!("vertebra: {note}");
+    }
+    Ok(run)
 }

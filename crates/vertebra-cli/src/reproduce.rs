@@ -1,6 +1,7 @@
 //! `vertebra reproduce`: every scene both ways over seeded starts; a table
 //! of each figure's median and spread, the rod's advantage with its spread,
-//! CSV, plots, pictures and `summary.json`.
+//! CSV, plots, pictures, `summary.json`, and seed 0's run of each scene and
+//! spine as an animated glTF file (`<scene>-<spine>.glb`).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -13,6 +14,7 @@ use vertebra_scenes::{
 };
 use vertebra_world::JointSolver;
 
+use crate::gltf_out::write_run;
 use crate::output::{io, joints_name, spine_name, spreads, write_csv};
 use crate::plots::{font_options, picture, plot, plot_locus, to_png};
 
@@ -48,6 +50,11 @@ pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), Stri
             let seeded = Seeded::run(&config, seeds, |done, _| bar.set_position(done as u64))
                 .map_err(|e| e.to_string())?;
             bar.finish();
+            // Seed 0's run (the paper's start) to look at in any glTF viewer.
+            write_run(
+                &config,
+                &out.join(format!("{scene}-{}.glb", spine_name(spine))),
+            )?;
             write_csv(
                 &out.join(format!("{scene}-{}.csv", spine_name(spine))),
                 &seeded,

@@ -31,7 +31,7 @@ pub use kinematics::{Locus, kinematics};
 pub use quantity::{Quantity, Stats};
 pub use ragdoll_drop::ragdoll_drop;
 pub use recovery::{RECOVERED, Recovery};
-pub use run::{Frame, MAX_FRAMES, SceneRun, run, run_observed};
+pub use run::{FRAME_DT, Frame, MAX_FRAMES, SceneRun, run, run_observed};
 pub use scene::Scene;
 pub use scene_world::SceneWorld;
 pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};

@@ -14,6 +14,9 @@ use crate::{Scene, SceneConfig, SceneWorld, build};
 /// 1e12 frames aborted allocating 16 TB.
 pub const MAX_FRAMES: usize = 1_000_000;
 
+/// One frame's time step (s): every scene runs at 60 Hz.
+pub const FRAME_DT: f32 = 1.0 / 60.0;
+
 /// What one frame measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Frame {
@@ -85,7 +88,7 @@ pub fn run_observed<E: From<RagdollError>>(
         .into());
     }
     let mut built = build(config)?;
-    let dt = 1.0 / 60.0;
+    let dt = FRAME_DT;
     let mut out = Vec::with_capacity(frames);
     let mut snapshots = Vec::new();
     let start = Instant::now();
