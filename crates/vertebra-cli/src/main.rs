@@ -6,6 +6,7 @@
 mod check;
 mod output;
 mod plots;
+mod render;
 mod reproduce;
 mod skeleton_csv;
 

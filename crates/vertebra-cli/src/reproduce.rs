@@ -15,6 +15,7 @@ use vertebra_world::JointSolver;
 
 use crate::output::{io, joints_name, spine_name, spreads, write_csv};
 use crate::plots::{font_options, picture, plot, plot_locus, to_png};
+use crate::skeleton_csv::Failed;
 
 /// Seeds `reproduce` runs each scene from unless told: enough for the 10th
 /// and 90th percentiles, and the whole command in well under a minute on
@@ -48,6 +49,9 @@ pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), Stri
             let seeded = Seeded::run(&config, seeds, |done, _| bar.set_position(done as u64))
                 .map_err(|e| e.to_string())?;
             bar.finish();
+            if scene == Scene::RagdollDrop {
+                figure_1(out, &config)?;
+            }
             write_csv(
                 &out.join(format!("{scene}-{}.csv", spine_name(spine))),
                 &seeded,
@@ -93,6 +97,30 @@ pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), Stri
     }
     println!("results in {}", out.display());
     Ok(())
+}
+
+/// Figure 1: `config`'s pile at rest (seed 0's last frame), rendered to
+/// `figure1-SPINE.png` in `out`.
+fn figure_1(out: &Path, config: &SceneConfig) -> Result<(), String> {
+    let frames = config.frames.unwrap_or(config.scene.default_frames());
+    let mut image = None;
+    let first = SceneConfig {
+        seed: 0,
+        ..config.clone()
+    };
+    vertebra_scenes::run_observed(
+        &first,
+        |_, _| {},
+        |frame, scene| {
+            if frame + 1 == frames {
+                image = Some(crate::render::figure_1(scene).map_err(Failed)?);
+            }
+            Ok(())
+        },
+    )
+    .map_err(|Failed(e)| e)?;
+    let path = out.join(format!("figure1-{}.png", spine_name(config.spine)));
+    image.ok_or("no frame to draw")?.save_png(&path)
 }
 
 /// One scene's block of the table: each figure's median [band] per spine,
