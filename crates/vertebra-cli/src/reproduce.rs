@@ -46,12 +46,14 @@ pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), Stri
             config.joints = joints;
             let label = format!("{scene} ({})", spine_name(spine));
             let bar = progress(label, seeds);
-            let seeded = Seeded::run(&config, seeds, |done, _| bar.set_position(done as u64))
-                .map_err(|e| e.to_string())?;
+            // Figure 1's run beside the seeds' (one more run in the pool).
+            let (seeded, figure) = rayon::join(
+                || Seeded::run(&config, seeds, |done, _| bar.set_position(done as u64)),
+                || (scene == Scene::RagdollDrop).then(|| figure_1(out, &config)),
+            );
+            let seeded = seeded.map_err(|e| e.to_string())?;
+            figure.transpose()?;
             bar.finish();
-            if scene == Scene::RagdollDrop {
-                figure_1(out, &config)?;
-            }
             write_csv(
                 &out.join(format!("{scene}-{}.csv", spine_name(spine))),
                 &seeded,

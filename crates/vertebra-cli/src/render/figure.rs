@@ -3,7 +3,7 @@
 //! simplified ragdoll's spine bodies, which the rod replaces in the world,
 //! are drawn where the rod puts them), every body a capsule in the
 //! ragdoll's own colour; the static colliders are grey, the ground a
-//! checker of 0.5 m squares. The camera looks down at 40 degrees from
+//! checker of 0.5 m squares. The camera looks down at 50 degrees from
 //! 30 degrees off the +Z axis, at the middle of everything bounded, from
 //! far enough that all of it is in view; walls (upright static boxes
 //! taller than thick) on the camera's side of the middle (the pit's two
@@ -137,6 +137,7 @@ fn view<'a>(objects: impl Iterator<Item = &'a Object>) -> (Vec3, Vec3) {
             (lo.min(a), hi.max(b))
         });
     if !(min.is_finite() && max.is_finite()) {
+        // Nothing bounded: the origin, from above and in front.
         return (Vec3::ZERO, Vec3::new(0.0, 2.0, 4.0));
     }
     // Aimed a fifth of the way up: the near side, closer to the eye, is
@@ -175,5 +176,94 @@ fn cut_away(object: Object, target: Vec3, away: Vec3) -> Object {
             half_extents: half_extents.with_y(0.5 * CUT_HEIGHT),
         },
         ..object
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Quat, Vec3};
+    use vertebra_ragdoll::SpineMode;
+    use vertebra_scenes::{Scene as Scenes, SceneConfig, build};
+
+    use super::{FOV_Y, HEIGHT, WIDTH, cut_away, ragdolls, statics, view};
+    use crate::render::{Object, Paint, Primitive};
+
+    fn wall(centre: Vec3, half_extents: Vec3, rotation: Quat) -> Object {
+        Object {
+            primitive: Primitive::Box {
+                centre,
+                rotation,
+                half_extents,
+            },
+            paint: Paint::Plain(Vec3::splat(0.5)),
+        }
+    }
+
+    #[test]
+    fn only_walls_on_the_cameras_side_are_cut_down_to_their_foot() {
+        let (along_z, thin) = (Vec3::new(1.6, 0.5, 0.05), Vec3::new(0.3, 0.15, 0.3));
+        let near = wall(Vec3::new(0.0, 0.5, 1.55), along_z, Quat::IDENTITY);
+        let cut = cut_away(near, Vec3::ZERO, Vec3::Z);
+        assert_eq!(
+            cut.primitive,
+            Primitive::Box {
+                centre: Vec3::new(0.0, 0.05, 1.55),
+                rotation: Quat::IDENTITY,
+                half_extents: Vec3::new(1.6, 0.05, 0.05),
+            }
+        );
+        let kept = [
+            wall(Vec3::new(0.0, 0.5, -1.55), along_z, Quat::IDENTITY),
+            wall(Vec3::new(0.6, 0.15, 0.6), thin, Quat::IDENTITY),
+            wall(
+                Vec3::new(0.0, 0.5, 1.55),
+                along_z,
+                Quat::from_rotation_x(0.5),
+            ),
+        ];
+        for object in kept {
+            assert_eq!(cut_away(object, Vec3::ZERO, Vec3::Z), object);
+        }
+    }
+
+    #[test]
+    fn the_drop_is_drawn_whole_and_all_in_view() {
+        let mut config = SceneConfig::new(Scenes::RagdollDrop, SpineMode::Rod);
+        config.ragdolls = 3;
+        let scene = build(&config).unwrap();
+        let bodies = ragdolls(&scene).unwrap();
+        // Every described body, the rod's spine bodies too.
+        let desc = scene.ragdolls[0].description();
+        assert_eq!(bodies.len(), 3 * desc.bodies.len());
+        // The ground, four walls and three boxes.
+        let statics = statics(&scene).unwrap();
+        assert_eq!(statics.len(), 8);
+        // Every bounding box's corners project inside the image: on the
+        // image plane at the focal length f (pixels), within half the
+        // width and height of the centre.
+        let (target, eye) = view(bodies.iter().chain(&statics));
+        let forward = (target - eye).normalize();
+        let right = forward.cross(Vec3::Y).normalize();
+        let up = right.cross(forward);
+        let focal = 0.5 * HEIGHT as f32 / (0.5 * FOV_Y).to_radians().tan();
+        for (lo, hi) in bodies
+            .iter()
+            .chain(&statics)
+            .filter_map(|o| o.primitive.bounds())
+        {
+            for k in 0..8 {
+                let corner =
+                    Vec3::select(glam::BVec3::new(k & 1 > 0, k & 2 > 0, k & 4 > 0), hi, lo);
+                let v = corner - eye;
+                let (x, y) = (
+                    focal * v.dot(right) / v.dot(forward),
+                    focal * v.dot(up) / v.dot(forward),
+                );
+                assert!(
+                    x.abs() < 0.5 * WIDTH as f32 && y.abs() < 0.5 * HEIGHT as f32,
+                    "{corner} is at ({x}, {y}) px from the centre"
+                );
+            }
+        }
     }
 }

@@ -62,7 +62,15 @@ impl Primitive {
             }
             Primitive::Capsule { a, b, radius } => {
                 let axis = b - a;
-                let side = cylinder(ray, a, axis, radius, t_min, t_max);
+                let side = match cylinder(ray, a, axis, radius, t_min, t_max) {
+                    // Outside the infinite cylinder that holds the capsule:
+                    // a miss.
+                    Side::Missed => return None,
+                    // Entering the cylinder between the end planes: the
+                    // capsule's entry (nothing of it lies nearer).
+                    Side::Entry(hit) => return Some(hit),
+                    Side::Other(hit) => hit,
+                };
                 let cap_a = sphere(ray, a, radius, t_min, t_max, |p| (p - a).dot(axis) <= 0.0);
                 let cap_b = sphere(ray, b, radius, t_min, t_max, |p| (p - b).dot(axis) >= 0.0);
                 nearest(nearest(side, cap_a), cap_b)
@@ -177,35 +185,48 @@ fn sphere(
     })
 }
 
+/// What the ray meets of a capsule's cylinder side.
+enum Side {
+    /// The ray misses the infinite cylinder, so the capsule too.
+    Missed,
+    /// The ray's first point on the infinite cylinder, within `(t_min,
+    /// t_max)` and between the end planes.
+    Entry(Hit),
+    /// Otherwise: the nearest hit on the side between the end planes, if
+    /// any (from inside, past an end plane, or parallel to the axis).
+    Other(Option<Hit>),
+}
+
 /// The ray against the side of the cylinder of `radius` about `a`..`a +
-/// axis`, between its end planes. None for a ray parallel to the axis (it
-/// meets the side nowhere or everywhere; the caps give its hits).
-fn cylinder(ray: &Ray, a: Vec3, axis: Vec3, radius: f32, t_min: f32, t_max: f32) -> Option<Hit> {
+/// axis`, between its end planes. A ray parallel to the axis meets the
+/// side nowhere or everywhere: `Other(None)`, the caps give its hits.
+fn cylinder(ray: &Ray, a: Vec3, axis: Vec3, radius: f32, t_min: f32, t_max: f32) -> Side {
     let length2 = axis.length_squared();
     if length2 < PARALLEL {
-        return None;
+        return Side::Other(None);
     }
     let u = axis / length2.sqrt();
     let across = |v: Vec3| v - u * v.dot(u);
     let (d, o) = (across(ray.dir), across(ray.origin - a));
     let a2 = d.length_squared();
     if a2 < PARALLEL {
-        return None;
+        return Side::Other(None);
     }
-    let along = |p: Vec3| (p - a).dot(axis);
-    let inside = |p: Vec3| (0.0..=length2).contains(&along(p));
-    let t = roots(
-        ray,
-        d.dot(o) / a2,
-        (o.length_squared() - radius * radius) / a2,
-        t_min,
-        t_max,
-        inside,
-    )?;
-    Some(Hit {
+    // t^2 + 2 b t + c = 0: the ray's distance from the axis is `radius`.
+    let (b, c) = (d.dot(o) / a2, (o.length_squared() - radius * radius) / a2);
+    if b * b - c < 0.0 {
+        return Side::Missed;
+    }
+    let inside = |p: Vec3| (0.0..=length2).contains(&(p - a).dot(axis));
+    let hit = |t: f32| Hit {
         t,
         normal: across(ray.at(t) - a) / radius,
-    })
+    };
+    let first = -b - (b * b - c).sqrt();
+    if first > t_min && first < t_max && inside(ray.at(first)) {
+        return Side::Entry(hit(first));
+    }
+    Side::Other(roots(ray, b, c, t_min, t_max, inside).map(hit))
 }
 
 /// The ray against the box by slabs in the box's frame: the entry, or

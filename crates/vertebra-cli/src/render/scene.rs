@@ -84,8 +84,9 @@ impl Scene {
         })
     }
 
-    /// The nearest hit along `ray` within `(t_min, t_max)`, and what it hit.
-    pub fn closest(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<(Hit, &Object)> {
+    /// The nearest hit along `ray` within `(t_min, t_max)`, and the index
+    /// of the object it hit ([`Self::object`]).
+    pub fn closest(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<(Hit, usize)> {
         let mut best: Option<(Hit, usize)> = None;
         let mut consider = |k: usize, t_max: f32| {
             let hit = self.objects[k].primitive.intersect(ray, t_min, t_max);
@@ -99,7 +100,12 @@ impl Scene {
             t_max = consider(k, t_max).unwrap_or(t_max);
         }
         self.bvh.walk(ray, t_max, consider);
-        best.map(|(hit, k)| (hit, &self.objects[k]))
+        best
+    }
+
+    /// Object `k` (as [`Self::closest`] numbers them).
+    pub fn object(&self, k: usize) -> &Object {
+        &self.objects[k]
     }
 
     /// Whether anything lies along `ray` within `(t_min, t_max)`.

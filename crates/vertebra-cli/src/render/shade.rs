@@ -46,13 +46,26 @@ impl Light {
     }
 }
 
-/// The linear RGB seen along `ray`: the background, or the nearest
-/// surface's paint times `ambient + sun max(n . l, 0)`, the sun term
-/// dropped where a shadow ray towards the light is blocked (`n` the unit
-/// normal on the side facing the ray, `l` the light's direction).
-pub fn radiance(scene: &Scene, light: &Light, ray: &Ray) -> Vec3 {
-    let Some((hit, object)) = scene.closest(ray, 0.0, f32::INFINITY) else {
-        return BACKGROUND;
+/// What one ray sees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Linear RGB.
+    pub colour: Vec3,
+    /// The object hit ([`Scene::closest`]'s index), or `None`: the
+    /// background.
+    pub object: Option<usize>,
+}
+
+/// What `ray` sees: the background, or the nearest surface's paint times
+/// `ambient + sun max(n . l, 0)`, the sun term dropped where a shadow ray
+/// towards the light is blocked (`n` the unit normal on the side facing
+/// the ray, `l` the light's direction).
+pub fn sample(scene: &Scene, light: &Light, ray: &Ray) -> Sample {
+    let Some((hit, k)) = scene.closest(ray, 0.0, f32::INFINITY) else {
+        return Sample {
+            colour: BACKGROUND,
+            object: None,
+        };
     };
     let point = ray.at(hit.t);
     let normal = if hit.normal.dot(ray.dir) > 0.0 {
@@ -69,5 +82,8 @@ pub fn radiance(scene: &Scene, light: &Light, ray: &Ray) -> Vec3 {
         !scene.blocked(&shadow, 0.0, f32::INFINITY)
     };
     let sun = if lit { light.sun * facing } else { 0.0 };
-    object.paint.at(point) * (light.ambient + sun)
+    Sample {
+        colour: scene.object(k).paint.at(point) * (light.ambient + sun),
+        object: Some(k),
+    }
 }
