@@ -10,6 +10,7 @@ use vertebra_ragdoll::{Pose, RagdollDesc, SpineMode};
 use vertebra_scenes::{Quantity, Scene, Seeded};
 
 use crate::output::{io, spine_name};
+use crate::render::capsules;
 use crate::render::colour::{hex, ragdoll_colour};
 
 /// Renders the SVG at `svg` to a PNG beside it (same name, `.png`), with
@@ -154,10 +155,8 @@ pub fn plot_locus(path: &Path, locus: &vertebra_scenes::Locus) -> Result<(), Str
 /// Side views (z forward, y up, seen from -x) of every ragdoll at the
 /// first, middle (mid-push for controllability) and last frame, both
 /// ways, from the first seed's run: figures 2 and 7, and the drop's pile.
-/// A lone ragdoll is drawn in its spine's colour (as in the plots),
-/// at 60% opacity, several each in its own colour (figure 1's), the
-/// farther first, at 85% so those behind show a little. Every panel has the same scale
-/// (at most 120 px/m), fit to all the picture's poses.
+/// Every panel has the same scale (at most 120 px/m), fit to all the
+/// picture's poses.
 pub fn picture(path: &Path, scene: Scene, runs: &[(SpineMode, Seeded)]) -> Result<(), String> {
     let desc = RagdollDesc::reference_humanoid();
     let frames: Vec<&[Vec<Pose>]> = runs.iter().map(|(_, s)| &s.runs[0].snapshots[..]).collect();
@@ -185,24 +184,7 @@ pub fn picture(path: &Path, scene: Scene, runs: &[(SpineMode, Seeded)]) -> Resul
                     row as f32 * panel_h + 30.0 + (max.y - p.y) * scale,
                 )
             };
-            let mut order: Vec<usize> = (0..ragdolls.len()).collect();
-            let depth = |k: usize| ragdolls[k].bones.iter().map(|b| b.0.x).sum::<f32>();
-            order.sort_by(|&a, &b| depth(b).total_cmp(&depth(a)));
-            for k in order {
-                let (colour, opacity) = match ragdolls.len() {
-                    1 => (colour_name(*spine).to_owned(), 0.6),
-                    _ => (hex(ragdoll_colour(k)), 0.85),
-                };
-                for ([a, b], radius) in capsules(&desc, &ragdolls[k]) {
-                    let ((x1, y1), (x2, y2)) = (at(a), at(b));
-                    writeln!(
-                        svg,
-                        "<line x1=\"{x1:.1}\" y1=\"{y1:.1}\" x2=\"{x2:.1}\" y2=\"{y2:.1}\" stroke=\"{colour}\" stroke-width=\"{:.1}\" stroke-linecap=\"round\" opacity=\"{opacity}\"/>",
-                        2.0 * radius * scale
-                    )
-                    .ok();
-                }
-            }
+            draw_ragdolls(&mut svg, &desc, ragdolls, *spine, at, scale);
         }
         let count = poses.first().map_or(0, Vec::len);
         let who = if count > 1 {
@@ -216,24 +198,43 @@ pub fn picture(path: &Path, scene: Scene, runs: &[(SpineMode, Seeded)]) -> Resul
     std::fs::write(path, svg).map_err(io)
 }
 
+/// One panel's ragdolls, each body a round-capped line as wide as its
+/// capsule, placed by `at` (m, world to px) at `scale` px/m. A lone
+/// ragdoll is drawn in its spine's colour (as in the plots) at 60%
+/// opacity; several each in its own colour (figure 1's), the farther
+/// (larger x, seen from -x) first, at 85% so those behind show a little.
+fn draw_ragdolls(
+    svg: &mut String,
+    desc: &RagdollDesc,
+    ragdolls: &[Pose],
+    spine: SpineMode,
+    at: impl Fn(Vec3) -> (f32, f32),
+    scale: f32,
+) {
+    let mut order: Vec<usize> = (0..ragdolls.len()).collect();
+    let depth = |k: usize| ragdolls[k].bones.iter().map(|b| b.0.x).sum::<f32>();
+    order.sort_by(|&a, &b| depth(b).total_cmp(&depth(a)));
+    for k in order {
+        let (colour, opacity) = match ragdolls.len() {
+            1 => (colour_name(spine).to_owned(), 0.6),
+            _ => (hex(ragdoll_colour(k)), 0.85),
+        };
+        for ([a, b], radius) in capsules(desc, &ragdolls[k]) {
+            let ((x1, y1), (x2, y2)) = (at(a), at(b));
+            writeln!(
+                svg,
+                "<line x1=\"{x1:.1}\" y1=\"{y1:.1}\" x2=\"{x2:.1}\" y2=\"{y2:.1}\" stroke=\"{colour}\" stroke-width=\"{:.1}\" stroke-linecap=\"round\" opacity=\"{opacity}\"/>",
+                2.0 * radius * scale
+            )
+            .ok();
+        }
+    }
+}
+
 fn colour_name(spine: SpineMode) -> &'static str {
     if spine == SpineMode::Rod {
         "red"
     } else {
         "blue"
     }
-}
-
-/// Each body of `desc` at `pose` as its capsule: the core segment's ends
-/// (m, world) and the radius (m).
-fn capsules<'a>(
-    desc: &'a RagdollDesc,
-    pose: &'a Pose,
-) -> impl Iterator<Item = ([Vec3; 2], f32)> + 'a {
-    desc.bodies.iter().zip(&pose.bones).map(|(body, &(p, q))| {
-        (
-            body.segment.map(|s| p + q * (s - body.centre())),
-            body.radius,
-        )
-    })
 }

@@ -12,7 +12,7 @@
 
 use glam::{Quat, Vec3};
 use vertebra_collide::ColliderShape;
-use vertebra_ragdoll::SpineMapping;
+use vertebra_ragdoll::{Pose, RagdollDesc, SpineMapping};
 use vertebra_scenes::SceneWorld;
 use vertebra_world::Shape;
 
@@ -55,20 +55,28 @@ fn ragdolls(scene: &SceneWorld) -> Result<Vec<Object>, String> {
             .skeleton_pose(&scene.world, SpineMapping::Arc)
             .map_err(|e| e.to_string())?;
         let paint = Paint::Plain(linear_rgb(ragdoll_colour(k)));
-        let desc = ragdoll.description();
-        for (body, &(p, q)) in desc.bodies.iter().zip(&pose.bones) {
-            let [a, b] = body.segment.map(|s| p + q * (s - body.centre()));
+        for ([a, b], radius) in capsules(ragdoll.description(), &pose) {
             objects.push(Object {
-                primitive: Primitive::Capsule {
-                    a,
-                    b,
-                    radius: body.radius,
-                },
+                primitive: Primitive::Capsule { a, b, radius },
                 paint,
             });
         }
     }
     Ok(objects)
+}
+
+/// Each body of `desc` at `pose` as its capsule: the core segment's ends
+/// (m, world) and the radius (m).
+pub fn capsules<'a>(
+    desc: &'a RagdollDesc,
+    pose: &'a Pose,
+) -> impl Iterator<Item = ([Vec3; 2], f32)> + 'a {
+    desc.bodies.iter().zip(&pose.bones).map(|(body, &(p, q))| {
+        (
+            body.segment.map(|s| p + q * (s - body.centre())),
+            body.radius,
+        )
+    })
 }
 
 /// The colliders on bodies of no ragdoll (the ground, walls, boxes).

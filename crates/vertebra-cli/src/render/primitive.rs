@@ -17,6 +17,7 @@ pub struct Ray {
 }
 
 impl Ray {
+    /// The point `t` metres along the ray.
     pub fn at(&self, t: f32) -> Vec3 {
         self.origin + self.dir * t
     }

@@ -10,14 +10,11 @@ use super::primitive::{Hit, Primitive, Ray};
 /// How a surface is coloured (linear RGB, 0 to 1 each).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Paint {
+    /// One colour.
     Plain(Vec3),
     /// Squares of `size` metres over the world's x and z, alternating
     /// `a` and `b` (a floor).
-    Checker {
-        a: Vec3,
-        b: Vec3,
-        size: f32,
-    },
+    Checker { a: Vec3, b: Vec3, size: f32 },
 }
 
 impl Paint {
@@ -43,12 +40,14 @@ impl Paint {
     }
 }
 
+/// A primitive and its paint.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Object {
     pub primitive: Primitive,
     pub paint: Paint,
 }
 
+/// Objects ready to be ray cast.
 pub struct Scene {
     /// The bounded objects, indexed by the tree, then the planes.
     objects: Vec<Object>,
