@@ -7,6 +7,7 @@ mod check;
 mod gltf_out;
 mod output;
 mod plots;
+mod render;
 mod reproduce;
 mod skeleton_csv;
 

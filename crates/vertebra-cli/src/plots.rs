@@ -1,14 +1,17 @@
 //! Pictures: figure 8's plots with the spread over seeds as a band, figure
-//! 6's loci, and side views of the ragdolls; PNGs rendered from the SVGs.
+//! 6's loci, and side views of every ragdoll; PNGs rendered from the SVGs.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
+use glam::Vec3;
 use plotters::prelude::*;
 use vertebra_ragdoll::{Pose, RagdollDesc, SpineMode};
 use vertebra_scenes::{Quantity, Scene, Seeded};
 
 use crate::output::{io, spine_name};
+use crate::render::capsules;
+use crate::render::colour::{hex, ragdoll_colour};
 
 /// Renders the SVG at `svg` to a PNG beside it (same name, `.png`), with
 /// the system's fonts (DejaVu on the project's machines; without fonts the
@@ -149,57 +152,89 @@ pub fn plot_locus(path: &Path, locus: &vertebra_scenes::Locus) -> Result<(), Str
     root.present().map_err(io)
 }
 
-/// Side views (z forward, y up) of the first ragdoll at the first, middle
-/// (mid-push for controllability) and last frame, both ways, from the
-/// first seed's run: figures 2 and 7.
+/// Side views (z forward, y up, seen from -x) of every ragdoll at the
+/// first, middle (mid-push for controllability) and last frame, both
+/// ways, from the first seed's run: figures 2 and 7, and the drop's pile.
+/// Every panel has the same scale (at most 120 px/m), fit to all the
+/// picture's poses.
 pub fn picture(path: &Path, scene: Scene, runs: &[(SpineMode, Seeded)]) -> Result<(), String> {
     let desc = RagdollDesc::reference_humanoid();
-    // Three columns of 300 px, one 400 px row per spine; hips at 160 px
-    // from the row's top (bodies reach about 1 m = 120 px either way).
-    let (width, height, scale) = (300.0 * 3.0, 400.0 * 2.0, 120.0f32);
-    let mut svg = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\"><rect width=\"100%\" height=\"100%\" fill=\"white\"/>"
+    let frames: Vec<&[Vec<Pose>]> = runs.iter().map(|(_, s)| &s.runs[0].snapshots[..]).collect();
+    let all = frames.iter().flat_map(|f| f.iter().flatten());
+    let (min, max) = all.flat_map(|pose| capsules(&desc, pose)).fold(
+        (Vec3::INFINITY, Vec3::NEG_INFINITY),
+        |(lo, hi), ([a, b], r)| (lo.min(a.min(b) - r), hi.max(a.max(b) + r)),
     );
-    for (row, (spine, seeded)) in runs.iter().enumerate() {
-        let run = &seeded.runs[0];
-        let colour = if *spine == SpineMode::Rod {
-            "red"
-        } else {
-            "blue"
-        };
-        for (col, pose) in run.snapshots.iter().enumerate() {
-            let (ox, oy) = (150.0 + 300.0 * col as f32, 200.0 + 400.0 * row as f32);
-            draw_pose(&mut svg, &desc, pose, ox, oy, scale, colour);
+    let (min, max) = (min - 0.1, max + 0.1);
+    let size = max - min;
+    let scale = 120f32.min(280.0 / size.z).min(520.0 / size.y);
+    // Panels at least 300 px wide (the row's caption), the poses centred.
+    let (panel_w, panel_h) = ((size.z * scale + 20.0).max(300.0), size.y * scale + 40.0);
+    let left = 0.5 * (panel_w - size.z * scale);
+    let columns = frames.iter().map(|f| f.len()).max().unwrap_or(0) as f32;
+    let (width, height) = (panel_w * columns.max(1.0), panel_h * runs.len() as f32);
+    let mut svg = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\"><rect width=\"100%\" height=\"100%\" fill=\"white\"/>"
+    );
+    for (row, ((spine, seeded), poses)) in runs.iter().zip(&frames).enumerate() {
+        for (col, ragdolls) in poses.iter().enumerate() {
+            let at = |p: Vec3| {
+                (
+                    col as f32 * panel_w + left + (p.z - min.z) * scale,
+                    row as f32 * panel_h + 30.0 + (max.y - p.y) * scale,
+                )
+            };
+            draw_ragdolls(&mut svg, &desc, ragdolls, *spine, at, scale);
         }
-        writeln!(svg, "<text x=\"10\" y=\"{}\" font-family=\"sans-serif\" font-size=\"16\">{scene} ({}, seed {}): first, middle, last frame</text>", 24 + 400 * row, spine_name(*spine), seeded.first).ok();
+        let count = poses.first().map_or(0, Vec::len);
+        let who = if count > 1 {
+            format!("all {count} ragdolls, ")
+        } else {
+            String::new()
+        };
+        writeln!(svg, "<text x=\"10\" y=\"{:.0}\" font-family=\"sans-serif\" font-size=\"16\">{scene} ({}, seed {}): {who}first, middle, last frame</text>", 22.0 + panel_h * row as f32, spine_name(*spine), seeded.first).ok();
     }
     svg.push_str("</svg>");
     std::fs::write(path, svg).map_err(io)
 }
 
-fn draw_pose(
+/// One panel's ragdolls, each body a round-capped line as wide as its
+/// capsule, placed by `at` (m, world to px) at `scale` px/m. A lone
+/// ragdoll is drawn in its spine's colour (as in the plots) at 60%
+/// opacity; several each in its own colour (figure 1's), the farther
+/// (larger x, seen from -x) first, at 85% so those behind show a little.
+fn draw_ragdolls(
     svg: &mut String,
     desc: &RagdollDesc,
-    pose: &Pose,
-    ox: f32,
-    oy: f32,
+    ragdolls: &[Pose],
+    spine: SpineMode,
+    at: impl Fn(Vec3) -> (f32, f32),
     scale: f32,
-    colour: &str,
 ) {
-    let centre = pose.bones[desc.root].0;
-    for (i, body) in desc.bodies.iter().enumerate() {
-        let (p, q) = pose.bones[i];
-        let c = body.centre();
-        let [a, b] = body.segment.map(|s| p + q * (s - c) - centre);
-        writeln!(
-            svg,
-            "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"{colour}\" stroke-width=\"{:.1}\" stroke-linecap=\"round\" opacity=\"0.6\"/>",
-            ox + a.z * scale,
-            oy - a.y * scale,
-            ox + b.z * scale,
-            oy - b.y * scale,
-            2.0 * body.radius * scale
-        )
-        .ok();
+    let mut order: Vec<usize> = (0..ragdolls.len()).collect();
+    let depth = |k: usize| ragdolls[k].bones.iter().map(|b| b.0.x).sum::<f32>();
+    order.sort_by(|&a, &b| depth(b).total_cmp(&depth(a)));
+    for k in order {
+        let (colour, opacity) = match ragdolls.len() {
+            1 => (colour_name(spine).to_owned(), 0.6),
+            _ => (hex(ragdoll_colour(k)), 0.85),
+        };
+        for ([a, b], radius) in capsules(desc, &ragdolls[k]) {
+            let ((x1, y1), (x2, y2)) = (at(a), at(b));
+            writeln!(
+                svg,
+                "<line x1=\"{x1:.1}\" y1=\"{y1:.1}\" x2=\"{x2:.1}\" y2=\"{y2:.1}\" stroke=\"{colour}\" stroke-width=\"{:.1}\" stroke-linecap=\"round\" opacity=\"{opacity}\"/>",
+                2.0 * radius * scale
+            )
+            .ok();
+        }
+    }
+}
+
+fn colour_name(spine: SpineMode) -> &'static str {
+    if spine == SpineMode::Rod {
+        "red"
+    } else {
+        "blue"
     }
 }

@@ -17,6 +17,7 @@ use vertebra_world::JointSolver;
 use crate::gltf_out::write_run;
 use crate::output::{io, joints_name, spine_name, spreads, write_csv};
 use crate::plots::{font_options, picture, plot, plot_locus, to_png};
+use crate::skeleton_csv::Failed;
 
 /// Seeds `reproduce` runs each scene from unless told: enough for the 10th
 /// and 90th percentiles, and the whole command in well under a minute on
@@ -47,8 +48,13 @@ pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), Stri
             config.joints = joints;
             let label = format!("{scene} ({})", spine_name(spine));
             let bar = progress(label, seeds);
-            let seeded = Seeded::run(&config, seeds, |done, _| bar.set_position(done as u64))
-                .map_err(|e| e.to_string())?;
+            // Figure 1's run beside the seeds' (one more run in the pool).
+            let (seeded, figure) = rayon::join(
+                || Seeded::run(&config, seeds, |done, _| bar.set_position(done as u64)),
+                || (scene == Scene::RagdollDrop).then(|| figure_1(out, &config)),
+            );
+            let seeded = seeded.map_err(|e| e.to_string())?;
+            figure.transpose()?;
             bar.finish();
             // Seed 0's run (the paper's start) to look at in any glTF viewer.
             write_run(
@@ -100,6 +106,30 @@ pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), Stri
     }
     println!("results in {}", out.display());
     Ok(())
+}
+
+/// Figure 1: `config`'s pile at rest (seed 0's last frame), rendered to
+/// `figure1-SPINE.png` in `out`.
+fn figure_1(out: &Path, config: &SceneConfig) -> Result<(), String> {
+    let frames = config.frames.unwrap_or(config.scene.default_frames());
+    let mut image = None;
+    let first = SceneConfig {
+        seed: 0,
+        ..config.clone()
+    };
+    vertebra_scenes::run_observed(
+        &first,
+        |_, _| {},
+        |frame, scene| {
+            if frame + 1 == frames {
+                image = Some(crate::render::figure_1(scene).map_err(Failed)?);
+            }
+            Ok(())
+        },
+    )
+    .map_err(|Failed(e)| e)?;
+    let path = out.join(format!("figure1-{}.png", spine_name(config.spine)));
+    image.ok_or("no frame to draw")?.save_png(&path)
 }
 
 /// One scene's block of the table: each figure's median [band] per spine,

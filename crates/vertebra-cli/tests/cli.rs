@@ -1001,14 +1001,46 @@ fn reproduce_with_direct_joints_writes_beside_the_iterative_run() {
 
 /// `reproduce`'s progress is drawn only on a terminal: run with stderr
 /// into a pipe (a log file, CI), it writes no carriage returns and no bar
-/// (the hand-written bar it replaced wrote one `\r` line per seed).
+/// (the hand-written bar it replaced wrote one `\r` line per seed). The
+/// same run writes figure 1 for both spines, and side views of every
+/// ragdoll: the drop's 30 in 30 colours.
 #[test]
-fn reproduce_writes_no_progress_into_a_pipe() {
+fn reproduce_writes_figure_1_and_every_ragdoll_and_no_progress_into_a_pipe() {
     let out = std::env::temp_dir().join(format!("vertebra-progress-{}", std::process::id()));
     let (code, _, stderr) =
         vertebra(&["reproduce", "--seeds", "1", "--out", out.to_str().unwrap()]);
+    let read = |name: &str| std::fs::read(out.join(name));
+    let figures = ["figure1-rod.png", "figure1-sockets.png"].map(read);
+    let poses = ["ragdoll-drop-poses.svg", "passive-bending-poses.svg"].map(read);
     std::fs::remove_dir_all(&out).ok();
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains('\r'), "{stderr:?}");
     assert!(!stderr.contains("seeds"), "{stderr:?}");
+    for figure in figures {
+        let png = resvg::tiny_skia::Pixmap::decode_png(&figure.expect("figure 1 written"))
+            .expect("a PNG");
+        assert_eq!((png.width(), png.height()), (1200, 800));
+        let colours: std::collections::HashSet<_> = png
+            .pixels()
+            .iter()
+            .map(|p| (p.red(), p.green(), p.blue()))
+            .collect();
+        assert!(
+            colours.len() > 1000,
+            "shaded, in many colours: {}",
+            colours.len()
+        );
+    }
+    let strokes = |svg: &[u8]| {
+        let svg = String::from_utf8_lossy(svg);
+        let colours: std::collections::HashSet<String> = svg
+            .split("stroke=\"")
+            .skip(1)
+            .map(|s| s[..s.find('"').unwrap()].to_owned())
+            .collect();
+        colours
+    };
+    let [drop, bending] = poses.map(|p| strokes(&p.expect("side views written")));
+    assert_eq!(drop.len(), 30, "{drop:?}");
+    assert_eq!(bending, ["blue", "red"].map(String::from).into());
 }

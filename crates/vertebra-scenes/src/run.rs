@@ -55,9 +55,10 @@ pub struct SceneRun {
     pub ms_per_step: f64,
     /// The final world state's hash.
     pub state_hash: u64,
-    /// The first ragdoll's skeleton (arc mapping) at the first, middle
-    /// (controllability: frame 60, mid-push) and last frame, for pictures.
-    pub snapshots: Vec<Pose>,
+    /// Every ragdoll's skeleton (arc mapping) at the first, middle
+    /// (controllability: frame 60, mid-push) and last frame, for pictures:
+    /// `snapshots[k][r]` is ragdoll `r` at the `k`-th of those frames.
+    pub snapshots: Vec<Vec<Pose>>,
     /// Every body's final position (m): (ragdoll index, position).
     pub final_positions: Vec<(usize, glam::Vec3)>,
 }
@@ -102,7 +103,11 @@ pub fn run_observed<E: From<RagdollError>>(
             frames / 2
         };
         if frame == 0 || frame == middle || frame + 1 == frames {
-            snapshots.push(built.ragdolls[0].skeleton_pose(&built.world, SpineMapping::Arc)?);
+            let poses = built
+                .ragdolls
+                .iter()
+                .map(|r| r.skeleton_pose(&built.world, SpineMapping::Arc));
+            snapshots.push(poses.collect::<Result<Vec<_>, _>>()?);
         }
         observe(frame, &built)?;
         progress(frame + 1, frames);

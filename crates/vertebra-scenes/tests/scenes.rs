@@ -13,7 +13,7 @@ fn passive_bending_slumps_to_the_spine_limits() {
     let mut errors = Vec::new();
     for spine in BOTH {
         let r = run(&SceneConfig::new(Scene::PassiveBending, spine), |_, _| {}).unwrap();
-        let last = r.snapshots.last().unwrap();
+        let last = &r.snapshots.last().unwrap()[0];
         // The bend between hips and chest: the sum of the three spine
         // joints' 20 degree cones, and the rod's 60 degree limit.
         let bend = (last.bones[hips].1 * Vec3::Y)
