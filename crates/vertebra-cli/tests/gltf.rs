@@ -535,3 +535,26 @@ fn a_failed_run_leaves_no_gltf_file() {
     );
     assert!(!path.exists(), "no file left behind");
 }
+
+#[test]
+fn a_run_too_long_to_keep_is_refused_at_its_first_frame() {
+    // 30 ragdolls of 74 nodes and 8 statics, a million frames: 58 GiB of
+    // keyframes.
+    let path = temp("long.glb");
+    let (code, stderr) = vertebra(&[
+        "scene",
+        "ragdoll-drop",
+        "--spine",
+        "rod",
+        "--frames",
+        "1000000",
+        "--gltf",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("at most 1024 MiB (fewer --frames)"),
+        "{stderr}"
+    );
+    assert!(!path.exists(), "no file left behind");
+}
