@@ -152,6 +152,21 @@ pub(crate) unsafe fn out<T>(ptr: *mut T, what: &str) -> Result<Out<T>, Failure> 
     Ok(Out(ptr))
 }
 
+/// Refuses a count of `T`s no array can hold (more than `isize::MAX`
+/// bytes, as a slice may span at most): a caller's mistake (a negative
+/// count cast to `size_t`, a garbage length) that must not reach
+/// `from_raw_parts`, where it is undefined behaviour.
+fn check_len<T>(len: usize, what: &str) -> Result<(), Failure> {
+    let bytes = len.checked_mul(size_of::<T>());
+    match bytes.is_some_and(|b| b <= isize::MAX as usize) {
+        true => Ok(()),
+        false => Err(Failure::new(
+            VtResult::OutOfRange,
+            format!("{what} has a count of {len}; no array holds that many"),
+        )),
+    }
+}
+
 /// `len` items at `ptr` (any pointer when `len` is 0).
 ///
 /// # Safety
@@ -165,6 +180,7 @@ pub(crate) unsafe fn slice<'a, T>(
         return Ok(&[]);
     }
     check(ptr, what)?;
+    check_len::<T>(len, what)?;
     // SAFETY: checked non-null and aligned; `len` readable items by the
     // contract. Every item type is plain numbers.
     Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
@@ -184,6 +200,7 @@ pub(crate) unsafe fn slice_mut<'a, T>(
         return Ok(&mut []);
     }
     check(ptr, what)?;
+    check_len::<T>(len, what)?;
     // SAFETY: checked non-null and aligned; `len` writable items, not
     // aliased, by the contract. Every item type is plain numbers.
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, len) })

@@ -2423,3 +2423,75 @@ fn a_ragdoll_built_at_a_bad_pose_is_refused_with_nothing_added() {
     });
     assert!(ragdoll.is_null());
 }
+
+#[test]
+fn a_count_no_array_can_hold_is_refused_naming_it() {
+    // A count whose bytes exceed isize::MAX describes no array: refused,
+    // naming it, before any slice is made of it.
+    let s = Scene::new();
+    let w = s.w();
+    let desc = humanoid();
+    let through = [v(0.0, 0.0, 0.0); 2];
+    let huge = usize::MAX / 2;
+    // Each call: live objects; the count is refused before the
+    // pointer is read past its first item.
+    // SAFETY: live objects and valid places, but for the argument refused.
+    s.refuses(VtResult::OutOfRange, &["contacts"], || unsafe {
+        let contact = std::mem::zeroed::<VtContact>();
+        vt_world_set_contacts(w, &contact, huge)
+    });
+    // SAFETY: live objects and valid places, but for the argument refused.
+    s.refuses(VtResult::OutOfRange, &["through"], || unsafe {
+        vt_rod_from_pose(
+            w,
+            s.a,
+            s.b,
+            through.as_ptr(),
+            usize::MAX,
+            &mut rod_desc(&s.world, s.a, s.b),
+        )
+    });
+    // SAFETY: live objects and valid places, but for the argument refused.
+    s.refuses(VtResult::OutOfRange, &["data"], || unsafe {
+        vt_world_restore(w, through.as_ptr().cast(), usize::MAX)
+    });
+    let mut pose = [VtTransform {
+        position: v(0.0, 0.0, 0.0),
+        rotation: IDENTITY,
+    }; 2];
+    // SAFETY: as above.
+    refused(
+        unsafe { vt_ragdoll_desc_bind_pose(desc.0, pose.as_mut_ptr(), huge) },
+        VtResult::OutOfRange,
+        &["pose"],
+    );
+    let options = VtBuildOptions {
+        spine: 0,
+        at_switch: 0,
+        stabilise: 0,
+        stabilise_ratio: 1.0,
+    };
+    let mut ragdoll = null_mut();
+    // SAFETY: live objects and valid places, but for the argument refused.
+    s.refuses(VtResult::OutOfRange, &["pose"], || unsafe {
+        vt_ragdoll_build(
+            w,
+            null_mut(),
+            desc.0,
+            &options,
+            pose.as_ptr(),
+            null(),
+            huge,
+            DT,
+            &mut ragdoll,
+        )
+    });
+    assert!(ragdoll.is_null());
+    let skeleton = CSkeleton::reference();
+    // SAFETY: as above.
+    refused(
+        unsafe { vt_skeleton_bind_pose(skeleton.0, pose.as_mut_ptr(), huge) },
+        VtResult::OutOfRange,
+        &["local"],
+    );
+}
