@@ -2495,3 +2495,53 @@ fn a_count_no_array_can_hold_is_refused_naming_it() {
         &["local"],
     );
 }
+
+#[test]
+fn a_refused_collider_call_writes_nothing_and_adds_nothing() {
+    let s = Scene::new();
+    let layer = CLayer::new();
+    let before = layer.bytes();
+    let mut storage = [0u64; 2];
+    let odd = storage
+        .as_mut_ptr()
+        .cast::<u8>()
+        .wrapping_add(1)
+        .cast::<usize>();
+    // SAFETY: a live layer; readable collider; `odd` is refused.
+    refused(
+        unsafe { vt_collisions_add(layer.0, &plane(s.ground), odd) },
+        NULL,
+        &["index", "aligned"],
+    );
+    assert!(layer.bytes() == before, "a refused add added a collider");
+    let mut bad = plane(s.ground);
+    bad.plane_normal = v(0.0, NAN, 0.0);
+    // SAFETY: as above.
+    refused(
+        unsafe { vt_collisions_add(layer.0, &bad, null_mut()) },
+        VtResult::Collider,
+        &["normal"],
+    );
+    bad = plane(s.ground);
+    bad.friction = -1.0;
+    // SAFETY: as above.
+    refused(
+        unsafe { vt_collisions_add(layer.0, &bad, null_mut()) },
+        VtResult::Collider,
+        &["friction"],
+    );
+    bad = plane(s.ground);
+    bad.kind = 2;
+    // SAFETY: as above.
+    refused(
+        unsafe { vt_collisions_add(layer.0, &bad, null_mut()) },
+        ENUM,
+        &["collider.kind"],
+    );
+    for margin in [NAN, INF, -1.0] {
+        // SAFETY: a live layer.
+        let r = unsafe { vt_collisions_set_prediction(layer.0, margin) };
+        assert_ne!(r, VtResult::Ok, "{margin}");
+    }
+    assert!(layer.bytes() == before);
+}
