@@ -152,6 +152,19 @@ pub(crate) unsafe fn out<T>(ptr: *mut T, what: &str) -> Result<Out<T>, Failure> 
     Ok(Out(ptr))
 }
 
+/// The output place `ptr`, or none for null (an output the caller does
+/// not want).
+///
+/// # Safety
+/// `ptr` is null or points to writable memory for a `T`.
+pub(crate) unsafe fn optional<T>(ptr: *mut T, what: &str) -> Result<Option<Out<T>>, Failure> {
+    match ptr.is_null() {
+        true => Ok(None),
+        // SAFETY: the function's contract.
+        false => unsafe { out(ptr, what) }.map(Some),
+    }
+}
+
 /// Refuses a count of `T`s no array can hold (more than `isize::MAX`
 /// bytes, as a slice may span at most): a caller's mistake (a negative
 /// count cast to `size_t`, a garbage length) that must not reach

@@ -2545,3 +2545,39 @@ fn a_refused_collider_call_writes_nothing_and_adds_nothing() {
     }
     assert!(layer.bytes() == before);
 }
+
+#[test]
+fn a_refused_placement_writes_none_of_its_outputs() {
+    let c = Drop_::new(VtSpineMode::Rod);
+    let sentinel = v(9.0, 9.0, 9.0);
+    let (mut low, mut high) = (sentinel, sentinel);
+    let mut storage = [0u64; 8];
+    let odd = storage
+        .as_mut_ptr()
+        .cast::<u8>()
+        .wrapping_add(1)
+        .cast::<VtTransform>();
+    // SAFETY: live objects; `odd` is refused.
+    refused(
+        unsafe { vt_ragdoll_placement(c.ragdoll, c.world.0, odd, &mut low, &mut high) },
+        NULL,
+        &["root", "aligned"],
+    );
+    assert_eq!((low, high), (sentinel, sentinel));
+    let odd = odd.cast::<VtVec3>();
+    // SAFETY: as above.
+    refused(
+        unsafe { vt_ragdoll_placement(c.ragdoll, c.world.0, null_mut(), &mut low, odd) },
+        NULL,
+        &["max", "aligned"],
+    );
+    assert_eq!(low, sentinel);
+    assert_eq!(storage, [0; 8]);
+    let mut root = VtTransform {
+        position: sentinel,
+        rotation: IDENTITY,
+    };
+    // SAFETY: live objects; writable places.
+    ok(unsafe { vt_ragdoll_placement(c.ragdoll, c.world.0, &mut root, &mut low, &mut high) });
+    assert!(low.y < root.position.y && root.position.y < high.y);
+}
