@@ -73,7 +73,13 @@ pub unsafe extern "C" fn vt_world_set_contacts(
     unsafe {
         with_world(world, |w| {
             let contacts: Vec<Contact> = contacts?.iter().map(Contact::from).collect();
-            Ok(w.set_contacts(&contacts)?)
+            w.set_contacts(&contacts).map_err(|error| {
+                let k = contacts
+                    .iter()
+                    .position(|c| c.validate_with(w.bodies()).is_err());
+                let Failure { code, message } = error.into();
+                Failure::new(code, format!("contact {}: {message}", k.unwrap_or(0)))
+            })
         })
     }
 }

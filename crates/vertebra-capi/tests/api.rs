@@ -2581,3 +2581,29 @@ fn a_refused_placement_writes_none_of_its_outputs() {
     ok(unsafe { vt_ragdoll_placement(c.ragdoll, c.world.0, &mut root, &mut low, &mut high) });
     assert!(low.y < root.position.y && root.position.y < high.y);
 }
+
+#[test]
+fn a_refused_contact_is_named_by_its_place_in_the_list() {
+    let s = Scene::new();
+    let good = VtContact {
+        body_a: s.ground,
+        body_b: s.a,
+        point: v(0.0, 0.8, 0.0),
+        normal: v(0.0, 1.0, 0.0),
+        depth: 0.0,
+        friction: 0.5,
+        restitution: 0.0,
+    };
+    let mut list = [good; 4];
+    list[2].body_b = bits_body();
+    // SAFETY: a live world; four readable contacts.
+    s.refuses(VtResult::ForeignHandle, &["contact 2", "body"], || unsafe {
+        vt_world_set_contacts(s.w(), list.as_ptr(), list.len())
+    });
+    list[2] = good;
+    list[3].friction = NAN;
+    // SAFETY: as above.
+    s.refuses(VtResult::NonFinite, &["contact 3", "friction"], || unsafe {
+        vt_world_set_contacts(s.w(), list.as_ptr(), list.len())
+    });
+}
