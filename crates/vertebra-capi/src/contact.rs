@@ -104,9 +104,9 @@ pub unsafe extern "C" fn vt_world_contacts(
     // SAFETY: the function's contract.
     unsafe {
         with_world(world, |w| {
-            let have = w.contacts();
-            count?.set(have.len());
+            let (have, count) = (w.contacts(), count?);
             if capacity < have.len() {
+                count.set(have.len());
                 return Err(Failure::new(
                     VtResult::BufferTooSmall,
                     format!("contacts holds {capacity}; the world has {}", have.len()),
@@ -116,7 +116,7 @@ pub unsafe extern "C" fn vt_world_contacts(
             for (to, from) in place.iter_mut().zip(have) {
                 *to = from.into();
             }
-            Ok(())
+            count.done(have.len())
         })
     }
 }

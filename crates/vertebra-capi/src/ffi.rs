@@ -247,8 +247,8 @@ pub(crate) unsafe fn copy_text(
     // SAFETY: the caller's contract.
     let length = unsafe { out(length, "length") }?;
     let needed = text.len() + 1;
-    length.set(needed);
     if capacity < needed {
+        length.set(needed);
         return Err(Failure::new(
             VtResult::BufferTooSmall,
             format!("the buffer holds {capacity} bytes; the text needs {needed}"),
@@ -258,7 +258,7 @@ pub(crate) unsafe fn copy_text(
     let bytes = unsafe { slice_mut(buffer.cast::<u8>(), needed, "buffer") }?;
     bytes[..text.len()].copy_from_slice(text.as_bytes());
     bytes[text.len()] = 0;
-    Ok(())
+    length.done(needed)
 }
 
 /// A new object for C to own (freed by its destroy function).

@@ -2607,3 +2607,39 @@ fn a_refused_contact_is_named_by_its_place_in_the_list() {
         vt_world_set_contacts(s.w(), list.as_ptr(), list.len())
     });
 }
+
+#[test]
+fn a_null_array_with_room_is_refused_without_its_count_written() {
+    // The count (or length) is written on success and, as the needed
+    // length, when the array is too small; a null array said to have room
+    // is neither: refused, nothing written.
+    let s = Scene::new();
+    let contact = VtContact {
+        body_a: s.ground,
+        body_b: s.a,
+        point: v(0.0, 0.8, 0.0),
+        normal: v(0.0, 1.0, 0.0),
+        depth: 0.0,
+        friction: 0.5,
+        restitution: 0.0,
+    };
+    // SAFETY: a live world; one readable contact.
+    ok(unsafe { vt_world_set_contacts(s.w(), &contact, 1) });
+    let mut count = 77usize;
+    // SAFETY: a live world; a null array (refused); `count` writable.
+    s.refuses(NULL, &["contacts"], || unsafe {
+        vt_world_contacts(s.w(), null_mut(), 5, &mut count)
+    });
+    assert_eq!(count, 77);
+    let desc = humanoid();
+    let mut length = 77usize;
+    // SAFETY: a live description; a null buffer (refused); writable length.
+    let r = unsafe { vt_ragdoll_desc_body_name(desc.0, 0, null_mut(), 64, &mut length) };
+    refused(r, NULL, &["buffer"]);
+    assert_eq!(length, 77);
+    let skeleton = CSkeleton::reference();
+    // SAFETY: as above.
+    let r = unsafe { vt_skeleton_bone_name(skeleton.0, 0, null_mut(), 64, &mut length) };
+    refused(r, NULL, &["buffer"]);
+    assert_eq!(length, 77);
+}
