@@ -1414,7 +1414,8 @@ void vt_skeleton_mapper_destroy(struct VtSkeletonMapper *mapper);
 //
 // # Safety
 // `mapper` is live; `model` points to `bone_count` readable transforms;
-// `pose` points to `body_count` writable transforms.
+// `pose` points to `body_count` writable transforms (the two may
+// overlap).
 enum VtResult vt_skeleton_mapper_map_to_ragdoll(const struct VtSkeletonMapper *mapper,
                                                 const struct VtTransform *model,
                                                 size_t bone_count,
@@ -1430,7 +1431,8 @@ enum VtResult vt_skeleton_mapper_map_to_ragdoll(const struct VtSkeletonMapper *m
 //
 // # Safety
 // `mapper`, `ragdoll` and `world` are live; `animation` points to `count`
-// readable transforms; `bones` to `count` writable ones.
+// readable transforms; `bones` to `count` writable ones (it may be
+// `animation`: mapped in place).
 enum VtResult vt_skeleton_mapper_map_to_skeleton(const struct VtSkeletonMapper *mapper,
                                                  struct VtRagdoll *ragdoll,
                                                  struct VtWorld *world,

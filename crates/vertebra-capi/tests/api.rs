@@ -2643,3 +2643,93 @@ fn a_null_array_with_room_is_refused_without_its_count_written() {
     refused(r, NULL, &["buffer"]);
     assert_eq!(length, 77);
 }
+
+#[test]
+fn a_pose_mapped_in_place_equals_one_mapped_into_another_array() {
+    // The input and output arrays may be one (valid C: both are
+    // `VtTransform *`); the input is read whole before the output is
+    // written.
+    let c = Drop_::new(VtSpineMode::Rod);
+    c.step(10);
+    let skeleton = CSkeleton::reference();
+    let mut mapper = null_mut();
+    // SAFETY: live objects; writable.
+    ok(unsafe {
+        vt_skeleton_mapper_create(skeleton.0, c.desc.0, VtSpineMode::Rod as u32, &mut mapper)
+    });
+    let mut count = 0;
+    // SAFETY: a live skeleton; writable.
+    ok(unsafe { vt_skeleton_bone_count(skeleton.0, &mut count) });
+    let start = VtTransform {
+        position: v(0.0, 0.0, 0.0),
+        rotation: IDENTITY,
+    };
+    let mut local = vec![start; count];
+    // SAFETY: `count` writable transforms.
+    ok(unsafe { vt_skeleton_bind_pose(skeleton.0, local.as_mut_ptr(), count) });
+    let model_to_world = VtTransform {
+        position: v(0.2, 0.0, 0.1),
+        rotation: Quat::from_rotation_y(0.5).into(),
+    };
+    let mut apart = vec![start; count];
+    // SAFETY: live objects; `count` readable and writable transforms.
+    ok(unsafe {
+        vt_skeleton_mapper_map_to_skeleton(
+            mapper,
+            c.ragdoll,
+            c.world.0,
+            local.as_ptr(),
+            model_to_world,
+            VtSpineMapping::Arc as u32,
+            apart.as_mut_ptr(),
+            count,
+        )
+    });
+    let mut in_place = local.clone();
+    let shared = in_place.as_mut_ptr();
+    // SAFETY: as above, one array for both.
+    ok(unsafe {
+        vt_skeleton_mapper_map_to_skeleton(
+            mapper,
+            c.ragdoll,
+            c.world.0,
+            shared,
+            model_to_world,
+            VtSpineMapping::Arc as u32,
+            shared,
+            count,
+        )
+    });
+    assert_eq!(format!("{in_place:?}"), format!("{apart:?}"));
+    // Model-space bones mapped onto the bodies, in place in an array long
+    // enough for either.
+    let mut model = vec![start; count];
+    let model_pose = Skeleton::reference()
+        .bind_pose()
+        .to_model(&Skeleton::reference())
+        .expect("the model pose");
+    for (to, from) in model.iter_mut().zip(&model_pose.bones) {
+        *to = (*from).into();
+    }
+    let bodies = lifted_bind(&c.desc, 0.0).len();
+    let mut apart = vec![start; bodies];
+    // SAFETY: a live mapper; readable and writable arrays of their counts.
+    ok(unsafe {
+        vt_skeleton_mapper_map_to_ragdoll(
+            mapper,
+            model.as_ptr(),
+            count,
+            model_to_world,
+            apart.as_mut_ptr(),
+            bodies,
+        )
+    });
+    let shared = model.as_mut_ptr();
+    // SAFETY: as above; the output is the start of the input's array.
+    ok(unsafe {
+        vt_skeleton_mapper_map_to_ragdoll(mapper, shared, count, model_to_world, shared, bodies)
+    });
+    assert_eq!(format!("{:?}", &model[..bodies]), format!("{apart:?}"));
+    // SAFETY: made above, freed once.
+    unsafe { vt_skeleton_mapper_destroy(mapper) };
+}
