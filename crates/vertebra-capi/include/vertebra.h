@@ -785,7 +785,12 @@ typedef struct VtTaskSystem {
   // How many threads may run items at once (1 to 256): the number of
   // items a substep asks for.
   uint32_t workers;
-  // The job system's `parallel_for` (a `VtParallelFor`; not null).
+  // The job system's `parallel_for` (a `VtParallelFor`; not null). It
+  // returns normally (a C++ exception must not leave it or the items),
+  // and neither it nor the items call vertebra on the world being
+  // stepped: that world is inside `vt_world_step` (such a call is
+  // refused with `VT_RESULT_POISONED` at best; a destroy there frees
+  // the world under the step).
   void (*parallel_for)(void *context, uint32_t count, VtTaskFn task, const void *task_context);
   // Passed back as `parallel_for`'s `context`.
   void *context;

@@ -95,7 +95,10 @@ pub(crate) unsafe fn enter<'a, T: Object>(ptr: *mut T) -> Result<Entered<'a, T>,
     if *object.poisoned() {
         return Err(Failure::new(
             VtResult::Poisoned,
-            format!("the {} was poisoned by an earlier panic", T::NAME),
+            format!(
+                "the {} was poisoned by an earlier panic, or is inside a call still running (a callback calling back into it)",
+                T::NAME
+            ),
         ));
     }
     *object.poisoned() = true;
