@@ -789,7 +789,12 @@ typedef struct VtTaskSystem {
   // How many threads may run items at once (1 to 256): the number of
   // items a substep asks for.
   uint32_t workers;
-  // The job system's `parallel_for` (a `VtParallelFor`; not null).
+  // The job system's `parallel_for` (a `VtParallelFor`; not null). It
+  // returns normally (a C++ exception must not leave it or the items),
+  // and neither it nor the items call vertebra on the world being
+  // stepped: that world is inside `vt_world_step` (such a call is
+  // refused with `VT_RESULT_POISONED` at best; a destroy there frees
+  // the world under the step).
   void (*parallel_for)(void *context, uint32_t count, VtTaskFn task, const void *task_context);
   // Passed back as `parallel_for`'s `context`.
   void *context;
@@ -1418,7 +1423,8 @@ void vt_skeleton_mapper_destroy(struct VtSkeletonMapper *mapper);
 //
 // # Safety
 // `mapper` is live; `model` points to `bone_count` readable transforms;
-// `pose` points to `body_count` writable transforms.
+// `pose` points to `body_count` writable transforms (the two may
+// overlap).
 enum VtResult vt_skeleton_mapper_map_to_ragdoll(const struct VtSkeletonMapper *mapper,
                                                 const struct VtTransform *model,
                                                 size_t bone_count,
@@ -1434,7 +1440,8 @@ enum VtResult vt_skeleton_mapper_map_to_ragdoll(const struct VtSkeletonMapper *m
 //
 // # Safety
 // `mapper`, `ragdoll` and `world` are live; `animation` points to `count`
-// readable transforms; `bones` to `count` writable ones.
+// readable transforms; `bones` to `count` writable ones (it may be
+// `animation`: mapped in place).
 enum VtResult vt_skeleton_mapper_map_to_skeleton(const struct VtSkeletonMapper *mapper,
                                                  struct VtRagdoll *ragdoll,
                                                  struct VtWorld *world,

@@ -7,7 +7,7 @@ use vertebra_world::Contact;
 
 use crate::body::VtShape;
 use crate::error::{Failure, VtResult};
-use crate::ffi::{Object, boxed, call, enter, free, out, read, slice};
+use crate::ffi::{Object, boxed, call, enter, free, optional, out, read, slice};
 use crate::ragdoll::VtRagdoll;
 use crate::snapshot::VtBytes;
 use crate::types::{VtBody, VtVec3, flag, pick};
@@ -141,12 +141,17 @@ pub unsafe extern "C" fn vt_collisions_add(
 ) -> VtResult {
     // SAFETY: the function's contract.
     let collider = unsafe { read(collider, "collider") };
+    // The place for the index is checked before the collider goes in: a
+    // refused call adds nothing.
+    // SAFETY: the function's contract.
+    let index = unsafe { optional(index, "index") };
     // SAFETY: the function's contract.
     unsafe {
         with_layer(collisions, |layer| {
-            let added = layer.collisions.add(collider?.try_into()?)?;
-            if !index.is_null() {
-                out(index, "index")?.set(added);
+            let (collider, index) = (collider?, index?);
+            let added = layer.collisions.add(collider.try_into()?)?;
+            if let Some(index) = index {
+                index.set(added);
             }
             Ok(())
         })

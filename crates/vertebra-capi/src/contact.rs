@@ -73,7 +73,13 @@ pub unsafe extern "C" fn vt_world_set_contacts(
     unsafe {
         with_world(world, |w| {
             let contacts: Vec<Contact> = contacts?.iter().map(Contact::from).collect();
-            Ok(w.set_contacts(&contacts)?)
+            w.set_contacts(&contacts).map_err(|error| {
+                let k = contacts
+                    .iter()
+                    .position(|c| c.validate_with(w.bodies()).is_err());
+                let Failure { code, message } = error.into();
+                Failure::new(code, format!("contact {}: {message}", k.unwrap_or(0)))
+            })
         })
     }
 }
@@ -98,9 +104,9 @@ pub unsafe extern "C" fn vt_world_contacts(
     // SAFETY: the function's contract.
     unsafe {
         with_world(world, |w| {
-            let have = w.contacts();
-            count?.set(have.len());
+            let (have, count) = (w.contacts(), count?);
             if capacity < have.len() {
+                count.set(have.len());
                 return Err(Failure::new(
                     VtResult::BufferTooSmall,
                     format!("contacts holds {capacity}; the world has {}", have.len()),
@@ -110,7 +116,7 @@ pub unsafe extern "C" fn vt_world_contacts(
             for (to, from) in place.iter_mut().zip(have) {
                 *to = from.into();
             }
-            Ok(())
+            count.done(have.len())
         })
     }
 }

@@ -95,7 +95,10 @@ pub(crate) unsafe fn enter<'a, T: Object>(ptr: *mut T) -> Result<Entered<'a, T>,
     if *object.poisoned() {
         return Err(Failure::new(
             VtResult::Poisoned,
-            format!("the {} was poisoned by an earlier panic", T::NAME),
+            format!(
+                "the {} was poisoned by an earlier panic, or is inside a call still running (a callback calling back into it)",
+                T::NAME
+            ),
         ));
     }
     *object.poisoned() = true;
@@ -152,6 +155,34 @@ pub(crate) unsafe fn out<T>(ptr: *mut T, what: &str) -> Result<Out<T>, Failure> 
     Ok(Out(ptr))
 }
 
+/// The output place `ptr`, or none for null (an output the caller does
+/// not want).
+///
+/// # Safety
+/// `ptr` is null or points to writable memory for a `T`.
+pub(crate) unsafe fn optional<T>(ptr: *mut T, what: &str) -> Result<Option<Out<T>>, Failure> {
+    match ptr.is_null() {
+        true => Ok(None),
+        // SAFETY: the function's contract.
+        false => unsafe { out(ptr, what) }.map(Some),
+    }
+}
+
+/// Refuses a count of `T`s no array can hold (more than `isize::MAX`
+/// bytes, as a slice may span at most): a caller's mistake (a negative
+/// count cast to `size_t`, a garbage length) that must not reach
+/// `from_raw_parts`, where it is undefined behaviour.
+fn check_len<T>(len: usize, what: &str) -> Result<(), Failure> {
+    let bytes = len.checked_mul(size_of::<T>());
+    match bytes.is_some_and(|b| b <= isize::MAX as usize) {
+        true => Ok(()),
+        false => Err(Failure::new(
+            VtResult::OutOfRange,
+            format!("{what} has a count of {len}; no array holds that many"),
+        )),
+    }
+}
+
 /// `len` items at `ptr` (any pointer when `len` is 0).
 ///
 /// # Safety
@@ -165,6 +196,7 @@ pub(crate) unsafe fn slice<'a, T>(
         return Ok(&[]);
     }
     check(ptr, what)?;
+    check_len::<T>(len, what)?;
     // SAFETY: checked non-null and aligned; `len` readable items by the
     // contract. Every item type is plain numbers.
     Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
@@ -184,6 +216,7 @@ pub(crate) unsafe fn slice_mut<'a, T>(
         return Ok(&mut []);
     }
     check(ptr, what)?;
+    check_len::<T>(len, what)?;
     // SAFETY: checked non-null and aligned; `len` writable items, not
     // aliased, by the contract. Every item type is plain numbers.
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, len) })
@@ -217,8 +250,8 @@ pub(crate) unsafe fn copy_text(
     // SAFETY: the caller's contract.
     let length = unsafe { out(length, "length") }?;
     let needed = text.len() + 1;
-    length.set(needed);
     if capacity < needed {
+        length.set(needed);
         return Err(Failure::new(
             VtResult::BufferTooSmall,
             format!("the buffer holds {capacity} bytes; the text needs {needed}"),
@@ -228,7 +261,7 @@ pub(crate) unsafe fn copy_text(
     let bytes = unsafe { slice_mut(buffer.cast::<u8>(), needed, "buffer") }?;
     bytes[..text.len()].copy_from_slice(text.as_bytes());
     bytes[text.len()] = 0;
-    Ok(())
+    length.done(needed)
 }
 
 /// A new object for C to own (freed by its destroy function).

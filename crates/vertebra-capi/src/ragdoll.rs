@@ -11,7 +11,9 @@ use vertebra_ragdoll::{
 
 use crate::collide::VtCollisions;
 use crate::error::{Failure, VtResult};
-use crate::ffi::{Object, boxed, call, copy_text, enter, free, out, read, shared, slice, text};
+use crate::ffi::{
+    Object, boxed, call, copy_text, enter, free, optional, out, read, shared, slice, text,
+};
 use crate::types::{VtBody, VtTransform, VtVec3, flag, pick};
 use crate::world::VtWorld;
 
@@ -675,18 +677,29 @@ pub unsafe extern "C" fn vt_ragdoll_placement(
     min: *mut VtVec3,
     max: *mut VtVec3,
 ) -> VtResult {
+    // Every place is checked before any is written: a refused call
+    // writes none.
+    // SAFETY: the function's contract.
+    let places = unsafe {
+        (
+            optional(root, "root"),
+            optional(min, "min"),
+            optional(max, "max"),
+        )
+    };
     // SAFETY: the function's contract.
     unsafe {
         with_ragdoll(ragdoll, world, |r, w| {
+            let (root, min, max) = (places.0?, places.1?, places.2?);
             let transform = r.root_transform(w)?;
             let (low, high) = r.bounds(w)?;
             for (place, value) in [(min, low), (max, high)] {
-                if !place.is_null() {
-                    out(place, "bounds")?.set(value.into());
+                if let Some(place) = place {
+                    place.set(value.into());
                 }
             }
-            if !root.is_null() {
-                out(root, "root")?.set(transform.into());
+            if let Some(root) = root {
+                root.set(transform.into());
             }
             Ok(())
         })

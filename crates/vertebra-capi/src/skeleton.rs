@@ -293,7 +293,8 @@ pub unsafe extern "C" fn vt_skeleton_mapper_destroy(mapper: *mut VtSkeletonMappe
 ///
 /// # Safety
 /// `mapper` is live; `model` points to `bone_count` readable transforms;
-/// `pose` points to `body_count` writable transforms.
+/// `pose` points to `body_count` writable transforms (the two may
+/// overlap).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vt_skeleton_mapper_map_to_ragdoll(
     mapper: *const VtSkeletonMapper,
@@ -311,14 +312,16 @@ pub unsafe extern "C" fn vt_skeleton_mapper_map_to_ragdoll(
                 slice(model, bone_count, "model")?,
             )
         };
-        // SAFETY: the function's contract.
-        let place = unsafe { slice_mut(pose, body_count, "pose") }?;
+        // The input is copied before the output is lent: the two arrays
+        // may overlap (mapped in place).
         let animation = ModelPose {
             bones: model.iter().map(|&t| t.into()).collect(),
         };
         let mapped = mapper
             .mapper
             .map_to_ragdoll(&animation, model_to_world.into())?;
+        // SAFETY: the function's contract; `model` is no longer used.
+        let place = unsafe { slice_mut(pose, body_count, "pose") }?;
         write_pose(&mapped, place)
     })
 }
@@ -331,7 +334,8 @@ pub unsafe extern "C" fn vt_skeleton_mapper_map_to_ragdoll(
 ///
 /// # Safety
 /// `mapper`, `ragdoll` and `world` are live; `animation` points to `count`
-/// readable transforms; `bones` to `count` writable ones.
+/// readable transforms; `bones` to `count` writable ones (it may be
+/// `animation`: mapped in place).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vt_skeleton_mapper_map_to_skeleton(
     mapper: *const VtSkeletonMapper,
@@ -353,8 +357,6 @@ pub unsafe extern "C" fn vt_skeleton_mapper_map_to_skeleton(
         };
         // SAFETY: the function's contract.
         let (ragdoll, world) = unsafe { (enter(ragdoll)?, enter(world)?) };
-        // SAFETY: the function's contract.
-        let place = unsafe { slice_mut(bones, count, "bones") }?;
         let mapping = spine_mapping(mapping)?;
         let animation = LocalPose {
             bones: animation.iter().map(|&t| t.into()).collect(),
@@ -366,6 +368,9 @@ pub unsafe extern "C" fn vt_skeleton_mapper_map_to_skeleton(
             model_to_world.into(),
             mapping,
         )?;
+        // SAFETY: the function's contract; `animation`'s slice is no longer
+        // used (it was copied above), so `bones` may be the same array.
+        let place = unsafe { slice_mut(bones, count, "bones") }?;
         write_bones(&mapped.bones, place)
     })
 }

@@ -17,7 +17,12 @@ pub type VtTaskFn = unsafe extern "C" fn(task_context: *const c_void, index: u32
 
 /// Runs `task(task_context, i)` for every `i` in `0 .. count`, on
 /// whichever threads and in whichever order, and returns when all have
-/// run. `task` and `task_context` must not be used after it returns.
+/// run. `task` and `task_context` must not be used after it returns. It
+/// returns normally (a C++ exception must not leave it or `task`), and
+/// neither it nor the jobs it runs call vertebra with the world being
+/// stepped: that world is inside `vt_world_step` (such a call is refused
+/// with `VT_RESULT_POISONED` at best, and destroying the world there frees
+/// it under the step).
 pub type VtParallelFor = unsafe extern "C" fn(
     context: *mut c_void,
     count: u32,
@@ -36,7 +41,12 @@ pub struct VtTaskSystem {
     /// How many threads may run items at once (1 to 256): the number of
     /// items a substep asks for.
     pub workers: u32,
-    /// The job system's `parallel_for` (a `VtParallelFor`; not null).
+    /// The job system's `parallel_for` (a `VtParallelFor`; not null). It
+    /// returns normally (a C++ exception must not leave it or the items),
+    /// and neither it nor the items call vertebra on the world being
+    /// stepped: that world is inside `vt_world_step` (such a call is
+    /// refused with `VT_RESULT_POISONED` at best; a destroy there frees
+    /// the world under the step).
     pub parallel_for: Option<
         unsafe extern "C" fn(
             context: *mut c_void,

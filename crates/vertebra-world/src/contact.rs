@@ -62,8 +62,10 @@ impl Contact {
         Ok(())
     }
 
-    /// Checks the bodies too: live, and at least one dynamic.
-    pub(crate) fn validate_with(&self, bodies: &BodyStore) -> Result<(), Error> {
+    /// Checks the bodies too (live in `bodies`, and at least one
+    /// dynamic): what [`World::set_contacts`](crate::World::set_contacts)
+    /// checks of each contact, in order.
+    pub fn validate_with(&self, bodies: &BodyStore) -> Result<(), Error> {
         self.validate()?;
         crate::checks::joint_bodies(bodies, self.body_a, self.body_b)
     }
