@@ -234,6 +234,21 @@ pub(crate) unsafe fn text<'a>(ptr: *const c_char, what: &str) -> Result<&'a str,
         .map_err(|e| Failure::new(VtResult::NotUtf8, format!("{what} is not UTF-8: {e}")))
 }
 
+/// Writes into `index` where `find` finds the name at `name` (a
+/// NUL-terminated UTF-8 string); `find` says why it does not.
+///
+/// # Safety
+/// `name` is null or a NUL-terminated string; `index` is null or writable.
+pub(crate) unsafe fn index_of(
+    name: *const c_char,
+    index: *mut usize,
+    find: impl FnOnce(&str) -> Result<usize, Failure>,
+) -> Result<(), Failure> {
+    // SAFETY: the function's contract.
+    let (name, index) = unsafe { (text(name, "name")?, out(index, "index")?) };
+    index.done(find(name)?)
+}
+
 /// Writes `text` with its NUL into `buffer` of `capacity` bytes and its
 /// length with the NUL into `length`; refused (`BufferTooSmall`, nothing
 /// but `length` written) when it does not fit. `buffer` may be null when

@@ -12,7 +12,7 @@ use vertebra_ragdoll::{
 use crate::collide::VtCollisions;
 use crate::error::{Failure, VtResult};
 use crate::ffi::{
-    Object, boxed, call, copy_text, enter, free, optional, out, read, shared, slice, text,
+    Object, boxed, call, copy_text, enter, free, index_of, optional, out, read, shared, slice, text,
 };
 use crate::types::{VtBody, VtTransform, VtVec3, flag, pick};
 use crate::world::VtWorld;
@@ -278,21 +278,14 @@ pub unsafe extern "C" fn vt_ragdoll_desc_body_index(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (desc, name, index) = unsafe {
-            (
-                shared(desc, "desc")?,
-                text(name, "name")?,
-                out(index, "index")?,
-            )
+        let desc = unsafe { shared(desc, "desc") }?;
+        let find = |name: &str| {
+            let found = desc.desc.body_index(name);
+            let why = || format!("the ragdoll has no body `{name}`");
+            found.ok_or_else(|| Failure::new(VtResult::Ragdoll, why()))
         };
-        let found = desc.desc.body_index(name).ok_or_else(|| {
-            Failure::new(
-                VtResult::Ragdoll,
-                format!("the ragdoll has no body `{name}`"),
-            )
-        })?;
-        index.set(found);
-        Ok(())
+        // SAFETY: the function's contract.
+        unsafe { index_of(name, index, find) }
     })
 }
 

@@ -9,7 +9,9 @@ use vertebra_ragdoll::{
 };
 
 use crate::error::{Failure, VtResult};
-use crate::ffi::{Out, boxed, call, copy_text, enter, free, out, shared, slice, slice_mut, text};
+use crate::ffi::{
+    Out, boxed, call, copy_text, enter, free, index_of, out, shared, slice, slice_mut, text,
+};
 use crate::ragdoll::{VtRagdoll, VtRagdollDesc, write_pose};
 use crate::types::{VtTransform, pick};
 use crate::world::VtWorld;
@@ -159,21 +161,14 @@ pub unsafe extern "C" fn vt_skeleton_bone_index(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (skeleton, name, index) = unsafe {
-            (
-                shared(skeleton, "skeleton")?,
-                text(name, "name")?,
-                out(index, "index")?,
-            )
+        let skeleton = unsafe { shared(skeleton, "skeleton") }?;
+        let find = |name: &str| {
+            let found = skeleton.skeleton.bone_index(name);
+            let why = || format!("the skeleton has no bone `{name}`");
+            found.ok_or_else(|| Failure::new(VtResult::Ragdoll, why()))
         };
-        let found = skeleton.skeleton.bone_index(name).ok_or_else(|| {
-            Failure::new(
-                VtResult::Ragdoll,
-                format!("the skeleton has no bone `{name}`"),
-            )
-        })?;
-        index.set(found);
-        Ok(())
+        // SAFETY: the function's contract.
+        unsafe { index_of(name, index, find) }
     })
 }
 

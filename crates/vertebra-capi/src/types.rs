@@ -129,56 +129,25 @@ impl From<(Vec3, Quat)> for VtTransform {
     }
 }
 
-impl From<VtBody> for BodyHandle {
-    fn from(h: VtBody) -> Self {
-        BodyHandle::from_raw(h.index, h.lineage, h.generation)
-    }
-}
-
-impl From<BodyHandle> for VtBody {
-    fn from(h: BodyHandle) -> Self {
-        let (index, lineage, generation) = h.to_raw();
-        Self {
-            index,
-            lineage,
-            generation,
+/// Each C handle to its Rust handle and back: the same three numbers.
+macro_rules! handle_conversions {
+    ($($c:ident <-> $rust:ident),*) => {$(
+        impl From<$c> for $rust {
+            fn from(h: $c) -> Self {
+                $rust::from_raw(h.index, h.lineage, h.generation)
+            }
         }
-    }
-}
 
-impl From<VtJoint> for JointHandle {
-    fn from(h: VtJoint) -> Self {
-        JointHandle::from_raw(h.index, h.lineage, h.generation)
-    }
-}
-
-impl From<JointHandle> for VtJoint {
-    fn from(h: JointHandle) -> Self {
-        let (index, lineage, generation) = h.to_raw();
-        Self {
-            index,
-            lineage,
-            generation,
+        impl From<$rust> for $c {
+            fn from(h: $rust) -> Self {
+                let (index, lineage, generation) = h.to_raw();
+                Self { index, lineage, generation }
+            }
         }
-    }
+    )*};
 }
 
-impl From<VtRod> for RodHandle {
-    fn from(h: VtRod) -> Self {
-        RodHandle::from_raw(h.index, h.lineage, h.generation)
-    }
-}
-
-impl From<RodHandle> for VtRod {
-    fn from(h: RodHandle) -> Self {
-        let (index, lineage, generation) = h.to_raw();
-        Self {
-            index,
-            lineage,
-            generation,
-        }
-    }
-}
+handle_conversions!(VtBody <-> BodyHandle, VtJoint <-> JointHandle, VtRod <-> RodHandle);
 
 /// The value of an enum field, or a refusal naming the field.
 pub(crate) fn pick<T: Copy>(value: u32, field: &str, values: &[T]) -> Result<T, Failure> {

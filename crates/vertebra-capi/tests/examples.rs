@@ -189,28 +189,37 @@ fn the_cpp_example_prints_what_the_rust_api_computes() {
     assert_eq!(run(&exe), rust_twin());
 }
 
-#[test]
-fn the_c_example_runs_clean_under_the_sanitizers() {
+/// Flags for a build under the address and undefined sanitizers.
+const SANITIZED: [&str; 5] = [
+    "-std=c11",
+    "-g",
+    "-fsanitize=address,undefined",
+    "-fno-sanitize-recover=all",
+    "-fno-omit-frame-pointer",
+];
+
+/// The C example `source` built under the sanitizers, or `None` (with
+/// the reason printed) where no C compiler or no sanitizer runtime exists.
+fn sanitized(source: &str, name: &str) -> Option<PathBuf> {
     let Some(cc) = compiler("CC", &["cc", "gcc", "clang"]) else {
         println!("skipped: no C compiler on this machine");
-        return;
+        return None;
     };
-    let flags = [
-        "-std=c11",
-        "-g",
-        "-fsanitize=address,undefined",
-        "-fno-sanitize-recover=all",
-        "-fno-omit-frame-pointer",
-    ];
-    let exe = match build(&cc, "drop.c", &flags, "drop_sanitized") {
-        Ok(exe) => exe,
+    match build(&cc, source, &SANITIZED, name) {
+        Ok(exe) => Some(exe),
         Err(why) if why.contains("asan") || why.contains("ubsan") || why.contains("sanitize") => {
             println!("skipped: {cc} cannot build with the sanitizers here: {why}");
-            return;
+            None
         }
-        Err(why) => panic!("the sanitized C example does not build: {why}"),
-    };
-    assert_eq!(run(&exe), rust_twin());
+        Err(why) => panic!("{source} does not build under the sanitizers: {why}"),
+    }
+}
+
+#[test]
+fn the_c_example_runs_clean_under_the_sanitizers() {
+    if let Some(exe) = sanitized("drop.c", "drop_sanitized") {
+        assert_eq!(run(&exe), rust_twin());
+    }
 }
 
 /// What the error-paths example prints last: every check passed.
@@ -235,24 +244,8 @@ fn the_c_error_paths_are_refused_as_documented() {
 
 #[test]
 fn the_c_error_paths_run_clean_and_free_everything_under_the_sanitizers() {
-    let Some(cc) = compiler("CC", &["cc", "gcc", "clang"]) else {
-        println!("skipped: no C compiler on this machine");
+    let Some(exe) = sanitized("errors.c", "errors_sanitized") else {
         return;
-    };
-    let flags = [
-        "-std=c11",
-        "-g",
-        "-fsanitize=address,undefined",
-        "-fno-sanitize-recover=all",
-        "-fno-omit-frame-pointer",
-    ];
-    let exe = match build(&cc, "errors.c", &flags, "errors_sanitized") {
-        Ok(exe) => exe,
-        Err(why) if why.contains("asan") || why.contains("ubsan") || why.contains("sanitize") => {
-            println!("skipped: {cc} cannot build with the sanitizers here: {why}");
-            return;
-        }
-        Err(why) => panic!("the sanitized C error example does not build: {why}"),
     };
     // The leak checker is on by default with the address sanitizer; a
     // leak makes the run fail.
