@@ -6,7 +6,7 @@ use core::f32::consts::PI;
 use glam::{Mat3, Vec3};
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
-use vertebra_kernels::direct::{self, JointLane, JointRows, Topology, TreeBlock};
+use vertebra_kernels::direct::{self, JointLane, JointRows, SwingRows, Topology, TreeBlock};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
@@ -283,15 +283,17 @@ fn pad(input: &mut Input, blocks: &mut Blocks) {
 /// inertias arbitrary, lanes padding at random.
 fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
     let kinds = [
-        JointRows::Socket,
+        JointRows::Socket(SwingRows::Cone),
+        JointRows::Socket(SwingRows::Ellipse),
+        JointRows::Socket(SwingRows::Pyramid),
         JointRows::Hinge,
         JointRows::Fixed,
         JointRows::Rod,
     ];
-    let mut shape = vec![(kinds[input.pick(4)], Some(0), Some(1))];
+    let mut shape = vec![(kinds[input.pick(kinds.len())], Some(0), Some(1))];
     let grounded = input.flag();
     if grounded {
-        shape.push((kinds[input.pick(4)], None, Some(0)));
+        shape.push((kinds[input.pick(kinds.len())], None, Some(0)));
     }
     let topology = Topology::new(2, &shape).expect("a tree");
     let mut block = TreeBlock::padding(0, &topology);
@@ -325,8 +327,20 @@ fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
                     rest_length: input.positive(1.0),
                     swing_max: input.float(PI).abs(),
                     twist,
+                    ellipse: [input.positive(1.0), input.positive(1.0)],
+                    pyramid: [sorted_range(input), sorted_range(input)],
+                    softness: if input.flag() {
+                        LimitLane {
+                            compliance: input.positive(1.0),
+                            period2: input.positive(0.01),
+                            damping_time: input.positive(0.1),
+                        }
+                    } else {
+                        LimitLane::HARD
+                    },
                 },
             );
+            block.soft |= joint.is_soft(lane);
             joint.bodies.set_start(lane, &start(input));
         }
     }
@@ -403,10 +417,20 @@ fn run(
         blocks: &mut contacts,
         rows: &rows,
     });
-    backend.dispatch(direct::PositionPass {
-        blocks: &mut [tree.clone()],
+    let mut trees = [tree.clone()];
+    backend.dispatch(direct::StartPass {
+        blocks: &mut trees,
         topologies: core::slice::from_ref(topology),
         rows: &rows,
+    });
+    backend.dispatch(direct::PositionPass {
+        blocks: &mut trees,
+        topologies: core::slice::from_ref(topology),
+        rows: &rows,
+        scale: direct::SubstepScale {
+            inv_h: inv_h2.sqrt(),
+            inv_h2,
+        },
     });
     (0..rows.pose.len())
         .flat_map(|i| rows.pose[i].get())

@@ -423,18 +423,19 @@ fn solve_positions<L: Lane>(
     let lambda = twist::solve(&mut a, &mut b, &m, rest, &twist_drive, start_twist, lambda);
     lambda.store(&mut block.twist_lambda[start..]);
 
-    let m = LocalFrames::tangents(&a, &b, frames, (ta, tb));
-    bend::limit(&mut a, &mut b, &m, L::load(&block.bend_max[start..]));
-    let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
-    let (lo, hi) = (
-        L::load(&block.twist_min[start..]),
-        L::load(&block.twist_max[start..]),
-    );
-    twist::limit(&mut a, &mut b, &m, lo, hi);
-
-    // The curve moves the bodies along a world gradient: its frames are
-    // the world's. The length needs only the bend angle.
+    // A block whose rods the direct solve holds leaves it their limits,
+    // curve and length: only the soft bend and twist are iterated. The
+    // curve moves the bodies along a world gradient: its frames are the
+    // world's. The length needs only the bend angle.
     if block.bodies.direct == 0 {
+        let m = LocalFrames::tangents(&a, &b, frames, (ta, tb));
+        bend::limit(&mut a, &mut b, &m, L::load(&block.bend_max[start..]));
+        let m = LocalFrames::new(&a, &b, frame_a, frame_b, ta);
+        let (lo, hi) = (
+            L::load(&block.twist_min[start..]),
+            L::load(&block.twist_max[start..]),
+        );
+        twist::limit(&mut a, &mut b, &m, lo, hi);
         let chord = block.bodies.start(start);
         let f = world_tangents(&a, &b, frames, (ta, tb));
         curve::solve(&mut a, &mut b, &f, &chord);

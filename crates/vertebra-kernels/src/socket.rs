@@ -257,9 +257,12 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
             .solve(start, a, b, frame_a, frame_b, inv_h, inv_h2);
     }
 
-    if SHAPED {
+    // A block whose joints the direct solve holds leaves it their limits
+    // and points: only the drive is iterated.
+    let iterated = block.bodies.direct == 0;
+    if SHAPED && iterated {
         solve_shaped(block, start, &mut a, &mut b, inv_h, inv_h2);
-    } else {
+    } else if iterated {
         swing::solve(
             &mut a,
             &mut b,
@@ -273,7 +276,7 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
         );
         twist::solve(&mut a, &mut b, frame_a, frame_b, lo, hi);
     }
-    if block.bodies.direct == 0 {
+    if iterated {
         point::solve(
             &mut a,
             &mut b,

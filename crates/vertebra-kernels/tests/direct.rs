@@ -12,10 +12,12 @@ use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::{BodyLanes, BodyRows, PairStart, StartLane};
 use vertebra_kernels::direct::ldl::{self, MAX, PACKED, at};
-use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows};
+use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows, SwingRows};
 use vertebra_kernels::direct::{
-    JointLane, NONE, NodeKind, PositionPass, Topology, TopologyError, TreeBlock,
+    JointLane, NONE, NodeKind, PositionPass, SubstepScale, Topology, TopologyError, TreeBlock,
 };
+use vertebra_kernels::limited::LimitLane;
+use vertebra_kernels::parts::limit::Softness;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Backend, Sym3, Vec3};
 
@@ -346,10 +348,15 @@ impl Measured {
         worst
     }
 
-    /// The largest error over rows `rows`.
+    /// The largest error over rows `rows`: a limit row's violation (its
+    /// signed distance where positive, else 0), any other's size.
     fn error(&self, rows: core::ops::Range<usize>) -> f64 {
         let c = self.rows().c;
-        rows.map(|k| (c[k] as f64).abs()).fold(0.0, f64::max)
+        rows.map(|k| match self.kind.is_limit(k) {
+            true => (c[k] as f64).max(0.0),
+            false => (c[k] as f64).abs(),
+        })
+        .fold(0.0, f64::max)
     }
 
     /// Along the step `dx = -J^T C` of the analytic Jacobian over rows
@@ -403,6 +410,9 @@ fn joint(r: &mut StdRng, kind: JointRows, misalignment: GQuat) -> Measured {
             rest_length: 0.0,
             swing_max: core::f32::consts::PI,
             twist: [-core::f32::consts::PI, core::f32::consts::PI],
+            ellipse: [1.0, 1.0],
+            pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
+            softness: Softness::hard(),
             start: pair_start(&start),
         },
     }
@@ -441,6 +451,9 @@ fn rod(r: &mut StdRng, distance: f32, bend: f32, misalignment: GQuat) -> Measure
             rest_length,
             swing_max: core::f32::consts::PI,
             twist: [-core::f32::consts::PI, core::f32::consts::PI],
+            ellipse: [1.0, 1.0],
+            pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
+            softness: Softness::hard(),
             // The rows' displacements measured from the origin: no gap.
             start: pair_start(&StartLane::default()),
         },
@@ -455,7 +468,11 @@ fn turn(r: &mut StdRng, angle: f32) -> GQuat {
 #[test]
 fn point_rows_are_exact_gradients_everywhere() {
     let mut r = StdRng::seed_from_u64(10);
-    for kind in [JointRows::Socket, JointRows::Hinge, JointRows::Fixed] {
+    for kind in [
+        JointRows::Socket(SwingRows::Cone),
+        JointRows::Hinge,
+        JointRows::Fixed,
+    ] {
         for _ in 0..200 {
             let angle = r.random_range(0.0..3.0);
             let misalignment = turn(&mut r, angle);
@@ -567,6 +584,9 @@ fn curve_rows_stay_gradients_for_a_rod_bent_a_right_angle_in_its_frame_plane() {
                     / (2.0 * core::f32::consts::FRAC_PI_4.sin()),
                 swing_max: core::f32::consts::PI,
                 twist: [-core::f32::consts::PI, core::f32::consts::PI],
+                ellipse: [1.0, 1.0],
+                pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
+                softness: Softness::hard(),
                 start: pair_start(&StartLane::default()),
             },
         };
@@ -779,7 +799,7 @@ fn star(r: &mut StdRng) -> Tree {
         JointRows::Hinge,
         JointRows::Fixed,
         JointRows::Rod,
-        JointRows::Socket,
+        JointRows::Socket(SwingRows::Cone),
     ];
     let mut tree = Tree::new();
     tree.bodies.push(body_at(r, DVec3::ZERO, 10.0));
@@ -861,8 +881,7 @@ impl Scene {
                     frame_a: j.frame_a,
                     frame_b: j.frame_b,
                     rest_length: j.rest_length,
-                    swing_max: core::f32::consts::PI,
-                    twist: [-core::f32::consts::PI, core::f32::consts::PI],
+                    ..JointLane::FREE
                 },
             );
             node.bodies.set_start(0, &j.start);
@@ -886,6 +905,9 @@ impl Scene {
                 rest_length: joint.rest_length,
                 swing_max: core::f32::consts::PI,
                 twist: [-core::f32::consts::PI, core::f32::consts::PI],
+                ellipse: [1.0, 1.0],
+                pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
+                softness: Softness::hard(),
                 start: pair_start(&joint.start),
             },
         }
@@ -926,11 +948,18 @@ impl Scene {
     }
 }
 
+/// A substep of 1/60 s.
+const SCALE: SubstepScale = SubstepScale {
+    inv_h: 60.0,
+    inv_h2: 3600.0,
+};
+
 fn pass(backend: Backend, rows: &BodyRows, blocks: &mut [TreeBlock], topologies: &[Topology]) {
     backend.dispatch(PositionPass {
         blocks,
         topologies,
         rows,
+        scale: SCALE,
     });
 }
 
@@ -949,17 +978,20 @@ fn errors(tree: &Tree, offsets: &Offsets, passes: usize) -> Vec<f64> {
     errors
 }
 
-use JointRows::{Fixed, Hinge, Rod, Socket as Point};
+use JointRows::{Fixed, Hinge, Rod};
+
+/// A socket with a circular cone.
+const POINT: JointRows = JointRows::Socket(SwingRows::Cone);
 
 /// The trees of the first-order tests, by name: sockets hanging from a
 /// static anchor, every kind mixed (straight rods) likewise and with the
 /// static body on each joint's other side, and a free star.
 fn named_tree(r: &mut StdRng, name: &str) -> Tree {
     match name {
-        "sockets" => hanging_chain(r, &[Point]),
-        "mixed" => hanging_chain(r, &[Hinge, Fixed, Rod, Point, Hinge, Rod]),
+        "sockets" => hanging_chain(r, &[POINT]),
+        "mixed" => hanging_chain(r, &[Hinge, Fixed, Rod, POINT, Hinge, Rod]),
         "mixed, each joint's sides swapped" => {
-            let mut tree = hanging_chain(r, &[Fixed, Rod, Hinge, Point, Rod, Hinge]);
+            let mut tree = hanging_chain(r, &[Fixed, Rod, Hinge, POINT, Rod, Hinge]);
             swap_sides(&mut tree);
             tree
         }
@@ -1076,6 +1108,9 @@ fn one_pass_solves_every_linearised_row_and_moves_the_bodies_by_its_unknowns() {
             for (m, joint) in pass.before.iter().zip(&tree.joints) {
                 let rows = m.rows();
                 for k in 0..m.kind.count() {
+                    if m.kind.is_limit(k) && rows.c[k] <= 0.0 {
+                        continue; // a limit not violated is not held
+                    }
                     let mut linearised = rows.c[k] as f64;
                     for (side, jacobian) in [(joint.a, rows.ja[k]), (joint.b, rows.jb[k])] {
                         let Some(i) = side else { continue };
@@ -1163,7 +1198,7 @@ fn a_free_tree_keeps_its_linear_momentum_and_its_angular_to_first_order() {
 /// Six bodies hanging below a static anchor joined by rods bent 0.3 to 1
 /// rad (their ends' tangents at half that to the chord).
 fn bent_rod_chain(r: &mut StdRng) -> Tree {
-    let mut tree = hanging_chain(r, &[Point]);
+    let mut tree = hanging_chain(r, &[POINT]);
     tree.joints.clear();
     for i in 0..6 {
         let a = if i == 0 { None } else { Some(i - 1) };
@@ -1210,7 +1245,7 @@ struct Trees {
     topology: Topology,
 }
 
-const KINDS: [JointRows; 4] = [Point, Hinge, Fixed, Rod];
+const KINDS: [JointRows; 4] = [POINT, Hinge, Fixed, Rod];
 
 /// Static bodies at the end of the rows, shared by every lane.
 const STATICS: usize = 2;
@@ -1345,6 +1380,7 @@ fn random_lane(
                     let lo = r.random_range(-core::f32::consts::PI..0.0);
                     [lo, r.random_range(lo..core::f32::consts::PI)]
                 },
+                ..JointLane::FREE
             },
         );
         node.bodies.set_start(lane, &start);
@@ -1394,17 +1430,7 @@ fn clear_lane(trees: &mut Trees, lane: usize) {
     for body in &mut block.bodies {
         body.set(lane, 0, false, 1.0, Mat3::IDENTITY);
     }
-    let empty = JointLane {
-        body_a: 0,
-        body_b: 0,
-        anchor_a: GVec3::ZERO,
-        anchor_b: GVec3::ZERO,
-        frame_a: GQuat::IDENTITY,
-        frame_b: GQuat::IDENTITY,
-        rest_length: 0.0,
-        swing_max: core::f32::consts::PI,
-        twist: [-core::f32::consts::PI, core::f32::consts::PI],
-    };
+    let empty = JointLane::FREE;
     for joint in &mut block.joints {
         joint.set(lane, &empty);
         joint.bodies.set_start(lane, &StartLane::default());
@@ -1536,7 +1562,7 @@ fn topology_orders_every_node_after_its_children_and_the_root_last() {
         let topology = Topology::new(n, &shape).expect("a tree");
         check_order(&topology, n, &shape);
     }
-    for tree in [hanging_chain(&mut r, &[Point]), star(&mut r)] {
+    for tree in [hanging_chain(&mut r, &[POINT]), star(&mut r)] {
         let shape: Shape = tree
             .joints
             .iter()
@@ -1554,7 +1580,7 @@ fn topology_refuses_loops_disconnected_sets_and_bad_joints() {
             "a triangle",
             3,
             vec![
-                (Point, Some(0), Some(1)),
+                (POINT, Some(0), Some(1)),
                 (Hinge, Some(1), Some(2)),
                 (Rod, Some(2), Some(0)),
             ],
@@ -1563,55 +1589,55 @@ fn topology_refuses_loops_disconnected_sets_and_bad_joints() {
         (
             "two joints between one pair",
             2,
-            vec![(Point, Some(0), Some(1)), (Fixed, Some(1), Some(0))],
+            vec![(POINT, Some(0), Some(1)), (Fixed, Some(1), Some(0))],
             Loop,
         ),
         (
             "a body joined to itself",
             2,
-            vec![(Point, Some(0), Some(1)), (Hinge, Some(1), Some(1))],
+            vec![(POINT, Some(0), Some(1)), (Hinge, Some(1), Some(1))],
             Loop,
         ),
         (
             "two joints to static bodies",
             2,
             vec![
-                (Point, None, Some(0)),
-                (Point, Some(0), Some(1)),
-                (Point, Some(1), None),
+                (POINT, None, Some(0)),
+                (POINT, Some(0), Some(1)),
+                (POINT, Some(1), None),
             ],
             Loop,
         ),
         (
             "two grounded pairs",
             2,
-            vec![(Point, None, Some(0)), (Point, Some(1), None)],
+            vec![(POINT, None, Some(0)), (POINT, Some(1), None)],
             Loop,
         ),
         ("two free bodies", 2, vec![], Disconnected),
         (
             "two pairs",
             4,
-            vec![(Point, Some(0), Some(1)), (Rod, Some(2), Some(3))],
+            vec![(POINT, Some(0), Some(1)), (Rod, Some(2), Some(3))],
             Disconnected,
         ),
         (
             "a body left out",
             2,
-            vec![(Point, None, Some(0))],
+            vec![(POINT, None, Some(0))],
             Disconnected,
         ),
         ("nothing", 0, vec![], Disconnected),
         (
             "a body past the count",
             3,
-            vec![(Point, Some(0), Some(1)), (Point, Some(1), Some(3))],
+            vec![(POINT, Some(0), Some(1)), (POINT, Some(1), Some(3))],
             BadJoint,
         ),
         (
             "a joint to no body",
             2,
-            vec![(Point, Some(0), Some(1)), (Point, None, None)],
+            vec![(POINT, Some(0), Some(1)), (POINT, None, None)],
             BadJoint,
         ),
     ];
@@ -1633,7 +1659,7 @@ fn topology_refuses_loops_disconnected_sets_and_bad_joints() {
         fewer.remove(inner.expect("n > 1 bodies are joined"));
         assert_eq!(Topology::new(n, &fewer), Err(Disconnected), "{fewer:?}");
         let (a, b) = (r.random_range(0..n as u32), r.random_range(0..n as u32));
-        shape.insert(r.random_range(0..=shape.len()), (Point, Some(a), Some(b)));
+        shape.insert(r.random_range(0..=shape.len()), (POINT, Some(a), Some(b)));
         assert_eq!(Topology::new(n, &shape), Err(Loop), "{shape:?}");
     }
 }

@@ -2,8 +2,9 @@
 //! and which only fail to hold their axes (issue 15; docs/joints.md, "The
 //! anatomical drop").
 //!
-//! `cargo run --release -p vertebra-scenes --example limits -- SPINE S I SEED`
-//! (`SPINE` is `rod` or `sockets`) runs the 600-frame anatomical drop at S
+//! `cargo run --release -p vertebra-scenes --example limits -- SPINE S I SEED [JOINTS]`
+//! (`SPINE` is `rod` or `sockets`; `JOINTS` is `iterative`, the default, or
+//! `direct`) runs the 600-frame anatomical drop at S
 //! substeps x I iterations from SEED and prints, per joint name (over all
 //! 30 ragdolls; `rod` for the rod), the largest limit violation and the
 //! largest angular error (the held rotations too), in degrees, each with
@@ -27,6 +28,9 @@ fn main() {
     let mut config = SceneConfig::new(Scene::AnatomicalDrop, spine);
     (config.substeps, config.iterations) = (number(1) as u32, number(2) as u32);
     config.seed = number(3);
+    if args.get(4).map(String::as_str) == Some("direct") {
+        config.joints = vertebra_world::JointSolver::Direct;
+    }
     let mut scene = build(&config).expect("the scene builds");
     let desc = RagdollDesc::anatomical_humanoid();
     let (mut joints, mut rods) = (HashMap::new(), HashMap::new());

@@ -89,6 +89,13 @@ impl LimitSoftness {
     }
 }
 
+/// An elliptical cone's semi-axis for the half-angle `half` (rad):
+/// `sin(half / 2)` by the kernels' polynomial (so that every platform lays
+/// out the same bits), at least `parts::ellipse::MIN_SEMI_AXIS`.
+pub(crate) fn ellipse_semi_axis(half: f32) -> f32 {
+    vertebra_math::poly::sin(0.5 * half).max(vertebra_kernels::parts::ellipse::MIN_SEMI_AXIS)
+}
+
 /// A socket's swing limit: how far b's twist axis (its joint frame's +X)
 /// may turn away from a's, measured on the swing of the swing-twist
 /// decomposition (twist about +X) in a's joint frame.

@@ -18,11 +18,9 @@ use std::collections::BTreeSet;
 use vertebra_kernels::body::{BodyPairs, StartLane};
 use vertebra_kernels::fixed::{FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{HingeBlock, HingeLane};
-use vertebra_kernels::parts::ellipse::MIN_SEMI_AXIS;
 use vertebra_kernels::rod::{RodBlock, RodLane};
 use vertebra_kernels::socket::{ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
-use vertebra_math::poly;
 use vertebra_scheduler::{Colouring, MAX_COLOURS};
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 
@@ -541,14 +539,9 @@ pub(crate) fn socket_lane(desc: &JointDesc, limits: &SwingTwist, bodies: &BodySt
     }
 }
 
-/// `sin(angle / 2)` by the kernels' polynomial.
-fn half_sine(angle: f32) -> f32 {
-    poly::sin(0.5 * angle)
-}
-
 /// The shaped path's settings for a socket's limits.
 fn shaped_limits(limits: &SwingTwist) -> ShapedLimits {
-    let semi = |half: f32| half_sine(half).max(MIN_SEMI_AXIS);
+    let semi = crate::joint::ellipse_semi_axis;
     let mut shaped = ShapedLimits::FREE;
     match limits.swing {
         Swing::Free => {}

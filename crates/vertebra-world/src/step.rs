@@ -200,6 +200,15 @@ fn start_drives(world: &mut World, h: f32) {
             });
         }
     }
+    for bin in &bins {
+        if some(&bin.trees) {
+            world.backend.dispatch(direct::StartPass {
+                blocks: &mut layout.trees.blocks[bin.trees.clone()],
+                topologies: &layout.trees.topologies,
+                rows,
+            });
+        }
+    }
     layout.bins = bins;
 }
 
@@ -533,11 +542,16 @@ impl Pass for Positions {
         rows: &BodyRows,
         backend: Backend,
     ) {
+        let scale = direct::SubstepScale {
+            inv_h: self.inv_h,
+            inv_h2: self.inv_h2,
+        };
         for block in blocks.chunks_mut(1) {
             backend_for_tree(backend, &block[0]).dispatch(direct::PositionPass {
                 blocks: block,
                 topologies,
                 rows,
+                scale,
             });
         }
     }

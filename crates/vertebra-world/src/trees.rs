@@ -18,11 +18,14 @@ use core::f32::consts::PI;
 use std::collections::BTreeMap;
 
 use vertebra_kernels::body::StartLane;
-use vertebra_kernels::direct::{BodyNode, JointLane, JointNode, JointRows, Topology, TreeBlock};
+use vertebra_kernels::direct::{
+    BodyNode, JointLane, JointNode, JointRows, SwingRows, Topology, TreeBlock,
+};
+use vertebra_kernels::limited::LimitLane;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 
-use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing};
+use crate::joint::{JointDesc, JointKind, Swing, ellipse_semi_axis};
 use crate::rod::RodDesc;
 
 /// A joint (or rod) of a tree: where its lane is.
@@ -149,6 +152,7 @@ impl Trees {
                 }
             };
             block.joints[k].set(lane, &lane_data);
+            block.soft |= lane_data.softness != LimitLane::HARD;
         }
     }
 
@@ -191,35 +195,40 @@ pub(crate) fn set_mass(node: &mut BodyNode, lane: usize, bodies: &BodyStore) {
     node.set_mass(lane, bodies.mass[i], bodies.inertia[i]);
 }
 
-/// A joint's lane, with the limits the direct solve holds: the plain
-/// path's cone and twist range and a hinge's range, when hard (a soft
-/// limit, and the shaped path's ellipse and pyramid, stay iterative).
+/// A joint's lane, with every limit the direct solve holds: a socket's
+/// swing (cone, ellipse or pyramid) and twist range, a hinge's range, hard
+/// or soft.
 fn joint_lane(d: &JointDesc) -> JointLane {
-    let (swing_max, twist) = match d.kind {
-        JointKind::Socket(limits) if limits.is_plain() => (
-            match limits.swing {
-                Swing::Cone(half) => half,
-                _ => PI,
-            },
-            limits.twist.unwrap_or([-PI, PI]),
-        ),
-        JointKind::Hinge {
-            range: Some(range),
-            softness: LimitSoftness::Hard,
-        } => (PI, range),
-        _ => (PI, [-PI, PI]),
-    };
-    JointLane {
+    let free = [-PI, PI];
+    let mut lane = JointLane {
         body_a: d.body_a.index() as u32 + 1,
         body_b: d.body_b.index() as u32 + 1,
         anchor_a: d.anchor_a,
         anchor_b: d.anchor_b,
         frame_a: d.frame_a.normalize(),
         frame_b: d.frame_b.normalize(),
-        rest_length: 0.0,
-        swing_max,
-        twist,
+        ..JointLane::FREE
+    };
+    match d.kind {
+        JointKind::Socket(limits) => {
+            match limits.swing {
+                Swing::Free => {}
+                Swing::Cone(half) => lane.swing_max = half,
+                Swing::Ellipse { y, z } => {
+                    lane.ellipse = [ellipse_semi_axis(y), ellipse_semi_axis(z)]
+                }
+                Swing::Pyramid { y, z } => lane.pyramid = [y, z],
+            }
+            lane.twist = limits.twist.unwrap_or(free);
+            lane.softness = limits.softness.lane();
+        }
+        JointKind::Hinge { range, softness } => {
+            lane.twist = range.unwrap_or(free);
+            lane.softness = softness.lane();
+        }
+        JointKind::Fixed => {}
     }
+    lane
 }
 
 /// A rod's lane: its points are the centres of mass (zero anchors).
@@ -234,12 +243,17 @@ fn rod_lane(d: &RodDesc) -> JointLane {
         rest_length: d.rest_length,
         swing_max: d.bend_limit.unwrap_or(PI),
         twist: d.twist_limit.unwrap_or([-PI, PI]),
+        ..JointLane::FREE
     }
 }
 
 fn rows_of(kind: &JointKind) -> JointRows {
     match kind {
-        JointKind::Socket(_) => JointRows::Socket,
+        JointKind::Socket(limits) => JointRows::Socket(match limits.swing {
+            Swing::Free | Swing::Cone(_) => SwingRows::Cone,
+            Swing::Ellipse { .. } => SwingRows::Ellipse,
+            Swing::Pyramid { .. } => SwingRows::Pyramid,
+        }),
         JointKind::Hinge { .. } => JointRows::Hinge,
         JointKind::Fixed => JointRows::Fixed,
     }

@@ -39,9 +39,10 @@ use vertebra_math::row::NO_WRITE;
 use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
+use crate::limited::{LimitLane, SoftnessBlock};
 use ldl::{MAX, PACKED};
-use rows::Geometry;
-pub use rows::JointRows;
+use rows::{Geometry, MAX_LIMITS};
+pub use rows::{JointRows, SwingRows};
 
 /// No node: the root's parent, or a joint's side on a static or kinematic
 /// body.
@@ -283,6 +284,19 @@ pub struct JointNode {
     pub twist_min: [f32; BLOCK_LANES],
     /// The twist range's high end (rad).
     pub twist_max: [f32; BLOCK_LANES],
+    /// The elliptical cone's semi-axes, `sin(theta_y / 2)` and
+    /// `sin(theta_z / 2)` (1: none).
+    pub ellipse: [[f32; BLOCK_LANES]; 2],
+    /// The pyramid's ranges about Y and Z, `[min, max]` each (rad).
+    pub pyramid: [[[f32; BLOCK_LANES]; 2]; 2],
+    /// The limits' softness (all zero: hard; `parts::limit`).
+    pub softness: SoftnessBlock,
+    /// Each limit row's violation at the substep's start (the damping's
+    /// `C_0`; [`StartPass`]).
+    pub limit_start: [[f32; BLOCK_LANES]; MAX_LIMITS],
+    /// Each limit row's multiplier accumulated over the substep (a soft
+    /// limit's spring force; reset by [`StartPass`]).
+    pub limit_lambda: [[f32; BLOCK_LANES]; MAX_LIMITS],
 }
 
 /// A joint's geometry in one lane, as the world lays it out.
@@ -305,9 +319,35 @@ pub struct JointLane {
     /// The hard swing cone's half-angle, or the rod's bend limit (rad; pi
     /// for none).
     pub swing_max: f32,
-    /// The hard twist range, a hinge's hard range or the rod's twist limit
+    /// The socket's twist range, a hinge's range or the rod's twist limit
     /// (rad; `[-pi, pi]` for none).
     pub twist: [f32; 2],
+    /// The elliptical cone's semi-axes `[sin(theta_y / 2), sin(theta_z /
+    /// 2)]` (`[1, 1]` for none).
+    pub ellipse: [f32; 2],
+    /// The pyramid's ranges about Y and Z (rad; `[-pi, pi]` for none).
+    pub pyramid: [[f32; 2]; 2],
+    /// The limits' softness ([`LimitLane::HARD`]: hard).
+    pub softness: LimitLane,
+}
+
+impl JointLane {
+    /// The null rows, no anchors, identity frames and no limits: padding,
+    /// and the base a lane's own fields are written over.
+    pub const FREE: Self = Self {
+        body_a: 0,
+        body_b: 0,
+        anchor_a: glam::Vec3::ZERO,
+        anchor_b: glam::Vec3::ZERO,
+        frame_a: glam::Quat::IDENTITY,
+        frame_b: glam::Quat::IDENTITY,
+        rest_length: 0.0,
+        swing_max: core::f32::consts::PI,
+        twist: [-core::f32::consts::PI, core::f32::consts::PI],
+        ellipse: [1.0, 1.0],
+        pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
+        softness: LimitLane::HARD,
+    };
 }
 
 impl JointNode {
@@ -315,20 +355,7 @@ impl JointNode {
     pub fn padding() -> Self {
         let mut node = Self::zeroed();
         for lane in 0..BLOCK_LANES {
-            node.set(
-                lane,
-                &JointLane {
-                    body_a: 0,
-                    body_b: 0,
-                    anchor_a: glam::Vec3::ZERO,
-                    anchor_b: glam::Vec3::ZERO,
-                    frame_a: glam::Quat::IDENTITY,
-                    frame_b: glam::Quat::IDENTITY,
-                    rest_length: 0.0,
-                    swing_max: core::f32::consts::PI,
-                    twist: [-core::f32::consts::PI, core::f32::consts::PI],
-                },
-            );
+            node.set(lane, &JointLane::FREE);
         }
         node
     }
@@ -343,10 +370,32 @@ impl JointNode {
         self.rest_length[lane] = j.rest_length;
         self.swing_max[lane] = j.swing_max;
         (self.twist_min[lane], self.twist_max[lane]) = (j.twist[0], j.twist[1]);
+        for (axis, semi) in self.ellipse.iter_mut().zip(j.ellipse) {
+            axis[lane] = semi;
+        }
+        for (axis, range) in self.pyramid.iter_mut().zip(j.pyramid) {
+            (axis[0][lane], axis[1][lane]) = (range[0], range[1]);
+        }
+        self.softness.set(lane, &j.softness);
+    }
+
+    /// Whether the lane's limits are soft.
+    pub fn is_soft(&self, lane: usize) -> bool {
+        self.softness.get(lane) != LimitLane::HARD
+    }
+
+    /// The lanes from `start` whose limits are soft.
+    #[inline(always)]
+    fn soft_lanes<L: Lane>(&self, start: usize) -> L::Mask {
+        let s = &self.softness;
+        let sum = L::load(&s.compliance[start..])
+            + L::load(&s.period2[start..])
+            + L::load(&s.damping_time[start..]);
+        sum.gt(L::splat(0.0))
     }
 
     #[inline(always)]
-    fn geometry<L: Lane>(&self, start: usize) -> Geometry<L> {
+    fn geometry<L: Lane>(&self, start: usize, scale: SubstepScale) -> Geometry<L> {
         Geometry {
             anchor_a: self.anchor_a.load(start),
             anchor_b: self.anchor_b.load(start),
@@ -354,13 +403,37 @@ impl JointNode {
             frame_b: self.frame_b.load(start),
             rest_length: L::load(&self.rest_length[start..]),
             swing_max: L::load(&self.swing_max[start..]),
+            ellipse: load_pair(&self.ellipse, start),
+            pyramid: [
+                load_pair(&self.pyramid[0], start),
+                load_pair(&self.pyramid[1], start),
+            ],
             twist: [
                 L::load(&self.twist_min[start..]),
                 L::load(&self.twist_max[start..]),
             ],
+            softness: self
+                .softness
+                .lanes(start, L::splat(scale.inv_h), L::splat(scale.inv_h2)),
             start: self.bodies.start(start),
         }
     }
+}
+
+/// Two arrays' lanes from `start`.
+#[inline(always)]
+fn load_pair<L: Lane>(r: &[[f32; BLOCK_LANES]; 2], start: usize) -> [L; 2] {
+    [L::load(&r[0][start..]), L::load(&r[1][start..])]
+}
+
+/// The substep's `1 / h` (1/s) and `1 / h^2` (1/s^2), which scale the
+/// soft limits' compliance and damping (`parts::limit`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubstepScale {
+    /// `1 / h`.
+    pub inv_h: f32,
+    /// `1 / h^2`.
+    pub inv_h2: f32,
 }
 
 /// A node's working values in each lane, rewritten every iteration.
@@ -374,6 +447,14 @@ pub struct NodeScratch {
     /// The block coupling it to its parent: the joint's rows (of the
     /// node or of its parent) against the body's six unknowns, row by row.
     pub coupling: [[f32; BLOCK_LANES]; MAX * 6],
+    /// A joint's limit rows as measured (held or not): each row's signed
+    /// distance past its limit and its angular Jacobians on a and b
+    /// (`c, J_a, J_b`: seven values a row), which predict where the
+    /// solve's step takes it.
+    pub limits: [[f32; BLOCK_LANES]; MAX_LIMITS * 7],
+    /// A joint's limit rows held in this solve (1) or not (0): the active
+    /// set.
+    pub active: [[f32; BLOCK_LANES]; MAX_LIMITS],
 }
 
 impl NodeScratch {
@@ -382,6 +463,8 @@ impl NodeScratch {
         diagonal: [[0.0; BLOCK_LANES]; PACKED],
         rhs: [[0.0; BLOCK_LANES]; MAX],
         coupling: [[0.0; BLOCK_LANES]; MAX * 6],
+        limits: [[0.0; BLOCK_LANES]; MAX_LIMITS * 7],
+        active: [[0.0; BLOCK_LANES]; MAX_LIMITS],
     };
 }
 
@@ -392,6 +475,9 @@ pub struct TreeBlock {
     pub topology: u32,
     /// Bit `i` set: lane `i` holds no tree.
     pub padding: u32,
+    /// Some lane has a soft limit (its rows then carry compliance and
+    /// damping, and [`StartPass`] measures their start).
+    pub soft: bool,
     /// The bodies, in the topology's body order.
     pub bodies: Vec<BodyNode>,
     /// The joints, in the topology's joint order.
@@ -406,6 +492,7 @@ impl TreeBlock {
         Self {
             topology,
             padding: (1 << BLOCK_LANES) - 1,
+            soft: false,
             bodies: vec![BodyNode::padding(); shape.bodies],
             joints: vec![JointNode::padding(); shape.joints],
             scratch: vec![NodeScratch::ZERO; shape.nodes.len()],
@@ -421,6 +508,8 @@ pub struct PositionPass<'a> {
     pub topologies: &'a [Topology],
     /// Body rows, read and written.
     pub rows: &'a BodyRows,
+    /// The substep's time scale (the soft limits').
+    pub scale: SubstepScale,
 }
 
 impl LaneKernel for PositionPass<'_> {
@@ -433,26 +522,88 @@ impl LaneKernel for PositionPass<'_> {
                 topology: &self.topologies[block.topology as usize],
                 block,
                 rows: self.rows,
+                scale: self.scale,
             };
             for_live_slices::<L, _>(padding, &mut slices);
         }
     }
 }
 
+/// How many times one solve may factor its tree with a changed active set
+/// (`solve::settle`): the first, then up to this many less one.
+pub const MAX_PASSES: usize = 4;
+
 /// One block of a [`PositionPass`].
 struct Slices<'a> {
     topology: &'a Topology,
     block: &'a mut TreeBlock,
     rows: &'a BodyRows,
+    scale: SubstepScale,
 }
 
 impl LaneSlices for Slices<'_> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
-        let (topology, rows) = (self.topology, self.rows);
-        solve::assemble::<L>(self.block, topology, rows, start);
-        solve::eliminate::<L>(self.block, topology, start);
-        solve::substitute::<L>(self.block, topology, start);
+        let (topology, rows, scale) = (self.topology, self.rows, self.scale);
+        let mut first = true;
+        for pass in 1..=MAX_PASSES {
+            solve::assemble::<L>(self.block, topology, rows, start, scale, first);
+            solve::eliminate::<L>(self.block, topology, start);
+            solve::substitute::<L>(self.block, topology, start);
+            first = false;
+            if !solve::settle::<L>(self.block, topology, start) || pass == MAX_PASSES {
+                break;
+            }
+        }
+        solve::accumulate::<L>(self.block, topology, start);
         solve::apply::<L>(self.block, topology, rows, start);
+    }
+}
+
+/// The trees' substep start, before the bodies are predicted: every limit
+/// row's multiplier reset, and a soft block's violations measured (the
+/// damping's `C_0`, as `crate::limited::StartPass` measures the parts').
+pub struct StartPass<'a> {
+    /// The blocks.
+    pub blocks: &'a mut [TreeBlock],
+    /// Their topologies.
+    pub topologies: &'a [Topology],
+    /// Body rows, read.
+    pub rows: &'a BodyRows,
+}
+
+impl LaneKernel for StartPass<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        for block in self.blocks.iter_mut() {
+            for joint in block.joints.iter_mut() {
+                joint.limit_lambda = [[0.0; BLOCK_LANES]; MAX_LIMITS];
+            }
+            if !block.soft {
+                continue;
+            }
+            let padding = block.padding;
+            let mut starts = Starts {
+                topology: &self.topologies[block.topology as usize],
+                block,
+                rows: self.rows,
+            };
+            for_live_slices::<L, _>(padding, &mut starts);
+        }
+    }
+}
+
+/// One block of a [`StartPass`].
+struct Starts<'a> {
+    topology: &'a Topology,
+    block: &'a mut TreeBlock,
+    rows: &'a BodyRows,
+}
+
+impl LaneSlices for Starts<'_> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        solve::start_limits::<L>(self.block, self.topology, self.rows, start);
     }
 }

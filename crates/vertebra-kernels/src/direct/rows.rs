@@ -10,7 +10,7 @@
 //! | fixed lock (3) | `C = log((q_b F_b)(q_a F_a)*)`; `J_b = [0, 1]`, `J_a = [0, -1]` |
 //! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b` (from a's +Y reflected likewise); `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
 //! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, 0]`, `J_a = [-o, 0]` (the paper's "purely through linear motion") |
-//! | hard limits (socket cone and twist, hinge range, rod bend and twist: 1 each) | the violation, 0 within the limit; `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative part turns about; a zero row (dropped) while not violated |
+//! | limits (socket swing: a cone's or an ellipse's 1, a pyramid's 2; socket twist, hinge range, rod bend and twist: 1 each) | the signed distance past the limit (positive beyond it, negative inside: how far its boundary is), `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative parts turn about; which are held is the solve's active set (`super::solve`), and a row not held is zeroed (dropped) |
 //!
 //! The single angle the iterative parts correct (`hinge_axis`, `curve`)
 //! has no direction where the error is zero: a row along `n` would vanish
@@ -26,14 +26,32 @@ use vertebra_math::{Lane, Quat, Vec3, poly};
 
 use super::ldl::MAX;
 use crate::body::{BodyLanes, PairStart, safe_ratio};
-use crate::parts::rod::{bend, curve, length, twist as rod_twist};
-use crate::parts::{axis_x, frames, lock, point, swing, twist};
+use crate::parts::limit::Softness;
+use crate::parts::rod::{curve, length, twist as rod_twist};
+use crate::parts::{axis_x, ellipse, frames, lock, point, pyramid, swing, swing_direction, twist};
 
-/// What a joint holds equal, and so its rows.
+/// A limit row's error where the limit has no bound (a cone of pi, a
+/// range of `[-pi, pi]`): far inside, so the row is never held and no
+/// step is predicted to cross it.
+pub const FREE: f32 = -1.0e3;
+
+/// A socket's swing limit, as its rows see it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum SwingRows {
+    /// A circular cone (or none: a half-angle of pi), in radians.
+    Cone,
+    /// An elliptical cone, in swing sines (`parts::ellipse`).
+    Ellipse,
+    /// A pyramid: one row for each of its two angles.
+    Pyramid,
+}
+
+/// What a joint holds, and so its rows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum JointRows {
-    /// A socket: the point, the swing cone and the twist range (5 rows).
-    Socket,
+    /// A socket: the point, the swing limit (one row, two for a pyramid)
+    /// and the twist range (5 or 6 rows).
+    Socket(SwingRows),
     /// A hinge: the point, the axis and the range (6 rows).
     Hinge,
     /// A fixed joint: the point and the lock (6 rows).
@@ -46,11 +64,37 @@ impl JointRows {
     /// How many rows.
     pub const fn count(self) -> usize {
         match self {
-            JointRows::Socket | JointRows::Rod => 5,
-            JointRows::Hinge | JointRows::Fixed => 6,
+            JointRows::Socket(SwingRows::Pyramid) | JointRows::Hinge | JointRows::Fixed => 6,
+            JointRows::Socket(_) | JointRows::Rod => 5,
         }
     }
+
+    /// The first of the limit rows, which run to the last row (`count()`
+    /// for none: a fixed joint).
+    pub const fn first_limit(self) -> usize {
+        match self {
+            JointRows::Socket(_) | JointRows::Rod => 3,
+            JointRows::Hinge => 5,
+            JointRows::Fixed => 6,
+        }
+    }
+
+    /// Whether row `k` is a limit's.
+    pub const fn is_limit(self, k: usize) -> bool {
+        k >= self.first_limit() && k < self.count()
+    }
+
+    /// How the softness of row `k` is scaled: a quarter for the ellipse's
+    /// row, whose error is in swing sines (half a radian per radian for
+    /// small swings: `parts::ellipse`), else one.
+    pub const fn is_sine_row(self, k: usize) -> bool {
+        matches!(self, JointRows::Socket(SwingRows::Ellipse)) && k == 3
+    }
 }
+
+/// The most limit rows a joint has (a pyramid socket's two swing rows and
+/// its twist).
+pub const MAX_LIMITS: usize = 3;
 
 /// A joint's rows: errors and both bodies' Jacobians (`[linear,
 /// angular]`, world).
@@ -80,9 +124,16 @@ pub struct Geometry<L> {
     pub rest_length: L,
     /// The swing cone's half-angle (rad; the rod's bend limit; pi: none).
     pub swing_max: L,
+    /// The elliptical cone's semi-axes `[sin(theta_y / 2), sin(theta_z /
+    /// 2)]` (`[1, 1]`: none).
+    pub ellipse: [L; 2],
+    /// The pyramid's ranges about Y and Z (rad; `[-pi, pi]`: none).
+    pub pyramid: [[L; 2]; 2],
     /// The twist range (rad; a hinge's range; the rod's twist limit;
     /// `[-pi, pi]`: none).
     pub twist: [L; 2],
+    /// The limits' softness, scaled to the substep (all zero: hard).
+    pub softness: Softness<L>,
     /// Where the pair's points (a rod's centres) stood as the step began.
     pub start: PairStart<L>,
 }
@@ -98,10 +149,20 @@ impl<L: Lane> Rows<L> {
             c: [zero; MAX],
         };
         match kind {
-            JointRows::Socket => {
+            JointRows::Socket(SwingRows::Cone) => {
                 rows.point(0, a, b, g);
                 rows.swing(3, a, b, g);
                 rows.twist(4, a, b, g);
+            }
+            JointRows::Socket(SwingRows::Ellipse) => {
+                rows.point(0, a, b, g);
+                rows.ellipse(3, a, b, g);
+                rows.twist(4, a, b, g);
+            }
+            JointRows::Socket(SwingRows::Pyramid) => {
+                rows.point(0, a, b, g);
+                rows.pyramid(3, a, b, g);
+                rows.twist(5, a, b, g);
             }
             JointRows::Hinge => {
                 rows.point(0, a, b, g);
@@ -129,20 +190,12 @@ impl<L: Lane> Rows<L> {
         self.ja[k] = [-lb.x, -lb.y, -lb.z, -aa.x, -aa.y, -aa.z];
     }
 
-    /// A limit's row: its violation `c` (0: not violated) grows as b turns
-    /// about `jb` and as a turns against `ja` (world). A limit not
-    /// violated has no row (a zero row, dropped), so the solve never holds
-    /// a joint inside its range: an active set chosen afresh each
-    /// iteration.
+    /// A limit's row: its signed distance `c` past the limit grows as b
+    /// turns about `jb` and as a turns against `ja` (world). Which rows
+    /// are held is the solve's active set (`super::solve`).
     #[inline(always)]
     fn limit(&mut self, k: usize, c: L, ja: Vec3<L>, jb: Vec3<L>) {
-        let active = c.ne(L::splat(0.0));
-        let zero = Vec3::zero();
-        let (ja, jb) = (
-            Vec3::select(active, ja, zero),
-            Vec3::select(active, jb, zero),
-        );
-        self.set(k, c, (zero, jb), ja);
+        self.set(k, c, (Vec3::zero(), jb), ja);
     }
 
     /// The swing cone: the angle between the twist axes past its
@@ -150,16 +203,43 @@ impl<L: Lane> Rows<L> {
     #[inline(always)]
     fn swing(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         let (n, theta) = swing::measure(a, b, g.frame_a, g.frame_b);
-        self.limit(at, swing::overshoot(theta, g.swing_max), n, n);
+        self.limit(at, bounded(theta - g.swing_max, g.swing_max), n, n);
     }
 
-    /// The twist range (a hinge's range): the signed excess about `t_b`
-    /// (`parts::twist`).
+    /// The elliptical cone, in swing sines (`parts::ellipse`): outside,
+    /// the distance to its nearest point along the ellipse's normal there.
+    #[inline(always)]
+    fn ellipse(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let dir = swing_direction::measure(a, b, g.frame_a, g.frame_b);
+        let [semi_y, semi_z] = g.ellipse;
+        let (n, c) = ellipse::signed(&dir, semi_y, semi_z, L::splat(FREE));
+        let n = a.q.rotate(n);
+        self.limit(at, c, n, n);
+    }
+
+    /// The pyramid's two swing angles (`parts::pyramid`).
+    #[inline(always)]
+    fn pyramid(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        let dir = swing_direction::measure(a, b, g.frame_a, g.frame_b);
+        let [y, z] = g.pyramid;
+        for (k, (n, c)) in pyramid::signed(&dir, y, z, L::splat(FREE))
+            .into_iter()
+            .enumerate()
+        {
+            let n = a.q.rotate(n);
+            self.limit(at + k, c, n, n);
+        }
+    }
+
+    /// The twist range (a hinge's range): the signed distance past the
+    /// nearer end about `t_b` (`parts::twist`).
     #[inline(always)]
     fn twist(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         let [lo, hi] = g.twist;
-        let ([axis_a, axis_b], c) = twist::violation_local(a, b, g.frame_a, g.frame_b, lo, hi);
-        self.limit(at, c, a.q.rotate(axis_a), b.q.rotate(axis_b));
+        let ([axis_a, axis_b], phi) = twist::measure_local(a, b, g.frame_a, g.frame_b);
+        let (c, sign) = twist::signed(phi, lo, hi, L::splat(FREE));
+        let (ja, jb) = (a.q.rotate(axis_a), b.q.rotate(axis_b));
+        self.limit(at, c, ja.scale(sign), jb.scale(sign));
     }
 
     /// The rod's bend limit and twist range (`parts::rod::bend`,
@@ -167,12 +247,12 @@ impl<L: Lane> Rows<L> {
     #[inline(always)]
     fn rod_limits(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         let f = frames(a, b, g.frame_a, g.frame_b);
-        let (n, c) = bend::overshoot(&f, g.swing_max);
-        self.limit(at, c, n, n);
+        let (n, psi) = crate::parts::rod::bend_angle(f.ta, f.tb);
+        self.limit(at, bounded(psi - g.swing_max, g.swing_max), n, n);
         let [lo, hi] = g.twist;
-        let e = twist::excess(rod_twist::measure(&f), lo, hi);
+        let (c, sign) = twist::signed(rod_twist::measure(&f), lo, hi, L::splat(FREE));
         let (na, nb) = rod_twist::axes(&f);
-        self.limit(at + 1, e, na, nb);
+        self.limit(at + 1, c, na.scale(sign), nb.scale(sign));
     }
 
     /// The point: `d` along the world axes; moving b along `e` moves its
@@ -244,6 +324,13 @@ impl<L: Lane> Rows<L> {
         let (o, c) = length::measure(a, b, &f, g.rest_length, &g.start);
         self.set(at, c, (o, Vec3::zero()), Vec3::zero());
     }
+}
+
+/// A cone's (a rod bend's) signed distance `c` past the half-angle
+/// `max`, or [`FREE`] where the half-angle is pi or more (no bound).
+#[inline(always)]
+fn bounded<L: Lane>(c: L, max: L) -> L {
+    L::select(max.ge(L::splat(core::f32::consts::PI)), L::splat(FREE), c)
 }
 
 /// The world's axes: the rows of a vector error measured along them (the

@@ -8,11 +8,11 @@
 //! stay in registers.
 
 use vertebra_math::block::BLOCK_LANES;
-use vertebra_math::{Lane, Sym3, Vec3};
+use vertebra_math::{Lane, Mask, Sym3, Vec3};
 
 use super::ldl::{self, MAX, PACKED, at};
-use super::rows::{JointRows, Rows};
-use super::{NONE, NodeKind, Topology, TreeBlock};
+use super::rows::{FREE, Geometry, JointRows, MAX_LIMITS, Rows};
+use super::{JointNode, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
 use crate::body::{BodyLanes, BodyRows};
 
 /// Loads lane values from scratch arrays.
@@ -34,16 +34,21 @@ fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
 }
 
 /// Every node's starting block: a body's mass matrix (world), a joint's
-/// zero (hard rows) with its errors on the right, and each joint's
-/// Jacobians written where the tree couples it to each body.
+/// zero (hard rows; a soft limit's compliance) with its errors on the
+/// right, and each joint's Jacobians written where the tree couples it to
+/// each body. A limit row is held where the active set says (`first`: the
+/// limits violated now), else zeroed (dropped by the factorisation).
 #[inline(always)]
 pub(super) fn assemble<L: Lane>(
     block: &mut TreeBlock,
     topology: &Topology,
     rows: &BodyRows,
     start: usize,
+    scale: SubstepScale,
+    first: bool,
 ) {
     let zero = L::splat(0.0);
+    let soft = block.soft;
     for (n, node) in topology.nodes.iter().enumerate() {
         let mut diagonal = [zero; PACKED];
         let mut rhs = [zero; MAX];
@@ -80,9 +85,26 @@ pub(super) fn assemble<L: Lane>(
             } => {
                 let joint = &block.joints[index as usize];
                 let (body_a, body_b) = joint.bodies.gather::<L>(rows, start);
-                let measured = Rows::measure(kind, &body_a, &body_b, &joint.geometry(start));
+                let geometry = joint.geometry(start, scale);
+                let mut measured = Rows::measure(kind, &body_a, &body_b, &geometry);
                 let count = kind.count();
+                let limits = hold_limits(&mut block.scratch[n], kind, &mut measured, start, first);
                 rhs[..count].copy_from_slice(&measured.c[..count]);
+                if soft {
+                    let held = Held {
+                        joint,
+                        kind,
+                        geometry: &geometry,
+                        active: limits,
+                    };
+                    soften(
+                        &held,
+                        (&body_a, &body_b),
+                        &measured,
+                        start,
+                        (&mut diagonal, &mut rhs),
+                    );
+                }
                 // The coupling to body `side` sits with whichever of the two
                 // is the other's child.
                 for (side, jacobian) in [(a, &measured.ja), (b, &measured.jb)] {
@@ -109,6 +131,214 @@ pub(super) fn assemble<L: Lane>(
         let scratch = &mut block.scratch[n];
         store(&diagonal, &mut scratch.diagonal, start);
         store(&rhs, &mut scratch.rhs, start);
+    }
+}
+
+/// Records a joint's limit rows as measured (for [`settle`]), chooses
+/// which are held (`first`: those violated now, else the active set
+/// [`settle`] left) and zeroes the others; returns the held mask per limit
+/// row.
+#[inline(always)]
+fn hold_limits<L: Lane>(
+    scratch: &mut super::NodeScratch,
+    kind: JointRows,
+    measured: &mut Rows<L>,
+    start: usize,
+    first: bool,
+) -> [L::Mask; MAX_LIMITS] {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    let mut held = [zero.gt(zero); MAX_LIMITS];
+    for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
+        let c = measured.c[k];
+        let mut record = [zero; 7];
+        record[0] = c;
+        record[1..4].copy_from_slice(&measured.ja[k][3..6]);
+        record[4..7].copy_from_slice(&measured.jb[k][3..6]);
+        store(&record, &mut scratch.limits[l * 7..l * 7 + 7], start);
+        let active = if first {
+            c.gt(zero)
+        } else {
+            L::load(&scratch.active[l][start..]).gt(zero)
+        };
+        L::select(active, one, zero).store(&mut scratch.active[l][start..]);
+        measured.c[k] = L::select(active, c, zero);
+        for j in 0..6 {
+            measured.ja[k][j] = L::select(active, measured.ja[k][j], zero);
+            measured.jb[k][j] = L::select(active, measured.jb[k][j], zero);
+        }
+        held[l] = active;
+    }
+    held
+}
+
+/// A joint's held limit rows, as [`soften`] reads them.
+struct Held<'a, L: Lane> {
+    joint: &'a JointNode,
+    kind: JointRows,
+    geometry: &'a Geometry<L>,
+    active: [L::Mask; MAX_LIMITS],
+}
+
+/// A soft limit's row (`parts::limit`, whose header derives the step):
+/// with `alpha = alpha~ + spring w` (`w` the row's own generalised inverse
+/// mass) and `gamma` the damping, XPBD's damped step
+/// `((1 + gamma) J dx + alpha dlambda = -(C + alpha lambda + gamma (C -
+/// C_0))` divided by `1 + gamma`: `-alpha / (1 + gamma)` on the row's
+/// diagonal, the right-hand side over `1 + gamma`. Zero compliance and
+/// damping leave the hard row as it was, bit for bit.
+#[inline(always)]
+fn soften<L: Lane>(
+    held: &Held<'_, L>,
+    (a, b): (&BodyLanes<L>, &BodyLanes<L>),
+    measured: &Rows<L>,
+    start: usize,
+    (diagonal, rhs): (&mut [L; PACKED], &mut [L; MAX]),
+) {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    let soft = held.geometry.softness;
+    for (l, k) in (held.kind.first_limit()..held.kind.count()).enumerate() {
+        let active = held.active[l];
+        let c = measured.c[k];
+        let ja = Vec3::new(measured.ja[k][3], measured.ja[k][4], measured.ja[k][5]);
+        let jb = Vec3::new(measured.jb[k][3], measured.jb[k][4], measured.jb[k][5]);
+        let w = inverse_mass(a, ja) + inverse_mass(b, jb);
+        let quarter = if held.kind.is_sine_row(k) {
+            L::splat(0.25)
+        } else {
+            one
+        };
+        let alpha = soft.alpha_tilde * quarter + soft.spring * w;
+        let lambda = L::select(active, L::load(&held.joint.limit_lambda[l][start..]), zero);
+        let c0 = L::load(&held.joint.limit_start[l][start..]);
+        let damping = L::select(active, soft.gamma * (c - c0), zero);
+        let inv = one / (one + soft.gamma);
+        let damped = (soft.alpha_tilde + soft.spring + soft.gamma).gt(zero) & active;
+        rhs[k] = L::select(damped, (c + alpha * lambda + damping) * inv, rhs[k]);
+        diagonal[at(k, k)] = L::select(damped, -(alpha * inv), diagonal[at(k, k)]);
+    }
+}
+
+/// `j^T I^-1 j` for a world axis `j` (the body's inverse inertia is in its
+/// own frame).
+#[inline(always)]
+fn inverse_mass<L: Lane>(body: &BodyLanes<L>, j: Vec3<L>) -> L {
+    let local = body.q.inverse_rotate(j);
+    local.dot(body.inv_inertia.mul_vec(local))
+}
+
+/// The active set after a solve, for every joint's limit rows, from the
+/// solve's multipliers and its step: a held row whose multiplier would
+/// pull (`lambda + dlambda > 0` for a soft row's accumulated `lambda`, the
+/// solve's `dlambda > 0` for a hard row's: the step moves it toward the
+/// limit) is released; a row not held that the step would carry past its
+/// limit (`c + J_a dx_a + J_b dx_b > 0`, linearised) is held. Returns
+/// whether any lane's set changed (then the tree is factored again with
+/// it; a lane whose set did not change gets the same bits again, so how
+/// many passes its slice takes does not change its result).
+#[inline(always)]
+pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) -> bool {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    let mut changed = zero.gt(zero);
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let NodeKind::Joint {
+            index,
+            rows: kind,
+            a,
+            b,
+        } = node.kind
+        else {
+            continue;
+        };
+        let limits = kind.first_limit();
+        if limits == kind.count() {
+            continue;
+        }
+        let dlambda = load::<L, MAX>(&block.scratch[n].rhs, start);
+        let turn_a = turn_of(block, a, start);
+        let turn_b = turn_of(block, b, start);
+        let joint = &block.joints[index as usize];
+        let soft = joint.soft_lanes::<L>(start);
+        for (l, k) in (limits..kind.count()).enumerate() {
+            let scratch = &block.scratch[n];
+            let record = load::<L, 7>(&scratch.limits[l * 7..l * 7 + 7], start);
+            let ja = Vec3::new(record[1], record[2], record[3]);
+            let jb = Vec3::new(record[4], record[5], record[6]);
+            let predicted = record[0] + ja.dot(turn_a) + jb.dot(turn_b);
+            let held = L::load(&scratch.active[l][start..]).gt(zero);
+            let lambda = L::select(soft, L::load(&joint.limit_lambda[l][start..]), zero);
+            let pulls = (lambda + dlambda[k]).gt(zero);
+            let crosses = predicted.gt(zero) & record[0].gt(L::splat(FREE));
+            let now = held.and_not(pulls) | crosses.and_not(held);
+            changed = changed | (now.and_not(held)) | (held.and_not(now));
+            L::select(now, one, zero).store(&mut block.scratch[n].active[l][start..]);
+        }
+    }
+    let mut lanes = [0.0f32; BLOCK_LANES];
+    L::select(changed, one, zero).store(&mut lanes);
+    lanes[..L::WIDTH].iter().any(|&v| v != 0.0)
+}
+
+/// Body node `n`'s turn from the solve (zero for none: static or
+/// kinematic).
+#[inline(always)]
+fn turn_of<L: Lane>(block: &TreeBlock, n: u32, start: usize) -> Vec3<L> {
+    if n == NONE {
+        return Vec3::zero();
+    }
+    let x = load::<L, MAX>(&block.scratch[n as usize].rhs, start);
+    Vec3::new(x[3], x[4], x[5])
+}
+
+/// Adds each held limit row's multiplier to its joint's substep total
+/// (a soft limit's spring force; zero for a row not held).
+#[inline(always)]
+pub(super) fn accumulate<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
+    if !block.soft {
+        return;
+    }
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let NodeKind::Joint {
+            index, rows: kind, ..
+        } = node.kind
+        else {
+            continue;
+        };
+        let dlambda = load::<L, MAX>(&block.scratch[n].rhs, start);
+        let joint = &mut block.joints[index as usize];
+        for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
+            let total = L::load(&joint.limit_lambda[l][start..]) + dlambda[k];
+            total.store(&mut joint.limit_lambda[l][start..]);
+        }
+    }
+}
+
+/// Each limit row's violation as the substep starts (`C_0`, 0 within the
+/// limit), for a soft limit's damping.
+#[inline(always)]
+pub(super) fn start_limits<L: Lane>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    rows: &BodyRows,
+    start: usize,
+) {
+    let scale = SubstepScale {
+        inv_h: 0.0,
+        inv_h2: 0.0,
+    };
+    for node in &topology.nodes {
+        let NodeKind::Joint {
+            index, rows: kind, ..
+        } = node.kind
+        else {
+            continue;
+        };
+        let joint = &mut block.joints[index as usize];
+        let (a, b) = joint.bodies.gather::<L>(rows, start);
+        let measured = Rows::measure(kind, &a, &b, &joint.geometry(start, scale));
+        for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
+            let violation = measured.c[k].max(L::splat(0.0));
+            violation.store(&mut joint.limit_start[l][start..]);
+        }
     }
 }
 
@@ -335,6 +565,8 @@ pub(super) fn apply<L: Lane>(
 
 /// Every joint's rows count is 5 or 6 (the sizes above).
 const _: () = {
-    assert!(JointRows::Socket.count() == 5 && JointRows::Rod.count() == 5);
+    use super::rows::SwingRows::{Cone, Ellipse, Pyramid};
+    assert!(JointRows::Socket(Cone).count() == 5 && JointRows::Socket(Ellipse).count() == 5);
+    assert!(JointRows::Rod.count() == 5 && JointRows::Socket(Pyramid).count() == 6);
     assert!(JointRows::Hinge.count() == 6 && JointRows::Fixed.count() == 6);
 };

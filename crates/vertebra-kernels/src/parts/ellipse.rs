@@ -95,16 +95,50 @@ pub fn violation<L: Lane>(dir: &Direction<L>, semi_y: L, semi_z: L) -> (Vec3<L>,
     let (ey, ez) = (p[0] - q[0], p[1] - q[1]);
     let c = (ey * ey + ez * ez).sqrt();
     let (ey, ez) = (safe_ratio(ey, c), safe_ratio(ez, c));
+    let n = plane_axis(dir, k, [ey, ez]);
+    (
+        Vec3::select(active, n, Vec3::zero()),
+        L::select(active, c, zero),
+    )
+}
+
+/// As [`violation`], signed for the direct solve's active set: outside,
+/// the same distance and axis; inside, the first-order distance to the
+/// boundary along the gradient of `s = sqrt((p_y / A)^2 + (p_z / B)^2)`,
+/// `(s - 1) / |grad s|` (negative), about the level set's normal, which
+/// meet the outside's on the boundary. An ellipse with no semi-axis below
+/// 1 (half-angles of pi) never binds: its distance is `free`.
+#[inline(always)]
+pub fn signed<L: Lane>(dir: &Direction<L>, semi_y: L, semi_z: L, free: L) -> (Vec3<L>, L) {
+    let one = L::splat(1.0);
+    let (outside_axis, outside) = violation(dir, semi_y, semi_z);
+    let (p, k) = sines(dir);
+    let (u, v) = (p[0] / semi_y, p[1] / semi_z);
+    let s = (u * u + v * v).sqrt();
+    let (gy, gz) = (safe_ratio(u, s * semi_y), safe_ratio(v, s * semi_z));
+    let norm = (gy * gy + gz * gz).sqrt();
+    let inside = safe_ratio(s - one, norm);
+    let inside_axis = plane_axis(dir, k, [safe_ratio(gy, norm), safe_ratio(gz, norm)]);
+    let beyond = s.gt(one);
+    let bounded = semi_y.min(semi_z).lt(one);
+    (
+        Vec3::select(beyond, outside_axis, inside_axis),
+        L::select(bounded, L::select(beyond, outside, inside), free),
+    )
+}
+
+/// The rotation axis (a's body frame) along which a unit direction
+/// `e = (e_y, e_z)` of the swing-sine plane grows (the module
+/// documentation's `g`, through `swing_direction`).
+#[inline(always)]
+fn plane_axis<L: Lane>(dir: &Direction<L>, k: L, [ey, ez]: [L; 2]) -> Vec3<L> {
+    let zero = L::splat(0.0);
     let inv_k = safe_ratio(L::splat(1.0), k);
     let inv_k3 = inv_k * inv_k * inv_k;
     let d = dir.d;
     let g = Vec3::new(ey * d.z * inv_k3, zero, -(ey * inv_k))
         + Vec3::new(-(ez * d.y * inv_k3), ez * inv_k, zero);
-    let n = swing_direction::axis(dir, g);
-    (
-        Vec3::select(active, n, Vec3::zero()),
-        L::select(active, c, zero),
-    )
+    swing_direction::axis(dir, g)
 }
 
 /// The angle (rad) from b's twist axis to the nearest allowed one in the

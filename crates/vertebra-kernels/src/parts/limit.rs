@@ -57,6 +57,17 @@ pub struct Softness<L> {
 }
 
 impl<L: Lane> Softness<L> {
+    /// A hard limit: all zero.
+    #[inline(always)]
+    pub fn hard() -> Self {
+        let zero = L::splat(0.0);
+        Self {
+            alpha_tilde: zero,
+            spring: zero,
+            gamma: zero,
+        }
+    }
+
     /// From per-lane `compliance` (rad / (N m)), `period2` (s^2) and
     /// `damping_time` (s), with `1 / h` and `1 / h^2`.
     #[inline(always)]

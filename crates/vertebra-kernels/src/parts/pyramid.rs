@@ -49,6 +49,37 @@ pub fn violations<L: Lane>(dir: &Direction<L>, y: [L; 2], z: [L; 2]) -> [(Vec3<L
     ]
 }
 
+/// As [`violations`], signed for the direct solve's active set: each
+/// angle's distance past the nearer bounded end of its range (negative
+/// inside, `free` for a range with no bounded end; `twist::signed`) and
+/// the axis along which it grows (a's body frame).
+#[inline(always)]
+pub fn signed<L: Lane>(dir: &Direction<L>, y: [L; 2], z: [L; 2], free: L) -> [(Vec3<L>, L); 2] {
+    let (zero, two) = (L::splat(0.0), L::splat(2.0));
+    let d = dir.d;
+    let base = L::splat(1.0) + d.x;
+    let (theta_y, theta_z) = angles(dir);
+    let gy = Vec3::new(d.z, zero, -base).scale(safe_ratio(two, d.z * d.z + base * base));
+    let gz = Vec3::new(-d.y, base, zero).scale(safe_ratio(two, d.y * d.y + base * base));
+    [
+        signed_axis(dir, theta_y, y, gy, free),
+        signed_axis(dir, theta_z, z, gz, free),
+    ]
+}
+
+/// The signed distance and axis for one angle of gradient `g`.
+#[inline(always)]
+fn signed_axis<L: Lane>(
+    dir: &Direction<L>,
+    theta: L,
+    range: [L; 2],
+    g: Vec3<L>,
+    free: L,
+) -> (Vec3<L>, L) {
+    let (c, sign) = super::twist::signed(theta, range[0], range[1], free);
+    (swing_direction::axis(dir, g).scale(sign), c)
+}
+
 /// `|e|` and `sign(e) n` for one angle of gradient `g`.
 #[inline(always)]
 fn excess_axis<L: Lane>(dir: &Direction<L>, theta: L, range: [L; 2], g: Vec3<L>) -> (Vec3<L>, L) {

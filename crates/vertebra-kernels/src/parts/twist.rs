@@ -56,6 +56,25 @@ pub fn excess<L: Lane>(phi: L, lo: L, hi: L) -> L {
     phi - phi.max(lo).min(hi)
 }
 
+/// The signed distance (rad) of `phi` past the nearer bounded end of
+/// `[lo, hi]`, and the sign of the axis along which it grows: positive
+/// beyond the range, negative inside it (how far the end is), so that a
+/// linearisation predicts where a step would cross it (the direct solve's
+/// active set, `direct::rows`). An end at pi or beyond (-pi or beyond for
+/// `lo`) is no end: with neither bounded the distance is `free`, far
+/// inside, and never crossed.
+#[inline(always)]
+pub fn signed<L: Lane>(phi: L, lo: L, hi: L, free: L) -> (L, L) {
+    let pi = L::splat(core::f32::consts::PI);
+    let above = L::select(hi.ge(pi), free, phi - hi);
+    let below = L::select(lo.le(-pi), free, lo - phi);
+    let upper = above.ge(below);
+    (
+        above.max(below),
+        L::select(upper, L::splat(1.0), L::splat(-1.0)),
+    )
+}
+
 /// Enforces the range; returns the |excess| before the correction (rad).
 /// Measured and corrected in the bodies' own frames
 /// ([`violation_local`], [`super::angle::correct_local`]).
