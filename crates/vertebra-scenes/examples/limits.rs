@@ -2,9 +2,10 @@
 //! and which only fail to hold their axes (issue 15; docs/joints.md, "The
 //! anatomical drop").
 //!
-//! `cargo run --release -p vertebra-scenes --example limits -- SPINE S I SEED [JOINTS]`
+//! `cargo run --release -p vertebra-scenes --example limits -- SPINE S I SEED [JOINTS [SCENE]]`
 //! (`SPINE` is `rod` or `sockets`; `JOINTS` is `iterative`, the default, or
-//! `direct`) runs the 600-frame anatomical drop at S
+//! `direct`; `SCENE` is `anatomical`, the default, or `reference`, the
+//! reference humanoid's drop) runs the 600-frame drop at S
 //! substeps x I iterations from SEED and prints, per joint name (over all
 //! 30 ragdolls; `rod` for the rod), the largest limit violation and the
 //! largest angular error (the held rotations too), in degrees, each with
@@ -25,14 +26,17 @@ fn main() {
         "rod" => SpineMode::Rod,
         _ => SpineMode::Sockets,
     };
-    let mut config = SceneConfig::new(Scene::AnatomicalDrop, spine);
+    let (scene_kind, desc) = match args.get(5).map(String::as_str) {
+        Some("reference") => (Scene::RagdollDrop, RagdollDesc::reference_humanoid()),
+        _ => (Scene::AnatomicalDrop, RagdollDesc::anatomical_humanoid()),
+    };
+    let mut config = SceneConfig::new(scene_kind, spine);
     (config.substeps, config.iterations) = (number(1) as u32, number(2) as u32);
     config.seed = number(3);
     if args.get(4).map(String::as_str) == Some("direct") {
         config.joints = vertebra_world::JointSolver::Direct;
     }
     let mut scene = build(&config).expect("the scene builds");
-    let desc = RagdollDesc::anatomical_humanoid();
     let (mut joints, mut rods) = (HashMap::new(), HashMap::new());
     for (r, ragdoll) in scene.ragdolls.iter().enumerate() {
         for (j, joint) in ragdoll.joints.iter().enumerate() {
@@ -49,7 +53,7 @@ fn main() {
     let dt = 1.0 / 60.0;
     for frame in 0..600 {
         scene
-            .advance(Scene::AnatomicalDrop, frame, dt)
+            .advance(scene_kind, frame, dt)
             .expect("a frame");
         let r = scene
             .world
