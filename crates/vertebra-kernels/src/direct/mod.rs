@@ -41,7 +41,7 @@ use vertebra_math::{Lane, LaneKernel};
 use crate::body::{BodyPairs, BodyRows};
 use crate::limited::{LimitLane, SoftnessBlock};
 use ldl::{MAX, PACKED};
-use rows::{Geometry, MAX_LIMITS};
+use rows::{Geometry, LIMIT_RECORD, MAX_LIMITS};
 pub use rows::{JointRows, SwingRows};
 
 /// No node: the root's parent, or a joint's side on a static or kinematic
@@ -448,10 +448,10 @@ pub struct NodeScratch {
     /// node or of its parent) against the body's six unknowns, row by row.
     pub coupling: [[f32; BLOCK_LANES]; MAX * 6],
     /// A joint's limit rows as measured (held or not): each row's signed
-    /// distance past its limit and its angular Jacobians on a and b
-    /// (`c, J_a, J_b`: seven values a row), which predict where the
-    /// solve's step takes it.
-    pub limits: [[f32; BLOCK_LANES]; MAX_LIMITS * 7],
+    /// distance past its limit, its angular Jacobians on a and b and its
+    /// generalised inverse mass (`c, J_a, J_b, w`: eight values a row),
+    /// which predict where the solve's step takes it.
+    pub limits: [[f32; BLOCK_LANES]; MAX_LIMITS * LIMIT_RECORD],
     /// A joint's limit rows held in this solve (1) or not (0): the active
     /// set.
     pub active: [[f32; BLOCK_LANES]; MAX_LIMITS],
@@ -463,7 +463,7 @@ impl NodeScratch {
         diagonal: [[0.0; BLOCK_LANES]; PACKED],
         rhs: [[0.0; BLOCK_LANES]; MAX],
         coupling: [[0.0; BLOCK_LANES]; MAX * 6],
-        limits: [[0.0; BLOCK_LANES]; MAX_LIMITS * 7],
+        limits: [[0.0; BLOCK_LANES]; MAX_LIMITS * LIMIT_RECORD],
         active: [[0.0; BLOCK_LANES]; MAX_LIMITS],
     };
 }
@@ -478,6 +478,10 @@ pub struct TreeBlock {
     /// Some lane has a soft limit (its rows then carry compliance and
     /// damping, and [`StartPass`] measures their start).
     pub soft: bool,
+    /// The next solve chooses its limits' active set afresh (the limits
+    /// violated then), as the first of a substep does ([`StartPass`] sets
+    /// it); a later one starts from the set the solve before settled on.
+    pub fresh: bool,
     /// The bodies, in the topology's body order.
     pub bodies: Vec<BodyNode>,
     /// The joints, in the topology's joint order.
@@ -493,6 +497,7 @@ impl TreeBlock {
             topology,
             padding: (1 << BLOCK_LANES) - 1,
             soft: false,
+            fresh: true,
             bodies: vec![BodyNode::padding(); shape.bodies],
             joints: vec![JointNode::padding(); shape.joints],
             scratch: vec![NodeScratch::ZERO; shape.nodes.len()],
@@ -525,6 +530,7 @@ impl LaneKernel for PositionPass<'_> {
                 scale: self.scale,
             };
             for_live_slices::<L, _>(padding, &mut slices);
+            block.fresh = false;
         }
     }
 }
@@ -545,7 +551,7 @@ impl LaneSlices for Slices<'_> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
         let (topology, rows, scale) = (self.topology, self.rows, self.scale);
-        let mut first = true;
+        let mut first = self.block.fresh;
         for pass in 1..=MAX_PASSES {
             solve::assemble::<L>(self.block, topology, rows, start, scale, first);
             solve::eliminate::<L>(self.block, topology, start);
@@ -561,7 +567,8 @@ impl LaneSlices for Slices<'_> {
 }
 
 /// The trees' substep start, before the bodies are predicted: every limit
-/// row's multiplier reset, and a soft block's violations measured (the
+/// row's multiplier reset, the next solve's active set chosen afresh, and
+/// a soft block's violations measured (the
 /// damping's `C_0`, as `crate::limited::StartPass` measures the parts').
 pub struct StartPass<'a> {
     /// The blocks.
@@ -577,6 +584,7 @@ impl LaneKernel for StartPass<'_> {
     #[inline(always)]
     fn run<L: Lane>(self) {
         for block in self.blocks.iter_mut() {
+            block.fresh = true;
             for joint in block.joints.iter_mut() {
                 joint.limit_lambda = [[0.0; BLOCK_LANES]; MAX_LIMITS];
             }

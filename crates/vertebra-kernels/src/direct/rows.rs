@@ -96,6 +96,10 @@ impl JointRows {
 /// its twist).
 pub const MAX_LIMITS: usize = 3;
 
+/// Values the solve records of each limit row (`super::NodeScratch::limits`):
+/// `c`, the angular `J_a` and `J_b`, and `w`.
+pub const LIMIT_RECORD: usize = 8;
+
 /// A joint's rows: errors and both bodies' Jacobians (`[linear,
 /// angular]`, world).
 #[derive(Clone, Copy, Debug)]

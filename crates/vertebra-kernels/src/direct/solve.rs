@@ -11,7 +11,7 @@ use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Lane, Mask, Sym3, Vec3};
 
 use super::ldl::{self, MAX, PACKED, at};
-use super::rows::{FREE, Geometry, JointRows, MAX_LIMITS, Rows};
+use super::rows::{FREE, Geometry, JointRows, LIMIT_RECORD as RECORD, MAX_LIMITS, Rows};
 use super::{JointNode, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
 use crate::body::{BodyLanes, BodyRows};
 
@@ -88,7 +88,13 @@ pub(super) fn assemble<L: Lane>(
                 let geometry = joint.geometry(start, scale);
                 let mut measured = Rows::measure(kind, &body_a, &body_b, &geometry);
                 let count = kind.count();
-                let limits = hold_limits(&mut block.scratch[n], kind, &mut measured, start, first);
+                let (limits, weights) = hold_limits(
+                    &mut block.scratch[n],
+                    (kind, &mut measured),
+                    (&body_a, &body_b),
+                    start,
+                    first,
+                );
                 rhs[..count].copy_from_slice(&measured.c[..count]);
                 if soft {
                     let held = Held {
@@ -96,14 +102,9 @@ pub(super) fn assemble<L: Lane>(
                         kind,
                         geometry: &geometry,
                         active: limits,
+                        weights,
                     };
-                    soften(
-                        &held,
-                        (&body_a, &body_b),
-                        &measured,
-                        start,
-                        (&mut diagonal, &mut rhs),
-                    );
+                    soften(&held, &measured, start, (&mut diagonal, &mut rhs));
                 }
                 // The coupling to body `side` sits with whichever of the two
                 // is the other's child.
@@ -134,27 +135,37 @@ pub(super) fn assemble<L: Lane>(
     }
 }
 
-/// Records a joint's limit rows as measured (for [`settle`]), chooses
-/// which are held (`first`: those violated now, else the active set
-/// [`settle`] left) and zeroes the others; returns the held mask per limit
-/// row.
+/// Records a joint's limit rows as measured (for [`settle`]: each row's
+/// signed distance, its angular Jacobians and its generalised inverse
+/// mass `w = j_a^T I_a^-1 j_a + j_b^T I_b^-1 j_b`), chooses which are held
+/// (`first`: those violated now, else the active set [`settle`] left) and
+/// zeroes the others; returns the held mask and `w` per limit row.
 #[inline(always)]
 fn hold_limits<L: Lane>(
     scratch: &mut super::NodeScratch,
-    kind: JointRows,
-    measured: &mut Rows<L>,
+    (kind, measured): (JointRows, &mut Rows<L>),
+    (a, b): (&BodyLanes<L>, &BodyLanes<L>),
     start: usize,
     first: bool,
-) -> [L::Mask; MAX_LIMITS] {
+) -> ([L::Mask; MAX_LIMITS], [L; MAX_LIMITS]) {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
     let mut held = [zero.gt(zero); MAX_LIMITS];
+    let mut weights = [zero; MAX_LIMITS];
     for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
         let c = measured.c[k];
-        let mut record = [zero; 7];
+        let mut record = [zero; RECORD];
         record[0] = c;
         record[1..4].copy_from_slice(&measured.ja[k][3..6]);
         record[4..7].copy_from_slice(&measured.jb[k][3..6]);
-        store(&record, &mut scratch.limits[l * 7..l * 7 + 7], start);
+        let ja = Vec3::new(record[1], record[2], record[3]);
+        let jb = Vec3::new(record[4], record[5], record[6]);
+        weights[l] = inverse_mass(a, ja) + inverse_mass(b, jb);
+        record[7] = weights[l];
+        store(
+            &record,
+            &mut scratch.limits[l * RECORD..(l + 1) * RECORD],
+            start,
+        );
         let active = if first {
             c.gt(zero)
         } else {
@@ -168,7 +179,7 @@ fn hold_limits<L: Lane>(
         }
         held[l] = active;
     }
-    held
+    (held, weights)
 }
 
 /// A joint's held limit rows, as [`soften`] reads them.
@@ -177,6 +188,7 @@ struct Held<'a, L: Lane> {
     kind: JointRows,
     geometry: &'a Geometry<L>,
     active: [L::Mask; MAX_LIMITS],
+    weights: [L; MAX_LIMITS],
 }
 
 /// A soft limit's row (`parts::limit`, whose header derives the step):
@@ -189,7 +201,6 @@ struct Held<'a, L: Lane> {
 #[inline(always)]
 fn soften<L: Lane>(
     held: &Held<'_, L>,
-    (a, b): (&BodyLanes<L>, &BodyLanes<L>),
     measured: &Rows<L>,
     start: usize,
     (diagonal, rhs): (&mut [L; PACKED], &mut [L; MAX]),
@@ -198,10 +209,7 @@ fn soften<L: Lane>(
     let soft = held.geometry.softness;
     for (l, k) in (held.kind.first_limit()..held.kind.count()).enumerate() {
         let active = held.active[l];
-        let c = measured.c[k];
-        let ja = Vec3::new(measured.ja[k][3], measured.ja[k][4], measured.ja[k][5]);
-        let jb = Vec3::new(measured.jb[k][3], measured.jb[k][4], measured.jb[k][5]);
-        let w = inverse_mass(a, ja) + inverse_mass(b, jb);
+        let (c, w) = (measured.c[k], held.weights[l]);
         let quarter = if held.kind.is_sine_row(k) {
             L::splat(0.25)
         } else {
@@ -226,12 +234,21 @@ fn inverse_mass<L: Lane>(body: &BodyLanes<L>, j: Vec3<L>) -> L {
     local.dot(body.inv_inertia.mul_vec(local))
 }
 
+/// The active set's hysteresis (rad, or swing sines for an ellipse): how
+/// far past its limit a step must carry a row not held before [`settle`]
+/// holds it, and how far inside a held row's release must let it move
+/// (its multiplier times its `w`) before [`settle`] lets it go. A row on
+/// its boundary to round-off is then neither held nor released pass after
+/// pass (in the drop, without the margin, most solves took the bound on
+/// passes).
+const CROSSING: f32 = 1.0e-4;
+
 /// The active set after a solve, for every joint's limit rows, from the
 /// solve's multipliers and its step: a held row whose multiplier would
-/// pull (`lambda + dlambda > 0` for a soft row's accumulated `lambda`, the
-/// solve's `dlambda > 0` for a hard row's: the step moves it toward the
-/// limit) is released; a row not held that the step would carry past its
-/// limit (`c + J_a dx_a + J_b dx_b > 0`, linearised) is held. Returns
+/// pull by more than the hysteresis (`w (lambda + dlambda) > CROSSING`
+/// for a soft row's accumulated `lambda`, `w dlambda` for a hard row's:
+/// the step moves it toward the limit) is released; a row not held that the step would carry past its
+/// limit (`c + J_a dx_a + J_b dx_b > CROSSING`, linearised) is held. Returns
 /// whether any lane's set changed (then the tree is factored again with
 /// it; a lane whose set did not change gets the same bits again, so how
 /// many passes its slice takes does not change its result).
@@ -260,14 +277,14 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
         let soft = joint.soft_lanes::<L>(start);
         for (l, k) in (limits..kind.count()).enumerate() {
             let scratch = &block.scratch[n];
-            let record = load::<L, 7>(&scratch.limits[l * 7..l * 7 + 7], start);
+            let record = load::<L, RECORD>(&scratch.limits[l * RECORD..(l + 1) * RECORD], start);
             let ja = Vec3::new(record[1], record[2], record[3]);
             let jb = Vec3::new(record[4], record[5], record[6]);
             let predicted = record[0] + ja.dot(turn_a) + jb.dot(turn_b);
             let held = L::load(&scratch.active[l][start..]).gt(zero);
             let lambda = L::select(soft, L::load(&joint.limit_lambda[l][start..]), zero);
-            let pulls = (lambda + dlambda[k]).gt(zero);
-            let crosses = predicted.gt(zero) & record[0].gt(L::splat(FREE));
+            let pulls = ((lambda + dlambda[k]) * record[7]).gt(L::splat(CROSSING));
+            let crosses = predicted.gt(L::splat(CROSSING)) & record[0].gt(L::splat(FREE));
             let now = held.and_not(pulls) | crosses.and_not(held);
             changed = changed | (now.and_not(held)) | (held.and_not(now));
             L::select(now, one, zero).store(&mut block.scratch[n].active[l][start..]);
