@@ -431,6 +431,7 @@ fn run(
             inv_h: inv_h2.sqrt(),
             inv_h2,
         },
+        passes: direct::MAX_PASSES,
     });
     (0..rows.pose.len())
         .flat_map(|i| rows.pose[i].get())

@@ -462,9 +462,13 @@ trait Pass: Sync {
 }
 
 /// The position iteration.
+#[derive(Clone, Copy)]
 struct Positions {
     inv_h: f32,
     inv_h2: f32,
+    /// How many times a tree solve may factor its tree
+    /// (`direct::PositionPass::passes`).
+    passes: usize,
 }
 
 impl Pass for Positions {
@@ -552,6 +556,7 @@ impl Pass for Positions {
                 topologies,
                 rows,
                 scale,
+                passes: self.passes,
             });
         }
     }
@@ -761,16 +766,24 @@ impl Substep<'_> {
         let h = self.h;
         let bodies = &self.bodies;
         self.body_pass(cursor, |c, rows| predict(c, bodies, rows, h));
+        // An iteration's tree solve factors each tree once; the closing
+        // solves settle the limits' active set (docs/direct.md, "The
+        // limits").
         let positions = Positions {
             inv_h: 1.0 / h,
             inv_h2: 1.0 / (h * h),
+            passes: 1,
+        };
+        let closing = Positions {
+            passes: direct::MAX_PASSES,
+            ..positions
         };
         for _ in 0..self.iterations {
             self.for_each_colour(cursor, 0, &positions);
         }
         if let Some(joints) = self.joint_bins.first() {
             for _ in 0..CLOSING_SOLVES {
-                self.trees_stage(cursor, joints, &positions);
+                self.trees_stage(cursor, joints, &closing);
             }
         }
         self.bins_stage(cursor, |bin| {
@@ -778,7 +791,7 @@ impl Substep<'_> {
                 self.solve_bin(bin, &positions);
             }
             for _ in 0..CLOSING_SOLVES {
-                self.solve_bin_trees(bin, &positions);
+                self.solve_bin_trees(bin, &closing);
             }
         });
         self.body_pass(cursor, |c, rows| derive_velocities(c, bodies, rows, h));

@@ -515,6 +515,11 @@ pub struct PositionPass<'a> {
     pub rows: &'a BodyRows,
     /// The substep's time scale (the soft limits').
     pub scale: SubstepScale,
+    /// How many times a solve may factor a tree, its active set settled
+    /// between (at least once; [`MAX_PASSES`] for a closing solve). The
+    /// set a solve leaves is where the next starts from, whatever the
+    /// bound.
+    pub passes: usize,
 }
 
 impl LaneKernel for PositionPass<'_> {
@@ -528,6 +533,7 @@ impl LaneKernel for PositionPass<'_> {
                 block,
                 rows: self.rows,
                 scale: self.scale,
+                passes: self.passes,
             };
             for_live_slices::<L, _>(padding, &mut slices);
             block.fresh = false;
@@ -535,8 +541,8 @@ impl LaneKernel for PositionPass<'_> {
     }
 }
 
-/// How many times one solve may factor its tree with a changed active set
-/// (`solve::settle`): the first, then up to this many less one.
+/// How many times a closing solve may factor its tree with a changed
+/// active set (`solve::settle`): the first, then up to this many less one.
 pub const MAX_PASSES: usize = 4;
 
 /// One block of a [`PositionPass`].
@@ -545,6 +551,7 @@ struct Slices<'a> {
     block: &'a mut TreeBlock,
     rows: &'a BodyRows,
     scale: SubstepScale,
+    passes: usize,
 }
 
 impl LaneSlices for Slices<'_> {
@@ -552,12 +559,12 @@ impl LaneSlices for Slices<'_> {
     fn slice<L: Lane>(&mut self, start: usize) {
         let (topology, rows, scale) = (self.topology, self.rows, self.scale);
         let mut first = self.block.fresh;
-        for pass in 1..=MAX_PASSES {
+        for pass in 1..=self.passes.max(1) {
             solve::assemble::<L>(self.block, topology, rows, start, scale, first);
             solve::eliminate::<L>(self.block, topology, start);
             solve::substitute::<L>(self.block, topology, start);
             first = false;
-            if !solve::settle::<L>(self.block, topology, start) || pass == MAX_PASSES {
+            if !solve::settle::<L>(self.block, topology, start) || pass >= self.passes {
                 break;
             }
         }
