@@ -292,7 +292,11 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
     }
     let mut lanes = [0.0f32; BLOCK_LANES];
     L::select(changed, one, zero).store(&mut lanes);
-    lanes[..L::WIDTH].iter().any(|&v| v != 0.0)
+    let mut any = false;
+    for lane in &lanes[..L::WIDTH] {
+        any |= *lane != 0.0;
+    }
+    any
 }
 
 /// Body node `n`'s turn from the solve (zero for none: static or
