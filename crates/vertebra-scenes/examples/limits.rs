@@ -52,9 +52,7 @@ fn main() {
     let mut peaks: BTreeMap<&str, (Peak, Peak)> = BTreeMap::new();
     let dt = 1.0 / 60.0;
     for frame in 0..600 {
-        scene
-            .advance(scene_kind, frame, dt)
-            .expect("a frame");
+        scene.advance(scene_kind, frame, dt).expect("a frame");
         let r = scene
             .world
             .residuals()
