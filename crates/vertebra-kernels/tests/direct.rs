@@ -1886,7 +1886,6 @@ fn twist_and_hinge_range_rows_are_the_twist_past_the_nearer_end_and_its_gradient
 /// the twist and one pass leaves a first-order twist error. Not fixed
 /// here: it changes the direct golden hashes.
 #[test]
-#[ignore = "the socket's twist row is not its gradient under a swing (off by tan(theta / 2))"]
 fn twist_row_is_its_gradient_under_a_swing() {
     let mut r = StdRng::seed_from_u64(46);
     for _ in 0..200 {
@@ -2719,7 +2718,6 @@ fn a_soft_limit_takes_back_the_xpbd_fraction_of_its_violation() {
 /// the violation: first order (measured up to 16% at 0.4 rad, 34% at
 /// 0.8, 55% at 1.2).
 #[test]
-#[ignore = "the socket's twist row is not its gradient under a swing: one pass leaves up to 55% of the twist"]
 fn one_pass_brings_a_swung_sockets_twist_back_to_its_range() {
     for theta in [0.0f32, 0.4, 0.8, 1.2] {
         for seed in 0..100 {
