@@ -575,3 +575,21 @@ pub fn single_ragdoll_solved(
     }
     scene
 }
+
+/// `scene` (the ragdoll drop, [`Scene::RagdollDrop`], or its anatomical
+/// twin, [`Scene::AnatomicalDrop`]) with 30 ragdolls (their default), its
+/// joints solved directly ([`JointSolver::Direct`]) at 1 substep x 4
+/// iterations on one thread on `backend`, its residuals not measured, one
+/// second (60 frames) in: falling and landing, many contacts.
+pub fn direct_drop_scene(scene: Scene, spine: SpineMode, backend: BackendChoice) -> SceneWorld {
+    let mut config = SceneConfig::new(scene, spine);
+    (config.substeps, config.iterations) = (1, 4);
+    (config.ragdolls, config.threads, config.backend) = (30, 1, backend);
+    config.joints = JointSolver::Direct;
+    config.measure_residuals = false;
+    let mut world = build(&config).expect("the drop scene");
+    for frame in 0..60 {
+        world.advance(config.scene, frame, DT).expect("a frame");
+    }
+    world
+}

@@ -1,15 +1,21 @@
 //! Time per step of the ragdoll drop for 1, 30 and 300 ragdolls, standard
 //! (socket spine) and simplified (rod spine), at 20 iterations, one second
 //! in; collision detection and the solver step timed apart, so `frame` =
-//! `detect` + `step`. Then the step at 1 and 2 threads.
+//! `detect` + `step`. Then the step at 1 and 2 threads. Then (`direct_step`)
+//! the step alone with the joints solved directly at 1 substep x 4
+//! iterations, residuals not measured, one thread, one second in: the
+//! 30-ragdoll drop on the reference humanoid and on the anatomical one,
+//! each with both spines.
 //! `cargo bench -p vertebra-benches --bench step`
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use vertebra_benches::{DT, drop_scene};
+use vertebra_benches::{DT, direct_drop_scene, drop_scene};
 use vertebra_ragdoll::SpineMode;
+use vertebra_scenes::Scene;
+use vertebra_world::BackendChoice;
 
 const SPINES: [(&str, SpineMode); 2] = [
     ("simplified", SpineMode::Rod),
@@ -65,5 +71,22 @@ fn threads(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, per_step, threads);
+fn direct(c: &mut Criterion) {
+    let mut group = c.benchmark_group("direct_step");
+    group.sample_size(20);
+    for (scene_name, scene) in [
+        ("reference", Scene::RagdollDrop),
+        ("anatomical", Scene::AnatomicalDrop),
+    ] {
+        for (spine_name, spine) in [("rod", SpineMode::Rod), ("sockets", SpineMode::Sockets)] {
+            let mut world = direct_drop_scene(scene, spine, BackendChoice::Auto);
+            group.bench_function(format!("{scene_name}_{spine_name}_1x4"), |b| {
+                b.iter_custom(|iters| frames(&mut world, iters, true))
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, per_step, threads, direct);
 criterion_main!(benches);

@@ -1,7 +1,12 @@
 //! Instructions per step (callgrind) of the 30-ragdoll drop one second in,
 //! per spine and backend: the solver step alone, its contacts found before
-//! the measured call. Needs valgrind and `iai-callgrind-runner` 0.16.1
+//! the measured call. Then (`direct_1x4`) the same with the joints solved
+//! directly at 1 substep x 4 iterations, residuals not measured, on avx2:
+//! the 30-ragdoll drop on the reference humanoid and on the anatomical one,
+//! each with both spines. Needs valgrind and `iai-callgrind-runner` 0.16.1
 //! (`./benches/install-iai-runner.sh`).
+//! `cargo bench -p vertebra-benches --bench step_instructions` (`-- direct`
+//! for the direct group alone)
 
 // The iai-callgrind macros generate undocumented modules and items.
 #![allow(missing_docs)]
@@ -9,9 +14,10 @@
 use std::hint::black_box;
 
 use iai_callgrind::{library_benchmark, library_benchmark_group, main};
-use vertebra_benches::{DT, INSTRUCTION_BACKENDS, drop_scene_on};
+use vertebra_benches::{DT, INSTRUCTION_BACKENDS, direct_drop_scene, drop_scene_on};
 use vertebra_ragdoll::SpineMode;
-use vertebra_scenes::SceneWorld;
+use vertebra_scenes::{Scene, SceneWorld};
+use vertebra_world::BackendChoice;
 
 fn prepared(scene: SceneWorld) -> SceneWorld {
     let mut scene = scene;
@@ -54,5 +60,61 @@ fn step_standard(mut scene: SceneWorld) -> Option<f32> {
     black_box(scene.world.residuals().map(|r| r.eps_lin_cm))
 }
 
+fn direct(scene: Scene, spine: SpineMode, backend: usize) -> SceneWorld {
+    let backend = BackendChoice::Forced(INSTRUCTION_BACKENDS[backend]);
+    prepared(direct_drop_scene(scene, spine, backend))
+}
+
+fn reference_rod(backend: usize) -> SceneWorld {
+    direct(Scene::RagdollDrop, SpineMode::Rod, backend)
+}
+
+fn reference_sockets(backend: usize) -> SceneWorld {
+    direct(Scene::RagdollDrop, SpineMode::Sockets, backend)
+}
+
+fn anatomical_rod(backend: usize) -> SceneWorld {
+    direct(Scene::AnatomicalDrop, SpineMode::Rod, backend)
+}
+
+fn anatomical_sockets(backend: usize) -> SceneWorld {
+    direct(Scene::AnatomicalDrop, SpineMode::Sockets, backend)
+}
+
+// The drops with their joints solved directly at 1x4, on avx2 only (3); the
+// scene is returned so that its drop is not counted.
+#[library_benchmark]
+#[benches::backend(args = [3], setup = reference_rod)]
+fn direct_reference_rod_1x4(mut scene: SceneWorld) -> SceneWorld {
+    scene.world.step(DT).expect("a step");
+    black_box(scene)
+}
+
+#[library_benchmark]
+#[benches::backend(args = [3], setup = reference_sockets)]
+fn direct_reference_sockets_1x4(mut scene: SceneWorld) -> SceneWorld {
+    scene.world.step(DT).expect("a step");
+    black_box(scene)
+}
+
+#[library_benchmark]
+#[benches::backend(args = [3], setup = anatomical_rod)]
+fn direct_anatomical_rod_1x4(mut scene: SceneWorld) -> SceneWorld {
+    scene.world.step(DT).expect("a step");
+    black_box(scene)
+}
+
+#[library_benchmark]
+#[benches::backend(args = [3], setup = anatomical_sockets)]
+fn direct_anatomical_sockets_1x4(mut scene: SceneWorld) -> SceneWorld {
+    scene.world.step(DT).expect("a step");
+    black_box(scene)
+}
+
 library_benchmark_group!(name = drop_30; benchmarks = step_simplified, step_standard);
-main!(library_benchmark_groups = drop_30);
+library_benchmark_group!(
+    name = direct_1x4;
+    benchmarks = direct_reference_rod_1x4, direct_reference_sockets_1x4,
+        direct_anatomical_rod_1x4, direct_anatomical_sockets_1x4
+);
+main!(library_benchmark_groups = drop_30, direct_1x4);
