@@ -116,8 +116,8 @@ fn anatomical_drop_direct() {
 // them: its elliptical sockets, hinges and rod through both solves.
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
-const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x2a02_6cee_6d92_1348;
-const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x34ba_9c8a_7994_6333;
+const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0xec65_e3d1_f8d4_bd3f;
+const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x855d_a1c6_fc07_5c99;
 
 // The direct solve's (issue 18), set by the commit that introduced them;
 // all four moved by issue 30's limits: every limit row in the solve with
@@ -126,11 +126,16 @@ const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x34ba_9c8a_7994_6333;
 // limits iterated as well before). They were 0x2d9f_e5a8_b349_f6a8
 // (bending, sockets), 0xcead_d528_664e_36fc (bending, rod),
 // 0x051a_b093_7a68_03cf (drop, sockets) and 0x8ca6_8dbe_7040_0965 (drop,
-// rod). The iterated solver's four did not move.
+// rod). The iterated solver's four did not move. Then the two drops' and
+// the anatomical drop's direct ones by the socket's twist row taking its
+// exact gradient (the rod's twist axes): they were 0x65de_b486_3a49_f307
+// (drop, sockets), 0x28a8_4720_0b0e_213e (drop, rod), 0x2a02_6cee_6d92_1348
+// (anatomical, sockets) and 0x34ba_9c8a_7994_6333 (anatomical, rod);
+// passive bending's, whose twists stay in range, did not move.
 const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x1400_152b_eb04_3d1b;
 const GOLDEN_BENDING_ROD_DIRECT: u64 = 0xdd60_df2e_065c_7745;
-const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x65de_b486_3a49_f307;
-const GOLDEN_DROP_ROD_DIRECT: u64 = 0x28a8_4720_0b0e_213e;
+const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x9abf_0858_ac35_d97f;
+const GOLDEN_DROP_ROD_DIRECT: u64 = 0x4010_54ca_4ac9_5921;
 
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision
