@@ -1437,7 +1437,6 @@ fn random_lane(
                     let compliance = log_uniform(r, -6.0, -1.0);
                     common::limit_softness(r, compliance)
                 },
-                ..JointLane::FREE
             },
         );
         node.bodies.set_start(lane, &start);
@@ -2276,9 +2275,9 @@ fn settle_once(tree: &Tree, offsets: &Offsets, row: usize) -> Settled {
     for k in 0..tree.joints.len() {
         let m = scene.measured(&rows, k);
         let c = m.rows().c;
-        for i in 0..m.kind.count() {
+        for (i, &ci) in c.iter().enumerate().take(m.kind.count()) {
             if k == j && i == row {
-                after = c[i] as f64;
+                after = ci as f64;
                 continue;
             }
             let error = m.error(i..i + 1);
