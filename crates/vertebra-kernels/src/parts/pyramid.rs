@@ -33,16 +33,24 @@ pub fn angles<L: Lane>(dir: &Direction<L>) -> (L, L) {
     (two * poly::atan2(-d.z, base), two * poly::atan2(d.y, base))
 }
 
-/// The violations `|e|` (rad) of the ranges `y` and `z` (rad) and their
-/// axes `sign(e) n` (`d|e|/dtheta_b`, world, not unit).
+/// The swing angles about Y and Z (rad) with their gradients `g_y`, `g_z`
+/// (the module documentation's, a's joint frame).
 #[inline(always)]
-pub fn violations<L: Lane>(dir: &Direction<L>, y: [L; 2], z: [L; 2]) -> [(Vec3<L>, L); 2] {
+fn gradients<L: Lane>(dir: &Direction<L>) -> [(L, Vec3<L>); 2] {
     let (zero, two) = (L::splat(0.0), L::splat(2.0));
     let d = dir.d;
     let base = L::splat(1.0) + d.x;
     let (theta_y, theta_z) = angles(dir);
     let gy = Vec3::new(d.z, zero, -base).scale(safe_ratio(two, d.z * d.z + base * base));
     let gz = Vec3::new(-d.y, base, zero).scale(safe_ratio(two, d.y * d.y + base * base));
+    [(theta_y, gy), (theta_z, gz)]
+}
+
+/// The violations `|e|` (rad) of the ranges `y` and `z` (rad) and their
+/// axes `sign(e) n` (`d|e|/dtheta_b`, world, not unit).
+#[inline(always)]
+pub fn violations<L: Lane>(dir: &Direction<L>, y: [L; 2], z: [L; 2]) -> [(Vec3<L>, L); 2] {
+    let [(theta_y, gy), (theta_z, gz)] = gradients(dir);
     [
         excess_axis(dir, theta_y, y, gy),
         excess_axis(dir, theta_z, z, gz),
@@ -55,12 +63,7 @@ pub fn violations<L: Lane>(dir: &Direction<L>, y: [L; 2], z: [L; 2]) -> [(Vec3<L
 /// the axis along which it grows (a's body frame).
 #[inline(always)]
 pub fn signed<L: Lane>(dir: &Direction<L>, y: [L; 2], z: [L; 2], free: L) -> [(Vec3<L>, L); 2] {
-    let (zero, two) = (L::splat(0.0), L::splat(2.0));
-    let d = dir.d;
-    let base = L::splat(1.0) + d.x;
-    let (theta_y, theta_z) = angles(dir);
-    let gy = Vec3::new(d.z, zero, -base).scale(safe_ratio(two, d.z * d.z + base * base));
-    let gz = Vec3::new(-d.y, base, zero).scale(safe_ratio(two, d.y * d.y + base * base));
+    let [(theta_y, gy), (theta_z, gz)] = gradients(dir);
     [
         signed_axis(dir, theta_y, y, gy, free),
         signed_axis(dir, theta_z, z, gz, free),
