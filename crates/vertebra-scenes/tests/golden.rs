@@ -112,15 +112,15 @@ fn anatomical_drop_direct() {
     check_solved(scene, SpineMode::Rod, direct, GOLDEN_ANATOMICAL_ROD_DIRECT);
 }
 
-// The anatomical drop's (issue 30), set by the commit that introduced
+// The anatomical drop's: its elliptical sockets, hinges and rod; set by the commit that introduced
 // them: its elliptical sockets, hinges and rod through both solves.
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
 const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0xec65_e3d1_f8d4_bd3f;
 const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x855d_a1c6_fc07_5c99;
 
-// The direct solve's (issue 18), set by the commit that introduced them;
-// all four moved by issue 30's limits: every limit row in the solve with
+// The direct solve's, set by the commit that introduced them;
+// all four moved when every limit row joined the solve with
 // its signed distance and an active set settled in the closing solves,
 // and the joint blocks the trees hold iterating only their drives (their
 // limits iterated as well before). They were 0x2d9f_e5a8_b349_f6a8

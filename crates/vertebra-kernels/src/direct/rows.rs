@@ -10,7 +10,7 @@
 //! | fixed lock (3) | `C = log((q_b F_b)(q_a F_a)*)`; `J_b = [0, 1]`, `J_a = [0, -1]` |
 //! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b` (from a's +Y reflected likewise); `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
 //! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, 0]`, `J_a = [-o, 0]` (the paper's "purely through linear motion") |
-//! | limits (socket swing: a cone's or an ellipse's 1, a pyramid's 2; socket twist, hinge range, rod bend and twist: 1 each) | the signed distance past the limit (positive beyond it, negative inside: how far its boundary is), `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative parts turn about; which are held is the solve's active set (`super::solve`), and a row not held is zeroed (dropped) |
+//! | limits (socket swing: a cone's or an ellipse's 1, a pyramid's 2; socket twist, hinge range, rod bend and twist: 1 each) | the signed distance past the limit (positive beyond it, negative inside: how far its boundary is), `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative parts turn about; which are held is the solve's active set (the solve's `settle`), and a row not held is zeroed (dropped) |
 //!
 //! The single angle the iterative parts correct (`hinge_axis`, `curve`)
 //! has no direction where the error is zero: a row along `n` would vanish
@@ -96,7 +96,7 @@ impl JointRows {
 /// its twist).
 pub const MAX_LIMITS: usize = 3;
 
-/// Values the solve records of each limit row (`super::NodeScratch::limits`):
+/// Values the solve records of each limit row (a node scratch's `limits`):
 /// `c`, the angular `J_a` and `J_b`, and `w`.
 pub const LIMIT_RECORD: usize = 8;
 
@@ -196,7 +196,7 @@ impl<L: Lane> Rows<L> {
 
     /// A limit's row: its signed distance `c` past the limit grows as b
     /// turns about `jb` and as a turns against `ja` (world). Which rows
-    /// are held is the solve's active set (`super::solve`).
+    /// are held is the solve's active set (the solve's `settle`).
     #[inline(always)]
     fn limit(&mut self, k: usize, c: L, ja: Vec3<L>, jb: Vec3<L>) {
         self.set(k, c, (Vec3::zero(), jb), ja);
