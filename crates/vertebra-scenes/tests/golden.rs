@@ -112,8 +112,8 @@ fn anatomical_drop_direct() {
     check_solved(scene, SpineMode::Rod, direct, GOLDEN_ANATOMICAL_ROD_DIRECT);
 }
 
-// The anatomical drop's: its elliptical sockets, hinges and rod; set by the commit that introduced
-// them: its elliptical sockets, hinges and rod through both solves.
+// The anatomical drop's, set by the commit that introduced them: its
+// elliptical sockets, hinges and rod through both solves.
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
 const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0xec65_e3d1_f8d4_bd3f;
