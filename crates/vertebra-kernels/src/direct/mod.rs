@@ -436,6 +436,9 @@ pub struct SubstepScale {
     pub inv_h2: f32,
 }
 
+/// Values a node's measured block holds ([`NodeScratch::measured`]).
+pub const MEASURED: usize = 7;
+
 /// A node's working values in each lane, rewritten every iteration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
@@ -444,6 +447,11 @@ pub struct NodeScratch {
     pub diagonal: [[f32; BLOCK_LANES]; PACKED],
     /// The right-hand side, then the node's unknowns.
     pub rhs: [[f32; BLOCK_LANES]; MAX],
+    /// The block as the solve measured it, from which each of its passes
+    /// starts: a body's mass and world inertia (`m, xx, xy, xz, yy, yz,
+    /// zz`), a joint's errors up to its limit rows (theirs are in
+    /// `limits`).
+    pub measured: [[f32; BLOCK_LANES]; MEASURED],
     /// The block coupling it to its parent: the joint's rows (of the
     /// node or of its parent) against the body's six unknowns, row by row.
     pub coupling: [[f32; BLOCK_LANES]; MAX * 6],
@@ -462,6 +470,7 @@ impl NodeScratch {
     pub const ZERO: Self = Self {
         diagonal: [[0.0; BLOCK_LANES]; PACKED],
         rhs: [[0.0; BLOCK_LANES]; MAX],
+        measured: [[0.0; BLOCK_LANES]; MEASURED],
         coupling: [[0.0; BLOCK_LANES]; MAX * 6],
         limits: [[0.0; BLOCK_LANES]; MAX_LIMITS * LIMIT_RECORD],
         active: [[0.0; BLOCK_LANES]; MAX_LIMITS],
@@ -559,8 +568,9 @@ impl LaneSlices for Slices<'_> {
     fn slice<L: Lane>(&mut self, start: usize) {
         let (topology, rows, scale) = (self.topology, self.rows, self.scale);
         let mut first = self.block.fresh;
+        solve::measure::<L>(self.block, topology, rows, start, scale);
         for pass in 1..=self.passes.max(1) {
-            solve::assemble::<L>(self.block, topology, rows, start, scale, first);
+            solve::hold::<L>(self.block, topology, start, scale, first);
             solve::eliminate::<L>(self.block, topology, start);
             solve::substitute::<L>(self.block, topology, start);
             first = false;

@@ -11,9 +11,10 @@ use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Lane, Mask, Sym3, Vec3};
 
 use super::ldl::{self, MAX, PACKED, at};
-use super::rows::{FREE, Geometry, JointRows, LIMIT_RECORD as RECORD, MAX_LIMITS, Rows};
-use super::{JointNode, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
+use super::rows::{FREE, JointRows, LIMIT_RECORD as RECORD, MAX_LIMITS, Rows};
+use super::{JointNode, MEASURED, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
 use crate::body::{BodyLanes, BodyRows};
+use crate::parts::limit::Softness;
 
 /// Loads lane values from scratch arrays.
 #[inline(always)]
@@ -33,25 +34,22 @@ fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
     }
 }
 
-/// Every node's starting block: a body's mass matrix (world), a joint's
-/// zero (hard rows; a soft limit's compliance) with its errors on the
-/// right, and each joint's Jacobians written where the tree couples it to
-/// each body. A limit row is held where the active set says (`first`: the
-/// limits violated now), else zeroed (dropped by the factorisation).
+/// Measures every node's block where the tree stands (bodies do not move
+/// between a solve's passes, so only its first measures): a body's mass
+/// matrix (world) and a joint's errors into `measured`, each joint's
+/// Jacobians where the tree couples it to each body (its limit rows' are
+/// [`hold`]'s), and each limit row's record.
 #[inline(always)]
-pub(super) fn assemble<L: Lane>(
+pub(super) fn measure<L: Lane>(
     block: &mut TreeBlock,
     topology: &Topology,
     rows: &BodyRows,
     start: usize,
     scale: SubstepScale,
-    first: bool,
 ) {
     let zero = L::splat(0.0);
-    let soft = block.soft;
     for (n, node) in topology.nodes.iter().enumerate() {
-        let mut diagonal = [zero; PACKED];
-        let mut rhs = [zero; MAX];
+        let mut measured = [zero; MEASURED];
         match node.kind {
             NodeKind::Body { index } => {
                 let body = &block.bodies[index as usize];
@@ -67,15 +65,9 @@ pub(super) fn assemble<L: Lane>(
                     yz,
                 }
                 .rotated(q);
-                for k in 0..3 {
-                    diagonal[at(k, k)] = mass;
-                }
-                diagonal[at(3, 3)] = inertia.xx;
-                diagonal[at(4, 3)] = inertia.xy;
-                diagonal[at(5, 3)] = inertia.xz;
-                diagonal[at(4, 4)] = inertia.yy;
-                diagonal[at(5, 4)] = inertia.yz;
-                diagonal[at(5, 5)] = inertia.zz;
+                measured = [
+                    mass, inertia.xx, inertia.xy, inertia.xz, inertia.yy, inertia.yz, inertia.zz,
+                ];
             }
             NodeKind::Joint {
                 index,
@@ -86,45 +78,128 @@ pub(super) fn assemble<L: Lane>(
                 let joint = &block.joints[index as usize];
                 let (body_a, body_b) = joint.bodies.gather::<L>(rows, start);
                 let geometry = joint.geometry(start, scale);
-                let mut measured = Rows::measure(kind, &body_a, &body_b, &geometry);
-                let count = kind.count();
-                let (limits, weights) = hold_limits(
+                let rows = Rows::measure(kind, &body_a, &body_b, &geometry);
+                let first = kind.first_limit();
+                measured[..first].copy_from_slice(&rows.c[..first]);
+                record_limits(
                     &mut block.scratch[n],
-                    (kind, &mut measured),
+                    kind,
+                    &rows,
                     (&body_a, &body_b),
                     start,
-                    first,
                 );
-                rhs[..count].copy_from_slice(&measured.c[..count]);
-                if soft {
-                    let held = Held {
-                        joint,
-                        kind,
-                        geometry: &geometry,
-                        active: limits,
-                        weights,
-                    };
-                    soften(&held, &measured, start, (&mut diagonal, &mut rhs));
-                }
-                // The coupling to body `side` sits with whichever of the two
-                // is the other's child.
-                for (side, jacobian) in [(a, &measured.ja), (b, &measured.jb)] {
+                for (side, jacobian) in [(a, &rows.ja), (b, &rows.jb)] {
                     if side == NONE {
                         continue;
                     }
-                    let holder = if node.parent == side {
-                        n
-                    } else {
-                        side as usize
-                    };
                     let mut flat = [zero; MAX * 6];
-                    for (r, row) in jacobian.iter().take(count).enumerate() {
+                    for (r, row) in jacobian.iter().take(first).enumerate() {
                         flat[r * 6..r * 6 + 6].copy_from_slice(row);
                     }
+                    let holder = holder(n, node.parent, side);
                     store(
-                        &flat[..count * 6],
+                        &flat[..first * 6],
                         &mut block.scratch[holder].coupling,
                         start,
+                    );
+                }
+            }
+        }
+        store(&measured, &mut block.scratch[n].measured, start);
+    }
+}
+
+/// Which node holds the coupling of joint node `n` (parent `parent`) to
+/// its body node `side`: whichever of the two is the other's child.
+#[inline(always)]
+fn holder(n: usize, parent: u32, side: u32) -> usize {
+    if parent == side { n } else { side as usize }
+}
+
+/// Records a joint's limit rows as measured (for [`hold`] and [`settle`]:
+/// each row's signed distance, its angular Jacobians and its generalised
+/// inverse mass `w = j_a^T I_a^-1 j_a + j_b^T I_b^-1 j_b`).
+#[inline(always)]
+fn record_limits<L: Lane>(
+    scratch: &mut super::NodeScratch,
+    kind: JointRows,
+    measured: &Rows<L>,
+    (a, b): (&BodyLanes<L>, &BodyLanes<L>),
+    start: usize,
+) {
+    let zero = L::splat(0.0);
+    for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
+        let mut record = [zero; RECORD];
+        record[0] = measured.c[k];
+        record[1..4].copy_from_slice(&measured.ja[k][3..6]);
+        record[4..7].copy_from_slice(&measured.jb[k][3..6]);
+        let ja = Vec3::new(record[1], record[2], record[3]);
+        let jb = Vec3::new(record[4], record[5], record[6]);
+        record[7] = inverse_mass(a, ja) + inverse_mass(b, jb);
+        store(
+            &record,
+            &mut scratch.limits[l * RECORD..(l + 1) * RECORD],
+            start,
+        );
+    }
+}
+
+/// Every node's starting block from what [`measure`] left: a body's mass
+/// matrix, a joint's zero (hard rows; a soft limit's compliance) with its
+/// errors on the right. A limit row is held where the active set says
+/// (`first`: the limits violated now), its Jacobians written where the
+/// tree couples it; else it is zeroed (dropped by the factorisation).
+#[inline(always)]
+pub(super) fn hold<L: Lane>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    start: usize,
+    scale: SubstepScale,
+    first: bool,
+) {
+    let zero = L::splat(0.0);
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let measured = load::<L, MEASURED>(&block.scratch[n].measured, start);
+        let mut diagonal = [zero; PACKED];
+        let mut rhs = [zero; MAX];
+        match node.kind {
+            NodeKind::Body { .. } => {
+                let [mass, xx, xy, xz, yy, yz, zz] = measured;
+                for k in 0..3 {
+                    diagonal[at(k, k)] = mass;
+                }
+                diagonal[at(3, 3)] = xx;
+                diagonal[at(4, 3)] = xy;
+                diagonal[at(5, 3)] = xz;
+                diagonal[at(4, 4)] = yy;
+                diagonal[at(5, 4)] = yz;
+                diagonal[at(5, 5)] = zz;
+            }
+            NodeKind::Joint {
+                index,
+                rows: kind,
+                a,
+                b,
+            } => {
+                let limits = kind.first_limit();
+                rhs[..limits].copy_from_slice(&measured[..limits]);
+                let held = hold_limits::<L>(block, n, (kind, node.parent), (a, b), start, first);
+                for (l, k) in (limits..kind.count()).enumerate() {
+                    rhs[k] = L::select(held.active[l], held.c[l], zero);
+                }
+                if block.soft {
+                    let joint = &block.joints[index as usize];
+                    let softness =
+                        joint
+                            .softness
+                            .lanes(start, L::splat(scale.inv_h), L::splat(scale.inv_h2));
+                    soften(
+                        joint,
+                        kind,
+                        &softness,
+                        &held,
+                        start,
+                        (&mut diagonal, &mut rhs),
                     );
                 }
             }
@@ -135,60 +210,62 @@ pub(super) fn assemble<L: Lane>(
     }
 }
 
-/// Records a joint's limit rows as measured (for [`settle`]: each row's
-/// signed distance, its angular Jacobians and its generalised inverse
-/// mass `w = j_a^T I_a^-1 j_a + j_b^T I_b^-1 j_b`), chooses which are held
-/// (`first`: those violated now, else the active set [`settle`] left) and
-/// zeroes the others; returns the held mask and `w` per limit row.
+/// A joint's limit rows in one solve's pass: which are held, and each
+/// row's measured distance and `w`.
+struct Held<L: Lane> {
+    active: [L::Mask; MAX_LIMITS],
+    c: [L; MAX_LIMITS],
+    weights: [L; MAX_LIMITS],
+}
+
+/// Chooses which of joint node `n`'s limit rows are held (`first`: those
+/// violated now, else the active set [`settle`] left), records the set,
+/// and writes each row's Jacobians where the tree couples it to each body
+/// (zero for a row not held).
 #[inline(always)]
 fn hold_limits<L: Lane>(
-    scratch: &mut super::NodeScratch,
-    (kind, measured): (JointRows, &mut Rows<L>),
-    (a, b): (&BodyLanes<L>, &BodyLanes<L>),
+    block: &mut TreeBlock,
+    n: usize,
+    (kind, parent): (JointRows, u32),
+    (a, b): (u32, u32),
     start: usize,
     first: bool,
-) -> ([L::Mask; MAX_LIMITS], [L; MAX_LIMITS]) {
+) -> Held<L> {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    let mut held = [zero.gt(zero); MAX_LIMITS];
-    let mut weights = [zero; MAX_LIMITS];
+    let mut held = Held {
+        active: [zero.gt(zero); MAX_LIMITS],
+        c: [zero; MAX_LIMITS],
+        weights: [zero; MAX_LIMITS],
+    };
     for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
-        let c = measured.c[k];
-        let mut record = [zero; RECORD];
-        record[0] = c;
-        record[1..4].copy_from_slice(&measured.ja[k][3..6]);
-        record[4..7].copy_from_slice(&measured.jb[k][3..6]);
-        let ja = Vec3::new(record[1], record[2], record[3]);
-        let jb = Vec3::new(record[4], record[5], record[6]);
-        weights[l] = inverse_mass(a, ja) + inverse_mass(b, jb);
-        record[7] = weights[l];
-        store(
-            &record,
-            &mut scratch.limits[l * RECORD..(l + 1) * RECORD],
-            start,
-        );
+        let scratch = &mut block.scratch[n];
+        let record = load::<L, RECORD>(&scratch.limits[l * RECORD..(l + 1) * RECORD], start);
+        let c = record[0];
         let active = if first {
             c.gt(zero)
         } else {
             L::load(&scratch.active[l][start..]).gt(zero)
         };
         L::select(active, one, zero).store(&mut scratch.active[l][start..]);
-        measured.c[k] = L::select(active, c, zero);
-        for j in 0..6 {
-            measured.ja[k][j] = L::select(active, measured.ja[k][j], zero);
-            measured.jb[k][j] = L::select(active, measured.jb[k][j], zero);
+        (held.active[l], held.c[l], held.weights[l]) = (active, c, record[7]);
+        // A limit's row has no linear part: `J_a`'s is `-0`, `J_b`'s `0`
+        // (`rows::Rows::limit`).
+        let minus = L::splat(-0.0);
+        let ja = [minus, minus, minus, record[1], record[2], record[3]];
+        let jb = [zero, zero, zero, record[4], record[5], record[6]];
+        for (side, jacobian) in [(a, ja), (b, jb)] {
+            if side == NONE {
+                continue;
+            }
+            let mut row = [zero; 6];
+            for (r, j) in row.iter_mut().zip(jacobian) {
+                *r = L::select(active, j, zero);
+            }
+            let coupling = &mut block.scratch[holder(n, parent, side)].coupling;
+            store(&row, &mut coupling[k * 6..k * 6 + 6], start);
         }
-        held[l] = active;
     }
-    (held, weights)
-}
-
-/// A joint's held limit rows, as [`soften`] reads them.
-struct Held<'a, L: Lane> {
-    joint: &'a JointNode,
-    kind: JointRows,
-    geometry: &'a Geometry<L>,
-    active: [L::Mask; MAX_LIMITS],
-    weights: [L; MAX_LIMITS],
+    held
 }
 
 /// A soft limit's row (`parts::limit`, whose header derives the step):
@@ -200,24 +277,25 @@ struct Held<'a, L: Lane> {
 /// damping leave the hard row as it was, bit for bit.
 #[inline(always)]
 fn soften<L: Lane>(
-    held: &Held<'_, L>,
-    measured: &Rows<L>,
+    joint: &JointNode,
+    kind: JointRows,
+    soft: &Softness<L>,
+    held: &Held<L>,
     start: usize,
     (diagonal, rhs): (&mut [L; PACKED], &mut [L; MAX]),
 ) {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    let soft = held.geometry.softness;
-    for (l, k) in (held.kind.first_limit()..held.kind.count()).enumerate() {
+    for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
         let active = held.active[l];
-        let (c, w) = (measured.c[k], held.weights[l]);
-        let quarter = if held.kind.is_sine_row(k) {
+        let (c, w) = (held.c[l], held.weights[l]);
+        let quarter = if kind.is_sine_row(k) {
             L::splat(0.25)
         } else {
             one
         };
         let alpha = soft.alpha_tilde * quarter + soft.spring * w;
-        let lambda = L::select(active, L::load(&held.joint.limit_lambda[l][start..]), zero);
-        let c0 = L::load(&held.joint.limit_start[l][start..]);
+        let lambda = L::select(active, L::load(&joint.limit_lambda[l][start..]), zero);
+        let c0 = L::load(&joint.limit_start[l][start..]);
         let damping = L::select(active, soft.gamma * (c - c0), zero);
         let inv = one / (one + soft.gamma);
         let damped = (soft.alpha_tilde + soft.spring + soft.gamma).gt(zero) & active;
