@@ -65,17 +65,26 @@ pub fn factor<L: Lane, const N: usize>(a: &mut [L; PACKED]) {
 #[inline(always)]
 pub fn solve<L: Lane, const N: usize>(f: &[L; PACKED], x: &mut [L; MAX]) {
     let n = N;
-    for i in 0..n {
-        for k in 0..i {
-            x[i] -= f[at(i, k)] * x[k];
-        }
-    }
+    forward::<L, N>(f, x);
     for i in 0..n {
         x[i] *= f[at(i, i)];
     }
     for i in (0..n).rev() {
         for k in i + 1..n {
             x[i] -= f[at(k, i)] * x[k];
+        }
+    }
+}
+
+/// `L^-1 x` in place, forward through the unit lower triangle of the
+/// factors from [`factor`]. With `w = L^-1 u` and `v = L^-1 x`,
+/// `u^T A^-1 x = w^T D^-1 v`: a Schur complement `J^T A^-1 J` needs only
+/// the forward half of each column's solve.
+#[inline(always)]
+pub fn forward<L: Lane, const N: usize>(f: &[L; PACKED], x: &mut [L; MAX]) {
+    for i in 0..N {
+        for k in 0..i {
+            x[i] -= f[at(i, k)] * x[k];
         }
     }
 }

@@ -473,24 +473,58 @@ fn parent_size(topology: &Topology, parent: Option<usize>) -> Option<usize> {
     }
 }
 
-/// Factors node `n`'s `N x N` block in place; returns the factors and
-/// `D^-1 b`.
+/// Factors node `n`'s `N x N` block in place; returns the factors.
 #[inline(always)]
-fn factor<L: Lane, const N: usize>(
-    block: &mut TreeBlock,
-    n: usize,
-    start: usize,
-) -> ([L; PACKED], [L; MAX]) {
+fn factor<L: Lane, const N: usize>(block: &mut TreeBlock, n: usize, start: usize) -> [L; PACKED] {
     let mut factors = load::<L, PACKED>(&block.scratch[n].diagonal, start);
     ldl::factor::<L, N>(&mut factors);
     store(&factors, &mut block.scratch[n].diagonal, start);
-    let mut y = load::<L, MAX>(&block.scratch[n].rhs, start);
-    ldl::solve::<L, N>(&factors, &mut y);
-    (factors, y)
+    factors
+}
+
+/// Passes node `n`'s Schur complement to its parent `p`: with `A = L D
+/// L^T` its factors and `u_r` the `R` columns of its coupling (`N`
+/// entries each), `D_p -= U^T A^-1 U` and `b_p += U^T A^-1 b`, each as
+/// `w^T D^-1 v` of forward solves `w = L^-1 u` ([`ldl::forward`]).
+#[inline(always)]
+fn complement<L: Lane, const N: usize, const R: usize>(
+    block: &mut TreeBlock,
+    (n, p): (usize, usize),
+    factors: &[L; PACKED],
+    columns: &mut [[L; MAX]; R],
+    start: usize,
+) {
+    let mut z = load::<L, MAX>(&block.scratch[n].rhs, start);
+    ldl::forward::<L, N>(factors, &mut z);
+    let mut scaled = [[L::splat(0.0); MAX]; R];
+    for (column, scaled) in columns.iter_mut().zip(scaled.iter_mut()) {
+        ldl::forward::<L, N>(factors, column);
+        for i in 0..N {
+            scaled[i] = column[i] * factors[ldl::at(i, i)];
+        }
+    }
+    let mut d = load::<L, PACKED>(&block.scratch[p].diagonal, start);
+    let mut b = load::<L, MAX>(&block.scratch[p].rhs, start);
+    for r in 0..R {
+        for s in 0..=r {
+            let mut sum = scaled[r][0] * columns[s][0];
+            for i in 1..N {
+                sum += scaled[r][i] * columns[s][i];
+            }
+            d[at(r, s)] -= sum;
+        }
+        let mut sum = scaled[r][0] * z[0];
+        for i in 1..N {
+            sum += scaled[r][i] * z[i];
+        }
+        b[r] += sum;
+    }
+    store(&d, &mut block.scratch[p].diagonal, start);
+    store(&b, &mut block.scratch[p].rhs, start);
 }
 
 /// A joint node of `N` rows: factored, and its complement passed to its
-/// parent body.
+/// parent body (`J^T D^-1 J`: the coupling's six columns).
 #[inline(always)]
 fn joint_child<L: Lane, const N: usize>(
     block: &mut TreeBlock,
@@ -498,42 +532,22 @@ fn joint_child<L: Lane, const N: usize>(
     parent: Option<usize>,
     start: usize,
 ) {
-    let (factors, y) = factor::<L, N>(block, n, start);
+    let factors = factor::<L, N>(block, n, start);
     let Some(p) = parent else {
         return;
     };
-    let zero = L::splat(0.0);
     let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
-    // X = D^-1 J, column by column.
-    let mut x = [[zero; MAX]; 6];
-    for (c, column) in x.iter_mut().enumerate() {
+    let mut columns = [[L::splat(0.0); MAX]; 6];
+    for (c, column) in columns.iter_mut().enumerate() {
         for r in 0..N {
             column[r] = j[r * 6 + c];
         }
-        ldl::solve::<L, N>(&factors, column);
     }
-    let mut d = load::<L, PACKED>(&block.scratch[p].diagonal, start);
-    let mut b = load::<L, MAX>(&block.scratch[p].rhs, start);
-    for r in 0..6 {
-        for s in 0..=r {
-            let mut sum = j[r] * x[s][0];
-            for i in 1..N {
-                sum += j[i * 6 + r] * x[s][i];
-            }
-            d[at(r, s)] -= sum;
-        }
-        let mut sum = j[r] * y[0];
-        for i in 1..N {
-            sum += j[i * 6 + r] * y[i];
-        }
-        b[r] += sum;
-    }
-    store(&d, &mut block.scratch[p].diagonal, start);
-    store(&b, &mut block.scratch[p].rhs, start);
+    complement::<L, N, 6>(block, (n, p), &factors, &mut columns, start);
 }
 
 /// A body node: factored, and its complement passed to its parent joint
-/// of `N` rows (none: the root).
+/// of `N` rows (`J D^-1 J^T`: the joint's `N` rows; none: the root).
 #[inline(always)]
 fn body_child<L: Lane, const N: usize>(
     block: &mut TreeBlock,
@@ -541,36 +555,16 @@ fn body_child<L: Lane, const N: usize>(
     parent: Option<usize>,
     start: usize,
 ) {
-    let (factors, y) = factor::<L, 6>(block, n, start);
+    let factors = factor::<L, 6>(block, n, start);
     let Some(p) = parent else {
         return;
     };
-    let zero = L::splat(0.0);
     let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
-    // X = D^-1 J^T, one row of J at a time.
-    let mut x = [[zero; MAX]; N];
-    for (r, xr) in x.iter_mut().enumerate() {
-        xr.copy_from_slice(&j[r * 6..r * 6 + 6]);
-        ldl::solve::<L, 6>(&factors, xr);
+    let mut columns = [[L::splat(0.0); MAX]; N];
+    for (r, column) in columns.iter_mut().enumerate() {
+        column.copy_from_slice(&j[r * 6..r * 6 + 6]);
     }
-    let mut d = load::<L, PACKED>(&block.scratch[p].diagonal, start);
-    let mut b = load::<L, MAX>(&block.scratch[p].rhs, start);
-    for r in 0..N {
-        for s in 0..=r {
-            let mut sum = j[r * 6] * x[s][0];
-            for c in 1..6 {
-                sum += j[r * 6 + c] * x[s][c];
-            }
-            d[at(r, s)] -= sum;
-        }
-        let mut sum = j[r * 6] * y[0];
-        for c in 1..6 {
-            sum += j[r * 6 + c] * y[c];
-        }
-        b[r] += sum;
-    }
-    store(&d, &mut block.scratch[p].diagonal, start);
-    store(&b, &mut block.scratch[p].rhs, start);
+    complement::<L, 6, N>(block, (n, p), &factors, &mut columns, start);
 }
 
 /// Root first: each node's unknowns from its factored block, its
