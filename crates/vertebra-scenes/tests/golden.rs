@@ -116,8 +116,8 @@ fn anatomical_drop_direct() {
 // elliptical sockets, hinges and rod through both solves.
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
-const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0xec65_e3d1_f8d4_bd3f;
-const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x855d_a1c6_fc07_5c99;
+const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x50c8_df1a_1a03_746b;
+const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x979c_19ca_4c81_984d;
 
 // The direct solve's, set by the commit that introduced them;
 // all four moved when every limit row joined the solve with
@@ -131,11 +131,17 @@ const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x855d_a1c6_fc07_5c99;
 // exact gradient (the rod's twist axes): they were 0x65de_b486_3a49_f307
 // (drop, sockets), 0x28a8_4720_0b0e_213e (drop, rod), 0x2a02_6cee_6d92_1348
 // (anatomical, sockets) and 0x34ba_9c8a_7994_6333 (anatomical, rod);
-// passive bending's, whose twists stay in range, did not move.
-const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x1400_152b_eb04_3d1b;
-const GOLDEN_BENDING_ROD_DIRECT: u64 = 0xdd60_df2e_065c_7745;
-const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x9abf_0858_ac35_d97f;
-const GOLDEN_DROP_ROD_DIRECT: u64 = 0x4010_54ca_4ac9_5921;
+// passive bending's, whose twists stay in range, did not move. Then all
+// six by the elimination's Schur complements formed from forward solves
+// (`W^T D^-1 W`, a different order of the same sums): they were
+// 0x1400_152b_eb04_3d1b and 0xdd60_df2e_065c_7745 (bending),
+// 0x9abf_0858_ac35_d97f and 0x4010_54ca_4ac9_5921 (drop), and
+// 0xec65_e3d1_f8d4_bd3f and 0x855d_a1c6_fc07_5c99 (anatomical), sockets
+// then rod.
+const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0xda85_7ec1_6e55_e66b;
+const GOLDEN_BENDING_ROD_DIRECT: u64 = 0xbcb6_8235_7f1e_88a9;
+const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3160_b8fa_7c1a_7d0d;
+const GOLDEN_DROP_ROD_DIRECT: u64 = 0x32a4_83fc_f651_bae2;
 
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision
