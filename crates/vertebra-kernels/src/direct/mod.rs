@@ -463,6 +463,9 @@ pub struct NodeScratch {
     /// A joint's limit rows held in this solve (1) or not (0): the active
     /// set.
     pub active: [[f32; BLOCK_LANES]; MAX_LIMITS],
+    /// The active set the last settle chose, held in the next pass only
+    /// by a lane where a row crossed, and the next solve's start.
+    pub next: [[f32; BLOCK_LANES]; MAX_LIMITS],
 }
 
 impl NodeScratch {
@@ -474,6 +477,7 @@ impl NodeScratch {
         coupling: [[0.0; BLOCK_LANES]; MAX * 6],
         limits: [[0.0; BLOCK_LANES]; MAX_LIMITS * LIMIT_RECORD],
         active: [[0.0; BLOCK_LANES]; MAX_LIMITS],
+        next: [[0.0; BLOCK_LANES]; MAX_LIMITS],
     };
 }
 
@@ -551,7 +555,8 @@ impl LaneKernel for PositionPass<'_> {
 }
 
 /// How many times a closing solve may factor its tree with a changed
-/// active set (`solve::settle`): the first, then up to this many less one.
+/// active set (`solve::settle`: a row crossed its limit): the first, then
+/// up to this many less one.
 pub const MAX_PASSES: usize = 4;
 
 /// One block of a [`PositionPass`].
@@ -578,6 +583,7 @@ impl LaneSlices for Slices<'_> {
                 break;
             }
         }
+        solve::adopt::<L>(self.block, start);
         solve::accumulate::<L>(self.block, topology, start);
         solve::apply::<L>(self.block, topology, rows, start);
     }

@@ -325,15 +325,20 @@ const CROSSING: f32 = 1.0e-4;
 /// solve's multipliers and its step: a held row whose multiplier would
 /// pull by more than the hysteresis (`w (lambda + dlambda) > CROSSING`
 /// for a soft row's accumulated `lambda`, `w dlambda` for a hard row's:
-/// the step moves it toward the limit) is released; a row not held that the step would carry past its
-/// limit (`c + J_a dx_a + J_b dx_b > CROSSING`, linearised) is held. Returns
-/// whether any lane's set changed (then the tree is factored again with
-/// it; a lane whose set did not change gets the same bits again, so how
-/// many passes its slice takes does not change its result).
+/// the step moves it toward the limit) is released; a row not held that
+/// the step would carry past its limit (`c + J_a dx_a + J_b dx_b >
+/// CROSSING`, linearised) is held. The set is kept as the next solve's
+/// start ([`adopt`]). Only a crossing makes the tree worth factoring
+/// again: a held row that pulls violates nothing, it only holds its joint
+/// on the boundary until the next solve releases it. So a lane where some
+/// row crosses takes its new set for another pass, and every other lane
+/// keeps the set it had, which gives it the same bits again; returns
+/// whether any lane crossed. A lane's result is then its own, whatever
+/// its slice's other lanes do (every backend, bit for bit).
 #[inline(always)]
 pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) -> bool {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    let mut changed = zero.gt(zero);
+    let mut crossed = zero.gt(zero);
     for (n, node) in topology.nodes.iter().enumerate() {
         let NodeKind::Joint {
             index,
@@ -364,17 +369,34 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
             let pulls = ((lambda + dlambda[k]) * record[7]).gt(L::splat(CROSSING));
             let crosses = predicted.gt(L::splat(CROSSING)) & record[0].gt(L::splat(FREE));
             let now = held.and_not(pulls) | crosses.and_not(held);
-            changed = changed | (now.and_not(held)) | (held.and_not(now));
-            L::select(now, one, zero).store(&mut block.scratch[n].active[l][start..]);
+            crossed = crossed | now.and_not(held);
+            L::select(now, one, zero).store(&mut block.scratch[n].next[l][start..]);
+        }
+    }
+    for scratch in block.scratch.iter_mut() {
+        for (active, next) in scratch.active.iter_mut().zip(&scratch.next) {
+            let held = L::load(&active[start..]);
+            L::select(crossed, L::load(&next[start..]), held).store(&mut active[start..]);
         }
     }
     let mut lanes = [0.0f32; BLOCK_LANES];
-    L::select(changed, one, zero).store(&mut lanes);
+    L::select(crossed, one, zero).store(&mut lanes);
     let mut any = false;
     for lane in &lanes[..L::WIDTH] {
         any |= *lane != 0.0;
     }
     any
+}
+
+/// The set the last [`settle`] chose, releases included, as the next
+/// solve's start.
+#[inline(always)]
+pub(super) fn adopt<L: Lane>(block: &mut TreeBlock, start: usize) {
+    for scratch in block.scratch.iter_mut() {
+        for (active, next) in scratch.active.iter_mut().zip(&scratch.next) {
+            L::load(&next[start..]).store(&mut active[start..]);
+        }
+    }
 }
 
 /// Body node `n`'s turn from the solve (zero for none: static or
