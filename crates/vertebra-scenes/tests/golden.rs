@@ -116,8 +116,8 @@ fn anatomical_drop_direct() {
 // elliptical sockets, hinges and rod through both solves.
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
-const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x50c8_df1a_1a03_746b;
-const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x979c_19ca_4c81_984d;
+const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0xc656_e349_9e78_23bd;
+const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x6845_d290_5437_24b7;
 
 // The direct solve's, set by the commit that introduced them;
 // all four moved when every limit row joined the solve with
@@ -137,11 +137,15 @@ const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x979c_19ca_4c81_984d;
 // 0x1400_152b_eb04_3d1b and 0xdd60_df2e_065c_7745 (bending),
 // 0x9abf_0858_ac35_d97f and 0x4010_54ca_4ac9_5921 (drop), and
 // 0xec65_e3d1_f8d4_bd3f and 0x855d_a1c6_fc07_5c99 (anatomical), sockets
-// then rod.
-const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0xda85_7ec1_6e55_e66b;
-const GOLDEN_BENDING_ROD_DIRECT: u64 = 0xbcb6_8235_7f1e_88a9;
-const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3160_b8fa_7c1a_7d0d;
-const GOLDEN_DROP_ROD_DIRECT: u64 = 0x32a4_83fc_f651_bae2;
+// then rod. Then all six by the closing solves factoring again only for a
+// lane where a limit row crossed, not for a release alone: they were
+// 0xda85_7ec1_6e55_e66b and 0xbcb6_8235_7f1e_88a9 (bending),
+// 0x3160_b8fa_7c1a_7d0d and 0x32a4_83fc_f651_bae2 (drop), and
+// 0x50c8_df1a_1a03_746b and 0x979c_19ca_4c81_984d (anatomical).
+const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x54c3_20a6_97c2_c911;
+const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x7ac9_2204_2740_dfc5;
+const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3634_643b_ea27_12fe;
+const GOLDEN_DROP_ROD_DIRECT: u64 = 0xbcd9_d34d_fee2_a132;
 
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision
