@@ -3,7 +3,7 @@
 //! differences, one pass over small trees exact to first order (with the
 //! linear momentum kept), every limit row's signed distance against its
 //! closed form, trees posed past each limit brought back to it in one pass,
-//! the limits' active set (a limit never pulls), soft limits' XPBD step,
+//! the limits' active set (a limit pulls for one solve at most), soft limits' XPBD step,
 //! every backend giving the scalar reference's bits (limits of every shape,
 //! hard and soft, among them), and the topology's elimination order and
 //! refusals.
@@ -2347,7 +2347,7 @@ fn one_pass_brings_a_tree_past_any_limit_back_to_its_boundary() {
 }
 
 // ---------------------------------------------------------------------------
-// A limit never pulls: the active set of one pass.
+// A limit holds a joint out, and lets it go: the active set.
 // ---------------------------------------------------------------------------
 
 /// What one pass did to a tree's last joint's limits.
@@ -2370,6 +2370,21 @@ struct LimitPass {
 fn limit_pass(tree: &Tree, offsets: &Offsets, row: usize, limits: &JointLane) -> LimitPass {
     let scene = Scene::new(tree);
     let rows = scene.rows(offsets);
+    let mut blocks = vec![scene.block()];
+    next_limit_pass(&scene, &rows, &mut blocks, row, limits)
+}
+
+/// One more pass of `blocks` (one tree: `scene`'s) from where `rows`
+/// stand, as [`limit_pass`] measures it; the blocks keep the active set it
+/// leaves for the next.
+fn next_limit_pass(
+    scene: &Scene,
+    rows: &BodyRows,
+    blocks: &mut [TreeBlock],
+    row: usize,
+    limits: &JointLane,
+) -> LimitPass {
+    let tree = &scene.tree;
     let j = tree.joints.len() - 1;
     let measure = |rows: &BodyRows| {
         let mut m = scene.measured(rows, j);
@@ -2379,17 +2394,16 @@ fn limit_pass(tree: &Tree, offsets: &Offsets, row: usize, limits: &JointLane) ->
         let largest = limit_rows.map(|k| c[k] as f64).fold(f64::MIN, f64::max);
         (c[row] as f64, largest)
     };
-    let before = measure(&rows);
-    let mut m = scene.measured(&rows, j);
+    let before = measure(rows);
+    let mut m = scene.measured(rows, j);
     set_limits(&mut m.g, limits);
-    let mut blocks = vec![scene.block()];
     pass(
         Backend::Scalar,
-        &rows,
-        &mut blocks,
+        rows,
+        blocks,
         std::slice::from_ref(&scene.topology),
     );
-    let (after, largest) = measure(&rows);
+    let (after, largest) = measure(rows);
     let joint = &tree.joints[j];
     let step = |side: Option<usize>| match side {
         Some(i) => scene.unknowns(&blocks[0], i),
@@ -2511,17 +2525,22 @@ fn a_limit_inside_is_not_held_unless_the_step_would_cross_it() {
 }
 
 /// A limit violated as the pass starts (by 0.01) is held by its first
-/// factorisation; where the other rows' step (the bodies below shifted by
+/// factorisation. Where the other rows' step (the bodies below shifted by
 /// up to 4 cm) would carry the joint well inside (every limit row of the
-/// joint 0.03 or more, linearised), its multiplier pulls, and the pass
-/// releases it: the joint ends inside, carried in from where it was,
-/// where the same tree with no limits ends (its bits), not held at the
-/// boundary.
+/// joint 0.03 or more, linearised), its multiplier pulls: that violates
+/// nothing, so the solve does not factor the tree again for it, and the
+/// joint ends on its boundary to second order in the step's turn
+/// (`|c| <= K turn^2`: measured K = 15.9 for the cone, whose axis a light
+/// body's turn carries round, 13.0 for the ellipse, 10.4 for a rod's bend,
+/// at most 9.1 for the others; bound 20). The solve leaves the limit
+/// released: wherever the next solve's own step would keep it inside
+/// (1e-3, linearised), that solve moves the tree as the same tree with no
+/// limits does from there (its bits).
 #[test]
-fn a_violated_limit_the_other_rows_carry_inside_is_released() {
+fn a_violated_limit_the_other_rows_carry_inside_is_released_by_the_next_solve() {
     let mut r = StdRng::seed_from_u64(61);
     for case in LIMIT_CASES {
-        let mut released = 0;
+        let (mut pulled, mut released) = (0, 0);
         for bodies in [1, 2, 3] {
             for _ in 0..300 {
                 let (tree, offsets, row) = past_limit(&mut r, case, bodies, 0.01, None);
@@ -2531,23 +2550,41 @@ fn a_violated_limit_the_other_rows_carry_inside_is_released() {
                 if free.predicted > -0.03 {
                     continue; // the step alone would leave a limit near or past
                 }
-                released += 1;
-                let held = limit_pass(&tree, &offsets, row, &limits);
+                pulled += 1;
+                let scene = Scene::new(&tree);
+                let rows = scene.rows(&offsets);
+                let mut blocks = vec![scene.block()];
+                let held = next_limit_pass(&scene, &rows, &mut blocks, row, &limits);
                 let context = format!(
                     "{case}, {bodies} bodies: c {:.4} -> {:.4} (with no limit {:.4}, \
                      predicted {:.4})",
                     held.before, held.after, free.after, free.predicted
                 );
                 assert!(held.before > 0.0, "{context}: not posed past");
-                assert!(held.largest < 0.0, "{context}: held at its boundary");
-                assert!(held.after < held.before, "{context}: not carried in");
+                let turn = free.after - held.before;
                 assert!(
-                    same_bits(&held, &free),
-                    "{context}: the released limit changed the pass"
+                    held.after.abs() <= 20.0 * turn * turn + 1e-6,
+                    "{context}: not held on its boundary"
                 );
+                let free_scene = Scene::new(&unlimited(&tree));
+                let mut free_blocks = vec![free_scene.block()];
+                let free_rows = rows.clone();
+                let next_free =
+                    next_limit_pass(&free_scene, &free_rows, &mut free_blocks, row, &limits);
+                let next = next_limit_pass(&scene, &rows, &mut blocks, row, &limits);
+                if next_free.predicted < -1e-3 {
+                    released += 1;
+                    assert!(
+                        same_bits(&next, &next_free),
+                        "{context}: the next solve held it again"
+                    );
+                }
             }
         }
-        assert!(released >= 50, "{case}: only {released} releases");
+        assert!(
+            pulled >= 50 && released >= 10,
+            "{case}: only {pulled} pulls, {released} releases"
+        );
     }
 }
 
