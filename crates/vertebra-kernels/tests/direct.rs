@@ -2420,7 +2420,7 @@ fn next_limit_pass(
         .map(|k| c[k] as f64 + jacobian[k].iter().zip(&dx).map(|(j, x)| j * x).sum::<f64>())
         .fold(f64::MIN, f64::max);
     LimitPass {
-        bits: flatten(&rows),
+        bits: flatten(rows),
         before: before.0,
         after,
         largest,
