@@ -37,6 +37,7 @@ use parry3d::query::{
 use parry3d::shape::{
     PackedFeatureId, PolygonalFeature, Shape as ParryShape, ShapeType, SharedShape,
 };
+use vertebra_math::DefaultFloatMode;
 use vertebra_ragdoll::{BuildOptions, Ragdoll, RagdollDesc, RagdollError};
 use vertebra_world::{BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, World};
 
@@ -287,6 +288,7 @@ impl Collisions {
     /// body must be live in the world the set is used with when contacts
     /// are found.
     pub fn add(&mut self, collider: Collider) -> Result<usize, Error> {
+        let _mode = DefaultFloatMode::enter();
         let index = self.colliders.len();
         let shape = collider
             .geometry()
@@ -304,6 +306,7 @@ impl Collisions {
         shapes: &[(BodyHandle, Shape)],
         excluded: &[(BodyHandle, BodyHandle)],
     ) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         let start = self.colliders.len();
         let checked = shapes
             .iter()
@@ -326,6 +329,7 @@ impl Collisions {
     /// Adds a ragdoll's capsules (one per body, default friction and
     /// groups), its jointed pairs never tested. All or nothing.
     pub fn add_ragdoll(&mut self, ragdoll: &Ragdoll) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         self.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())
     }
 
@@ -345,6 +349,7 @@ impl Collisions {
         pose: &vertebra_ragdoll::Pose,
         previous: Option<(&vertebra_ragdoll::Pose, f32)>,
     ) -> Result<Ragdoll, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let geometries = desc
             .bodies
             .iter()
@@ -400,6 +405,7 @@ impl Collisions {
         pose: &vertebra_ragdoll::Pose,
         previous: Option<(&vertebra_ragdoll::Pose, f32)>,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let old = ragdoll.bodies.clone();
         ragdoll.recreate(world, pose, previous)?;
         let moved: HashMap<BodyHandle, BodyHandle> = old
@@ -463,6 +469,7 @@ impl Collisions {
     /// working memory every call: a game's loop uses
     /// [`Collisions::find_contacts_into`].
     pub fn find_contacts(&self, world: &World, dt: f32) -> Result<Vec<Contact>, Error> {
+        let _mode = DefaultFloatMode::enter();
         let mut contacts = Vec::new();
         self.detect(world, dt, &mut Detection::default(), &mut contacts)?;
         Ok(contacts)
@@ -481,6 +488,7 @@ impl Collisions {
         dt: f32,
         contacts: &mut Vec<Contact>,
     ) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         // Taken out and put back (moving a vector allocates nothing), so
         // that the detection reads the set while it writes its memory.
         let mut scratch = core::mem::take(&mut self.scratch);
@@ -801,6 +809,7 @@ fn push_manifold(
 
 /// The world pose of a body's collider frame (for callers drawing them).
 pub fn collider_pose(world: &World, body: BodyHandle) -> Result<(Vec3, Quat), Error> {
+    let _mode = DefaultFloatMode::enter();
     world.body(body).map(|s| (s.position, s.orientation))
 }
 

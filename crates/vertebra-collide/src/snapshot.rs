@@ -21,6 +21,7 @@ use serde::{Deserialize, Serialize};
 use vertebra_world::{BodyHandle, Error, World};
 
 use crate::{Collider, Collisions, check_prediction, ordered};
+use vertebra_math::DefaultFloatMode;
 
 const MAGIC: &[u8; 8] = b"VTBCOLLS";
 const VERSION: u32 = 2;
@@ -89,6 +90,7 @@ impl Collisions {
     /// collider, a group not yet given). A set's own snapshot always
     /// restores into its world. The set is unchanged on error.
     pub fn restore(&mut self, snapshot: &CollisionSnapshot, world: &World) -> Result<(), Error> {
+        let _mode = DefaultFloatMode::enter();
         let state = decode(&snapshot.bytes)?;
         check_prediction(state.prediction)?;
         let mut restored = Collisions {

@@ -13,7 +13,11 @@
 //! long as it lives and gives the caller its own mode back when dropped
 //! (the x64 calling conventions treat these bits the same way: callee-saved,
 //! standard values expected across calls). A step holds one on the thread
-//! that enters it and one on every worker for each chunk it solves.
+//! that enters it and one on every worker for each chunk it solves; every
+//! other public call of the world, ragdoll, collision and scene layers
+//! that computes what enters a world, or what a game reads back, holds
+//! one for its length (`docs/robustness.md`, "Soundness and numerics
+//! found by review").
 //!
 //! | target | register | what is set |
 //! | --- | --- | --- |

@@ -16,6 +16,7 @@ use crate::joint_def::{JointDef, JointSpec, check_joint, half_turn, resolve};
 use crate::skeleton::{Skeleton, Transform};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
 use crate::text::item;
+use vertebra_math::DefaultFloatMode;
 
 /// A value and the line of the file where it is defined (`None` when it
 /// was built in code).
@@ -307,6 +308,7 @@ impl RagdollDesc {
     /// joints' own strengths. For a description edited by hand; errors
     /// name the item and the field.
     pub fn validate(&self) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         self.problems().into_iter().next().map_or(Ok(()), Err)
     }
 
@@ -315,6 +317,7 @@ impl RagdollDesc {
     /// own, then the joint tree (once every joint passed), the spine (once
     /// the tree stands) and the drive settings.
     pub fn problems(&self) -> Vec<RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let mut problems = Problems::default();
         check(self, &At::default(), &mut problems);
         problems.done().err().unwrap_or_default()

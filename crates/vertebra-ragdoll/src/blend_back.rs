@@ -16,6 +16,7 @@ use crate::description::RagdollDesc;
 use crate::error::RagdollError;
 use crate::pose::Pose;
 use crate::skeleton::{LocalPose, Skeleton};
+use vertebra_math::DefaultFloatMode;
 
 /// A pose that blends bone by bone with another of its kind: a ragdoll
 /// [`Pose`] (checked against its [`RagdollDesc`]) or a skeleton's
@@ -113,6 +114,7 @@ impl<P: Blend> BlendBack<P> {
     /// that does not fit `rig` (naming the bone) and a duration that is not
     /// finite and positive.
     pub fn new(rig: &P::Rig, simulated: P, duration: f32) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if !(duration.is_finite() && duration > 0.0) {
             return Err(RagdollError::OutOfRange {
                 context: "blend back".to_owned(),
@@ -132,6 +134,7 @@ impl<P: Blend> BlendBack<P> {
     /// The ragdoll's weight now: 1 as the blend starts, 0 from `duration`
     /// on, smoothstep between (see the module documentation).
     pub fn weight(&self) -> f32 {
+        let _mode = DefaultFloatMode::enter();
         let x = (self.elapsed / self.duration).min(1.0);
         1.0 - x * x * (3.0 - 2.0 * x)
     }
@@ -141,11 +144,13 @@ impl<P: Blend> BlendBack<P> {
     /// Refused for an animation pose that does not fit `rig` (naming the
     /// bone).
     pub fn pose(&self, rig: &P::Rig, animation: &P) -> Result<P, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         animation.blend_all(rig, &self.simulated, self.weight())
     }
 
     /// Moves the blend on by `dt` seconds (finite, not negative).
     pub fn advance(&mut self, dt: f32) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if !(dt.is_finite() && dt >= 0.0) {
             return Err(RagdollError::OutOfRange {
                 context: "blend back".to_owned(),

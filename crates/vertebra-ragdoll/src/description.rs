@@ -27,6 +27,7 @@ use crate::skeleton::{Skeleton, Transform};
 use crate::skeleton_file::{RawBone, bones_all, syntax_naming};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
 use crate::text::{Lines, in_file, item, read_text};
+use vertebra_math::DefaultFloatMode;
 
 /// The reference humanoid, shipped with the crate: 13 bodies, 12 joints,
 /// a 4-body spine.
@@ -241,6 +242,7 @@ impl RagdollDesc {
     /// file's directory); every error names the file (and the line, where
     /// there is one).
     pub fn from_file(path: &Path) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         Self::check_file(path).map_err(first)
     }
 
@@ -254,6 +256,7 @@ impl RagdollDesc {
     /// once every joint resolves, the spine's chain once the tree stands,
     /// and the whole description once every part passed.
     pub fn check_file(path: &Path) -> Result<Self, Vec<RagdollError>> {
+        let _mode = DefaultFloatMode::enter();
         let text = read_text(path, "ragdoll").map_err(|e| vec![e])?;
         let dir = path.parent().unwrap_or(Path::new(""));
         Self::parse(&text, Given::Dir(dir))
@@ -265,12 +268,14 @@ impl RagdollDesc {
     /// that names a skeleton file is refused: only
     /// [`RagdollDesc::from_file`] knows where to look for it.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         Self::check_toml(text).map_err(first)
     }
 
     /// [`RagdollDesc::from_toml`], refused with every problem found, in
     /// file order ([`RagdollDesc::check_file`] says what is checked when).
     pub fn check_toml(text: &str) -> Result<Self, Vec<RagdollError>> {
+        let _mode = DefaultFloatMode::enter();
         Self::parse(text, Given::Nothing)
     }
 
@@ -280,6 +285,7 @@ impl RagdollDesc {
     /// bodies may be defined `from` one bone `to` another. A file that
     /// carries its own skeleton is refused.
     pub fn from_toml_with_skeleton(text: &str, skeleton: &Skeleton) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         Self::parse(text, Given::Skeleton(skeleton)).map_err(first)
     }
 
@@ -368,6 +374,7 @@ impl RagdollDesc {
     /// Total mass (kg): the sum of the bodies' masses (a file's
     /// `total_mass` has scaled them to it).
     pub fn total_mass(&self) -> f32 {
+        let _mode = DefaultFloatMode::enter();
         self.bodies.iter().map(|b| b.mass).sum()
     }
 }

@@ -14,6 +14,7 @@ use vertebra_world::{AngularDrive, JointKind, RodDesc, RodStiffness, World};
 use crate::error::RagdollError;
 use crate::pose::Pose;
 use crate::ragdoll::{Ragdoll, rod_name};
+use vertebra_math::DefaultFloatMode;
 
 /// How hard a joint is driven.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -168,6 +169,7 @@ impl Ragdoll {
         target: &Pose,
         settings: &DriveSettings,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         self.drive(world, target, None, settings)
     }
 
@@ -190,6 +192,7 @@ impl Ragdoll {
         dt: f32,
         settings: &DriveSettings,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         prev.validate(&self.desc)?;
         if !(dt.is_finite() && dt >= vertebra_world::MIN_TIME_STEP) {
             return Err(RagdollError::OutOfRange {

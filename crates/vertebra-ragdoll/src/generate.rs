@@ -18,6 +18,7 @@ use crate::error::RagdollError;
 use crate::joint_def::{JointFrame, JointSpec};
 use crate::skeleton::{Skeleton, Transform};
 use crate::spec::{BodySpec, SpineSpec};
+use vertebra_math::DefaultFloatMode;
 
 /// The shortest capsule segment a generated body may have (m): a body
 /// whose end is (nearly) its bone's origin has no direction to give its
@@ -245,6 +246,7 @@ impl RagdollGenerator {
     /// joint limits, axes and normals, sizes and masses out of the
     /// world's range), naming the body or joint (the bone's name).
     pub fn generate(self) -> Result<RagdollDesc, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let skeleton = &self.skeleton;
         let model = skeleton.bind_pose().to_model(skeleton)?.bones;
         let chosen = self.chosen()?;

@@ -20,6 +20,7 @@ use crate::generate::{BodyMass, BoneBody, RagdollGenerator, RodSpine, SegmentEnd
 use crate::joint_def::RawBoneJoint;
 use crate::skeleton::Skeleton;
 use crate::text::{Lines, in_file, item, read_text, syntax};
+use vertebra_math::DefaultFloatMode;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -62,6 +63,7 @@ impl RagdollGenerator {
     /// table) and for sense by [`RagdollGenerator::generate`] (errors
     /// name the bone).
     pub fn from_toml(text: &str, skeleton: &Skeleton) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         Self::read(text, skeleton).map_err(first)
     }
 
@@ -102,6 +104,7 @@ impl RagdollGenerator {
     /// [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES) into a generator over
     /// `skeleton` ([`RagdollGenerator::from_toml`]); errors name the file.
     pub fn from_file(path: &Path, skeleton: &Skeleton) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let text = read_text(path, "generator")?;
         Self::from_toml(&text, skeleton).map_err(|e| in_file(path, e))
     }
@@ -111,6 +114,7 @@ impl RagdollGenerator {
     /// table's problem of form (by line), else with what
     /// [`RagdollGenerator::generate`] refuses; each names the file.
     pub fn check_file(path: &Path, skeleton: &Skeleton) -> Result<RagdollDesc, Vec<RagdollError>> {
+        let _mode = DefaultFloatMode::enter();
         let text = read_text(path, "generator").map_err(|e| vec![e])?;
         Self::read(&text, skeleton)
             .and_then(|generator| generator.generate().map_err(|e| vec![e]))

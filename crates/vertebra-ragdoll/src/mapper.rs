@@ -41,6 +41,7 @@ use crate::mapping::{Chain, SpineMapping};
 use crate::pose::Pose;
 use crate::ragdoll::{Ragdoll, SpineMode, rod_name};
 use crate::skeleton::{Bone, LocalPose, ModelPose, Skeleton, Transform};
+use vertebra_math::DefaultFloatMode;
 
 /// Per described body its world pose (centre of mass, rotation relative to
 /// bind; a simplified ragdoll's interior spine bodies unread), and a
@@ -99,6 +100,7 @@ impl SkeletonMapper {
         desc: &RagdollDesc,
         spine: SpineMode,
     ) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         desc.validate()?;
         if let Some(own) = &desc.skeleton {
             same_bind(own, skeleton)?;
@@ -148,6 +150,7 @@ impl SkeletonMapper {
         spine: SpineMode,
         bones: &[Option<usize>],
     ) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         Self::bound(skeleton, desc, spine, bones, &vec![None; bones.len()])
     }
 
@@ -368,6 +371,7 @@ impl SkeletonMapper {
         animation: &ModelPose,
         model_to_world: Transform,
     ) -> Result<Pose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         self.check_bones("animation", &animation.bones)?;
         model_to_world.validate("model_to_world")?;
         let bones = self
@@ -394,6 +398,7 @@ impl SkeletonMapper {
         model_to_world: Transform,
         mapping: SpineMapping,
     ) -> Result<ModelPose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let (bodies, rod_frames) = self.read(ragdoll, world)?;
         self.map(
             &bodies,
@@ -418,6 +423,7 @@ impl SkeletonMapper {
         model_to_world: Transform,
         mapping: SpineMapping,
     ) -> Result<ModelPose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         bodies.validate(&self.desc)?;
         if let Some((a, b)) = rod_frames {
             for (field, q) in [("rod frame_a", a), ("rod frame_b", b)] {

@@ -23,6 +23,7 @@ use crate::error::RagdollError;
 use crate::pose::Pose;
 use crate::ragdoll::Ragdoll;
 use crate::skeleton::Transform;
+use vertebra_math::DefaultFloatMode;
 
 /// How a chain of bones without bodies is placed between its two bodies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -87,6 +88,7 @@ impl Chain {
         bind_rotations: Vec<Quat>,
         rod: bool,
     ) -> Self {
+        let _mode = DefaultFloatMode::enter();
         let fractions = fractions(&points);
         let bind_frames = bind_frames(&points);
         let last = points.len() - 1;
@@ -127,6 +129,7 @@ impl Chain {
         rod_frames: Option<(Quat, Quat)>,
         out: &mut [Transform],
     ) {
+        let _mode = DefaultFloatMode::enter();
         let last = self.points.len() - 1;
         let mut put = |k: usize, (p, q): (Vec3, Quat)| {
             out[self.bones[k - 1]] =
@@ -278,6 +281,7 @@ impl Ragdoll {
         world: &World,
         mapping: SpineMapping,
     ) -> Result<Pose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let mapper = &self.as_bones;
         let model = mapper.map_to_skeleton(
             self,

@@ -8,6 +8,7 @@ use vertebra_world::{BodyHandle, World};
 use crate::description::BodyDef;
 use crate::error::RagdollError;
 use crate::ragdoll::Ragdoll;
+use vertebra_math::DefaultFloatMode;
 
 impl Ragdoll {
     /// The root body's centre of mass (m, world) and orientation (relative
@@ -16,6 +17,7 @@ impl Ragdoll {
     /// every built ragdoll has. Refused for a removed ragdoll or a root
     /// body no longer in `world`.
     pub fn root_transform(&self, world: &World) -> Result<(Vec3, Quat), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let s = world
             .body(self.root()?)
             .map_err(|e| RagdollError::world(&self.body_context(self.desc.root), e))?;
@@ -28,6 +30,7 @@ impl Ragdoll {
     /// rod's ends are). For culling and for picking a ragdoll. Refused as
     /// [`Ragdoll::root_transform`], or naming a body no longer in `world`.
     pub fn bounds(&self, world: &World) -> Result<(Vec3, Vec3), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         self.root()?;
         let mut bounds = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         for (k, body) in self.live_bodies() {
@@ -55,6 +58,7 @@ impl Ragdoll {
         linear: Vec3,
         angular: Vec3,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         for (field, v) in [("linear velocity", linear), ("angular velocity", angular)] {
             if !v.is_finite() {
                 return Err(RagdollError::NonFinite {
@@ -104,6 +108,7 @@ impl Ragdoll {
         impulse: Vec3,
         point: Option<Vec3>,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let (k, handle) = self.named_body(body, "impulse")?;
         let in_body = |e| RagdollError::world(&self.body_context(k), e);
         match point {

@@ -19,6 +19,7 @@ use vertebra_world::{BodyKind, MAX_TIME_STEP, MIN_TIME_STEP, World};
 use crate::error::RagdollError;
 use crate::pose::Pose;
 use crate::ragdoll::Ragdoll;
+use vertebra_math::DefaultFloatMode;
 
 impl Ragdoll {
     /// Makes the body named `body` (its description's name, e.g. `thigh_l`)
@@ -36,6 +37,7 @@ impl Ragdoll {
         body: &str,
         kinematic: bool,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let (k, handle) = self.named_body(body, "set_body_kinematic")?;
         world
             .set_body_kind(handle, kind(kinematic))
@@ -51,6 +53,7 @@ impl Ragdoll {
     /// mask of another length, a `true` on a bone without a body, a removed
     /// ragdoll or a body no longer in `world` (named).
     pub fn set_kinematic(&self, world: &mut World, kinematic: &[bool]) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         self.root()?;
         if kinematic.len() != self.desc.bodies.len() {
             return Err(RagdollError::OutOfRange {
@@ -130,6 +133,7 @@ impl Ragdoll {
         pose: &Pose,
         dt: f32,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         pose.validate(&self.desc)?;
         if !(MIN_TIME_STEP..=MAX_TIME_STEP).contains(&dt) {
             return Err(RagdollError::OutOfRange {

@@ -8,6 +8,7 @@ use vertebra_world::{check_coordinate, check_unit_quat};
 
 use crate::description::RagdollDesc;
 use crate::error::RagdollError;
+use vertebra_math::DefaultFloatMode;
 
 /// A world transform per bone.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,6 +20,7 @@ pub struct Pose {
 impl Pose {
     /// The bind pose: every body at its capsule's midpoint, unrotated.
     pub fn bind(desc: &RagdollDesc) -> Self {
+        let _mode = DefaultFloatMode::enter();
         Self {
             bones: desc
                 .bodies
@@ -31,6 +33,7 @@ impl Pose {
     /// This pose turned by `rotation` about `pivot`, then moved by
     /// `translation` (all world).
     pub fn moved(&self, pivot: Vec3, rotation: Quat, translation: Vec3) -> Self {
+        let _mode = DefaultFloatMode::enter();
         let bones = self
             .bones
             .iter()
@@ -49,6 +52,7 @@ impl Pose {
         root: (Vec3, Quat),
         rotations: &[Quat],
     ) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if rotations.len() != desc.joints.len() {
             return Err(RagdollError::BadPose(format!(
                 "{} joint rotations for {} joints",
@@ -84,6 +88,7 @@ impl Pose {
     /// within [`MAX_COORDINATE`](vertebra_world::MAX_COORDINATE) of the
     /// origin, unit orientations.
     pub fn validate(&self, desc: &RagdollDesc) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if self.bones.len() != desc.bodies.len() {
             return Err(RagdollError::BadPose(format!(
                 "{} bones for {} bodies",

@@ -14,6 +14,7 @@ use crate::description::RagdollDesc;
 use crate::error::RagdollError;
 use crate::mapper::SkeletonMapper;
 use crate::pose::Pose;
+use vertebra_math::DefaultFloatMode;
 
 /// How the spine is simulated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -118,6 +119,7 @@ impl BuildOptions {
 
     /// Checks the stabilisation ratio.
     pub fn validate(&self) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         match self.stabilise {
             Some(ratio) if !(ratio.is_finite() && ratio >= 1.0) => Err(RagdollError::OutOfRange {
                 context: "build options".to_owned(),
@@ -154,6 +156,7 @@ pub struct Ragdoll {
 /// for a description that fails [`RagdollDesc::validate`] or options that
 /// fail [`BuildOptions::validate`].
 pub fn body_masses(desc: &RagdollDesc, options: &BuildOptions) -> Result<Vec<f32>, RagdollError> {
+    let _mode = DefaultFloatMode::enter();
     desc.validate()?;
     options.validate()?;
     Ok(masses_of(desc, options))
@@ -224,6 +227,7 @@ impl Ragdoll {
         pose: &Pose,
         previous: Option<(&Pose, f32)>,
     ) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         options.validate()?;
         desc.validate()?;
         pose.validate(desc)?;
@@ -453,6 +457,7 @@ impl Ragdoll {
         pose: &Pose,
         previous: Option<(&Pose, f32)>,
     ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         pose.validate(&self.desc)?;
         self.check_removable(world)?;
         let fresh = Self::build(world, &self.desc.clone(), self.options, pose, previous)?;

@@ -16,6 +16,7 @@ use glam::{Quat, Vec3};
 use vertebra_world::{MAX_COORDINATE, check_unit_quat};
 
 use crate::error::RagdollError;
+use vertebra_math::DefaultFloatMode;
 
 /// The most bones a skeleton may have.
 pub const MAX_BONES: usize = 4096;
@@ -38,6 +39,7 @@ impl Transform {
 
     /// A transform of `translation` (m) and `rotation`.
     pub fn new(translation: Vec3, rotation: Quat) -> Self {
+        let _mode = DefaultFloatMode::enter();
         Self {
             translation,
             rotation,
@@ -139,6 +141,7 @@ pub struct Skeleton {
 impl Skeleton {
     /// A skeleton of `bones`, checked; the error names the bone and field.
     pub fn new(bones: Vec<Bone>) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if bones.is_empty() || bones.len() > MAX_BONES {
             return Err(RagdollError::OutOfRange {
                 context: "skeleton".to_owned(),
@@ -192,6 +195,7 @@ impl Skeleton {
 
     /// The bind pose, parent-local.
     pub fn bind_pose(&self) -> LocalPose {
+        let _mode = DefaultFloatMode::enter();
         LocalPose {
             bones: self.bones.iter().map(|b| b.bind).collect(),
         }
@@ -245,6 +249,7 @@ impl LocalPose {
     /// does not fit `skeleton` (count, a non-finite transform or
     /// non-unit rotation: the error names the bone).
     pub fn to_model(&self, skeleton: &Skeleton) -> Result<ModelPose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         skeleton.check("", &self.bones)?;
         let mut model: Vec<Transform> = Vec::with_capacity(self.bones.len());
         for (local, bone) in self.bones.iter().zip(&skeleton.bones) {
@@ -270,6 +275,7 @@ impl ModelPose {
     /// This pose in local space: each bone relative to its parent. Refused
     /// as [`LocalPose::to_model`] refuses.
     pub fn to_local(&self, skeleton: &Skeleton) -> Result<LocalPose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         skeleton.check("", &self.bones)?;
         let bones = self
             .bones
@@ -288,6 +294,7 @@ impl ModelPose {
     /// world (the mapper's and the transition's output) back in the model
     /// frame: `pose.in_world(model_to_world.inverse())`.
     pub fn in_world(&self, model_to_world: Transform) -> ModelPose {
+        let _mode = DefaultFloatMode::enter();
         ModelPose {
             bones: self.bones.iter().map(|&t| model_to_world * t).collect(),
         }
@@ -309,6 +316,7 @@ impl LocalPose {
         other: &LocalPose,
         weights: &[f32],
     ) -> Result<LocalPose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         skeleton.check("", &self.bones)?;
         skeleton.check("", &other.bones)?;
         crate::blend::check_weights(weights, skeleton.len(), |k| {

@@ -14,6 +14,7 @@ use toml::Spanned;
 use crate::error::{Problems, RagdollError, first};
 use crate::skeleton::{Bone, MAX_BONES, Skeleton, Transform};
 use crate::text::{Lines, floats, in_file, read_text, same_bits, string, syntax};
+use vertebra_math::DefaultFloatMode;
 
 /// The reference animation skeleton, shipped with the crate
 /// (`models/skeleton.toml`): 63 bones (a root, the hips, five spine bones,
@@ -52,6 +53,7 @@ impl Skeleton {
     /// when left out), kept as written. Errors about a bone start with the
     /// line of its `[[bone]]`.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         Self::check_toml(text).map_err(first)
     }
 
@@ -59,6 +61,7 @@ impl Skeleton {
     /// than the first (which is what `from_toml` says), in file order: one
     /// for text that does not parse, else one per bad bone.
     pub fn check_toml(text: &str) -> Result<Self, Vec<RagdollError>> {
+        let _mode = DefaultFloatMode::enter();
         let lines = Lines::new(text);
         let raw: RawSkeleton = toml::from_str(text)
             .map_err(|e| vec![syntax_naming("skeleton", text, &lines, &e, &["bone"])])?;
@@ -69,12 +72,14 @@ impl Skeleton {
     /// [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES); every error names the
     /// file (and the line, where there is one).
     pub fn from_file(path: &Path) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         Self::check_file(path).map_err(first)
     }
 
     /// [`Skeleton::from_file`], refused with every problem found
     /// ([`Skeleton::check_toml`]), each naming the file: `vertebra check`.
     pub fn check_file(path: &Path) -> Result<Self, Vec<RagdollError>> {
+        let _mode = DefaultFloatMode::enter();
         let text = read_text(path, "skeleton").map_err(|e| vec![e])?;
         Self::check_toml(&text)
             .map_err(|problems| problems.into_iter().map(|e| in_file(path, e)).collect())

@@ -11,6 +11,7 @@ use crate::drive::DriveSettings;
 use crate::error::RagdollError;
 use crate::joint_def::JointSpec;
 use crate::skeleton::{Skeleton, Transform};
+use vertebra_math::DefaultFloatMode;
 
 /// A body as a builder gives it (and as a `[[body]]` table reads).
 #[derive(Clone, Debug, PartialEq)]
@@ -195,6 +196,7 @@ impl RagdollBuilder {
     /// The description, checked as a file is; errors name the item and
     /// the field.
     pub fn build(self) -> Result<RagdollDesc, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         assemble(Document {
             name: self.name,
             total_mass: self.total_mass,

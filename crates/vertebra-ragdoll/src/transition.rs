@@ -23,6 +23,7 @@ use crate::mapper::{BoneRole, SkeletonMapper};
 use crate::mapping::SpineMapping;
 use crate::ragdoll::Ragdoll;
 use crate::skeleton::{LocalPose, ModelPose, Transform};
+use vertebra_math::DefaultFloatMode;
 
 /// The chain bones' offsets from the mapping at the switch to ragdoll.
 ///
@@ -98,6 +99,7 @@ impl Transition {
         mapping: SpineMapping,
         fade: f32,
     ) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if fade.is_nan() || fade < 0.0 {
             return Err(RagdollError::OutOfRange {
                 context: "transition".to_owned(),
@@ -131,6 +133,7 @@ impl Transition {
     /// The share of the offsets still applied `since_switch` seconds after
     /// the switch: 1 when held, 0 once the fade is over.
     pub fn weight(&self, since_switch: f32) -> f32 {
+        let _mode = DefaultFloatMode::enter();
         if self.fade == f32::INFINITY {
             1.0
         } else if self.fade == 0.0 {
@@ -144,6 +147,7 @@ impl Transition {
     /// The largest offset's translation (m) and rotation (rad) at the
     /// switch: how far the pure mapping would have moved a chain bone.
     pub fn largest_offset(&self) -> (f32, f32) {
+        let _mode = DefaultFloatMode::enter();
         self.offsets.iter().fold((0.0f32, 0.0f32), |(t, r), o| {
             (t.max(o.translation.length()), r.max(angle(o.rotation)))
         })
@@ -164,6 +168,7 @@ impl Transition {
         model_to_world: Transform,
         since_switch: f32,
     ) -> Result<ModelPose, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if since_switch.is_nan() || since_switch < 0.0 {
             return Err(RagdollError::OutOfRange {
                 context: "transition".to_owned(),

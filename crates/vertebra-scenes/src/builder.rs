@@ -9,9 +9,11 @@ use crate::{
     Scene, SceneConfig, SceneWorld, controllability, heavy_chain, hit_reaction, passive_bending,
     ragdoll_drop,
 };
+use vertebra_math::DefaultFloatMode;
 
 /// Builds `config`'s scene at its first frame.
 pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
+    let _mode = DefaultFloatMode::enter();
     let desc = config.description()?;
     let drive = config.drive()?;
     let world = config.world()?;

@@ -6,6 +6,7 @@ use vertebra_math::Backend;
 use vertebra_ragdoll::{Pose, RagdollError, SpineMapping};
 
 use crate::{Scene, SceneConfig, SceneWorld, build};
+use vertebra_math::DefaultFloatMode;
 
 /// The most frames a run takes: 4.6 hours at 60 Hz. A run keeps a record
 /// per frame (20 bytes), reserved up front from the count, so the bound
@@ -69,6 +70,7 @@ pub fn run(
     config: &SceneConfig,
     progress: impl FnMut(usize, usize),
 ) -> Result<SceneRun, RagdollError> {
+    let _mode = DefaultFloatMode::enter();
     run_observed(config, progress, |_, _| Ok(()))
 }
 
@@ -79,6 +81,7 @@ pub fn run_observed<E: From<RagdollError>>(
     mut progress: impl FnMut(usize, usize),
     mut observe: impl FnMut(usize, &SceneWorld) -> Result<(), E>,
 ) -> Result<SceneRun, E> {
+    let _mode = DefaultFloatMode::enter();
     let frames = config.frames.unwrap_or(config.scene.default_frames());
     if !(1..=MAX_FRAMES).contains(&frames) {
         return Err(RagdollError::OutOfRange {

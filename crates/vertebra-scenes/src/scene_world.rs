@@ -9,6 +9,7 @@ use vertebra_ragdoll::{Pose, Ragdoll, RagdollError};
 use vertebra_world::{BodyHandle, Contact, JointHandle, RodHandle, World};
 
 use crate::{Frame, Scene};
+use vertebra_math::DefaultFloatMode;
 
 /// A built scene: its world, collisions and ragdolls, and what is
 /// measured. [`SceneWorld::advance`] runs one frame as [`run`](crate::run)
@@ -81,6 +82,7 @@ impl SceneWorld {
     /// colliders), through a list kept from frame to frame
     /// (`World::swap_contacts`): no allocation once it has grown.
     pub fn detect(&mut self, dt: f32) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         if let Some(collisions) = &mut self.collisions {
             collisions.find_contacts_into(&self.world, dt, &mut self.contacts)?;
             self.world.swap_contacts(&mut self.contacts)?;
@@ -92,6 +94,7 @@ impl SceneWorld {
     /// push of figure 7 (controllability, frames 30 to 90), the hits due
     /// this frame, the step.
     pub fn advance(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         self.detect(dt)?;
         if let (Some((body, force)), Scene::Controllability, true) =
             (self.push, scene, (30..90).contains(&frame))
@@ -116,6 +119,7 @@ impl SceneWorld {
     /// [`SceneConfig::measure_residuals`](crate::SceneConfig::measure_residuals)
     /// off.
     pub fn measure(&self, world: &World) -> Frame {
+        let _mode = DefaultFloatMode::enter();
         let r = world
             .residuals()
             .expect("the residuals are measured after every step or on demand");

@@ -8,6 +8,7 @@ use vertebra_ragdoll::{
 };
 
 use crate::SceneWorld;
+use vertebra_math::DefaultFloatMode;
 
 /// One mapper per ragdoll of a scene, onto the reference skeleton.
 pub struct SkeletonOut {
@@ -24,6 +25,7 @@ impl SkeletonOut {
     /// has a body without a bone of its name (a `--ragdoll` file of other
     /// names).
     pub fn new(scene: &SceneWorld) -> Result<Self, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         let skeleton = Skeleton::reference();
         let mappers = scene
             .ragdolls
@@ -47,6 +49,7 @@ impl SkeletonOut {
     /// ragdoll's root body as at bind pose: the root body's transform
     /// times its bind centre, inverted.
     pub fn poses(&self, scene: &SceneWorld) -> Result<Vec<ModelPose>, RagdollError> {
+        let _mode = DefaultFloatMode::enter();
         scene
             .ragdolls
             .iter()

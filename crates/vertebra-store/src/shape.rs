@@ -6,6 +6,7 @@ use core::f32::consts::PI;
 use glam::{Mat3, Vec3};
 
 use crate::error::{Error, check_finite, check_positive};
+use vertebra_math::DefaultFloatMode;
 
 /// A solid centred on its body's centre of mass, in the body frame.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -118,6 +119,7 @@ impl Shape {
     /// [`MassProperties::validate`] checks them: the mass (density times
     /// volume) within [`MASS_RANGE`], the inertia invertible.
     pub fn mass_properties(&self, density: f32) -> Result<MassProperties, Error> {
+        let _mode = DefaultFloatMode::enter();
         self.validate()?;
         self.check_size_range()?;
         check_positive("density", density)?;
@@ -136,6 +138,7 @@ impl Shape {
     /// within [`SIZE_RANGE`], the result checked as
     /// [`MassProperties::validate`] checks them.
     pub fn mass_properties_with_mass(&self, mass: f32) -> Result<MassProperties, Error> {
+        let _mode = DefaultFloatMode::enter();
         self.validate()?;
         self.check_size_range()?;
         check_mass(mass)?;

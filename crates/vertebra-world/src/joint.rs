@@ -6,6 +6,7 @@ use glam::{Quat, Vec3};
 use crate::drive::{AngularDrive, validate_drive};
 use serde::{Deserialize, Serialize};
 use vertebra_kernels::limited::LimitLane;
+use vertebra_math::DefaultFloatMode;
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, check_coordinate, check_unit_quat, check_unit_vec,
 };
@@ -262,6 +263,7 @@ impl JointDesc {
         anchor: Vec3,
         twist_axis: Vec3,
     ) -> Result<Self, Error> {
+        let _mode = DefaultFloatMode::enter();
         check_unit_vec("twist axis", twist_axis)?;
         let joint = Quat::from_rotation_arc(Vec3::X, twist_axis.normalize());
         let kind = JointKind::Socket(SwingTwist::FREE);
@@ -279,6 +281,7 @@ impl JointDesc {
         anchor: Vec3,
         axis: Vec3,
     ) -> Result<Self, Error> {
+        let _mode = DefaultFloatMode::enter();
         check_unit_vec("hinge axis", axis)?;
         let joint = Quat::from_rotation_arc(Vec3::X, axis.normalize());
         let kind = JointKind::Hinge {

@@ -7,6 +7,7 @@ use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
 
 use crate::drive::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
+use vertebra_math::DefaultFloatMode;
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, MAX_COORDINATE, check_coordinate, check_unit_quat,
     check_unit_vec,
@@ -148,6 +149,7 @@ impl RodDesc {
         body_b: BodyHandle,
         through: &[Vec3],
     ) -> Result<Self, Error> {
+        let _mode = DefaultFloatMode::enter();
         if body_a == body_b {
             return Err(Error::SameBody);
         }
