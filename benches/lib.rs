@@ -582,13 +582,23 @@ pub fn single_ragdoll_solved(
 /// iterations on one thread on `backend`, its residuals not measured, one
 /// second (60 frames) in: falling and landing, many contacts.
 pub fn direct_drop_scene(scene: Scene, spine: SpineMode, backend: BackendChoice) -> SceneWorld {
+    direct_drop_scene_at(scene, spine, backend, 60)
+}
+
+/// [`direct_drop_scene`] `frames` frames in.
+pub fn direct_drop_scene_at(
+    scene: Scene,
+    spine: SpineMode,
+    backend: BackendChoice,
+    frames: usize,
+) -> SceneWorld {
     let mut config = SceneConfig::new(scene, spine);
     (config.substeps, config.iterations) = (1, 4);
     (config.ragdolls, config.threads, config.backend) = (30, 1, backend);
     config.joints = JointSolver::Direct;
     config.measure_residuals = false;
     let mut world = build(&config).expect("the drop scene");
-    for frame in 0..60 {
+    for frame in 0..frames {
         world.advance(config.scene, frame, DT).expect("a frame");
     }
     world
