@@ -17,6 +17,11 @@ use vertebra_world::{BodyHandle, Error};
 
 use crate::{CollisionGroups, Collisions};
 
+/// The most groups a set gives ragdolls whose self-collision is off: 2^48
+/// (a ragdoll's turned off a million times a second for nine years), as a
+/// world's slot table gives at most 2^48 generations.
+pub const MAX_SELF_COLLISION_GROUPS: u64 = 1 << 48;
+
 /// The error for a body that has no collider in the set.
 fn no_collider() -> Error {
     Error::StaleHandle("collider body")
@@ -53,7 +58,11 @@ impl Collisions {
     /// (cheaper, and what a game wants of a ragdoll whose limbs may pass
     /// through each other). Its bodies keep colliding with everything else.
     /// Jointed pairs are never tested either way. Refused, with nothing
-    /// changed, as [`Collisions::set_ragdoll_groups`] is.
+    /// changed, as [`Collisions::set_ragdoll_groups`] is, and when turning
+    /// it off would take a group beyond the [`MAX_SELF_COLLISION_GROUPS`]
+    /// the set ever gives (only a restored snapshot's counter gets near
+    /// it): `Error::Collider` naming the ragdoll's first body and its first
+    /// collider, `OutOfRange` as the reason.
     pub fn set_ragdoll_self_collision(
         &mut self,
         ragdoll: &Ragdoll,
@@ -61,15 +70,39 @@ impl Collisions {
     ) -> Result<(), Error> {
         let bodies = ragdoll_bodies(ragdoll);
         self.check_colliders(&bodies)?;
+        // Every group below the counter may be in use: one more is the
+        // counter itself, and the counter goes up by one, never past the
+        // limit (so never wraps onto a group in use).
+        let given = if collide {
+            None
+        } else {
+            let next = self.next_apart.checked_add(1);
+            match next.filter(|&n| n <= MAX_SELF_COLLISION_GROUPS) {
+                Some(next) => Some((self.next_apart, next)),
+                None => return Err(self.groups_exhausted(bodies[0])),
+            }
+        };
         for body in &bodies {
             self.apart.remove(body);
         }
-        if !collide {
-            let group = self.next_apart;
-            self.next_apart += 1;
+        if let Some((group, next)) = given {
+            self.next_apart = next;
             self.apart.extend(bodies.iter().map(|&b| (b, group)));
         }
         Ok(())
+    }
+
+    /// The refusal of a group past [`MAX_SELF_COLLISION_GROUPS`] for the
+    /// ragdoll whose first body is `body` (which has a collider: checked).
+    fn groups_exhausted(&self, body: BodyHandle) -> Error {
+        let index = self.colliders().position(|c| c.body == body);
+        Error::Collider {
+            index: index.unwrap_or(0),
+            body,
+            reason: Box::new(Error::OutOfRange(
+                "ragdoll self-collision group (all 2^48 given)",
+            )),
+        }
     }
 
     /// Whether the bodies of `ragdoll` collide with each other (see

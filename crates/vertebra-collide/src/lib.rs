@@ -41,6 +41,7 @@ use vertebra_math::DefaultFloatMode;
 use vertebra_ragdoll::{BuildOptions, Ragdoll, RagdollDesc, RagdollError};
 use vertebra_world::{BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, World};
 
+pub use groups::MAX_SELF_COLLISION_GROUPS;
 pub use snapshot::CollisionSnapshot;
 
 /// Which colliders may touch (Rapier's `InteractionGroups`): a pair is

@@ -7,7 +7,8 @@
 //! groups) in the set's order, the excluded pairs in a canonical order
 //! (so equal sets give equal bytes), then the ragdolls' self-collision
 //! settings: every body whose self-collision is off with its ragdoll's
-//! group (u64), in a canonical order, and the next group to be given. The
+//! group (u64), in a canonical order, and the next group to be given (at
+//! most [`MAX_SELF_COLLISION_GROUPS`](crate::MAX_SELF_COLLISION_GROUPS)). The
 //! parry geometry is rebuilt from the shapes, exactly as
 //! [`Collisions::add`] builds it.
 //!
@@ -20,7 +21,7 @@
 use serde::{Deserialize, Serialize};
 use vertebra_world::{BodyHandle, Error, World};
 
-use crate::{Collider, Collisions, check_prediction, ordered};
+use crate::{Collider, Collisions, MAX_SELF_COLLISION_GROUPS, check_prediction, ordered};
 use vertebra_math::DefaultFloatMode;
 
 const MAGIC: &[u8; 8] = b"VTBCOLLS";
@@ -85,10 +86,13 @@ impl Collisions {
     /// naming the collider and its body for a collider [`Collisions::add`]
     /// would refuse or whose body is not in `world`; `NonFinite` or
     /// `NonPositive` for a margin [`Collisions::set_prediction`] would
-    /// refuse; `CorruptSnapshot` naming the entry for a self-collision
-    /// setting the API could not have made (a body twice, a body without a
-    /// collider, a group not yet given). A set's own snapshot always
-    /// restores into its world. The set is unchanged on error.
+    /// refuse; `CorruptSnapshot` naming the entry for a list the set could
+    /// not have written (an excluded pair or self-collision entry out of
+    /// the canonical order or repeated, a pair's bodies out of order), for
+    /// a self-collision setting the API could not have made (a body twice,
+    /// a body without a collider, a group not yet given) and for a group
+    /// counter beyond [`MAX_SELF_COLLISION_GROUPS`]. A set's own snapshot
+    /// always restores into its world. The set is unchanged on error.
     pub fn restore(&mut self, snapshot: &CollisionSnapshot, world: &World) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         let state = decode(&snapshot.bytes)?;
@@ -103,12 +107,23 @@ impl Collisions {
             }
             restored.add(collider)?;
         }
-        restored.excluded = state
-            .excluded
-            .into_iter()
-            .map(|(a, b)| ordered(a, b))
-            .collect();
+        for (k, &(a, b)) in state.excluded.iter().enumerate() {
+            if ordered(a, b) != (a, b) {
+                return Err(Error::CorruptSnapshot(format!(
+                    "excluded pair {k}: its bodies out of order"
+                )));
+            }
+        }
+        check_canonical("excluded pair", &state.excluded)?;
+        restored.excluded = state.excluded.into_iter().collect();
+        if state.next_apart > MAX_SELF_COLLISION_GROUPS {
+            return Err(Error::CorruptSnapshot(format!(
+                "self-collision groups: {} given, more than the 2^48 a set gives",
+                state.next_apart
+            )));
+        }
         restored.next_apart = state.next_apart;
+        check_canonical("self-collision entry", &state.apart)?;
         for (k, (body, group)) in state.apart.into_iter().enumerate() {
             restored.check_apart(body, group).map_err(|why| {
                 Error::CorruptSnapshot(format!("self-collision entry {k}: {why}"))
@@ -117,6 +132,19 @@ impl Collisions {
         }
         *self = restored;
         Ok(())
+    }
+}
+
+/// Refuses a list [`Collisions::snapshot`] could not have written: each
+/// entry once, in the canonical order it writes (ascending by encoding).
+fn check_canonical<T: Serialize>(what: &str, entries: &[T]) -> Result<(), Error> {
+    let keys: Vec<Vec<u8>> = entries.iter().map(encode).collect();
+    match keys.windows(2).position(|pair| pair[0] >= pair[1]) {
+        Some(k) => Err(Error::CorruptSnapshot(format!(
+            "{what} {}: out of order or repeated",
+            k + 1
+        ))),
+        None => Ok(()),
     }
 }
 

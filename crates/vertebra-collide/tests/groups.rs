@@ -5,7 +5,10 @@
 //! saved with the set, checked on restore, and a refusal changes nothing.
 
 use glam::{Quat, Vec3};
-use vertebra_collide::{Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions};
+use vertebra_collide::{
+    Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions,
+    MAX_SELF_COLLISION_GROUPS,
+};
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
 use vertebra_world::{BodyDesc, BodyHandle, Error, Shape, SolverConfig, World};
 
@@ -273,4 +276,96 @@ fn self_collision_settings_are_saved_restored_and_checked() {
         ))
     );
     assert_eq!(c.snapshot(), before);
+}
+
+/// `value` as a postcard varint (LEB128), appended to `bytes`.
+fn varint(mut value: u64, bytes: &mut Vec<u8>) {
+    while value >= 0x80 {
+        bytes.push(value as u8 | 0x80);
+        value >>= 7;
+    }
+    bytes.push(value as u8);
+}
+
+/// Issue 31, item 1. A collision snapshot's group counter (the next group
+/// to give, the payload's last varint) set to `u64::MAX` with the checksum
+/// made right was restored as `Ok`; turning one more ragdoll's
+/// self-collision off then overflowed it (a panic in debug builds, 0 in
+/// release: two ragdolls in one group, which pass through each other, and
+/// a set whose own next snapshot is refused). Now the counter is refused
+/// beyond `MAX_SELF_COLLISION_GROUPS` with the set unchanged; at the limit
+/// it is accepted, and the call that would give a group past it is refused
+/// naming the ragdoll's first body and collider, with nothing changed: the
+/// two overlapping ragdolls still meet.
+#[test]
+fn a_crafted_group_counter_is_refused_and_a_group_is_never_given_twice() {
+    let (mut w, mut c) = ground();
+    let desc = RagdollDesc::reference_humanoid();
+    let options = BuildOptions::new(SpineMode::Sockets);
+    let pose =
+        |x: f32| Pose::bind(&desc).moved(Vec3::ZERO, Quat::IDENTITY, Vec3::new(x, -0.1, 0.0));
+    let a = c
+        .build_ragdoll(&mut w, &desc, options, &pose(0.0), None)
+        .unwrap();
+    let b = c
+        .build_ragdoll(&mut w, &desc, options, &pose(0.15), None)
+        .unwrap();
+    c.set_ragdoll_self_collision(&a, false).unwrap();
+    let of = |r: &Ragdoll, body: BodyHandle| r.bodies.contains(&Some(body));
+    let crossing = |c: &Collisions, w: &World| {
+        let found = c.find_contacts(w, DT).unwrap();
+        let between = |k: &&vertebra_world::Contact| {
+            (of(&a, k.body_a) && of(&b, k.body_b)) || (of(&b, k.body_a) && of(&a, k.body_b))
+        };
+        found.iter().filter(between).count()
+    };
+    let meeting = crossing(&c, &w);
+    assert!(meeting > 0, "side by side, overlapping");
+    let good = c.snapshot().as_bytes().to_vec();
+    assert_eq!(good.last(), Some(&1), "one group given");
+    let with_counter = |given: u64| {
+        let mut bytes = good[..good.len() - 1].to_vec();
+        varint(given, &mut bytes);
+        resealed(bytes)
+    };
+    let before = c.snapshot();
+    for given in [u64::MAX, MAX_SELF_COLLISION_GROUPS + 1] {
+        let refused = c.restore(&with_counter(given), &w);
+        assert_eq!(
+            refused,
+            Err(Error::CorruptSnapshot(format!(
+                "self-collision groups: {given} given, more than the 2^48 a set gives"
+            )))
+        );
+        assert_eq!(c.snapshot(), before, "refused, unchanged");
+    }
+    // At the limit: accepted, and no group past it is given.
+    c.restore(&with_counter(MAX_SELF_COLLISION_GROUPS), &w)
+        .unwrap();
+    let at_limit = c.snapshot();
+    let first = b.bodies[0].unwrap();
+    let index = c.colliders().position(|k| k.body == first).unwrap();
+    assert_eq!(
+        c.set_ragdoll_self_collision(&b, false),
+        Err(Error::Collider {
+            index,
+            body: first,
+            reason: Box::new(Error::OutOfRange(
+                "ragdoll self-collision group (all 2^48 given)"
+            )),
+        })
+    );
+    assert_eq!(c.snapshot(), at_limit, "refused, unchanged");
+    assert!(c.ragdoll_self_collision(&b));
+    assert_eq!(crossing(&c, &w), meeting);
+    // One below: the last group goes to the second ragdoll, which still
+    // meets the first, and the set's own snapshot restores.
+    c.restore(&with_counter(MAX_SELF_COLLISION_GROUPS - 1), &w)
+        .unwrap();
+    c.set_ragdoll_self_collision(&b, false).unwrap();
+    assert!(!c.ragdoll_self_collision(&a) && !c.ragdoll_self_collision(&b));
+    assert_eq!(crossing(&c, &w), meeting, "two groups: they still meet");
+    let last = c.snapshot();
+    c.restore(&last, &w).unwrap();
+    assert_eq!(c.snapshot(), last);
 }

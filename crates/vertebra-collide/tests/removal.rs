@@ -449,3 +449,70 @@ fn crafted_collision_snapshots_never_panic_nor_admit_a_bad_value() {
     eprintln!("crafted collision snapshots: {accepted} accepted, {refusals} refused");
     assert!(accepted > 0 && refusals > 0);
 }
+
+/// The payload's layout, as `docs/contacts.md` documents it (format 2).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Payload {
+    prediction: f32,
+    colliders: Vec<Collider>,
+    excluded: Vec<(BodyHandle, BodyHandle)>,
+    apart: Vec<(BodyHandle, u64)>,
+    next_apart: u64,
+}
+
+/// A change to a decoded payload.
+type Change = Box<dyn FnOnce(&mut Payload)>;
+
+/// `good` decoded, changed by `change`, encoded and sealed again.
+fn crafted(good: &CollisionSnapshot, change: impl FnOnce(&mut Payload)) -> CollisionSnapshot {
+    let bytes = good.as_bytes();
+    let mut payload: Payload = postcard::from_bytes(&bytes[20..]).unwrap();
+    change(&mut payload);
+    let body = postcard::to_allocvec(&payload).unwrap();
+    resealed([&bytes[..20], &body[..]].concat())
+}
+
+/// Issue 31, item 1 (every value a collision snapshot carries): the lists
+/// the set writes in a canonical order (so equal sets give equal bytes)
+/// were put back in any order, with entries repeated and a pair's bodies
+/// swapped, and normalised without a word. A set writes each excluded pair
+/// once, its bodies in slot order, and both lists ascending by their
+/// encoding: anything else is refused by name with the set unchanged.
+#[test]
+fn lists_the_set_could_not_have_written_are_refused_by_name() {
+    let (w, mut c, ragdolls) = pile();
+    c.set_ragdoll_self_collision(&ragdolls[1], false).unwrap();
+    let good = c.snapshot();
+    assert_eq!(crafted(&good, |_| {}), good, "the layout is the set's");
+    let corrupt = |why: &str| Err(Error::CorruptSnapshot(why.into()));
+    let cases: [(&str, Change); 5] = [
+        (
+            "excluded pair 1: out of order or repeated",
+            Box::new(|p| p.excluded.insert(0, p.excluded[0])),
+        ),
+        (
+            "excluded pair 1: out of order or repeated",
+            Box::new(|p| p.excluded.swap(0, 1)),
+        ),
+        (
+            "excluded pair 0: its bodies out of order",
+            Box::new(|p| {
+                let (a, b) = p.excluded[0];
+                p.excluded[0] = (b, a);
+            }),
+        ),
+        (
+            "self-collision entry 1: out of order or repeated",
+            Box::new(|p| p.apart.swap(0, 1)),
+        ),
+        (
+            "self-collision entry 1: out of order or repeated",
+            Box::new(|p| p.apart.insert(0, p.apart[0])),
+        ),
+    ];
+    for (why, change) in cases {
+        let bad = crafted(&good, change);
+        assert_eq!(c.restore(&bad, &w), corrupt(why));
+        assert_eq!(c.snapshot(), good, "{why}: refused, unchanged");
+    }
+}
