@@ -1426,6 +1426,62 @@ fn corrupt_snapshot_bytes_are_refused_with_the_world_unchanged() {
     assert!(layer.bytes() == before.1);
 }
 
+/// The layer's snapshot `bytes` with its last varint (the group counter)
+/// set to `given` and the payload checksum made right again (the format
+/// is documented: magic 8, version 4, xxh3 8, payload).
+fn with_group_counter(bytes: &[u8], mut given: u64) -> Vec<u8> {
+    assert_eq!(bytes.last(), Some(&1), "one group given");
+    let mut out = bytes[..bytes.len() - 1].to_vec();
+    while given >= 0x80 {
+        out.push(given as u8 | 0x80);
+        given >>= 7;
+    }
+    out.push(given as u8);
+    let sum = xxhash_rust::xxh3::xxh3_64(&out[20..]);
+    out[12..20].copy_from_slice(&sum.to_le_bytes());
+    out
+}
+
+/// Issue 31, item 1, through C: a layer's snapshot whose group counter is
+/// `u64::MAX` (checksum made right) was restored by `vt_collisions_restore`
+/// as `VT_RESULT_OK`, and the next ragdoll's self-collision turned off
+/// wrapped it. Refused now, the layer unchanged; at the limit it restores,
+/// and the group past it is refused (`VT_RESULT_COLLIDER`, the ragdoll's
+/// first body named), the layer unchanged.
+#[test]
+fn a_crafted_group_counter_is_refused_through_c() {
+    let scene = Drop_::new(VtSpineMode::Sockets);
+    // SAFETY: live objects.
+    ok(unsafe { vt_collisions_set_ragdoll_self_collision(scene.layer.0, scene.ragdoll, 0) });
+    let good = scene.layer.bytes();
+    let world = scene.world.0;
+    let restore = |bytes: &[u8]| {
+        // SAFETY: live objects; readable bytes.
+        unsafe { vt_collisions_restore(scene.layer.0, world, bytes.as_ptr(), bytes.len()) }
+    };
+    let wrapped = with_group_counter(&good, u64::MAX);
+    refused(
+        restore(&wrapped),
+        VtResult::CorruptSnapshot,
+        &["self-collision groups", "18446744073709551615 given"],
+    );
+    assert!(scene.layer.bytes() == good, "refused, unchanged");
+    ok(restore(&with_group_counter(
+        &good,
+        vertebra_collide::MAX_SELF_COLLISION_GROUPS,
+    )));
+    let at_limit = scene.layer.bytes();
+    // SAFETY: live objects.
+    ok(unsafe { vt_collisions_set_ragdoll_self_collision(scene.layer.0, scene.ragdoll, 1) });
+    let on = scene.layer.bytes();
+    assert!(on != at_limit);
+    // SAFETY: live objects.
+    let r = unsafe { vt_collisions_set_ragdoll_self_collision(scene.layer.0, scene.ragdoll, 0) };
+    refused(r, VtResult::Collider, &["self-collision group", "2^48"]);
+    assert!(scene.layer.bytes() == on, "refused, unchanged");
+    scene.step(2);
+}
+
 /// One C world and its Rust twin with the same three boxes.
 struct Twins {
     c: CWorld,
