@@ -161,12 +161,19 @@ int main(int argc, char **argv) {
     OK(vt_collisions_update(collisions, world, dt));
     OK(vt_world_step(world, dt));
 
-    /* Snapshots: damaged bytes are refused, the world kept. */
+    /* Snapshots: damaged bytes are refused, the world kept. The layer's
+     * snapshot is taken with the world's, and restored after it: until
+     * then the layer refuses the restored world. */
     VtBytes *snapshot = NULL;
+    VtBytes *layer_snapshot = NULL;
     OK(vt_world_snapshot(world, &snapshot));
+    OK(vt_collisions_snapshot(collisions, world, &layer_snapshot));
     const uint8_t *data = NULL;
     size_t size = 0;
+    const uint8_t *layer_data = NULL;
+    size_t layer_size = 0;
     OK(vt_bytes_data(snapshot, &data, &size));
+    OK(vt_bytes_data(layer_snapshot, &layer_data, &layer_size));
     OK(vt_world_state_hash(world, &before));
     expect("half a snapshot", vt_world_restore(world, data, size / 2),
            VT_RESULT_CORRUPT_SNAPSHOT, NULL);
@@ -176,7 +183,12 @@ int main(int argc, char **argv) {
         return 1;
     }
     OK(vt_world_restore(world, data, size));
+    expect("a world restored without its layer", vt_collisions_update(collisions, world, dt),
+           VT_RESULT_WORLD_MISMATCH, "restored a snapshot");
+    OK(vt_collisions_restore(collisions, world, layer_data, layer_size));
+    OK(vt_collisions_update(collisions, world, dt));
     vt_bytes_destroy(snapshot);
+    vt_bytes_destroy(layer_snapshot);
 
     /* The job system: no callback, too many workers. */
     VtTaskSystem tasks = {4u, NULL, NULL};

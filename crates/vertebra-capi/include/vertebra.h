@@ -71,6 +71,11 @@ typedef enum VtResult {
   // An object a panic left poisoned: every call on it but its destroy
   // is refused.
   VT_RESULT_POISONED = 26,
+  // A collision layer used with, or restored for, a world it does not
+  // serve: the world restored a snapshot without the layer's snapshot
+  // taken with it, it is another world, or the layer's snapshot was
+  // taken with another state of the world (other bodies).
+  VT_RESULT_WORLD_MISMATCH = 27,
 } VtResult;
 
 // Which instruction set the kernels use.
@@ -995,22 +1000,39 @@ enum VtResult vt_collisions_set_prediction(struct VtCollisions *collisions, floa
 // seconds and hands them to the world for its next step (in place of
 // `vt_world_set_contacts`). A steady update allocates nothing.
 //
+// A layer serves one world as its state runs on: after
+// `vt_world_restore`, restore the layer's snapshot taken with the
+// world's (`vt_collisions_restore`), or every call of the layer that
+// takes the world is refused with `VT_RESULT_WORLD_MISMATCH` (the
+// world's bodies may not be those the layer knows: a restored ragdoll
+// would have no colliders). A new layer refuses a restored world too;
+// `vt_collisions_attach` declares a layer right for the world as it is.
+//
 // # Safety
 // `collisions` and `world` are live.
 enum VtResult vt_collisions_update(struct VtCollisions *collisions,
                                    struct VtWorld *world,
                                    float dt);
 
-// Writes a snapshot of the layer (colliders, groups, exclusions) into
-// `snapshot`, owned by the caller (`vt_bytes_destroy`).
+// Writes a snapshot of the layer (colliders, groups, exclusions, and the
+// identity of `world`'s bodies) into `snapshot`, owned by the caller
+// (`vt_bytes_destroy`). Take it with `vt_world_snapshot` of the world it
+// serves, at the same moment, and restore the two together (the world
+// first). `VT_RESULT_WORLD_MISMATCH` for a world the layer does not serve
+// (see `vt_collisions_update`).
 //
 // # Safety
-// `collisions` is live; `snapshot` is writable.
-enum VtResult vt_collisions_snapshot(struct VtCollisions *collisions, struct VtBytes **snapshot);
+// `collisions` and `world` are live; `snapshot` is writable.
+enum VtResult vt_collisions_snapshot(struct VtCollisions *collisions,
+                                     struct VtWorld *world,
+                                     struct VtBytes **snapshot);
 
 // Restores the layer from `length` bytes of its snapshot, checked against
-// `world` (restore the world first): refused, unchanged, for a collider
-// on a body the world lacks or damaged bytes.
+// `world` (restore the world first, from its snapshot taken with the
+// layer's): refused, unchanged, for a collider on a body the world lacks,
+// damaged bytes, or a world whose bodies are not those the snapshot was
+// taken with (`VT_RESULT_WORLD_MISMATCH`: a world snapshot of another
+// moment). The layer serves `world` from then on.
 //
 // # Safety
 // `collisions` and `world` are live; `data` points to `length` readable
@@ -1019,6 +1041,17 @@ enum VtResult vt_collisions_restore(struct VtCollisions *collisions,
                                     struct VtWorld *world,
                                     const uint8_t *data,
                                     size_t length);
+
+// Declares that the layer, as it is, serves `world` from now on: for a
+// world restored without the layer's snapshot when the layer is known to
+// be right for it (colliders added for the bodies of a world restored from
+// a snapshot taken before the layer existed). Refused, unchanged, naming
+// the collider, when a collider's body is not in `world`. Restoring the
+// layer's snapshot taken with the world's is the usual way.
+//
+// # Safety
+// `collisions` and `world` are live.
+enum VtResult vt_collisions_attach(struct VtCollisions *collisions, struct VtWorld *world);
 
 // Sets the contacts for the next step (`count` of them; they replace the
 // last set). Refused whole, naming the contact, if any is invalid.
@@ -1475,7 +1508,10 @@ enum VtResult vt_world_snapshot(struct VtWorld *world, struct VtBytes **snapshot
 // Restores the world from `length` bytes of a snapshot (copied; the
 // caller keeps them). Refused, with the world unchanged, for bytes of
 // another build or any state the API could not have produced. The world
-// takes the snapshot's handles: those of the world that took it work.
+// takes the snapshot's handles: those of the world that took it work. A
+// collision layer serving the world refuses it from then on
+// (`VT_RESULT_WORLD_MISMATCH`) until the layer's snapshot taken with this
+// one is restored after it (`vt_collisions_restore`).
 //
 // # Safety
 // `world` is a live world; `data` points to `length` readable bytes.

@@ -281,6 +281,14 @@ pub unsafe extern "C" fn vt_collisions_set_prediction(
 /// seconds and hands them to the world for its next step (in place of
 /// `vt_world_set_contacts`). A steady update allocates nothing.
 ///
+/// A layer serves one world as its state runs on: after
+/// `vt_world_restore`, restore the layer's snapshot taken with the
+/// world's (`vt_collisions_restore`), or every call of the layer that
+/// takes the world is refused with `VT_RESULT_WORLD_MISMATCH` (the
+/// world's bodies may not be those the layer knows: a restored ragdoll
+/// would have no colliders). A new layer refuses a restored world too;
+/// `vt_collisions_attach` declares a layer right for the world as it is.
+///
 /// # Safety
 /// `collisions` and `world` are live.
 #[unsafe(no_mangle)]
@@ -304,14 +312,19 @@ pub unsafe extern "C" fn vt_collisions_update(
     }
 }
 
-/// Writes a snapshot of the layer (colliders, groups, exclusions) into
-/// `snapshot`, owned by the caller (`vt_bytes_destroy`).
+/// Writes a snapshot of the layer (colliders, groups, exclusions, and the
+/// identity of `world`'s bodies) into `snapshot`, owned by the caller
+/// (`vt_bytes_destroy`). Take it with `vt_world_snapshot` of the world it
+/// serves, at the same moment, and restore the two together (the world
+/// first). `VT_RESULT_WORLD_MISMATCH` for a world the layer does not serve
+/// (see `vt_collisions_update`).
 ///
 /// # Safety
-/// `collisions` is live; `snapshot` is writable.
+/// `collisions` and `world` are live; `snapshot` is writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vt_collisions_snapshot(
     collisions: *mut VtCollisions,
+    world: *mut VtWorld,
     snapshot: *mut *mut VtBytes,
 ) -> VtResult {
     // SAFETY: the function's contract.
@@ -319,7 +332,8 @@ pub unsafe extern "C" fn vt_collisions_snapshot(
     // SAFETY: the function's contract.
     unsafe {
         with_layer(collisions, |layer| {
-            let bytes = layer.collisions.snapshot().as_bytes().to_vec();
+            let world = enter(world)?;
+            let bytes = layer.collisions.snapshot(&world.world)?.as_bytes().to_vec();
             snapshot?.set(boxed(VtBytes { bytes }));
             Ok(())
         })
@@ -327,8 +341,11 @@ pub unsafe extern "C" fn vt_collisions_snapshot(
 }
 
 /// Restores the layer from `length` bytes of its snapshot, checked against
-/// `world` (restore the world first): refused, unchanged, for a collider
-/// on a body the world lacks or damaged bytes.
+/// `world` (restore the world first, from its snapshot taken with the
+/// layer's): refused, unchanged, for a collider on a body the world lacks,
+/// damaged bytes, or a world whose bodies are not those the snapshot was
+/// taken with (`VT_RESULT_WORLD_MISMATCH`: a world snapshot of another
+/// moment). The layer serves `world` from then on.
 ///
 /// # Safety
 /// `collisions` and `world` are live; `data` points to `length` readable
@@ -348,6 +365,29 @@ pub unsafe extern "C" fn vt_collisions_restore(
             let world = enter(world)?;
             let snapshot = CollisionSnapshot::from_bytes(data?.to_vec());
             Ok(layer.collisions.restore(&snapshot, &world.world)?)
+        })
+    }
+}
+
+/// Declares that the layer, as it is, serves `world` from now on: for a
+/// world restored without the layer's snapshot when the layer is known to
+/// be right for it (colliders added for the bodies of a world restored from
+/// a snapshot taken before the layer existed). Refused, unchanged, naming
+/// the collider, when a collider's body is not in `world`. Restoring the
+/// layer's snapshot taken with the world's is the usual way.
+///
+/// # Safety
+/// `collisions` and `world` are live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_attach(
+    collisions: *mut VtCollisions,
+    world: *mut VtWorld,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let world = enter(world)?;
+            Ok(layer.collisions.attach(&world.world)?)
         })
     }
 }

@@ -74,6 +74,11 @@ pub enum VtResult {
     /// An object a panic left poisoned: every call on it but its destroy
     /// is refused.
     Poisoned = 26,
+    /// A collision layer used with, or restored for, a world it does not
+    /// serve: the world restored a snapshot without the layer's snapshot
+    /// taken with it, it is another world, or the layer's snapshot was
+    /// taken with another state of the world (other bodies).
+    WorldMismatch = 27,
 }
 
 /// A refusal: its code and message.
@@ -117,6 +122,7 @@ fn code(error: &Error) -> VtResult {
         Error::IncompatibleSnapshot(_) => VtResult::IncompatibleSnapshot,
         Error::CorruptSnapshot(_) => VtResult::CorruptSnapshot,
         Error::Collider { .. } => VtResult::Collider,
+        Error::WorldMismatch(_) => VtResult::WorldMismatch,
     }
 }
 
@@ -192,6 +198,7 @@ pub extern "C" fn vt_result_name(result: u32) -> *const c_char {
         24 => c"VT_RESULT_RAGDOLL",
         25 => c"VT_RESULT_PANIC",
         26 => c"VT_RESULT_POISONED",
+        27 => c"VT_RESULT_WORLD_MISMATCH",
         _ => c"VT_RESULT_UNKNOWN",
     };
     name.as_ptr()

@@ -76,7 +76,10 @@ pub unsafe extern "C" fn vt_world_snapshot(
 /// Restores the world from `length` bytes of a snapshot (copied; the
 /// caller keeps them). Refused, with the world unchanged, for bytes of
 /// another build or any state the API could not have produced. The world
-/// takes the snapshot's handles: those of the world that took it work.
+/// takes the snapshot's handles: those of the world that took it work. A
+/// collision layer serving the world refuses it from then on
+/// (`VT_RESULT_WORLD_MISMATCH`) until the layer's snapshot taken with this
+/// one is restored after it (`vt_collisions_restore`).
 ///
 /// # Safety
 /// `world` is a live world; `data` points to `length` readable bytes.

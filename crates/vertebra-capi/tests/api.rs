@@ -1193,6 +1193,7 @@ fn every_result_code_has_its_name() {
         (VtResult::Ragdoll, "VT_RESULT_RAGDOLL"),
         (VtResult::Panic, "VT_RESULT_PANIC"),
         (VtResult::Poisoned, "VT_RESULT_POISONED"),
+        (VtResult::WorldMismatch, "VT_RESULT_WORLD_MISMATCH"),
     ];
     for (k, (code, name)) in codes.into_iter().enumerate() {
         assert_eq!(code as u32, k as u32, "{name}: the codes count up from 0");
@@ -1200,7 +1201,7 @@ fn every_result_code_has_its_name() {
         let got = unsafe { CStr::from_ptr(vt_result_name(code as u32)) };
         assert_eq!(got.to_str(), Ok(name));
     }
-    for unknown in [27, 1000, u32::MAX] {
+    for unknown in [28, 1000, u32::MAX] {
         // SAFETY: as above.
         let got = unsafe { CStr::from_ptr(vt_result_name(unknown)) };
         assert_eq!(got.to_str(), Ok("VT_RESULT_UNKNOWN"));
@@ -1218,10 +1219,11 @@ impl CLayer {
         Self(layer)
     }
 
-    fn bytes(&self) -> Vec<u8> {
+    /// The layer's snapshot, taken with `world`, which it serves.
+    fn bytes(&self, world: &CWorld) -> Vec<u8> {
         let mut snapshot = null_mut();
-        // SAFETY: a live layer; writable.
-        ok(unsafe { vt_collisions_snapshot(self.0, &mut snapshot) });
+        // SAFETY: live objects; writable.
+        ok(unsafe { vt_collisions_snapshot(self.0, world.0, &mut snapshot) });
         let (mut data, mut length) = (null(), 0);
         // SAFETY: live bytes; writable outputs.
         ok(unsafe { vt_bytes_data(snapshot, &mut data, &mut length) });
@@ -1351,7 +1353,7 @@ fn lifted_bind(desc: &CDesc, lift: f32) -> Vec<VtTransform> {
 fn a_snapshot_restored_into_a_fresh_world_steps_as_the_original() {
     let scene = Drop_::new(VtSpineMode::Rod);
     scene.step(20);
-    let (world_bytes, layer_bytes) = (scene.world.bytes(), scene.layer.bytes());
+    let (world_bytes, layer_bytes) = (scene.world.bytes(), scene.layer.bytes(&scene.world));
     let fresh = CWorld::new();
     let layer = CLayer::new();
     // SAFETY: live objects; the bytes are readable.
@@ -1359,7 +1361,7 @@ fn a_snapshot_restored_into_a_fresh_world_steps_as_the_original() {
     // SAFETY: as above.
     ok(unsafe { vt_collisions_restore(layer.0, fresh.0, layer_bytes.as_ptr(), layer_bytes.len()) });
     assert_eq!(fresh.hash(), scene.world.hash());
-    assert!(layer.bytes() == layer_bytes);
+    assert!(layer.bytes(&fresh) == layer_bytes);
     scene.step(30);
     for _ in 0..30 {
         // SAFETY: live objects.
@@ -1370,15 +1372,62 @@ fn a_snapshot_restored_into_a_fresh_world_steps_as_the_original() {
     assert_ne!(fresh.hash(), CWorld::new().hash(), "the ragdoll moved");
 }
 
+/// Issue 31, item 10, through C: a world restored without its layer's
+/// snapshot (here, to before its ragdoll fell 20 frames) is refused by
+/// every layer call that takes it (`VT_RESULT_WORLD_MISMATCH`), the
+/// layer unchanged, until the layer's snapshot taken with the world's is
+/// restored; a new layer refuses a restored world until it is restored
+/// or attached.
+#[test]
+fn a_world_restored_without_its_layer_is_refused_through_c() {
+    let scene = Drop_::new(VtSpineMode::Rod);
+    let (world_bytes, layer_bytes) = (scene.world.bytes(), scene.layer.bytes(&scene.world));
+    scene.step(20);
+    let restore_world = |world: &CWorld| {
+        // SAFETY: a live world; readable bytes.
+        ok(unsafe { vt_world_restore(world.0, world_bytes.as_ptr(), world_bytes.len()) })
+    };
+    restore_world(&scene.world);
+    // SAFETY: live objects.
+    let r = unsafe { vt_collisions_update(scene.layer.0, scene.world.0, DT) };
+    refused(r, VtResult::WorldMismatch, &["restored a snapshot"]);
+    let mut snapshot = null_mut();
+    // SAFETY: live objects; writable.
+    let r = unsafe { vt_collisions_snapshot(scene.layer.0, scene.world.0, &mut snapshot) };
+    refused(r, VtResult::WorldMismatch, &["restored a snapshot"]);
+    assert!(snapshot.is_null(), "nothing written");
+    // SAFETY: live objects; readable bytes.
+    ok(unsafe {
+        vt_collisions_restore(
+            scene.layer.0,
+            scene.world.0,
+            layer_bytes.as_ptr(),
+            layer_bytes.len(),
+        )
+    });
+    scene.step(20);
+    // A new layer for a loaded world: refused, then attached.
+    let loaded = CWorld::new();
+    restore_world(&loaded);
+    let layer = CLayer::new();
+    // SAFETY: live objects.
+    let r = unsafe { vt_collisions_update(layer.0, loaded.0, DT) };
+    refused(r, VtResult::WorldMismatch, &["never served"]);
+    // SAFETY: live objects.
+    ok(unsafe { vt_collisions_attach(layer.0, loaded.0) });
+    // SAFETY: live objects.
+    ok(unsafe { vt_collisions_update(layer.0, loaded.0, DT) });
+}
+
 #[test]
 fn corrupt_snapshot_bytes_are_refused_with_the_world_unchanged() {
     let scene = Drop_::new(VtSpineMode::Rod);
     scene.step(5);
     let bytes = scene.world.bytes();
-    let layer_bytes = scene.layer.bytes();
+    let layer_bytes = scene.layer.bytes(&scene.world);
     let target = Scene::new();
     let layer = CLayer::new();
-    let before = (target.world.bytes(), layer.bytes());
+    let before = (target.world.bytes(), layer.bytes(&target.world));
     let mut rejected = 0;
     let cuts = [0, 1, 8, bytes.len() / 2, bytes.len() - 1];
     for cut in cuts {
@@ -1415,7 +1464,7 @@ fn corrupt_snapshot_bytes_are_refused_with_the_world_unchanged() {
         }
     }
     assert!(rejected > 0);
-    assert!(before == (target.world.bytes(), layer.bytes()));
+    assert!(before == (target.world.bytes(), layer.bytes(&target.world)));
     // The layer's snapshot needs the bodies it names: refused against a
     // world without them.
     let empty = CWorld::new();
@@ -1423,7 +1472,7 @@ fn corrupt_snapshot_bytes_are_refused_with_the_world_unchanged() {
     let r =
         unsafe { vt_collisions_restore(layer.0, empty.0, layer_bytes.as_ptr(), layer_bytes.len()) };
     assert_ne!(r, VtResult::Ok);
-    assert!(layer.bytes() == before.1);
+    assert!(layer.bytes(&target.world) == before.1);
 }
 
 /// The layer's snapshot `bytes` with its last varint (the group counter)
@@ -1453,7 +1502,7 @@ fn a_crafted_group_counter_is_refused_through_c() {
     let scene = Drop_::new(VtSpineMode::Sockets);
     // SAFETY: live objects.
     ok(unsafe { vt_collisions_set_ragdoll_self_collision(scene.layer.0, scene.ragdoll, 0) });
-    let good = scene.layer.bytes();
+    let good = scene.layer.bytes(&scene.world);
     let world = scene.world.0;
     let restore = |bytes: &[u8]| {
         // SAFETY: live objects; readable bytes.
@@ -1465,20 +1514,23 @@ fn a_crafted_group_counter_is_refused_through_c() {
         VtResult::CorruptSnapshot,
         &["self-collision groups", "18446744073709551615 given"],
     );
-    assert!(scene.layer.bytes() == good, "refused, unchanged");
+    assert!(
+        scene.layer.bytes(&scene.world) == good,
+        "refused, unchanged"
+    );
     ok(restore(&with_group_counter(
         &good,
         vertebra_collide::MAX_SELF_COLLISION_GROUPS,
     )));
-    let at_limit = scene.layer.bytes();
+    let at_limit = scene.layer.bytes(&scene.world);
     // SAFETY: live objects.
     ok(unsafe { vt_collisions_set_ragdoll_self_collision(scene.layer.0, scene.ragdoll, 1) });
-    let on = scene.layer.bytes();
+    let on = scene.layer.bytes(&scene.world);
     assert!(on != at_limit);
     // SAFETY: live objects.
     let r = unsafe { vt_collisions_set_ragdoll_self_collision(scene.layer.0, scene.ragdoll, 0) };
     refused(r, VtResult::Collider, &["self-collision group", "2^48"]);
-    assert!(scene.layer.bytes() == on, "refused, unchanged");
+    assert!(scene.layer.bytes(&scene.world) == on, "refused, unchanged");
     scene.step(2);
 }
 
@@ -2556,7 +2608,7 @@ fn a_count_no_array_can_hold_is_refused_naming_it() {
 fn a_refused_collider_call_writes_nothing_and_adds_nothing() {
     let s = Scene::new();
     let layer = CLayer::new();
-    let before = layer.bytes();
+    let before = layer.bytes(&s.world);
     let mut storage = [0u64; 2];
     let odd = storage
         .as_mut_ptr()
@@ -2569,7 +2621,10 @@ fn a_refused_collider_call_writes_nothing_and_adds_nothing() {
         NULL,
         &["index", "aligned"],
     );
-    assert!(layer.bytes() == before, "a refused add added a collider");
+    assert!(
+        layer.bytes(&s.world) == before,
+        "a refused add added a collider"
+    );
     let mut bad = plane(s.ground);
     bad.plane_normal = v(0.0, NAN, 0.0);
     // SAFETY: as above.
@@ -2599,7 +2654,7 @@ fn a_refused_collider_call_writes_nothing_and_adds_nothing() {
         let r = unsafe { vt_collisions_set_prediction(layer.0, margin) };
         assert_ne!(r, VtResult::Ok, "{margin}");
     }
-    assert!(layer.bytes() == before);
+    assert!(layer.bytes(&s.world) == before);
 }
 
 #[test]

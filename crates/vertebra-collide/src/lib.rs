@@ -22,8 +22,16 @@
 //! [`Collisions::find_contacts`] refuse with [`Error::Collider`], naming the
 //! collider and its body. The set is saved and restored alongside the world
 //! with [`Collisions::snapshot`] and [`Collisions::restore`].
+//!
+//! A set serves one world's run of states (its `Timeline`): a world that
+//! restored a snapshot is refused ([`Error::WorldMismatch`]) until the
+//! set's own snapshot taken with the world's is restored after it, and a
+//! set's snapshot is refused for a world whose bodies are not those it was
+//! taken with. Restore both, the world first; [`Collisions::attach`]
+//! declares a set right for a world as it is.
 
 mod groups;
+mod pairing;
 mod snapshot;
 
 use std::collections::{HashMap, HashSet};
@@ -39,7 +47,9 @@ use parry3d::shape::{
 };
 use vertebra_math::DefaultFloatMode;
 use vertebra_ragdoll::{BuildOptions, Ragdoll, RagdollDesc, RagdollError};
-use vertebra_world::{BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, World};
+use vertebra_world::{
+    BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, Timeline, World,
+};
 
 pub use groups::MAX_SELF_COLLISION_GROUPS;
 pub use snapshot::CollisionSnapshot;
@@ -194,6 +204,10 @@ pub struct Collisions {
     apart: HashMap<BodyHandle, u64>,
     /// The group the next ragdoll whose self-collision goes off gets.
     next_apart: u64,
+    /// The world's run of states the set serves, once it has served one
+    /// (`pairing.rs`). Not part of the set's state: never saved; a clone
+    /// serves the same world.
+    serves: Option<Timeline>,
     /// Working memory of [`Collisions::find_contacts_into`] (not part of
     /// the set's state: never saved, and a clone's starts empty in effect,
     /// as every call rewrites it).
@@ -340,8 +354,9 @@ impl Collisions {
     /// call: how a ragdoll joins a world with collision detection. All or
     /// nothing: every capsule is checked as a collider before the build,
     /// and a refused build leaves the world as it was, so on error the
-    /// world and the set are unchanged (the error names the body). Its
-    /// inverse is [`Collisions::remove_ragdoll`].
+    /// world and the set are unchanged (the error names the body); refused
+    /// too for a world the set does not serve (`WorldMismatch`, see
+    /// [`Collisions::attach`]). Its inverse is [`Collisions::remove_ragdoll`].
     pub fn build_ragdoll(
         &mut self,
         world: &mut World,
@@ -351,6 +366,7 @@ impl Collisions {
         previous: Option<(&vertebra_ragdoll::Pose, f32)>,
     ) -> Result<Ragdoll, RagdollError> {
         let _mode = DefaultFloatMode::enter();
+        self.check_serves(world).map_err(unserved)?;
         let geometries = desc
             .bodies
             .iter()
@@ -371,6 +387,7 @@ impl Collisions {
         for (a, b) in ragdoll.non_colliding_pairs() {
             self.exclude(a, b);
         }
+        self.serve(world);
         Ok(ragdoll)
     }
 
@@ -380,17 +397,20 @@ impl Collisions {
     /// [`Collisions::build_ragdoll`] (and of `Ragdoll::build` followed by
     /// [`Collisions::add_ragdoll`]). All or nothing: when the ragdoll cannot be
     /// removed (a body or joint already gone, a body held by another
-    /// joint) the world, the set and the ragdoll are unchanged.
+    /// joint), or the set does not serve `world` (`WorldMismatch`), the
+    /// world, the set and the ragdoll are unchanged.
     pub fn remove_ragdoll(
         &mut self,
         world: &mut World,
         ragdoll: &mut Ragdoll,
     ) -> Result<(), RagdollError> {
+        self.check_serves(world).map_err(unserved)?;
         let bodies: Vec<BodyHandle> = ragdoll.bodies.iter().flatten().copied().collect();
         ragdoll.remove(world)?;
         for body in bodies {
             self.remove_body(body);
         }
+        self.serve(world);
         Ok(())
     }
 
@@ -398,7 +418,8 @@ impl Collisions {
     /// its colliders, excluded pairs and self-collision setting from the
     /// old bodies to the new ones (friction, groups and any extra
     /// colliders kept, in their places in the set). All or nothing, as
-    /// `Ragdoll::recreate`.
+    /// `Ragdoll::recreate`; refused with nothing changed for a world the
+    /// set does not serve (`WorldMismatch`).
     pub fn recreate_ragdoll(
         &mut self,
         world: &mut World,
@@ -407,6 +428,7 @@ impl Collisions {
         previous: Option<(&vertebra_ragdoll::Pose, f32)>,
     ) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
+        self.check_serves(world).map_err(unserved)?;
         let old = ragdoll.bodies.clone();
         ragdoll.recreate(world, pose, previous)?;
         let moved: HashMap<BodyHandle, BodyHandle> = old
@@ -424,6 +446,7 @@ impl Collisions {
             .map(|&(a, b)| ordered(to(a), to(b)))
             .collect();
         self.apart = self.apart.iter().map(|(&b, &g)| (to(b), g)).collect();
+        self.serve(world);
         Ok(())
     }
 
@@ -466,7 +489,10 @@ impl Collisions {
     /// fast body meets the floor instead of passing into it; a gap does
     /// nothing until it closes. `Err(Error::Collider)` names the first
     /// collider whose body is no longer in `world` (remove a body's
-    /// colliders with [`Collisions::remove_body`]). Allocates its list and
+    /// colliders with [`Collisions::remove_body`]); `Err(WorldMismatch)`
+    /// for a world the set does not serve: one that restored a snapshot
+    /// since without the set's own restored after it, or another world
+    /// (see [`Collisions::attach`]). Allocates its list and
     /// working memory every call: a game's loop uses
     /// [`Collisions::find_contacts_into`].
     pub fn find_contacts(&self, world: &World, dt: f32) -> Result<Vec<Contact>, Error> {
@@ -495,6 +521,9 @@ impl Collisions {
         let mut scratch = core::mem::take(&mut self.scratch);
         let found = self.detect(world, dt, &mut scratch, contacts);
         self.scratch = scratch;
+        if found.is_ok() {
+            self.serve(world);
+        }
         found
     }
 
@@ -508,6 +537,7 @@ impl Collisions {
         contacts: &mut Vec<Contact>,
     ) -> Result<(), Error> {
         contacts.clear();
+        self.check_serves(world)?;
         vertebra_world::check_positive("time step", dt)?;
         self.sleep_state(world, scratch)?;
         if !scratch.acts.contains(&true) {
@@ -805,6 +835,14 @@ fn push_manifold(
             friction,
             restitution,
         });
+    }
+}
+
+/// A refusal of the set's own check on the world, in a ragdoll call.
+fn unserved(error: Error) -> RagdollError {
+    RagdollError::World {
+        context: "the collision set".into(),
+        error,
     }
 }
 

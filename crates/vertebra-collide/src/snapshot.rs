@@ -2,7 +2,9 @@
 //! rollback and save games need both, since contacts come from the set.
 //!
 //! Bytes: `"VTBCOLLS"`, the format version (u32 LE), the xxh3 hash of the
-//! payload (u64 LE), then the payload (postcard): the prediction margin,
+//! payload (u64 LE), then the payload (postcard): the world's bodies it was
+//! taken with (a u64 hash of every live body's handle, `pairing.rs`), the
+//! prediction margin,
 //! every collider as it was added (body, shape, friction, restitution,
 //! groups) in the set's order, the excluded pairs in a canonical order
 //! (so equal sets give equal bytes), then the ragdolls' self-collision
@@ -12,24 +14,28 @@
 //! parry geometry is rebuilt from the shapes, exactly as
 //! [`Collisions::add`] builds it.
 //!
-//! Format versions: 1, without the self-collision settings; 2, with them.
+//! Format versions: 1, without the self-collision settings; 2, with them;
+//! 3, with the world's bodies (issue 31, item 10).
 //!
 //! The bytes are untrusted input: the checksum only catches accidents (it
 //! is not keyed), so [`Collisions::restore`] checks every value as
-//! strictly as the API does, and every collider's body against the world.
+//! strictly as the API does, every collider's body against the world, and
+//! that the world's bodies are those the snapshot was taken with.
 
 use serde::{Deserialize, Serialize};
 use vertebra_world::{BodyHandle, Error, World};
 
+use crate::pairing::{OTHER_BODIES, census};
 use crate::{Collider, Collisions, MAX_SELF_COLLISION_GROUPS, check_prediction, ordered};
 use vertebra_math::DefaultFloatMode;
 
 const MAGIC: &[u8; 8] = b"VTBCOLLS";
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 const HEADER: usize = 20;
 
-/// A collision set's full state at one instant: [`Collisions::snapshot`]
-/// takes it, [`Collisions::restore`] puts it back.
+/// A collision set's full state at one instant, with the identity of the
+/// world's bodies it served: [`Collisions::snapshot`] takes it,
+/// [`Collisions::restore`] puts it back.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct CollisionSnapshot {
     bytes: Vec<u8>,
@@ -49,6 +55,7 @@ impl CollisionSnapshot {
 
 #[derive(Serialize, Deserialize)]
 struct State {
+    census: u64,
     prediction: f32,
     colliders: Vec<Collider>,
     excluded: Vec<(BodyHandle, BodyHandle)>,
@@ -57,13 +64,19 @@ struct State {
 }
 
 impl Collisions {
-    /// The set's full state now (see [`CollisionSnapshot`]).
-    pub fn snapshot(&self) -> CollisionSnapshot {
+    /// The set's full state now, taken with `world`, the world it serves
+    /// (see [`CollisionSnapshot`]): take it with `World::snapshot`, at the
+    /// same moment, and restore the two together. `Err(WorldMismatch)`
+    /// for a world the set does not serve (see [`Collisions::attach`]): a
+    /// snapshot of it would tie the set to bodies it does not know.
+    pub fn snapshot(&self, world: &World) -> Result<CollisionSnapshot, Error> {
+        self.check_serves(world)?;
         let mut excluded: Vec<_> = self.excluded.iter().copied().collect();
         excluded.sort_by_cached_key(encode);
         let mut apart: Vec<_> = self.apart.iter().map(|(&b, &g)| (b, g)).collect();
         apart.sort_by_cached_key(encode);
         let state = State {
+            census: census(world),
             prediction: self.prediction,
             colliders: self.colliders().copied().collect(),
             excluded,
@@ -76,11 +89,13 @@ impl Collisions {
         bytes.extend_from_slice(&VERSION.to_le_bytes());
         bytes.extend_from_slice(&xxhash_rust::xxh3::xxh3_64(&payload).to_le_bytes());
         bytes.extend_from_slice(&payload);
-        CollisionSnapshot { bytes }
+        Ok(CollisionSnapshot { bytes })
     }
 
     /// Puts the set back to `snapshot`, for use with `world` (restore the
-    /// world first: every collider's body must be live in it).
+    /// world first, from its snapshot taken with this one: every collider's
+    /// body must be live in it, and its bodies those the snapshot was taken
+    /// with). From then on the set serves `world` as it is now.
     /// `Err(CorruptSnapshot)` for bytes that are not a collision-set
     /// snapshot of this version, damaged or undecodable; `Err(Collider)`
     /// naming the collider and its body for a collider [`Collisions::add`]
@@ -91,8 +106,12 @@ impl Collisions {
     /// the canonical order or repeated, a pair's bodies out of order), for
     /// a self-collision setting the API could not have made (a body twice,
     /// a body without a collider, a group not yet given) and for a group
-    /// counter beyond [`MAX_SELF_COLLISION_GROUPS`]. A set's own snapshot
-    /// always restores into its world. The set is unchanged on error.
+    /// counter beyond [`MAX_SELF_COLLISION_GROUPS`]; `WorldMismatch` when the
+    /// world's bodies are not those the snapshot was taken with (a world
+    /// snapshot of another moment, with bodies added or removed between
+    /// the two). A set's own snapshot always restores into its world, and
+    /// a world restored from its snapshot taken at the same moment, in any
+    /// process. The set is unchanged on error.
     pub fn restore(&mut self, snapshot: &CollisionSnapshot, world: &World) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         let state = decode(&snapshot.bytes)?;
@@ -130,6 +149,10 @@ impl Collisions {
             })?;
             restored.apart.insert(body, group);
         }
+        if state.census != census(world) {
+            return Err(Error::WorldMismatch(OTHER_BODIES));
+        }
+        restored.serve(world);
         *self = restored;
         Ok(())
     }

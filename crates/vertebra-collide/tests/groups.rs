@@ -185,7 +185,7 @@ fn building_a_ragdoll_with_its_colliders_is_one_call() {
         step(&mut w2, &c2);
         assert_eq!(w1.state_hash(), w2.state_hash());
     }
-    let before = (w1.state_hash(), c1.snapshot());
+    let before = (w1.state_hash(), c1.snapshot(&w1).unwrap());
     let bad = Pose {
         bones: pose.bones[1..].to_vec(),
     };
@@ -194,7 +194,7 @@ fn building_a_ragdoll_with_its_colliders_is_one_call() {
         matches!(refused, Err(RagdollError::BadPose(_))),
         "{refused:?}"
     );
-    assert_eq!((w1.state_hash(), c1.snapshot()), before);
+    assert_eq!((w1.state_hash(), c1.snapshot(&w1).unwrap()), before);
     // And out again in one call: the set holds the ground alone.
     let mut r1 = r1;
     c1.remove_ragdoll(&mut w1, &mut r1).unwrap();
@@ -212,20 +212,20 @@ fn refused_group_settings_change_nothing() {
     let outside = Ragdoll::build(&mut w, &desc, options, &Pose::bind(&desc), None).unwrap();
     let mut inside = humanoid(&mut w, &mut c);
     let mut gone = inside.clone();
-    let before = c.snapshot();
+    let before = c.snapshot(&w).unwrap();
     let no_collider = Err(Error::StaleHandle("collider body"));
     let groups = CollisionGroups::default();
     assert_eq!(c.set_body_groups(bare, groups), no_collider);
     assert_eq!(c.set_ragdoll_groups(&outside, groups), no_collider);
     assert_eq!(c.set_ragdoll_self_collision(&outside, false), no_collider);
-    assert_eq!(c.snapshot(), before);
+    assert_eq!(c.snapshot(&w).unwrap(), before);
     c.set_ragdoll_self_collision(&inside, false).unwrap();
     c.remove_ragdoll(&mut w, &mut gone).unwrap();
     inside.bodies.iter_mut().for_each(|b| *b = None);
-    let before = c.snapshot();
+    let before = c.snapshot(&w).unwrap();
     assert_eq!(c.set_ragdoll_self_collision(&inside, true), no_collider);
     assert_eq!(c.set_ragdoll_groups(&gone, groups), no_collider);
-    assert_eq!(c.snapshot(), before);
+    assert_eq!(c.snapshot(&w).unwrap(), before);
 }
 
 /// `bytes` with its payload checksum made right again (the format is
@@ -236,7 +236,7 @@ fn resealed(mut bytes: Vec<u8>) -> CollisionSnapshot {
     CollisionSnapshot::from_bytes(bytes)
 }
 
-/// The self-collision setting is in the snapshot (format 2): restored, it
+/// The self-collision setting is in the snapshot (since format 2): restored, it
 /// is off again, and it follows a recreated ragdoll to its new bodies. A
 /// snapshot of format 1, or whose next group is one already given, is
 /// refused by name with the set unchanged.
@@ -245,18 +245,18 @@ fn self_collision_settings_are_saved_restored_and_checked() {
     let (mut w, mut c) = ground();
     let mut ragdoll = humanoid(&mut w, &mut c);
     c.set_ragdoll_self_collision(&ragdoll, false).unwrap();
-    let saved = c.snapshot();
+    let saved = c.snapshot(&w).unwrap();
     c.set_ragdoll_self_collision(&ragdoll, true).unwrap();
     c.restore(&saved, &w).unwrap();
     assert!(!c.ragdoll_self_collision(&ragdoll));
-    assert_eq!(c.snapshot(), saved);
+    assert_eq!(c.snapshot(&w).unwrap(), saved);
     assert_eq!(contacts(&w, &c, &ragdoll).0, 0);
     let desc = ragdoll.description().clone();
     c.recreate_ragdoll(&mut w, &mut ragdoll, &Pose::bind(&desc), None)
         .unwrap();
     assert!(!c.ragdoll_self_collision(&ragdoll));
-    let good = c.snapshot().as_bytes().to_vec();
-    let before = c.snapshot();
+    let good = c.snapshot(&w).unwrap().as_bytes().to_vec();
+    let before = c.snapshot(&w).unwrap();
     let mut older = good.clone();
     older[8] = 1;
     assert_eq!(
@@ -275,7 +275,7 @@ fn self_collision_settings_are_saved_restored_and_checked() {
             "self-collision entry 0: a group not given yet".into()
         ))
     );
-    assert_eq!(c.snapshot(), before);
+    assert_eq!(c.snapshot(&w).unwrap(), before);
 }
 
 /// `value` as a postcard varint (LEB128), appended to `bytes`.
@@ -321,14 +321,14 @@ fn a_crafted_group_counter_is_refused_and_a_group_is_never_given_twice() {
     };
     let meeting = crossing(&c, &w);
     assert!(meeting > 0, "side by side, overlapping");
-    let good = c.snapshot().as_bytes().to_vec();
+    let good = c.snapshot(&w).unwrap().as_bytes().to_vec();
     assert_eq!(good.last(), Some(&1), "one group given");
     let with_counter = |given: u64| {
         let mut bytes = good[..good.len() - 1].to_vec();
         varint(given, &mut bytes);
         resealed(bytes)
     };
-    let before = c.snapshot();
+    let before = c.snapshot(&w).unwrap();
     for given in [u64::MAX, MAX_SELF_COLLISION_GROUPS + 1] {
         let refused = c.restore(&with_counter(given), &w);
         assert_eq!(
@@ -337,12 +337,12 @@ fn a_crafted_group_counter_is_refused_and_a_group_is_never_given_twice() {
                 "self-collision groups: {given} given, more than the 2^48 a set gives"
             )))
         );
-        assert_eq!(c.snapshot(), before, "refused, unchanged");
+        assert_eq!(c.snapshot(&w).unwrap(), before, "refused, unchanged");
     }
     // At the limit: accepted, and no group past it is given.
     c.restore(&with_counter(MAX_SELF_COLLISION_GROUPS), &w)
         .unwrap();
-    let at_limit = c.snapshot();
+    let at_limit = c.snapshot(&w).unwrap();
     let first = b.bodies[0].unwrap();
     let index = c.colliders().position(|k| k.body == first).unwrap();
     assert_eq!(
@@ -355,7 +355,7 @@ fn a_crafted_group_counter_is_refused_and_a_group_is_never_given_twice() {
             )),
         })
     );
-    assert_eq!(c.snapshot(), at_limit, "refused, unchanged");
+    assert_eq!(c.snapshot(&w).unwrap(), at_limit, "refused, unchanged");
     assert!(c.ragdoll_self_collision(&b));
     assert_eq!(crossing(&c, &w), meeting);
     // One below: the last group goes to the second ragdoll, which still
@@ -365,7 +365,7 @@ fn a_crafted_group_counter_is_refused_and_a_group_is_never_given_twice() {
     c.set_ragdoll_self_collision(&b, false).unwrap();
     assert!(!c.ragdoll_self_collision(&a) && !c.ragdoll_self_collision(&b));
     assert_eq!(crossing(&c, &w), meeting, "two groups: they still meet");
-    let last = c.snapshot();
+    let last = c.snapshot(&w).unwrap();
     c.restore(&last, &w).unwrap();
-    assert_eq!(c.snapshot(), last);
+    assert_eq!(c.snapshot(&w).unwrap(), last);
 }

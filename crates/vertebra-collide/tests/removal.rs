@@ -80,8 +80,8 @@ fn all_live(w: &World, c: &Collisions) -> bool {
 #[test]
 fn add_jointed_adds_nothing_when_one_shape_is_refused() {
     // Failed before the fix: the first capsule was added, then the error.
-    let (_, mut c, [_, a, b]) = boxes();
-    let before = c.snapshot();
+    let (w, mut c, [_, a, b]) = boxes();
+    let before = c.snapshot(&w).unwrap();
     let good = Shape::Sphere { radius: 0.1 };
     let flat = Shape::Sphere { radius: 0.0 };
     let refused = c.add_jointed(&[(a, good), (b, flat)], &[(a, b)]);
@@ -90,7 +90,11 @@ fn add_jointed_adds_nothing_when_one_shape_is_refused() {
     };
     assert_eq!((*index, *body), (4, b), "the second new collider, on b");
     assert!(refused.unwrap_err().to_string().contains("collider 4"));
-    assert_eq!(c.snapshot(), before, "nothing was added or excluded");
+    assert_eq!(
+        c.snapshot(&w).unwrap(),
+        before,
+        "nothing was added or excluded"
+    );
     assert!(!c.is_excluded(a, b));
 }
 
@@ -99,7 +103,7 @@ fn colliders_beyond_the_size_limit_are_refused() {
     // Failed before the fix: a box of half extent 1e30 m was accepted and
     // its contacts had NaN points (found by the crafted snapshots below).
     let (mut w, mut c, [_, _, b]) = boxes();
-    let before = c.snapshot();
+    let before = c.snapshot(&w).unwrap();
     for shape in [
         Shape::Box {
             half_extents: Vec3::new(0.3, 1e30, 0.2),
@@ -130,7 +134,7 @@ fn colliders_beyond_the_size_limit_are_refused() {
         refused.to_string(),
         format!("collider 3 on body {b:?}: collider restitution (0 to 1) is out of range")
     );
-    assert_eq!(c.snapshot(), before);
+    assert_eq!(c.snapshot(&w).unwrap(), before);
     let floor = Shape::Box {
         half_extents: Vec3::new(MAX_COLLIDER_EXTENT, 1.0, MAX_COLLIDER_EXTENT),
     };
@@ -222,7 +226,7 @@ fn a_refused_ragdoll_removal_leaves_world_set_and_ragdoll_as_they_were() {
         w.bodies().len(),
         w.joints().count(),
         w.rods().count(),
-        c.snapshot(),
+        c.snapshot(&w).unwrap(),
         ragdolls[0].bodies.clone(),
         ragdolls[0].joints.clone(),
         ragdolls[0].rod,
@@ -237,7 +241,7 @@ fn a_refused_ragdoll_removal_leaves_world_set_and_ragdoll_as_they_were() {
         w.bodies().len(),
         w.joints().count(),
         w.rods().count(),
-        c.snapshot(),
+        c.snapshot(&w).unwrap(),
         ragdolls[0].bodies.clone(),
         ragdolls[0].joints.clone(),
         ragdolls[0].rod,
@@ -275,7 +279,7 @@ fn restoring_the_world_and_the_set_replays_bit_for_bit() {
     for _ in 0..30 {
         step(&mut w, &c);
     }
-    let (world_then, set_then) = (w.snapshot(), c.snapshot());
+    let (world_then, set_then) = (w.snapshot(), c.snapshot(&w).unwrap());
     let replay = |w: &mut World, c: &Collisions| -> Vec<u64> {
         (0..60)
             .map(|_| {
@@ -304,7 +308,11 @@ fn restoring_the_world_and_the_set_replays_bit_for_bit() {
     }
     w.restore(&world_then).unwrap();
     c.restore(&set_then, &w).unwrap();
-    assert_eq!(c.snapshot(), set_then, "the same set, the same bytes");
+    assert_eq!(
+        c.snapshot(&w).unwrap(),
+        set_then,
+        "the same set, the same bytes"
+    );
     assert_eq!(replay(&mut w, &c), first);
     // Through the bytes, into a fresh set.
     w.restore(&world_then).unwrap();
@@ -330,20 +338,25 @@ fn resealed(mut bytes: Vec<u8>) -> CollisionSnapshot {
 /// refusal when `None`) and the set unchanged.
 fn assert_refused(bad: &CollisionSnapshot, expected: Option<Error>) {
     let (w, mut c, _) = boxes();
-    let before = c.snapshot();
+    let before = c.snapshot(&w).unwrap();
     let result = c.restore(bad, &w);
     match (&result, expected) {
         (Err(e), Some(expected)) => assert_eq!(*e, expected),
         (Err(_), None) => {}
         (Ok(()), _) => panic!("accepted"),
     }
-    assert_eq!(c.snapshot(), before, "a refused restore changes nothing");
+    assert_eq!(
+        c.snapshot(&w).unwrap(),
+        before,
+        "a refused restore changes nothing"
+    );
 }
 
 #[test]
 fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
     let (mut own, c, [_, _, b]) = boxes();
-    let good = c.snapshot().as_bytes().to_vec();
+    let saved = c.snapshot(&own).unwrap();
+    let good = saved.as_bytes().to_vec();
     let corrupt = |why: &str| Some(Error::CorruptSnapshot(why.into()));
     assert_refused(
         &CollisionSnapshot::from_bytes(b"VTBSNAP1 and more bytes".to_vec()),
@@ -354,7 +367,7 @@ fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
         corrupt("not a collision-set snapshot"),
     );
     let mut newer = good.clone();
-    newer[8] = 3;
+    newer[8] = 4;
     assert_refused(
         &CollisionSnapshot::from_bytes(newer),
         Some(Error::IncompatibleSnapshot(
@@ -381,7 +394,7 @@ fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
     other.add_body(BodyDesc::fixed()).unwrap();
     other.add_body(BodyDesc::fixed()).unwrap();
     let mut set = Collisions::new();
-    let result = set.restore(&c.snapshot(), &other);
+    let result = set.restore(&saved, &other);
     assert!(
         matches!(&result, Err(Error::Collider { index: 0, reason, .. })
             if **reason == Error::ForeignHandle("body")),
@@ -391,7 +404,7 @@ fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
     // The boxes' own world without the third box: its collider is named.
     own.remove_body(b).unwrap();
     assert_eq!(
-        set.restore(&c.snapshot(), &own),
+        set.restore(&saved, &own),
         Err(Error::Collider {
             index: 2,
             body: b,
@@ -409,7 +422,7 @@ fn crafted_collision_snapshots_never_panic_nor_admit_a_bad_value() {
     // checksum: each is refused with the set unchanged, or accepted as a
     // set whose contacts the world takes.
     let (mut w, c, _) = boxes();
-    let good = c.snapshot().as_bytes().to_vec();
+    let good = c.snapshot(&w).unwrap().as_bytes().to_vec();
     let words: Vec<[u8; 4]> = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, 0.0, 1e30]
         .iter()
         .map(|x| x.to_le_bytes())
@@ -442,7 +455,11 @@ fn crafted_collision_snapshots_never_panic_nor_admit_a_bad_value() {
             }
             Err(_) => {
                 refusals += 1;
-                assert_eq!(set.snapshot(), c.snapshot(), "refused, unchanged");
+                assert_eq!(
+                    set.snapshot(&w).unwrap(),
+                    c.snapshot(&w).unwrap(),
+                    "refused, unchanged"
+                );
             }
         }
     }
@@ -450,9 +467,10 @@ fn crafted_collision_snapshots_never_panic_nor_admit_a_bad_value() {
     assert!(accepted > 0 && refusals > 0);
 }
 
-/// The payload's layout, as `docs/contacts.md` documents it (format 2).
+/// The payload's layout, as `docs/contacts.md` documents it (format 3).
 #[derive(serde::Serialize, serde::Deserialize)]
 struct Payload {
+    census: u64,
     prediction: f32,
     colliders: Vec<Collider>,
     excluded: Vec<(BodyHandle, BodyHandle)>,
@@ -482,7 +500,7 @@ fn crafted(good: &CollisionSnapshot, change: impl FnOnce(&mut Payload)) -> Colli
 fn lists_the_set_could_not_have_written_are_refused_by_name() {
     let (w, mut c, ragdolls) = pile();
     c.set_ragdoll_self_collision(&ragdolls[1], false).unwrap();
-    let good = c.snapshot();
+    let good = c.snapshot(&w).unwrap();
     assert_eq!(crafted(&good, |_| {}), good, "the layout is the set's");
     let corrupt = |why: &str| Err(Error::CorruptSnapshot(why.into()));
     let cases: [(&str, Change); 5] = [
@@ -513,6 +531,6 @@ fn lists_the_set_could_not_have_written_are_refused_by_name() {
     for (why, change) in cases {
         let bad = crafted(&good, change);
         assert_eq!(c.restore(&bad, &w), corrupt(why));
-        assert_eq!(c.snapshot(), good, "{why}: refused, unchanged");
+        assert_eq!(c.snapshot(&w).unwrap(), good, "{why}: refused, unchanged");
     }
 }

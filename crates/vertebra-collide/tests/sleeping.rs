@@ -348,11 +348,12 @@ fn a_snapshot_taken_asleep_steps_on_bit_for_bit_anywhere() {
         .unwrap();
     floor.frames(10);
     let snapshot = floor.world.snapshot();
+    let set = floor.collisions.snapshot(&floor.world).unwrap();
     // Another world (of another lineage) takes the snapshot, and with it
-    // the handles the colliders name.
+    // the handles the colliders name; its set takes the set's.
     let mut copy = Floor::new(sleeping());
     copy.world.restore(&snapshot).unwrap();
-    copy.collisions = floor.collisions.clone();
+    copy.collisions.restore(&set, &copy.world).unwrap();
     for body in floor.all() {
         assert_eq!(floor.asleep(body), copy.asleep(body));
     }
@@ -367,7 +368,7 @@ fn a_snapshot_taken_asleep_steps_on_bit_for_bit_anywhere() {
         ..SolverConfig::default()
     });
     awake.world.restore(&snapshot).unwrap();
-    awake.collisions = floor.collisions.clone();
+    awake.collisions.restore(&set, &awake.world).unwrap();
     awake.frame();
     assert_eq!(awake.world.island_count().1, 0);
 }

@@ -4,7 +4,8 @@
 //!
 //! The promises checked: no call returns `VT_RESULT_PANIC` (nor, so,
 //! `VT_RESULT_POISONED`); a refused call leaves the world and the
-//! collision layer as they were (their snapshots' bytes); every body is
+//! collision layer as they were (their snapshots' bytes, or the layer's
+//! refusal to take one for a world it no longer serves); every body is
 //! finite after every step.
 
 use std::ptr::{null, null_mut};
@@ -66,17 +67,26 @@ fn bytes(made: VtResult, bytes: *mut VtBytes) -> Vec<u8> {
 }
 
 impl Run {
-    /// The world's and the layer's whole state, as bytes.
-    fn state(&self) -> (Vec<u8>, Vec<u8>) {
+    /// The world's and the layer's whole state, as bytes; the layer's
+    /// refusal instead when it does not serve the world as it is (the world
+    /// was restored without the layer's snapshot after it).
+    fn state(&self) -> (Vec<u8>, Result<Vec<u8>, VtResult>) {
         let (mut w, mut c) = (null_mut(), null_mut());
         // SAFETY: live objects of this run; output places on the stack.
         let (a, b) = unsafe {
             (
                 vt_world_snapshot(self.world, &mut w),
-                vt_collisions_snapshot(self.collisions, &mut c),
+                vt_collisions_snapshot(self.collisions, self.world, &mut c),
             )
         };
-        (bytes(a, w), bytes(b, c))
+        let layer = match b {
+            VtResult::Ok => Ok(bytes(b, c)),
+            refused => {
+                assert_eq!(refused, VtResult::WorldMismatch, "a layer snapshot refused");
+                Err(refused)
+            }
+        };
+        (bytes(a, w), layer)
     }
 
     fn body(&self, input: &mut Input) -> VtBody {
@@ -353,13 +363,31 @@ impl Run {
                     }
                 }
                 _ => {
-                    // A snapshot taken and restored, or crafted bytes.
-                    let (mut world_bytes, _) = self.state();
+                    // A snapshot taken and restored, or crafted bytes; the
+                    // layer's restored after it, or not (then the layer
+                    // refuses the world until a later restore of both).
+                    let (mut world_bytes, layer_bytes) = self.state();
                     if input.flag() && !world_bytes.is_empty() {
                         let at = input.pick(world_bytes.len());
                         world_bytes[at] ^= 1 << input.pick(8);
                     }
-                    vt_world_restore(world, world_bytes.as_ptr(), world_bytes.len())
+                    let restored = vt_world_restore(world, world_bytes.as_ptr(), world_bytes.len());
+                    if let (VtResult::Ok, Ok(layer_bytes), true) =
+                        (restored, layer_bytes, input.flag())
+                    {
+                        let before = self.state();
+                        let r = vt_collisions_restore(
+                            collisions,
+                            world,
+                            layer_bytes.as_ptr(),
+                            layer_bytes.len(),
+                        );
+                        assert!(!matches!(r, VtResult::Panic | VtResult::Poisoned));
+                        if r != VtResult::Ok {
+                            assert!(self.state() == before, "a refused layer restore changed it");
+                        }
+                    }
+                    restored
                 }
             }
         }

@@ -23,7 +23,14 @@ struct Scene {
 
 /// What a refused call must leave as it was: the world (state hash and
 /// counts), the set (its snapshot bytes) and every ragdoll's handles.
-type Fingerprint = (u64, usize, usize, usize, CollisionSnapshot, Vec<String>);
+type Fingerprint = (
+    u64,
+    usize,
+    usize,
+    usize,
+    Result<CollisionSnapshot, Error>,
+    Vec<String>,
+);
 
 impl Scene {
     fn fingerprint(&self) -> Fingerprint {
@@ -32,7 +39,7 @@ impl Scene {
             self.world.bodies().len(),
             self.world.joints().count(),
             self.world.rods().count(),
-            self.collisions.snapshot(),
+            self.collisions.snapshot(&self.world),
             self.ragdolls
                 .iter()
                 .map(|r| format!("{:?} {:?} {:?}", r.bodies, r.joints, r.rod))
@@ -64,13 +71,13 @@ impl Scene {
             restitution: input.float(1.0),
             groups: Self::groups(input),
         };
-        let set = self.collisions.snapshot();
+        let set = self.collisions.snapshot(&self.world);
         if self.collisions.add(collider).is_err() {
             // The set refused the collider and must be as it was; the body
             // goes again, which the world rightly counts as a change (its
             // slot's generation moved), so this is no refused call.
             assert!(
-                self.collisions.snapshot() == set,
+                self.collisions.snapshot(&self.world) == set,
                 "a refused collider changed the set"
             );
             self.world.remove_body(body)?;
@@ -225,7 +232,10 @@ pub fn collisions(data: &[u8]) {
     };
     let mut saved = (
         scene.world.snapshot(),
-        scene.collisions.snapshot(),
+        scene
+            .collisions
+            .snapshot(&scene.world)
+            .expect("a new set serves its world"),
         Vec::new(),
     );
     for _ in 0..48 {
@@ -271,7 +281,10 @@ pub fn collisions(data: &[u8]) {
             6 => {
                 saved = (
                     scene.world.snapshot(),
-                    scene.collisions.snapshot(),
+                    scene
+                        .collisions
+                        .snapshot(&scene.world)
+                        .expect("serves its world"),
                     scene.ragdolls.clone(),
                 );
                 Ok(())

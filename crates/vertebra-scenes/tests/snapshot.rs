@@ -4,6 +4,7 @@
 //! refused with the world untouched.
 
 use glam::Vec3;
+use vertebra_collide::CollisionSnapshot;
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Scene, SceneConfig, SceneWorld, build};
 use vertebra_world::{BodyDesc, Error, Shape, Snapshot};
@@ -14,6 +15,22 @@ fn drop_scene(spine: SpineMode, ragdolls: usize) -> SceneWorld {
     let mut config = SceneConfig::new(Scene::RagdollDrop, spine);
     config.ragdolls = ragdolls;
     build(&config).unwrap()
+}
+
+/// The scene's world and its collision set (the drop's), saved together.
+fn save(scene: &SceneWorld) -> (Snapshot, Option<CollisionSnapshot>) {
+    let set = scene.collisions.as_ref();
+    let set = set.map(|c| c.snapshot(&scene.world).unwrap());
+    (scene.world.snapshot(), set)
+}
+
+/// Both put back: the world first, then its set (which serves a restored
+/// world only once its own snapshot taken with the world's is restored).
+fn load(scene: &mut SceneWorld, (world, set): &(Snapshot, Option<CollisionSnapshot>)) {
+    scene.world.restore(world).unwrap();
+    if let (Some(c), Some(set)) = (scene.collisions.as_mut(), set) {
+        c.restore(set, &scene.world).unwrap();
+    }
 }
 
 fn run(scene: &mut SceneWorld, frames: std::ops::Range<usize>) -> u64 {
@@ -28,7 +45,7 @@ fn stepping_on_from_a_restored_drop_is_bit_identical() {
     for spine in [SpineMode::Rod, SpineMode::Sockets] {
         let mut scene = drop_scene(spine, 30);
         run(&mut scene, 0..40);
-        let snapshot = scene.world.snapshot();
+        let snapshot = save(&scene);
         let at_snapshot = scene.world.state_hash();
         let ahead = run(&mut scene, 40..80);
         assert_ne!(ahead, at_snapshot, "the world moved on");
@@ -53,7 +70,7 @@ fn stepping_on_from_a_restored_drop_is_bit_identical() {
             .copied()
             .unwrap();
         scene.world.remove_joint(socket).unwrap();
-        scene.world.restore(&snapshot).unwrap();
+        load(&mut scene, &snapshot);
         assert_eq!(scene.world.state_hash(), at_snapshot);
         assert!(scene.world.body(extra).is_err(), "the added body is gone");
         assert!(
@@ -68,9 +85,11 @@ fn stepping_on_from_a_restored_drop_is_bit_identical() {
 fn a_snapshot_survives_its_bytes() {
     let mut scene = drop_scene(SpineMode::Rod, 3);
     run(&mut scene, 0..20);
-    let bytes = scene.world.snapshot().as_bytes().to_vec();
+    let (world, set) = save(&scene);
+    let bytes = world.as_bytes().to_vec();
+    let set = set.map(|s| CollisionSnapshot::from_bytes(s.as_bytes().to_vec()));
     let ahead = run(&mut scene, 20..40);
-    scene.world.restore(&Snapshot::from_bytes(bytes)).unwrap();
+    load(&mut scene, &(Snapshot::from_bytes(bytes), set));
     assert_eq!(run(&mut scene, 20..40), ahead);
 }
 

@@ -69,6 +69,13 @@ pub enum Error {
         /// Why.
         reason: Box<Error>,
     },
+    /// A companion of a world (a collision set) used with, or restored for,
+    /// a world it does not serve: one that restored a snapshot since the
+    /// companion last served it (without the companion's own snapshot taken
+    /// with it), another world, or a companion's snapshot taken with
+    /// another state of the world (other bodies). The message says which
+    /// and what to restore.
+    WorldMismatch(&'static str),
 }
 
 impl fmt::Display for Error {
@@ -103,6 +110,7 @@ impl fmt::Display for Error {
                 body,
                 reason,
             } => write!(f, "collider {index} on body {body:?}: {reason}"),
+            Error::WorldMismatch(why) => write!(f, "world mismatch: {why}"),
         }
     }
 }

@@ -63,7 +63,7 @@ pub use islands::SleepSettings;
 pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
-pub use snapshot::Snapshot;
+pub use snapshot::{Snapshot, Timeline};
 #[cfg(feature = "stage-timing")]
 pub use stages::timing as stage_timing;
 pub use tasks::{RayonTasks, SingleThreaded, TaskSystem};
@@ -113,6 +113,8 @@ pub struct World {
     residual_lanes: metrics::LaneResiduals,
     /// Bodies put back by the step's last-line NaN guard, ever.
     repaired: u64,
+    /// The run of states the world is on (no part of its state).
+    timeline: snapshot::Timeline,
 }
 
 impl World {
@@ -158,6 +160,7 @@ impl World {
             residuals_measured: false,
             residual_lanes: metrics::LaneResiduals::default(),
             repaired: 0,
+            timeline: snapshot::Timeline::begin(false),
         })
     }
 

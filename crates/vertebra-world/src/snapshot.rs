@@ -89,6 +89,42 @@ impl Snapshot {
     }
 }
 
+/// Which run of states a world is on. One begins when the world is made
+/// ([`World::new`]) and a new one each time it restores a snapshot
+/// ([`World::restore`]); every other call (stepping, adding, removing)
+/// stays on it. It is no part of the world's state (not in its snapshot,
+/// not in [`World::state_hash`]) and means nothing in another process.
+///
+/// What it is for: a companion that keeps its own state about the world's
+/// bodies, such as a collision set (`vertebra-collide`), records the
+/// timeline it serves. A world that restored a snapshot has left it, and
+/// the companion refuses it until its own snapshot taken with the world's
+/// is restored too (or it is told explicitly that it serves the world as
+/// it is), instead of serving a world whose bodies it does not know.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Timeline {
+    /// Unique in the process: one counter for every world.
+    id: u64,
+    restored: bool,
+}
+
+impl Timeline {
+    /// A timeline no world has been on; `restored` when a restore begins it.
+    pub(crate) fn begin(restored: bool) -> Self {
+        static NEXT: AtomicU64 = AtomicU64::new(0);
+        Self {
+            id: NEXT.fetch_add(1, Ordering::Relaxed),
+            restored,
+        }
+    }
+
+    /// Whether it began with a restore (the world's state came from a
+    /// snapshot), rather than with [`World::new`].
+    pub fn restored(self) -> bool {
+        self.restored
+    }
+}
+
 /// A new world's lineage: different for every world, across processes too
 /// (hashed with the process's random hasher keys).
 pub(crate) fn new_lineage() -> u32 {
@@ -282,6 +318,10 @@ impl World {
     /// was taken stay stale. `Err(IncompatibleSnapshot)` for another
     /// build's snapshot, `Err(CorruptSnapshot)` naming the item for damaged
     /// or crafted bytes; the world is unchanged on error.
+    ///
+    /// A successful restore begins a new [`Timeline`] (see
+    /// [`World::timeline`]): companions of the world, such as its collision
+    /// set, are restored after it from their own snapshots.
     pub fn restore(&mut self, snapshot: &Snapshot) -> Result<(), Error> {
         let _mode = vertebra_math::DefaultFloatMode::enter();
         let mut state = State::decode(&snapshot.bytes)?;
@@ -300,8 +340,16 @@ impl World {
         self.islands.derive();
         self.contacts = state.contacts;
         self.layout_dirty = true;
+        self.timeline = Timeline::begin(true);
         self.measure_residuals();
         Ok(())
+    }
+
+    /// The run of states the world is on (see [`Timeline`]): the one
+    /// [`World::new`] began, or the one the last successful
+    /// [`World::restore`] began.
+    pub fn timeline(&self) -> Timeline {
+        self.timeline
     }
 }
 
@@ -319,6 +367,32 @@ mod tests {
     #[test]
     fn lineages_differ() {
         assert_ne!(new_lineage(), new_lineage());
+    }
+
+    /// A world's timeline changes with every restore that succeeds, and
+    /// only then: not with steps, additions or a refused restore.
+    #[test]
+    fn a_timeline_begins_at_new_and_at_each_restore() {
+        let mut w = world();
+        let made = w.timeline();
+        assert!(!made.restored());
+        let saved = w.snapshot();
+        w.add_body(BodyDesc::fixed()).unwrap();
+        w.step(1.0 / 60.0).unwrap();
+        assert_eq!(w.timeline(), made);
+        let mut bytes = saved.as_bytes().to_vec();
+        bytes.truncate(bytes.len() - 1);
+        assert!(w.restore(&Snapshot::from_bytes(bytes)).is_err());
+        assert_eq!(w.timeline(), made, "a refused restore changes nothing");
+        w.restore(&saved).unwrap();
+        let restored = w.timeline();
+        assert!(restored.restored() && restored != made);
+        w.restore(&saved).unwrap();
+        assert_ne!(w.timeline(), restored, "each restore begins its own");
+        assert_ne!(
+            World::new(SolverConfig::default()).unwrap().timeline(),
+            made
+        );
     }
 
     /// Ground, three capsules hanging from it by a socket, a rod and a
