@@ -1,9 +1,14 @@
 //! Arbitrary sequences of adding and removing bodies, colliders and
 //! ragdolls, with snapshots of the world and the collision set (intact and
-//! crafted) and steps with collision detection.
+//! crafted: bytes overwritten, or the decoded state's counters, group ids,
+//! lists, handles and margin changed) and steps with collision detection.
 
 use glam::{Quat, Vec3};
-use vertebra_collide::{Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions};
+use serde::{Deserialize, Serialize};
+use vertebra_collide::{
+    Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions,
+    MAX_SELF_COLLISION_GROUPS,
+};
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
 use vertebra_world::{BodyDesc, BodyHandle, Error, Shape, Snapshot, SolverConfig, World};
 
@@ -31,6 +36,49 @@ type Fingerprint = (
     Result<CollisionSnapshot, Error>,
     Vec<String>,
 );
+
+/// The collision snapshot's payload, as `docs/contacts.md` documents it
+/// (format 3; the header is magic 8, version 4, xxh3 8). A valid snapshot
+/// must round-trip through it, so a format change fails the corpus replay
+/// until this copy follows.
+#[derive(Serialize, Deserialize)]
+struct Payload {
+    census: u64,
+    prediction: f32,
+    colliders: Vec<Collider>,
+    excluded: Vec<(BodyHandle, BodyHandle)>,
+    apart: Vec<(BodyHandle, u64)>,
+    next_apart: u64,
+}
+
+/// A group counter or group id of the kind that breaks things: the ends of
+/// the range, the limit and either side of it, and near `current`.
+fn counter(input: &mut Input, current: u64) -> u64 {
+    let limit = MAX_SELF_COLLISION_GROUPS;
+    let near = [
+        0,
+        1,
+        current.wrapping_sub(1),
+        current,
+        current.wrapping_add(1),
+        limit - 1,
+        limit,
+        limit + 1,
+        u64::MAX,
+    ];
+    near[input.pick(near.len())]
+}
+
+/// `handle` made stale (a later generation), foreign (another lineage) or
+/// pointing at another slot.
+fn skewed(input: &mut Input, handle: BodyHandle) -> BodyHandle {
+    let (index, lineage, generation) = handle.to_raw();
+    match input.pick(3) {
+        0 => BodyHandle::from_raw(index, lineage, generation + 1),
+        1 => BodyHandle::from_raw(index, lineage ^ 1, generation),
+        _ => BodyHandle::from_raw(index + 1, lineage, generation),
+    }
+}
 
 impl Scene {
     fn fingerprint(&self) -> Fingerprint {
@@ -174,6 +222,85 @@ impl Scene {
             .restore(&CollisionSnapshot::from_bytes(bytes), &self.world)
     }
 
+    /// A crafted collision state: the saved snapshot decoded through the
+    /// documented layout (which must give its bytes back), one to three of
+    /// its values changed (the group counter and group ids to the ends of
+    /// their range, the limit and either side of it; the world's bodies it
+    /// was taken with; the lists' order, repeats and a pair's bodies; a
+    /// handle made stale, foreign or another slot; the margin; groups),
+    /// encoded and sealed, and restored. When the set takes it, every
+    /// ragdoll's self-collision is turned off once more, which must give a
+    /// new group or be refused with nothing changed.
+    fn restore_crafted_state(
+        &mut self,
+        saved: &CollisionSnapshot,
+        input: &mut Input,
+    ) -> Result<(), Error> {
+        let bytes = saved.as_bytes();
+        let mut p: Payload = postcard::from_bytes(&bytes[20..]).expect("the documented layout");
+        let body = postcard::to_allocvec(&p).expect("encodes");
+        assert!(body == bytes[20..], "the layout copy is out of date");
+        for _ in 0..1 + input.pick(3) {
+            match input.pick(10) {
+                0 | 1 => p.next_apart = counter(input, p.next_apart),
+                2 if !p.apart.is_empty() => {
+                    let k = input.pick(p.apart.len());
+                    p.apart[k].1 = counter(input, p.next_apart);
+                }
+                3 => p.census ^= 1 << input.pick(64),
+                4 if p.excluded.len() > 1 => {
+                    let k = 1 + input.pick(p.excluded.len() - 1);
+                    p.excluded.swap(0, k);
+                }
+                4 | 5 if !p.excluded.is_empty() => {
+                    let k = input.pick(p.excluded.len());
+                    let (a, b) = p.excluded[k];
+                    if input.flag() {
+                        p.excluded[k] = (b, a);
+                    } else {
+                        p.excluded.insert(k, (a, b));
+                    }
+                }
+                6 if !p.apart.is_empty() => {
+                    let k = input.pick(p.apart.len());
+                    match input.pick(3) {
+                        0 => p.apart.insert(k, p.apart[k]),
+                        1 => drop(p.apart.remove(k)),
+                        _ => p.apart[k].0 = skewed(input, p.apart[k].0),
+                    }
+                }
+                7 if !p.colliders.is_empty() => {
+                    let k = input.pick(p.colliders.len());
+                    let collider = &mut p.colliders[k];
+                    if input.flag() {
+                        collider.body = skewed(input, collider.body);
+                    } else {
+                        collider.groups = Self::groups(input);
+                    }
+                }
+                8 => p.prediction = [f32::NAN, -1.0, 0.0, 1e30][input.pick(4)],
+                _ => {}
+            }
+        }
+        let body = postcard::to_allocvec(&p).expect("encodes");
+        let mut crafted = [&bytes[..20], &body[..]].concat();
+        let sum = xxhash_rust::xxh3::xxh3_64(&crafted[20..]);
+        crafted[12..20].copy_from_slice(&sum.to_le_bytes());
+        self.collisions
+            .restore(&CollisionSnapshot::from_bytes(crafted), &self.world)?;
+        for k in 0..self.ragdolls.len() {
+            let before = self.fingerprint();
+            let turned = self
+                .collisions
+                .set_ragdoll_self_collision(&self.ragdolls[k], false);
+            if turned.is_err() {
+                assert!(self.fingerprint() == before, "refused but changed");
+            }
+            self.check();
+        }
+        Ok(())
+    }
+
     /// Collision detection and a step: contacts always come (no collider
     /// outlives its body here), and the world always takes them.
     fn step(&mut self) -> Result<(), Error> {
@@ -188,8 +315,18 @@ impl Scene {
     }
 
     /// Every collider's body is in the world, every pending contact's too,
-    /// and every body is finite.
+    /// and every body is finite; the set serves the world, and its own
+    /// snapshot restores with the same bytes (a group counter that had
+    /// wrapped made it refuse its own snapshot).
     fn check(&self) {
+        let own = self
+            .collisions
+            .snapshot(&self.world)
+            .expect("the set serves its world");
+        let mut copy = self.collisions.clone();
+        copy.restore(&own, &self.world)
+            .expect("the set's own snapshot restores");
+        assert!(copy.snapshot(&self.world).as_ref() == Ok(&own));
         let live = |b: BodyHandle| self.world.body(b).is_ok();
         assert!(self.collisions.colliders().all(|c| live(c.body)));
         assert!(
@@ -210,9 +347,11 @@ impl Scene {
 /// added (in one call or two), removed, recreated (also after a joint of
 /// theirs was removed by hand), pairs excluded, groups set on bodies and
 /// ragdolls, ragdolls' self-collision turned off and on, the margin set, both snapshots taken and
-/// restored, crafted collision snapshots restored, steps with detection.
+/// restored, crafted collision snapshots restored (bytes, or decoded
+/// values: counters, group ids, lists, handles), steps with detection.
 /// No panic; a refused call leaves the world, the set and the ragdolls as
-/// they were; no collider or contact outlives its body.
+/// they were; no collider or contact outlives its body; the set's own
+/// snapshot always restores.
 pub fn collisions(data: &[u8]) {
     let mut input = Input::new(data);
     let mut world = World::new(SolverConfig::default()).expect("a valid config");
@@ -293,7 +432,8 @@ pub fn collisions(data: &[u8]) {
                 scene.restore(&saved);
                 Ok(())
             }
-            8 => scene.restore_crafted(&saved.1, &mut input),
+            8 if input.flag() => scene.restore_crafted(&saved.1, &mut input),
+            8 => scene.restore_crafted_state(&saved.1, &mut input),
             9 => {
                 if let (Some(a), Some(b)) = (scene.body(&mut input), scene.body(&mut input)) {
                     scene.collisions.exclude(a, b);
