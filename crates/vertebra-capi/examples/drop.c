@@ -50,14 +50,13 @@ int main(int argc, char **argv) {
     VtBody ground;
     CHECK(vt_body_desc_default(VT_BODY_KIND_STATIC, &ground_desc));
     CHECK(vt_world_add_body(world, &ground_desc, &ground));
+    /* Every collider starts from vt_collider_default (every group,
+     * friction 0.6): a zeroed one is in no group and collides with
+     * nothing. */
     VtCollider plane;
-    memset(&plane, 0, sizeof plane);
-    plane.body = ground;
+    CHECK(vt_collider_default(ground, &plane));
     plane.kind = VT_COLLIDER_KIND_PLANE;
     plane.plane_normal = (VtVec3){0.0f, 1.0f, 0.0f};
-    plane.friction = 0.6f;
-    plane.membership = 0xffffffffu;
-    plane.filter = 0xffffffffu;
     CHECK(vt_collisions_add(collisions, &plane, NULL));
 
     /* The ragdoll at its bind pose, half a metre up, with a rod spine,

@@ -161,6 +161,15 @@ int main(int argc, char **argv) {
     OK(vt_collisions_update(collisions, world, dt));
     OK(vt_world_step(world, dt));
 
+    /* Colliders start from vt_collider_default (a zeroed one collides
+     * with nothing); one whose shape was forgotten is refused. */
+    VtCollider collider;
+    OK(vt_collider_default(body, &collider));
+    expect("a collider without its shape", vt_collisions_add(collisions, &collider, NULL),
+           VT_RESULT_COLLIDER, "radius");
+    expect("a default collider into null", vt_collider_default(body, NULL),
+           VT_RESULT_NULL_POINTER, "collider");
+
     /* Snapshots: damaged bytes are refused, the world kept. The layer's
      * snapshot is taken with the world's, and restored after it: until
      * then the layer refuses the restored world. */

@@ -504,6 +504,12 @@ typedef struct VtBodyState {
 } VtBodyState;
 
 // A collider on a body.
+//
+// Start every one from `vt_collider_default`, which makes it collide with
+// everything, then set its shape (or `kind` and `plane_normal`). A
+// zero-initialised `VtCollider` (`= {0}`, `memset`, C++ `{}`) has
+// `membership` and `filter` 0: it is in no group and collides with
+// nothing, so its body falls through the ground without an error.
 typedef struct VtCollider {
   // The body it moves with.
   struct VtBody body;
@@ -517,10 +523,12 @@ typedef struct VtCollider {
   float friction;
   // Restitution (a pair uses the larger), in [0, 1].
   float restitution;
-  // The groups it is in (a bit set).
+  // The groups it is in (a bit set; all ones from
+  // `vt_collider_default`, 0 is in no group and collides with nothing).
   uint32_t membership;
   // The groups it collides with: a pair is tested when each one's
-  // membership meets the other's filter.
+  // membership meets the other's filter (all ones from
+  // `vt_collider_default`; 0 collides with nothing).
   uint32_t filter;
 } VtCollider;
 
@@ -924,6 +932,20 @@ enum VtResult vt_world_is_asleep(struct VtWorld *world, struct VtBody body, uint
 enum VtResult vt_world_set_sleep_allowed(struct VtWorld *world,
                                          struct VtBody body,
                                          uint32_t allowed);
+
+// Writes into `collider` a collider on `body` that collides with
+// everything, as the Rust API's `Collider::new` makes one: in every group
+// and colliding with every group (`membership` and `filter` all ones),
+// friction 0.6, no restitution, `kind` solid. Its shape is left for the
+// caller: `shape` is a sphere of radius 0 (m), which `vt_collisions_add`
+// refuses, so a collider whose shape was forgotten is never added; for
+// the ground set `kind` to `VT_COLLIDER_KIND_PLANE` (`plane_normal` is
+// already +y, body frame). Start every `VtCollider` here rather than from
+// zeroed memory, whose groups are 0: it would collide with nothing.
+//
+// # Safety
+// `collider` is writable.
+enum VtResult vt_collider_default(struct VtBody body, struct VtCollider *collider);
 
 // Makes an empty collision layer (free it with `vt_collisions_destroy`).
 //

@@ -5,7 +5,7 @@
 use vertebra_collide::{Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions};
 use vertebra_world::Contact;
 
-use crate::body::VtShape;
+use crate::body::{VtShape, VtShapeKind};
 use crate::error::{Failure, VtResult};
 use crate::ffi::{Object, boxed, call, enter, free, optional, out, read, slice};
 use crate::ragdoll::VtRagdoll;
@@ -42,6 +42,12 @@ pub enum VtColliderKind {
 }
 
 /// A collider on a body.
+///
+/// Start every one from `vt_collider_default`, which makes it collide with
+/// everything, then set its shape (or `kind` and `plane_normal`). A
+/// zero-initialised `VtCollider` (`= {0}`, `memset`, C++ `{}`) has
+/// `membership` and `filter` 0: it is in no group and collides with
+/// nothing, so its body falls through the ground without an error.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct VtCollider {
@@ -57,10 +63,12 @@ pub struct VtCollider {
     pub friction: f32,
     /// Restitution (a pair uses the larger), in [0, 1].
     pub restitution: f32,
-    /// The groups it is in (a bit set).
+    /// The groups it is in (a bit set; all ones from
+    /// `vt_collider_default`, 0 is in no group and collides with nothing).
     pub membership: u32,
     /// The groups it collides with: a pair is tested when each one's
-    /// membership meets the other's filter.
+    /// membership meets the other's filter (all ones from
+    /// `vt_collider_default`; 0 collides with nothing).
     pub filter: u32,
 }
 
@@ -82,6 +90,47 @@ impl TryFrom<VtCollider> for Collider {
             },
         })
     }
+}
+
+/// Writes into `collider` a collider on `body` that collides with
+/// everything, as the Rust API's `Collider::new` makes one: in every group
+/// and colliding with every group (`membership` and `filter` all ones),
+/// friction 0.6, no restitution, `kind` solid. Its shape is left for the
+/// caller: `shape` is a sphere of radius 0 (m), which `vt_collisions_add`
+/// refuses, so a collider whose shape was forgotten is never added; for
+/// the ground set `kind` to `VT_COLLIDER_KIND_PLANE` (`plane_normal` is
+/// already +y, body frame). Start every `VtCollider` here rather than from
+/// zeroed memory, whose groups are 0: it would collide with nothing.
+///
+/// # Safety
+/// `collider` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collider_default(body: VtBody, collider: *mut VtCollider) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let result = unsafe { out(collider, "collider") }?;
+        let rust = Collider::new(body.into(), ColliderShape::Plane(glam::Vec3::Y));
+        result.set(VtCollider {
+            body,
+            kind: VtColliderKind::Solid as u32,
+            shape: VtShape {
+                kind: VtShapeKind::Sphere as u32,
+                radius: 0.0,
+                half_extents: VtVec3::default(),
+                half_segment: VtVec3::default(),
+            },
+            plane_normal: VtVec3 {
+                x: 0.0,
+                y: 1.0,
+                z: 0.0,
+            },
+            friction: rust.friction,
+            restitution: rust.restitution,
+            membership: rust.groups.membership,
+            filter: rust.groups.filter,
+        });
+        Ok(())
+    })
 }
 
 /// Runs `body` on the layer at `collisions` inside [`call`].

@@ -1260,6 +1260,86 @@ fn plane(body: VtBody) -> VtCollider {
     }
 }
 
+/// `vt_collider_default` on `body`.
+fn default_collider(body: VtBody) -> VtCollider {
+    let mut collider = std::mem::MaybeUninit::<VtCollider>::uninit();
+    // SAFETY: `collider` is writable; vt_collider_default writes it whole.
+    ok(unsafe { vt_collider_default(body, collider.as_mut_ptr()) });
+    // SAFETY: written just above.
+    unsafe { collider.assume_init() }
+}
+
+/// Where a box (0.1 x 0.2 x 0.1 m half extents) dropped from 0.5 m onto a
+/// ground plane is after a second (its centre's height, m), both colliders
+/// made from `collider` with the shape or plane set.
+fn dropped_box(collider: impl Fn(VtBody) -> VtCollider) -> f32 {
+    let world = CWorld::new();
+    let layer = CLayer::new();
+    let ground = world.add(&body_desc(VtBodyKind::Static));
+    let mut plane = collider(ground);
+    plane.kind = VtColliderKind::Plane as u32;
+    plane.plane_normal = v(0.0, 1.0, 0.0);
+    let body = world.add(&box_desc(v(0.0, 0.5, 0.0)));
+    let mut solid = collider(body);
+    solid.kind = VtColliderKind::Solid as u32;
+    solid.shape = VtShape {
+        kind: VtShapeKind::Box as u32,
+        radius: 0.0,
+        half_extents: v(0.1, 0.2, 0.1),
+        half_segment: v(0.0, 0.0, 0.0),
+    };
+    for c in [plane, solid] {
+        // SAFETY: a live layer; readable collider.
+        ok(unsafe { vt_collisions_add(layer.0, &c, null_mut()) });
+    }
+    for _ in 0..60 {
+        // SAFETY: live objects.
+        ok(unsafe { vt_collisions_update(layer.0, world.0, DT) });
+        world.step(1);
+    }
+    let mut state = std::mem::MaybeUninit::<VtBodyState>::uninit();
+    // SAFETY: a live world; writable.
+    ok(unsafe { vt_world_body_state(world.0, body, state.as_mut_ptr()) });
+    // SAFETY: written by the call that succeeded.
+    unsafe { state.assume_init() }.position.y
+}
+
+/// Issue 31, item 12. A zero-initialised `VtCollider` (groups 0) collides
+/// with nothing: a box on one falls through the ground without an error.
+/// `vt_collider_default` gives the Rust API's `Collider::new`: every
+/// group, friction 0.6, no restitution; a box on it rests on the ground.
+/// Its shape left as written (a sphere of radius 0) is refused by
+/// `vt_collisions_add`, naming the collider, so a forgotten shape is never
+/// added; a null output is refused.
+#[test]
+fn a_default_collider_collides_with_everything_and_a_zeroed_one_with_nothing() {
+    let fell = dropped_box(|body| VtCollider {
+        body,
+        friction: 0.6,
+        // SAFETY: every field of VtCollider is a plain number: zero is valid.
+        ..unsafe { std::mem::zeroed() }
+    });
+    assert!(fell < -1.0, "through the ground: {fell} m");
+    let rests = dropped_box(default_collider);
+    assert!((rests - 0.2).abs() < 0.01, "on the ground: {rests} m");
+    let body = bits_body();
+    let c = default_collider(body);
+    let rust = Collider::new(body.into(), ColliderShape::Plane(Vec3::Y));
+    assert_eq!((c.membership, c.filter), (u32::MAX, u32::MAX));
+    assert_eq!(
+        (c.friction, c.restitution),
+        (rust.friction, rust.restitution)
+    );
+    assert_eq!(c.kind, VtColliderKind::Solid as u32);
+    let layer = CLayer::new();
+    // SAFETY: a live layer; readable collider.
+    let r = unsafe { vt_collisions_add(layer.0, &c, null_mut()) };
+    refused(r, VtResult::Collider, &["collider 0", "radius"]);
+    // SAFETY: null is refused before anything is written.
+    let r = unsafe { vt_collider_default(body, null_mut()) };
+    refused(r, VtResult::NullPointer, &["collider"]);
+}
+
 /// A world with the humanoid dropped on a ground plane through the
 /// collision layer: its world, layer, description and ragdoll.
 struct Drop_ {
