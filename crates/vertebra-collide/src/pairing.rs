@@ -8,7 +8,7 @@
 //! through the ground with no error (issue 31, item 10). So the two are
 //! tied, cheaply:
 //!
-//! - **The set records the world's [`Timeline`]** (a run of states: a world
+//! - **The set records the world's [`Timeline`](vertebra_world::Timeline)** (a run of states: a world
 //!   begins one when made and a new one with every snapshot it restores)
 //!   when it serves the world: at `find_contacts_into`, `build_ragdoll`,
 //!   `remove_ragdoll`, `recreate_ragdoll`, `restore` and [`Collisions::attach`].

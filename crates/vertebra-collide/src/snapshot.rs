@@ -10,7 +10,7 @@
 //! (so equal sets give equal bytes), then the ragdolls' self-collision
 //! settings: every body whose self-collision is off with its ragdoll's
 //! group (u64), in a canonical order, and the next group to be given (at
-//! most [`MAX_SELF_COLLISION_GROUPS`](crate::MAX_SELF_COLLISION_GROUPS)). The
+//! most [`MAX_SELF_COLLISION_GROUPS`]). The
 //! parry geometry is rebuilt from the shapes, exactly as
 //! [`Collisions::add`] builds it.
 //!
