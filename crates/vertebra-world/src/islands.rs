@@ -610,6 +610,23 @@ impl Islands {
         woke
     }
 
+    /// Copies the saved state (what a snapshot holds) into `copy`, reusing
+    /// its buffers: kept before a step that may unwind (`rollback.rs`).
+    pub fn keep_into(&self, copy: &mut Islands) {
+        copy.of.clone_from(&self.of);
+        copy.still.clone_from(&self.still);
+        copy.anchor.clone_from(&self.anchor);
+        copy.allowed.clone_from(&self.allowed);
+        copy.islands.clone_from(&self.islands);
+    }
+
+    /// Puts back the saved state [`Islands::keep_into`] copied, and what is
+    /// derived from it.
+    pub fn put_back(&mut self, copy: &Islands) {
+        copy.keep_into(self);
+        self.derive();
+    }
+
     /// Rebuilds what is derived (member lists, sleeping bodies) from the
     /// saved state, after a restore.
     pub fn derive(&mut self) {

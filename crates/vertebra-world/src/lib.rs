@@ -36,6 +36,7 @@ mod layout;
 mod metrics;
 mod parallel;
 mod rod;
+mod rollback;
 mod sleep;
 mod snapshot;
 mod stages;
@@ -43,6 +44,7 @@ mod step;
 mod tasks;
 mod trees;
 
+use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
 use std::sync::Arc;
 
 use glam::{Quat, Vec3};
@@ -115,6 +117,8 @@ pub struct World {
     repaired: u64,
     /// The run of states the world is on (no part of its state).
     timeline: snapshot::Timeline,
+    /// What a step that unwinds puts back (`rollback.rs`).
+    rollback: rollback::Rollback,
 }
 
 impl World {
@@ -161,6 +165,7 @@ impl World {
             residual_lanes: metrics::LaneResiduals::default(),
             repaired: 0,
             timeline: snapshot::Timeline::begin(false),
+            rollback: rollback::Rollback::default(),
         })
     }
 
@@ -607,6 +612,17 @@ impl World {
     /// ([`SolverConfig::measure_residuals`]). Once its buffers have grown to
     /// the world's bodies, joints and contacts, a step allocates nothing on
     /// one thread (`crates/vertebra-scenes/tests/allocation.rs`).
+    ///
+    /// **A task system that panics** ([`World::set_tasks`]: its
+    /// [`TaskSystem::workers`] or [`TaskSystem::parallel_for`], or an item
+    /// it runs) leaves the world unchanged: the step puts back everything
+    /// it had changed, bit for bit (state hash, snapshot bytes, sleep
+    /// state, the contacts set for the step, the NaN guard's count), and
+    /// the panic goes on to the caller. A caller that catches it may fix or
+    /// replace the task system and step again, as if the failed call had
+    /// never been made. (With one worker the step does not call the task
+    /// system past `workers`; the step's own code does not panic on any
+    /// state the API accepts, so nothing needs putting back there.)
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
         vertebra_store::check_positive("time step", dt)?;
         if dt > vertebra_store::MAX_TIME_STEP {
@@ -618,6 +634,26 @@ impl World {
             ));
         }
         let _mode = DefaultFloatMode::enter();
+        // Asked once, before anything changes: a task system whose answer
+        // changes from call to call, or that panics here, changes nothing.
+        let workers = self.tasks.workers();
+        if workers <= 1 {
+            self.advance(dt, workers);
+            return Ok(());
+        }
+        // Foreign code runs inside the step from here: what it may leave
+        // half done is kept first, and put back if the step unwinds.
+        self.keep_for_rollback();
+        if let Err(panic) = catch_unwind(AssertUnwindSafe(|| self.advance(dt, workers))) {
+            self.roll_back();
+            resume_unwind(panic);
+        }
+        Ok(())
+    }
+
+    /// The step of a valid `dt` on `workers` workers (the task system's
+    /// count, asked once).
+    fn advance(&mut self, dt: f32, workers: usize) {
         self.layout_dirty |= match self.config.sleep {
             Some(_) => self.islands.touch(&self.contacts, &self.bodies),
             None => self.islands.wake_all(),
@@ -629,7 +665,7 @@ impl World {
             &self.rods,
             &self.contacts,
             &self.joints_at,
-            self.tasks.workers(),
+            workers,
         );
         self.refresh_layout();
         let (max_linear, max_angular) =
@@ -641,11 +677,11 @@ impl World {
             .plan(&self.contacts, &self.bodies, asleep, &self.bins);
         // The contacts' lanes and the joints' start of step, on the workers
         // when there are many (step::start_blocks_all).
-        step::start_blocks_all(self, max_depth);
+        step::start_blocks_all(self, max_depth, workers);
         self.contact_layout.check();
         // Each substep launches the task system's workers once
         // (step::solve_substep).
-        step::step(self, dt);
+        step::step(self, dt, workers);
         if let Some(settings) = &self.config.sleep {
             let links = islands::links(&self.joints, &self.rods);
             self.layout_dirty |=
@@ -657,6 +693,5 @@ impl World {
         if self.residuals_measured {
             metrics::residuals(self);
         }
-        Ok(())
     }
 }

@@ -55,12 +55,17 @@ pub(crate) struct Stages {
 }
 
 impl Stages {
-    /// Runs the stage list `walk` describes on the workers of `tasks`, and
-    /// returns when every stage is finished. `walk` must describe the same
-    /// stages every time it is called (it is called once to count them,
-    /// then by each worker and by the caller).
-    pub fn run(&mut self, tasks: &dyn TaskSystem, walk: &(dyn Fn(&mut Cursor) + Sync)) {
-        let workers = tasks.workers();
+    /// Runs the stage list `walk` describes on `workers` workers of `tasks`
+    /// (the count the step asked it for once: `tasks` is not asked again),
+    /// and returns when every stage is finished. `walk` must describe the
+    /// same stages every time it is called (it is called once to count
+    /// them, then by each worker and by the caller).
+    pub fn run(
+        &mut self,
+        tasks: &dyn TaskSystem,
+        workers: usize,
+        walk: &(dyn Fn(&mut Cursor) + Sync),
+    ) {
         if workers <= 1 {
             // One worker: every stage in order, every chunk in the order the
             // lone worker would claim it, with no count, counter or wait (a
@@ -480,7 +485,7 @@ mod tests {
                     cursor.stage(&[&head, &tail]);
                 }
             };
-            Stages::default().run(&Tasks(runs), &walk);
+            Stages::default().run(&Tasks(runs), Tasks(runs).workers(), &walk);
             assert!(
                 counts.iter().all(|c| c.load(Ordering::Relaxed) == 1),
                 "{runs:?}: every chunk once"
@@ -501,9 +506,11 @@ mod tests {
                     }
                 });
                 assert!(chunks.chunks() <= pieces.clamp(1, MAX_SLICE_CHUNKS));
-                Stages::default().run(&Tasks(runs), &|cursor: &mut Cursor| {
-                    cursor.stage(&[&chunks])
-                });
+                Stages::default().run(
+                    &Tasks(runs),
+                    Tasks(runs).workers(),
+                    &|cursor: &mut Cursor| cursor.stage(&[&chunks]),
+                );
                 assert!(
                     seen.iter().enumerate().all(|(i, &v)| v == i),
                     "{runs:?}, {len} in {pieces}"
@@ -524,7 +531,7 @@ mod tests {
                     })]);
                 }
             };
-            stages.run(&Tasks(Runs::AtOnce), &walk);
+            stages.run(&Tasks(Runs::AtOnce), Tasks(Runs::AtOnce).workers(), &walk);
             assert_eq!(runs.load(Ordering::Relaxed), 2 * count);
         }
         assert_eq!(stages.counters.len(), 9);

@@ -53,8 +53,7 @@ const START_LAUNCH_CONTACTS: usize = 1024;
 /// writes only its own blocks, and reads only the bodies and the
 /// contacts); else all of it on the calling thread. The same bits either
 /// way.
-pub(crate) fn start_blocks_all(world: &mut World, max_depth: f32) {
-    let workers = world.tasks.workers();
+pub(crate) fn start_blocks_all(world: &mut World, max_depth: f32, workers: usize) {
     let bodies = &world.bodies;
     let (fill, blocks) = world
         .contact_layout
@@ -87,12 +86,14 @@ pub(crate) fn start_blocks_all(world: &mut World, max_depth: f32) {
     let trees = SliceChunks::new(&mut layout.trees.blocks, pieces, |_, b: &mut [_]| {
         start_blocks::<TreeBlock>(b, bodies)
     });
-    world.stages.run(&*world.tasks, &|cursor: &mut Cursor| {
-        cursor.stage(&[&contacts, &sockets, &hinges, &fixed, &rods, &trees])
-    });
+    world
+        .stages
+        .run(&*world.tasks, workers, &|cursor: &mut Cursor| {
+            cursor.stage(&[&contacts, &sockets, &hinges, &fixed, &rods, &trees])
+        });
 }
 
-pub(crate) fn step(world: &mut World, dt: f32) {
+pub(crate) fn step(world: &mut World, dt: f32, workers: usize) {
     let h = dt / world.config.substeps as f32;
     upload(&world.bodies, world.rows.get());
     world
@@ -128,7 +129,7 @@ pub(crate) fn step(world: &mut World, dt: f32) {
             .blocks
             .iter_mut()
             .for_each(|b| b.start_substep(remaining));
-        world.repaired += solve_substep(world, h);
+        world.repaired += solve_substep(world, h, workers);
     }
     commit(world);
     keep_drive_targets(world);
@@ -680,8 +681,7 @@ struct Substep<'a> {
 /// iterations, derive velocities, the velocity pass, damp and repair, as
 /// one launch of the task system's workers walking the stages
 /// ([`Substep::walk`]). Returns how many bodies were repaired.
-fn solve_substep(world: &mut World, h: f32) -> u64 {
-    let workers = world.tasks.workers();
+fn solve_substep(world: &mut World, h: f32, workers: usize) -> u64 {
     let config = &world.config;
     let b = &mut world.bodies;
     let n = b.capacity();
@@ -756,7 +756,9 @@ fn solve_substep(world: &mut World, h: f32) -> u64 {
     };
     world
         .stages
-        .run(&*world.tasks, &|cursor: &mut Cursor| substep.walk(cursor));
+        .run(&*world.tasks, workers, &|cursor: &mut Cursor| {
+            substep.walk(cursor)
+        });
     substep.repaired.into_inner()
 }
 

@@ -17,6 +17,17 @@
 //! finishes what is left when `parallel_for` returns (the borrow the work
 //! is lent under ends there), so a task system written in safe Rust
 //! cannot make the step race, deadlock or lose work, only slow it down.
+//!
+//! **A task system that panics** (in `workers`, in `parallel_for` before,
+//! while or after it runs the items, or in one of its threads) makes the
+//! step unwind, and leaves the world as it was before the step, bit for
+//! bit: the step keeps what it changes before its last `parallel_for`
+//! returns and puts it back (`rollback.rs`; see
+//! [`World::step`](crate::World::step)). The panic goes on to the caller,
+//! who may replace the task system ([`World::set_tasks`](crate::World::set_tasks))
+//! and step again. (The C ABI catches the panic and poisons the world
+//! object, as it does for every panic: `VT_RESULT_PANIC`, then
+//! `VT_RESULT_POISONED`; a C job system's callbacks must not unwind.)
 
 /// A job system the world's step runs its parallel work on.
 ///
@@ -29,14 +40,17 @@
 pub trait TaskSystem: Send + Sync {
     /// How many threads may run items at once (at least 1): the number of
     /// items the step asks for. The calling thread waits in
-    /// `parallel_for` and finishes what is left afterwards.
+    /// `parallel_for` and finishes what is left afterwards. Asked once as
+    /// each step begins (an answer of 0 counts as 1).
     fn workers(&self) -> usize;
 
     /// Runs `task(i)` for every `i` in `0..count`, on whichever threads
     /// and in whichever order, and returns when all have run (the borrow
     /// of `task` ends here: it cannot be kept). Items should run at once
     /// to gain anything, but need not: an item run after another, run
-    /// twice, or not run at all costs time, never a result.
+    /// twice, or not run at all costs time, never a result. A panic here
+    /// unwinds out of [`World::step`](crate::World::step) with the world
+    /// as it was before the step.
     fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync));
 }
 

@@ -202,6 +202,164 @@ fn a_task_system_that_panics_makes_the_step_panic_not_hang() {
     }
 }
 
+/// A task system of three workers that runs the items of every call in
+/// order, but fails its call `at` (counting from 0) as `how` says.
+struct PanicsAt {
+    at: usize,
+    how: Panics,
+    calls: AtomicUsize,
+}
+
+impl PanicsAt {
+    fn new(at: usize, how: Panics) -> Arc<Self> {
+        Arc::new(Self {
+            at,
+            how,
+            calls: AtomicUsize::new(0),
+        })
+    }
+}
+
+impl TaskSystem for PanicsAt {
+    fn workers(&self) -> usize {
+        3
+    }
+
+    fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync)) {
+        if self.calls.fetch_add(1, Ordering::Relaxed) == self.at {
+            self.how.parallel_for(count, task);
+        } else {
+            (0..count).for_each(task);
+        }
+    }
+}
+
+/// A task system whose `workers` panics.
+struct NoWorkers;
+
+impl TaskSystem for NoWorkers {
+    fn workers(&self) -> usize {
+        panic!("the engine's job system is gone")
+    }
+
+    fn parallel_for(&self, count: usize, task: &(dyn Fn(usize) + Sync)) {
+        (0..count).for_each(task);
+    }
+}
+
+/// Steps `world` on `tasks`, which must panic; then checks that the world
+/// is exactly as it was (snapshot bytes, state hash, contacts, sleep), and
+/// that stepping it again on one thread (`feed` between steps) gives the
+/// hashes a copy of it (restored from its snapshot) gives stepped alike.
+fn fails_and_retries(
+    what: &str,
+    mut world: World,
+    tasks: Arc<dyn TaskSystem>,
+    feed: impl Fn(&mut World),
+) {
+    let (snapshot, hash) = (world.snapshot(), world.state_hash());
+    let mut reference = World::new(*world.config()).unwrap();
+    reference.restore(&snapshot).unwrap();
+    let (islands, repaired) = (world.island_count(), world.repaired_bodies());
+    world.set_tasks(tasks);
+    let stepped = catch_unwind(AssertUnwindSafe(|| world.step(DT)));
+    assert!(stepped.is_err(), "{what}: the panic surfaced");
+    assert_eq!(world.state_hash(), hash, "{what}: the hash is as it was");
+    assert!(
+        world.snapshot() == snapshot,
+        "{what}: the state is as it was"
+    );
+    assert_eq!(world.island_count(), islands, "{what}: the islands too");
+    assert_eq!(world.repaired_bodies(), repaired, "{what}");
+    world.set_tasks(Arc::new(SingleThreaded));
+    for step in 0..10 {
+        world.step(DT).unwrap();
+        reference.step(DT).unwrap();
+        assert_eq!(
+            world.state_hash(),
+            reference.state_hash(),
+            "{what}: retried, {step} steps on"
+        );
+        feed(&mut world);
+        feed(&mut reference);
+    }
+}
+
+/// The attack: a task system that runs its items and then panics made the
+/// step unwind with part of its motion applied (a pendulum retried after
+/// it had fallen two steps' worth); and one that panics before running
+/// them, or in one of its threads, or asks for its workers and panics, at
+/// any substep, in the step's start with many contacts, and in a step whose
+/// contacts woke a sleeping island.
+#[test]
+fn a_task_system_that_panics_leaves_the_world_as_it_was() {
+    let swinging = || {
+        let mut world = chains(SolverConfig {
+            substeps: 4,
+            ..config(1)
+        });
+        for _ in 0..3 {
+            world.step(DT).unwrap();
+        }
+        world
+    };
+    for how in [Panics::After, Panics::Before, Panics::InAThread] {
+        for at in 0..4 {
+            let what = format!("chains, {how:?} at call {at}");
+            fails_and_retries(&what, swinging(), PanicsAt::new(at, how), |_| {});
+        }
+    }
+    fails_and_retries(
+        "chains, no workers",
+        swinging(),
+        Arc::new(NoWorkers),
+        |_| {},
+    );
+    // 1100 contacts: the first launch is the step's start.
+    let pile = || {
+        let (mut world, ground, balls) = resting_balls(config(1));
+        for _ in 0..3 {
+            let contacts = ground_contacts(&world, ground, &balls);
+            world.set_contacts(&contacts).unwrap();
+            world.step(DT).unwrap();
+        }
+        let contacts = ground_contacts(&world, ground, &balls);
+        world.set_contacts(&contacts).unwrap();
+        (world, ground, balls)
+    };
+    for at in 0..2 {
+        let (world, ground, balls) = pile();
+        let feed = |w: &mut World| {
+            let contacts = ground_contacts(w, ground, &balls);
+            w.set_contacts(&contacts).unwrap();
+        };
+        let what = format!("resting balls, after at call {at}");
+        fails_and_retries(&what, world, PanicsAt::new(at, Panics::After), feed);
+    }
+    // The woken bob touches the sleeping ball: the step wakes it and joins
+    // their islands before it panics.
+    let touching_sleeper = || {
+        let (mut world, _, bob, other) = sleeping_pendulum(Vec3::new(0.0, 1.0, 0.0));
+        assert!(world.is_asleep(other).unwrap());
+        world.wake(bob).unwrap();
+        world.apply_impulse(bob, Vec3::X).unwrap();
+        let at = world.bodies().position[other.index()];
+        world.set_contacts(&[touching(bob, other, at)]).unwrap();
+        world
+    };
+    for tasks in [
+        PanicsAt::new(0, Panics::After) as Arc<dyn TaskSystem>,
+        Arc::new(NoWorkers),
+    ] {
+        fails_and_retries(
+            "a contact waking a sleeper",
+            touching_sleeper(),
+            tasks,
+            |_| {},
+        );
+    }
+}
+
 #[test]
 fn sleep_settings_out_of_range_are_refused_naming_the_field() {
     let speeds = [
