@@ -83,6 +83,12 @@ pub(crate) fn root(parent: &mut [u32], mut i: usize) -> u32 {
 /// A body in no island: free slot, static or kinematic.
 pub(crate) const NO_ISLAND: u32 = u32::MAX;
 
+/// The longest stillness (s) a step can accumulate: it adds the step's
+/// time, at most [`MAX_TIME_STEP`](vertebra_store::MAX_TIME_STEP) = 1 s, to
+/// a double, and from 2^53 s on (285 million years) adding a second or less
+/// no longer changes it. A snapshot's stillness above this is refused.
+pub(crate) const MAX_STILLNESS: f64 = 9_007_199_254_740_992.0;
+
 /// When bodies fall asleep ([`SolverConfig::sleep`](crate::SolverConfig::sleep)):
 /// a body is still while the mean speed of its mass over each window of
 /// `time` stays below `speed`, and an island sleeps when all its bodies
@@ -640,10 +646,23 @@ impl Islands {
         }
     }
 
-    /// Checks a saved state against its bodies and links (a snapshot's:
-    /// every live dynamic body in a live island, nothing else in one,
-    /// every live island holding a body, the two dynamic bodies of every
-    /// link in one island, stillness finite and at least 0).
+    /// Checks a saved state against its bodies and links (a snapshot's),
+    /// as the API leaves it between calls:
+    ///
+    /// - the islands: every live dynamic body in a live island, nothing
+    ///   else in one, every live island holding a body, the two dynamic
+    ///   bodies of every link in one island, a free island with no flags;
+    /// - stillness: finite, at least 0 and at most [`MAX_STILLNESS`], zero
+    ///   for a body in no island; its anchor where a body can be (finite,
+    ///   within [`MAX_COORDINATE`](vertebra_store::MAX_COORDINATE)) with a
+    ///   unit orientation;
+    /// - sleep: a sleeping island has no split pending, and each of its
+    ///   bodies has been still (stillness above 0), may sleep, and is at
+    ///   rest (velocities zeroed as it fell asleep, no pending force or
+    ///   torque: setting or pushing a body wakes it); no link of a sleeping
+    ///   body moves it (a drive's moving target, a rod's moving rest, a
+    ///   kinematic body with a velocity: each keeps its island awake, and
+    ///   setting one wakes the island).
     pub fn validate(
         &self,
         bodies: &BodyStore,
@@ -659,25 +678,45 @@ impl Islands {
         {
             return Err(format!("islands: per-body arrays for {n} body slots"));
         }
+        if let Some(id) = (0..self.islands.len())
+            .find(|&k| !self.islands[k].live && self.islands[k] != Island::default())
+        {
+            return Err(format!("island {id}: free but flagged"));
+        }
         let mut used = vec![false; self.islands.len()];
         for i in 0..n {
             let dynamic = bodies.is_live(i) && bodies.kind[i] == BodyKind::Dynamic;
             let id = self.of[i];
-            match (dynamic, id) {
-                (false, NO_ISLAND) => {}
+            let island = match (dynamic, id) {
+                (false, NO_ISLAND) => None,
                 (false, _) => return Err(format!("body {i}: in an island but not dynamic")),
                 (true, NO_ISLAND) => return Err(format!("body {i}: dynamic in no island")),
                 (true, id) => match self.islands.get(id as usize) {
-                    Some(island) if island.live => used[id as usize] = true,
+                    Some(island) if island.live => {
+                        used[id as usize] = true;
+                        Some(island)
+                    }
                     _ => return Err(format!("body {i}: in island {id}, which is not live")),
                 },
+            };
+            let still = self.still[i];
+            if !(still.is_finite() && (0.0..=MAX_STILLNESS).contains(&still)) {
+                return Err(format!(
+                    "body {i}: stillness {still:e} (0 to {MAX_STILLNESS:e} s)"
+                ));
             }
-            if !(self.still[i].is_finite() && self.still[i] >= 0.0) {
-                return Err(format!("body {i}: stillness {}", self.still[i]));
+            if island.is_none() && still != 0.0 {
+                return Err(format!("body {i}: stillness {still} in no island"));
             }
             let (x, q) = self.anchor[i];
             if !(x.is_finite() && q.is_finite()) {
                 return Err(format!("body {i}: stillness anchor not finite"));
+            }
+            vertebra_store::check_coordinate("stillness anchor", x.as_vec3())
+                .and_then(|()| vertebra_store::check_unit_quat("stillness anchor orientation", q))
+                .map_err(|e| format!("body {i}: {e}"))?;
+            if island.is_some_and(|island| island.asleep) {
+                asleep_at_rest(bodies, i, still, self.allowed[i])?;
             }
         }
         if let Some(id) = (0..self.islands.len()).find(|&k| self.islands[k].live != used[k]) {
@@ -685,17 +724,68 @@ impl Islands {
                 "island {id}: live without bodies, or free with them"
             ));
         }
+        if let Some(id) = (0..self.islands.len()).find(|&k| {
+            let island = self.islands[k];
+            island.asleep && island.split
+        }) {
+            return Err(format!("island {id}: asleep with a split pending"));
+        }
+        let asleep = |i: usize| {
+            let id = self.of[i];
+            id != NO_ISLAND && self.islands[id as usize].asleep
+        };
         for link in links {
-            let (a, b) = (self.of[link.a as usize], self.of[link.b as usize]);
-            if a != NO_ISLAND && b != NO_ISLAND && a != b {
+            let (a, b) = (link.a as usize, link.b as usize);
+            let (x, y) = (self.of[a], self.of[b]);
+            if x != NO_ISLAND && y != NO_ISLAND && x != y {
                 return Err(format!(
-                    "bodies {} and {}: linked but in islands {a} and {b}",
-                    link.a, link.b
+                    "bodies {a} and {b}: linked but in islands {x} and {y}"
                 ));
+            }
+            let kinematic_moves = |i: usize| {
+                bodies.kind[i] == BodyKind::Kinematic
+                    && (bodies.linear_velocity[i] != Vec3::ZERO
+                        || bodies.angular_velocity[i] != Vec3::ZERO)
+            };
+            for (i, other) in [(a, b), (b, a)] {
+                if !asleep(i) {
+                    continue;
+                }
+                if link.moving {
+                    return Err(format!(
+                        "body {i}: asleep, held by a moving drive or rod rest (to body {other})"
+                    ));
+                }
+                if kinematic_moves(other) {
+                    return Err(format!(
+                        "body {i}: asleep, linked to kinematic body {other}, which moves"
+                    ));
+                }
             }
         }
         Ok(())
     }
+}
+
+/// Checks that body `i` of a sleeping island (`still` its stillness,
+/// `allowed` whether it may sleep) is as falling asleep left it.
+fn asleep_at_rest(bodies: &BodyStore, i: usize, still: f64, allowed: bool) -> Result<(), String> {
+    if still <= 0.0 {
+        return Err(format!("body {i}: asleep but never still"));
+    }
+    if !allowed {
+        return Err(format!("body {i}: asleep but not allowed to sleep"));
+    }
+    let moving = [
+        ("linear velocity", bodies.linear_velocity[i]),
+        ("angular velocity", bodies.angular_velocity[i]),
+        ("force", bodies.force[i]),
+        ("torque", bodies.torque[i]),
+    ];
+    if let Some((what, v)) = moving.iter().find(|(_, v)| *v != Vec3::ZERO) {
+        return Err(format!("body {i}: asleep but its {what} is {v}"));
+    }
+    Ok(())
 }
 
 /// A joint or rod as islands see it: its two bodies, and whether it moves

@@ -40,7 +40,11 @@
 //! a pending contact's bodies may both be kinematic, after
 //! `World::set_body_kind`, never both static) and structural
 //! ones (slot tables, array lengths, each body's joint count, the colouring
-//! as [`Colouring::validate`]). A refused snapshot gets
+//! as [`Colouring::validate`]), and the islands and sleep state as the API
+//! leaves them (`Islands::validate`: a sleeping body at rest, still, allowed
+//! to sleep and held by nothing that moves; stillness no longer than a step
+//! can accumulate; anchors where a body can be, with unit orientations). A
+//! refused snapshot gets
 //! `Err(CorruptSnapshot)` naming the item and the reason (or
 //! `Err(IncompatibleSnapshot)` for another build) and the world is
 //! unchanged.
@@ -358,7 +362,7 @@ mod tests {
     use glam::{Quat, Vec3};
 
     use super::*;
-    use crate::islands::NO_ISLAND;
+    use crate::islands::{Island, NO_ISLAND};
     use crate::{
         AngularDrive, BodyDesc, BodyKind, JointKind, LimitSoftness, RodStiffness, Shape,
         SolverConfig, Swing, SwingTwist,
@@ -707,7 +711,7 @@ mod tests {
             ),
             (
                 Box::new(|s| s.islands.still[3] = f64::NAN),
-                "body 3: stillness NaN",
+                "body 3: stillness NaN (0 to 9.007199254740992e15 s)",
             ),
             (
                 Box::new(|s| s.islands.anchor[3].0.x = f64::INFINITY),
@@ -733,6 +737,171 @@ mod tests {
             );
         }
         world.step(1.0 / 60.0).unwrap();
+    }
+
+    /// Without gravity: a ball hanging from the ground by a socket with a
+    /// still drive (body 2), one hanging from a kinematic body at rest by a
+    /// socket (body 3 from body 1), and a free ball (body 4); after 40 steps
+    /// all three islands sleep.
+    fn sleeping_world() -> World {
+        let mut world = World::new(SolverConfig {
+            gravity: Vec3::ZERO,
+            ..SolverConfig::default()
+        })
+        .unwrap();
+        let ground = world.add_body(BodyDesc::fixed()).unwrap();
+        let kinematic = BodyDesc {
+            kind: BodyKind::Kinematic,
+            ..BodyDesc::fixed().with_position(Vec3::new(2.0, 0.0, 0.0))
+        };
+        let holder = world.add_body(kinematic).unwrap();
+        let mass = Shape::Sphere { radius: 0.1 }
+            .mass_properties_with_mass(1.0)
+            .unwrap();
+        let ball = |x: f32| BodyDesc::dynamic(mass).with_position(Vec3::new(x, -0.5, 0.0));
+        let a = world.add_body(ball(0.0)).unwrap();
+        let b = world.add_body(ball(2.0)).unwrap();
+        world.add_body(ball(5.0)).unwrap();
+        let bodies = world.bodies();
+        let drive = AngularDrive::spring(Quat::IDENTITY, 4.0, 0.7);
+        let driven =
+            JointDesc::socket_at_world_anchor(bodies, ground, a, -0.25 * Vec3::Y, -Vec3::Y)
+                .unwrap()
+                .with_drive(drive);
+        let held = JointDesc::socket_at_world_anchor(
+            bodies,
+            holder,
+            b,
+            Vec3::new(2.0, -0.25, 0.0),
+            -Vec3::Y,
+        )
+        .unwrap();
+        world.add_joint(driven).unwrap();
+        world.add_joint(held).unwrap();
+        for _ in 0..40 {
+            world.step(1.0 / 60.0).unwrap();
+        }
+        assert_eq!(world.island_count(), (3, 3), "every island sleeps");
+        world
+    }
+
+    /// Sleep states the API could never produce, accepted before restore
+    /// checked the sleep state: a sleeping island moving at 400 m/s (6.67 m
+    /// in its first step awake), a sleeper held by a moving drive or a
+    /// moving kinematic body, a zero anchor orientation, a stillness of
+    /// 1e308 s; and every other value falling asleep or staying asleep
+    /// rules out.
+    #[test]
+    fn sleep_states_the_api_could_not_produce_are_refused_by_name() {
+        let mut world = sleeping_world();
+        let island = world.islands.of[2] as usize;
+        let free = world.islands.islands.len();
+        let cases: Vec<(Change, String)> = vec![
+            (
+                Box::new(|s| s.bodies.linear_velocity[2] = Vec3::new(400.0, 0.0, 0.0)),
+                "body 2: asleep but its linear velocity is [400, 0, 0]".into(),
+            ),
+            (
+                Box::new(|s| s.bodies.angular_velocity[4].z = -3.0),
+                "body 4: asleep but its angular velocity is [0, 0, -3]".into(),
+            ),
+            (
+                Box::new(|s| s.bodies.force[2] = Vec3::Y),
+                "body 2: asleep but its force is [0, 1, 0]".into(),
+            ),
+            (
+                Box::new(|s| s.bodies.torque[3] = Vec3::X),
+                "body 3: asleep but its torque is [1, 0, 0]".into(),
+            ),
+            (
+                Box::new(|s| {
+                    let drive = s.joints[0].as_mut().unwrap().drive.as_mut().unwrap();
+                    drive.target_velocity = Vec3::new(0.0, 0.5, 0.0);
+                }),
+                "body 2: asleep, held by a moving drive or rod rest (to body 0)".into(),
+            ),
+            (
+                Box::new(|s| s.bodies.linear_velocity[1] = Vec3::X),
+                "body 3: asleep, linked to kinematic body 1, which moves".into(),
+            ),
+            (
+                Box::new(|s| s.islands.anchor[2].1 = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)),
+                "body 2: stillness anchor orientation is not normalised".into(),
+            ),
+            (
+                Box::new(|s| s.islands.anchor[4].0.x = 2e6),
+                "body 4: stillness anchor is out of range".into(),
+            ),
+            (
+                Box::new(|s| s.islands.still[2] = 1e308),
+                "body 2: stillness 1e308 (0 to 9.007199254740992e15 s)".into(),
+            ),
+            (
+                Box::new(|s| s.islands.still[2] = 0.0),
+                "body 2: asleep but never still".into(),
+            ),
+            (
+                Box::new(|s| s.islands.still[0] = 1.0),
+                "body 0: stillness 1 in no island".into(),
+            ),
+            (
+                Box::new(|s| s.islands.allowed[3] = false),
+                "body 3: asleep but not allowed to sleep".into(),
+            ),
+            (
+                Box::new(move |s| s.islands.islands[island].split = true),
+                format!("island {island}: asleep with a split pending"),
+            ),
+            (
+                Box::new(|s| {
+                    s.islands.islands.push(Island {
+                        asleep: true,
+                        ..Island::default()
+                    })
+                }),
+                format!("island {free}: free but flagged"),
+            ),
+        ];
+        for (change, expected) in cases {
+            let snapshot = crafted(&world, change);
+            assert_eq!(
+                refusal(&mut world, &snapshot),
+                format!("corrupt snapshot: {expected}")
+            );
+        }
+        // The untouched sleeping state restores.
+        world.restore(&world.snapshot()).unwrap();
+    }
+
+    /// The attack's other state: every island of a world with a moving
+    /// drive put to sleep as it moves.
+    #[test]
+    fn every_island_put_to_sleep_while_a_drive_moves_is_refused() {
+        let mut world = world();
+        let moving = crafted(&world, |s| {
+            for island in s.islands.islands.iter_mut().filter(|x| x.live) {
+                island.asleep = true;
+            }
+        });
+        assert_eq!(
+            refusal(&mut world, &moving),
+            "corrupt snapshot: body 1: asleep but never still"
+        );
+        // Even at rest, still and with no force, the drive keeps it awake.
+        let at_rest = crafted(&world, |s| {
+            for island in s.islands.islands.iter_mut().filter(|x| x.live) {
+                island.asleep = true;
+            }
+            for i in 1..=3 {
+                s.bodies.linear_velocity[i] = Vec3::ZERO;
+                s.bodies.angular_velocity[i] = Vec3::ZERO;
+                s.islands.still[i] = 1.0;
+            }
+        });
+        assert_eq!(
+            refusal(&mut world, &at_rest),
+            "corrupt snapshot: body 2: asleep, held by a moving drive or rod rest (to body 3)"
+        );
     }
 
     #[test]
