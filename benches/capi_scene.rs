@@ -25,7 +25,11 @@ pub fn save(scene: &SceneWorld) -> Saved {
     let collisions = scene.collisions.as_ref().expect("the drop has colliders");
     Saved {
         world: scene.world.snapshot().as_bytes().to_vec(),
-        collisions: collisions.snapshot().as_bytes().to_vec(),
+        collisions: collisions
+            .snapshot(&scene.world)
+            .expect("the set serves its world")
+            .as_bytes()
+            .to_vec(),
     }
 }
 
