@@ -4,11 +4,13 @@
 //! tree and the spine chain found), and the checks
 //! [`RagdollDesc::validate`] runs on any description.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use vertebra_world::check_coordinate;
 
-use crate::description::{BodyDef, BoneBinding, RagdollDesc, SpineDef, finite, range};
+use crate::description::{
+    BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef, finite, range,
+};
 use crate::drive::DriveSettings;
 use crate::drive_def::{check_drive, own_strengths};
 use crate::error::{Problems, RagdollError, first};
@@ -119,6 +121,9 @@ pub(crate) fn assemble_all(
     doc: Document,
     mut problems: Problems,
 ) -> Result<RagdollDesc, Vec<RagdollError>> {
+    // The counts first, before any item is read: a description beyond them
+    // is refused with that problem alone, whatever its items hold.
+    counts(&doc.name, doc.bodies.len(), doc.joints.len()).map_err(|e| vec![e])?;
     let at = At {
         bodies: doc.bodies.iter().map(|b| b.line).collect(),
         joints: doc.joints.iter().map(|j| j.line).collect(),
@@ -324,8 +329,35 @@ impl RagdollDesc {
     }
 }
 
+/// At most [`MAX_BODIES`] bodies and [`MAX_JOINTS`] joints in the
+/// description called `name`: checked before any body or joint is, so
+/// that the work every other check does is bounded.
+fn counts(name: &str, bodies: usize, joints: usize) -> Result<(), RagdollError> {
+    let context = format!("ragdoll `{name}`");
+    range(
+        &context,
+        "body",
+        bodies <= MAX_BODIES,
+        &format!(
+            "has {bodies} bodies; a ragdoll has at most MAX_BODIES ({MAX_BODIES}), one per bone of the largest skeleton"
+        ),
+    )?;
+    range(
+        &context,
+        "joint",
+        joints <= MAX_JOINTS,
+        &format!(
+            "has {joints} joints; a ragdoll has at most MAX_JOINTS ({MAX_JOINTS}), one fewer than its bodies at most"
+        ),
+    )
+}
+
 /// `validate`'s checks of `desc`, each problem kept in `problems`.
 fn check(desc: &RagdollDesc, at: &At, problems: &mut Problems) {
+    if let Err(e) = counts(&desc.name, desc.bodies.len(), desc.joints.len()) {
+        problems.note(None, Err::<(), _>(e));
+        return;
+    }
     names(
         desc.bodies
             .iter()
@@ -489,18 +521,29 @@ fn tree(bodies: &[&str], joints: &[JointDef]) -> Result<(usize, Vec<Option<usize
             )));
         }
     }
-    // Every body must reach the root by parent links, without a cycle.
+    // Every body must reach the root by parent links, without a cycle:
+    // each walk up stops at a body an earlier walk reached the root from,
+    // so every body is walked through once (linear, however deep).
+    let mut reaches_root = vec![false; bodies.len()];
+    let mut walk = Vec::new();
     for start in 0..bodies.len() {
-        let (mut body, mut steps) = (start, 0);
-        while let Some(k) = parent_joint[body] {
-            body = joints[k].parent;
-            steps += 1;
-            if steps > bodies.len() {
+        let mut body = start;
+        walk.clear();
+        while !reaches_root[body] {
+            walk.push(body);
+            match parent_joint[body] {
+                Some(k) => body = joints[k].parent,
+                None => break,
+            }
+            if walk.len() > bodies.len() {
                 return Err(RagdollError::NotATree(format!(
                     "a cycle runs through body `{}`",
                     bodies[start]
                 )));
             }
+        }
+        for &b in &walk {
+            reaches_root[b] = true;
         }
     }
     let roots: Vec<usize> = (0..bodies.len())
@@ -601,18 +644,24 @@ fn check_spine(s: &SpineDef, desc: &RagdollDesc, context: &str) -> Result<(), Ra
         }
     }
     // The interior bodies disappear in the simplified ragdoll: nothing but
-    // the chain may hang from them.
-    for &interior in &s.bodies[1..s.bodies.len() - 1] {
-        if let Some(j) = joints
-            .iter()
-            .enumerate()
-            .find(|&(k, j)| j.parent == interior && !s.joints.contains(&k))
-        {
-            return Err(RagdollError::SpineNotChain(format!(
-                "joint `{}` hangs from an interior spine body; only the chain may",
-                j.1.name
-            )));
+    // the chain may hang from them. Per body, the first joint off the
+    // chain that hangs from it (one pass over the joints, not one per
+    // interior body).
+    let chain: HashSet<usize> = s.joints.iter().copied().collect();
+    let mut hanging: Vec<Option<usize>> = vec![None; bodies.len()];
+    for (k, j) in joints.iter().enumerate() {
+        if !chain.contains(&k) && j.parent < bodies.len() {
+            hanging[j.parent].get_or_insert(k);
         }
+    }
+    if let Some(k) = s.bodies[1..s.bodies.len() - 1]
+        .iter()
+        .find_map(|&interior| hanging[interior])
+    {
+        return Err(RagdollError::SpineNotChain(format!(
+            "joint `{}` hangs from an interior spine body; only the chain may",
+            joints[k].name
+        )));
     }
     let limits = [s.bend_limit, s.bend_stiffness, s.twist_stiffness];
     rod_limits(context, limits, s.twist_limit)

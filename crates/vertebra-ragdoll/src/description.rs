@@ -26,7 +26,7 @@ use crate::joint_def::{JointDef, RawJoint, joint_spec};
 use crate::skeleton::{Skeleton, Transform};
 use crate::skeleton_file::{RawBone, bones_all, syntax_naming};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
-use crate::text::{Lines, in_file, item, read_text};
+use crate::text::{Lines, in_file, item, read_text, within_cap};
 use vertebra_math::DefaultFloatMode;
 
 /// The reference humanoid, shipped with the crate: 13 bodies, 12 joints,
@@ -156,6 +156,18 @@ pub struct SpineDef {
     pub twist_stiffness: f32,
 }
 
+/// The most bodies a ragdoll description may have: one per bone of the
+/// largest skeleton ([`MAX_BONES`](crate::MAX_BONES)); a game's ragdoll
+/// has 10 to 100. Counted before any body is read, by every way a
+/// description is made (a file, a string, a builder, a generator) and by
+/// [`RagdollDesc::validate`].
+pub const MAX_BODIES: usize = crate::skeleton::MAX_BONES;
+
+/// The most joints a ragdoll description may have: a tree over
+/// [`MAX_BODIES`] bodies has one fewer. Counted with the bodies, before any
+/// joint is read.
+pub const MAX_JOINTS: usize = MAX_BODIES - 1;
+
 /// A validated ragdoll description: names unique, joints a tree over the
 /// bodies rooted at body `root`, every number finite and in range, each
 /// bone followed by at most one body.
@@ -263,7 +275,9 @@ impl RagdollDesc {
             .map_err(|problems| problems.into_iter().map(|e| in_file(path, e)).collect())
     }
 
-    /// Parses and validates a description. Errors about a body, joint,
+    /// Parses and validates a description of at most
+    /// [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES) (a longer one is refused
+    /// before it is parsed, as a file is). Errors about a body, joint,
     /// bone or the spine start with the line where it is defined. A file
     /// that names a skeleton file is refused: only
     /// [`RagdollDesc::from_file`] knows where to look for it.
@@ -289,8 +303,11 @@ impl RagdollDesc {
         Self::parse(text, Given::Skeleton(skeleton)).map_err(first)
     }
 
-    /// The description in `text`, or every problem found in it.
+    /// The description in `text`, or every problem found in it; a text
+    /// longer than [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES) is refused
+    /// before it is parsed.
     fn parse(text: &str, given: Given<'_>) -> Result<Self, Vec<RagdollError>> {
+        within_cap(text.len() as u64, "ragdoll").map_err(|e| vec![e])?;
         let lines = Lines::new(text);
         let raw: RawFile = toml::from_str(text).map_err(|e| {
             vec![syntax_naming(

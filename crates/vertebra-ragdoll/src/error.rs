@@ -15,12 +15,21 @@ pub enum RagdollError {
         message: String,
     },
     /// A ragdoll or skeleton file that could not be read: missing,
-    /// unreadable, larger than `MAX_FILE_BYTES`, or not UTF-8.
+    /// unreadable, not a regular file (a FIFO, a device, a directory), or
+    /// not UTF-8 (one larger than `MAX_FILE_BYTES` is
+    /// [`RagdollError::TooLarge`]).
     Unreadable {
         /// What the file holds: `ragdoll`, `skeleton` or `generator`.
         file: &'static str,
         /// Why.
         reason: String,
+    },
+    /// A ragdoll, generator or skeleton text (a file, or a string given to
+    /// a `from_toml`) longer than [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES):
+    /// refused before it is parsed.
+    TooLarge {
+        /// What the text holds: `ragdoll`, `skeleton` or `generator`.
+        file: &'static str,
     },
     /// An error in the ragdoll or skeleton file at `path`.
     File {
@@ -122,6 +131,11 @@ impl fmt::Display for RagdollError {
             RagdollError::Unreadable { file, reason } => {
                 write!(f, "cannot read the {file} file: {reason}")
             }
+            RagdollError::TooLarge { file } => write!(
+                f,
+                "the {file} text is larger than MAX_FILE_BYTES ({} bytes) and is refused before it is parsed; a {file} file is a few KB",
+                crate::MAX_FILE_BYTES
+            ),
             RagdollError::File { path, error } => write!(f, "{path}: {error}"),
             RagdollError::DuplicateName { line, kind, name } => {
                 if let Some(line) = line {

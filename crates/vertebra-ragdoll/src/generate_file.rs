@@ -19,7 +19,7 @@ use crate::error::{Problems, RagdollError, first};
 use crate::generate::{BodyMass, BoneBody, RagdollGenerator, RodSpine, SegmentEnd};
 use crate::joint_def::RawBoneJoint;
 use crate::skeleton::Skeleton;
-use crate::text::{Lines, in_file, item, read_text, syntax};
+use crate::text::{Lines, in_file, item, read_text, syntax, within_cap};
 use vertebra_math::DefaultFloatMode;
 
 #[derive(Deserialize)]
@@ -61,7 +61,10 @@ impl RagdollGenerator {
     /// `density`, at most one of `end`, `length` and `point`, the joint's
     /// fields those of its kind: errors start with the line of the body's
     /// table) and for sense by [`RagdollGenerator::generate`] (errors
-    /// name the bone).
+    /// name the bone). A text longer than
+    /// [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES) is refused before it is
+    /// parsed, as a file is, and more `[[body]]` tables than the skeleton
+    /// has bones before any is read.
     pub fn from_toml(text: &str, skeleton: &Skeleton) -> Result<Self, RagdollError> {
         let _mode = DefaultFloatMode::enter();
         Self::read(text, skeleton).map_err(first)
@@ -70,9 +73,22 @@ impl RagdollGenerator {
     /// [`RagdollGenerator::from_toml`], refused with every table's problem
     /// of form, in file order.
     fn read(text: &str, skeleton: &Skeleton) -> Result<Self, Vec<RagdollError>> {
+        within_cap(text.len() as u64, "generator").map_err(|e| vec![e])?;
         let lines = Lines::new(text);
         let raw: RawGenerator =
             toml::from_str(text).map_err(|e| vec![syntax("generator", &lines, &e)])?;
+        // A bone has at most one body: counted before any table is read.
+        if raw.body.len() > skeleton.len() {
+            return Err(vec![RagdollError::OutOfRange {
+                context: format!("generator `{}`", raw.name),
+                field: "body",
+                reason: format!(
+                    "has {} tables; at most one per bone of the skeleton ({})",
+                    raw.body.len(),
+                    skeleton.len()
+                ),
+            }]);
+        }
         let mut generator = crate::RagdollDesc::generator(&raw.name, skeleton);
         let mut problems = Problems::default();
         for b in &raw.body {

@@ -147,7 +147,8 @@ mod write;
 
 pub use blend_back::{Blend, BlendBack};
 pub use description::{
-    ANATOMICAL_HUMANOID, BodyDef, BoneBinding, REFERENCE_HUMANOID, RagdollDesc, SpineDef,
+    ANATOMICAL_HUMANOID, BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, REFERENCE_HUMANOID,
+    RagdollDesc, SpineDef,
 };
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;

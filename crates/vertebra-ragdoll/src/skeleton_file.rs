@@ -13,7 +13,7 @@ use toml::Spanned;
 
 use crate::error::{Problems, RagdollError, first};
 use crate::skeleton::{Bone, MAX_BONES, Skeleton, Transform};
-use crate::text::{Lines, floats, in_file, read_text, same_bits, string, syntax};
+use crate::text::{Lines, floats, in_file, read_text, same_bits, string, syntax, within_cap};
 use vertebra_math::DefaultFloatMode;
 
 /// The reference animation skeleton, shipped with the crate
@@ -51,7 +51,9 @@ impl Skeleton {
     /// `translation = [x, y, z]` (m, in the parent's frame) and optional
     /// `rotation = [x, y, z, w]` (a unit quaternion, within 1e-3; identity
     /// when left out), kept as written. Errors about a bone start with the
-    /// line of its `[[bone]]`.
+    /// line of its `[[bone]]`. A text longer than
+    /// [`MAX_FILE_BYTES`](crate::MAX_FILE_BYTES) is refused before it is
+    /// parsed, as a file is.
     pub fn from_toml(text: &str) -> Result<Self, RagdollError> {
         let _mode = DefaultFloatMode::enter();
         Self::check_toml(text).map_err(first)
@@ -62,6 +64,7 @@ impl Skeleton {
     /// for text that does not parse, else one per bad bone.
     pub fn check_toml(text: &str) -> Result<Self, Vec<RagdollError>> {
         let _mode = DefaultFloatMode::enter();
+        within_cap(text.len() as u64, "skeleton").map_err(|e| vec![e])?;
         let lines = Lines::new(text);
         let raw: RawSkeleton = toml::from_str(text)
             .map_err(|e| vec![syntax_naming("skeleton", text, &lines, &e, &["bone"])])?;

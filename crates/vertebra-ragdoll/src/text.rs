@@ -7,29 +7,45 @@ use std::path::Path;
 
 use crate::error::RagdollError;
 
-/// The largest ragdoll or skeleton file that `from_file` reads (bytes): the
-/// reference humanoid is 5 KB and a body, joint or bone about 150 bytes,
-/// so 1 MiB holds thousands; a larger file is refused before it is read
-/// whole. Only regular files are read: a pipe, a device (`/dev/zero`,
-/// `/dev/stdin`) or a directory is refused without opening it (opening a
-/// pipe waits for a writer, for ever).
+/// The largest ragdoll, generator or skeleton text the loaders take
+/// (bytes), from a file (`from_file`, `check_file`) or a string
+/// (`from_toml`, `check_toml`, and the C ABI's string functions): the
+/// reference humanoid is 5 KB and a body, joint or bone about 150 bytes, so
+/// 1 MiB holds thousands. A longer text is refused before it is parsed
+/// ([`RagdollError::TooLarge`]), a longer file before it is opened. Only
+/// regular files are read: a pipe, a device (`/dev/zero`, `/dev/stdin`) or
+/// a directory is refused without opening it (opening a pipe waits for a
+/// writer, for ever).
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
 
-/// The UTF-8 text of the `file` file (`ragdoll` or `skeleton`) at `path`,
-/// at most [`MAX_FILE_BYTES`]; the error names the file.
-pub(crate) fn read_text(path: &Path, file: &'static str) -> Result<String, RagdollError> {
-    let unreadable = |reason: String| RagdollError::File {
-        path: path.display().to_string(),
-        error: Box::new(RagdollError::Unreadable { file, reason }),
-    };
+/// Refuses a `file` text (`ragdoll`, `generator` or `skeleton`) of
+/// `bytes` bytes longer than [`MAX_FILE_BYTES`]: the one check every
+/// loader makes of its text, a file's or a string's, before it parses it.
+pub(crate) fn within_cap(bytes: u64, file: &'static str) -> Result<(), RagdollError> {
+    if bytes <= MAX_FILE_BYTES {
+        Ok(())
+    } else {
+        Err(RagdollError::TooLarge { file })
+    }
+}
+
+/// The UTF-8 text of the `file` file (`ragdoll`, `generator` or
+/// `skeleton`, which the errors name) at `path`: the one reader of every
+/// file the loaders (and `vertebra`) read. The file's type and size are
+/// checked before it is opened: anything but a regular file (a FIFO, a
+/// device, a directory) is refused without opening it, and so is a file
+/// longer than [`MAX_FILE_BYTES`]; both are checked again on what was
+/// opened, and at most `MAX_FILE_BYTES + 1` bytes are read. Every error
+/// names the file.
+pub fn read_text(path: &Path, file: &'static str) -> Result<String, RagdollError> {
+    let unreadable = |reason: String| in_file(path, RagdollError::Unreadable { file, reason });
     let regular = |meta: std::fs::Metadata| {
-        if meta.is_file() {
-            Ok(())
-        } else {
-            Err(unreadable(
+        if !meta.is_file() {
+            return Err(unreadable(
                 "not a regular file (a directory, a device or a pipe)".to_owned(),
-            ))
+            ));
         }
+        within_cap(meta.len(), file).map_err(|e| in_file(path, e))
     };
     regular(std::fs::metadata(path).map_err(|e| unreadable(e.to_string()))?)?;
     let opened = std::fs::File::open(path).map_err(|e| unreadable(e.to_string()))?;
@@ -40,11 +56,8 @@ pub(crate) fn read_text(path: &Path, file: &'static str) -> Result<String, Ragdo
         .take(MAX_FILE_BYTES + 1)
         .read_to_end(&mut bytes)
         .map_err(|e| unreadable(e.to_string()))?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(unreadable(format!(
-            "larger than {MAX_FILE_BYTES} bytes; a {file} file is a few KB"
-        )));
-    }
+    // And on what was read, in case the file grew since.
+    within_cap(bytes.len() as u64, file).map_err(|e| in_file(path, e))?;
     String::from_utf8(bytes).map_err(|e| {
         unreadable(format!(
             "not UTF-8 text (at byte {})",

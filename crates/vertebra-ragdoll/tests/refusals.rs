@@ -219,3 +219,148 @@ fn the_time_between_two_poses_is_at_least_the_shortest_step() {
         assert_eq!(world.bodies().len(), 0);
     }
 }
+
+/// A string whose first bytes are no TOML, `len` bytes long in all.
+fn long_text(len: usize) -> String {
+    let mut text = String::from("[[[ not toml\n");
+    text.push_str(&"#".repeat(len - text.len()));
+    text
+}
+
+/// Issue 31, item 7: the string entry points parsed any length (an
+/// 11.5 MB description took 16-37 s) where files are capped at
+/// `MAX_FILE_BYTES`. Every one refuses a longer text before parsing it:
+/// the text starts with a syntax error that a parser would name, and the
+/// refusal is the size, not that.
+#[test]
+fn a_text_longer_than_a_file_may_be_is_refused_before_it_is_parsed() {
+    use vertebra_ragdoll::{MAX_FILE_BYTES, RagdollGenerator, Skeleton};
+    let cap = MAX_FILE_BYTES as usize;
+    let refusal = |file: &str| {
+        format!(
+            "the {file} text is larger than MAX_FILE_BYTES (1048576 bytes) and is refused \
+             before it is parsed; a {file} file is a few KB"
+        )
+    };
+    let skeleton = Skeleton::reference();
+    let long = long_text(cap + 1);
+    let refused: [(&str, Result<(), RagdollError>); 6] = [
+        ("ragdoll", RagdollDesc::from_toml(&long).map(drop)),
+        (
+            "ragdoll",
+            RagdollDesc::check_toml(&long)
+                .map(drop)
+                .map_err(|mut p| p.remove(0)),
+        ),
+        (
+            "ragdoll",
+            RagdollDesc::from_toml_with_skeleton(&long, &skeleton).map(drop),
+        ),
+        ("skeleton", Skeleton::from_toml(&long).map(drop)),
+        (
+            "skeleton",
+            Skeleton::check_toml(&long)
+                .map(drop)
+                .map_err(|mut p| p.remove(0)),
+        ),
+        (
+            "generator",
+            RagdollGenerator::from_toml(&long, &skeleton).map(drop),
+        ),
+    ];
+    for (file, result) in refused {
+        assert_eq!(result.unwrap_err().to_string(), refusal(file));
+    }
+    // One byte less is parsed: its syntax error is named.
+    let fits = long_text(cap);
+    for text in [
+        RagdollDesc::from_toml(&fits).unwrap_err().to_string(),
+        Skeleton::from_toml(&fits).unwrap_err().to_string(),
+        RagdollGenerator::from_toml(&fits, &skeleton)
+            .unwrap_err()
+            .to_string(),
+    ] {
+        assert!(text.contains("line 1"), "{text}");
+    }
+}
+
+/// Issue 31, item 7: a 45,000-body description spent 11-31 s before it
+/// was refused for a skeleton it was never given. The counts are checked
+/// before any body or joint is: a description with more bodies (or
+/// joints) than a ragdoll may have is refused with that one problem,
+/// however many others its items have.
+#[test]
+fn more_bodies_or_joints_than_a_ragdoll_may_have_are_refused_before_any_is_read() {
+    use vertebra_ragdoll::{BodySpec, JointSpec, MAX_BONES};
+    use vertebra_world::SwingTwist;
+    let count = MAX_BONES + 1;
+    // Bodies placed on bones of a skeleton the description does not have:
+    // each is a problem, but the count is found first.
+    let mut builder = RagdollDesc::builder("big");
+    for i in 0..count {
+        builder = builder.body(BodySpec::from_bones(&format!("b{i}"), "x", "y", 0.05, 1.0));
+    }
+    for i in 1..count {
+        builder = builder.joint(JointSpec::socket(
+            &format!("j{i}"),
+            &format!("b{}", i - 1),
+            &format!("b{i}"),
+            Vec3::ZERO,
+            Vec3::Y,
+            SwingTwist::FREE,
+        ));
+    }
+    assert_eq!(
+        builder.build().unwrap_err().to_string(),
+        "ragdoll `big`: body has 4097 bodies; a ragdoll has at most MAX_BODIES (4096), \
+         one per bone of the largest skeleton"
+    );
+    // The same as a file (well within MAX_FILE_BYTES): one problem.
+    let mut text = String::from("name = \"big\"\n");
+    for i in 0..count {
+        text.push_str(&format!(
+            "[[body]]\nname = \"b{i}\"\nfrom = \"x\"\nto = \"y\"\nradius = 0.05\nmass = 1.0\n"
+        ));
+    }
+    let problems = RagdollDesc::check_toml(&text).unwrap_err();
+    assert_eq!(
+        problems.iter().map(ToString::to_string).collect::<Vec<_>>(),
+        [
+            "ragdoll `big`: body has 4097 bodies; a ragdoll has at most MAX_BODIES (4096), \
+          one per bone of the largest skeleton"
+        ]
+    );
+    // More joints than bodies can take in a tree, before any is resolved.
+    let mut builder = RagdollDesc::builder("knotted").body(BodySpec::capsule(
+        "only",
+        [Vec3::ZERO, Vec3::Y],
+        0.05,
+        1.0,
+    ));
+    for i in 0..MAX_BONES {
+        builder = builder.joint(JointSpec::socket(
+            &format!("j{i}"),
+            "nowhere",
+            "only",
+            Vec3::ZERO,
+            Vec3::Y,
+            SwingTwist::FREE,
+        ));
+    }
+    assert_eq!(
+        builder.build().unwrap_err().to_string(),
+        "ragdoll `knotted`: joint has 4096 joints; a ragdoll has at most MAX_JOINTS (4095), \
+         one fewer than its bodies at most"
+    );
+    // A generator choosing more bodies than its skeleton has bones.
+    let skeleton = vertebra_ragdoll::Skeleton::reference();
+    let mut text = String::from("name = \"many\"\n");
+    for _ in 0..=skeleton.len() {
+        text.push_str("[[body]]\nbone = \"nowhere\"\nradius = 0.05\nmass = 1.0\n");
+    }
+    let refused = vertebra_ragdoll::RagdollGenerator::from_toml(&text, &skeleton);
+    assert_eq!(
+        refused.unwrap_err().to_string(),
+        "generator `many`: body has 64 tables; at most one per bone of the skeleton (63)"
+    );
+}

@@ -382,9 +382,13 @@ fn skeleton_files_are_read_within_the_size_cap_and_named_in_errors() {
     let big = dir.join("big.toml");
     std::fs::write(&big, vec![b'#'; MAX_FILE_BYTES as usize + 1]).unwrap();
     let e = Skeleton::from_file(&big).unwrap_err().to_string();
-    assert!(
-        e.contains("cannot read the skeleton file: larger than 1048576 bytes"),
-        "{e}"
+    assert_eq!(
+        e,
+        format!(
+            "{}: the skeleton text is larger than MAX_FILE_BYTES (1048576 bytes) and is refused \
+             before it is parsed; a skeleton file is a few KB",
+            big.display()
+        )
     );
     let e = Skeleton::from_file(&dir.join("absent.toml"))
         .unwrap_err()
