@@ -1162,8 +1162,9 @@ enum VtResult vt_world_set_joint_drive(struct VtWorld *world,
 // `path` is a NUL-terminated string; `desc` is writable.
 enum VtResult vt_ragdoll_desc_from_file(const char *path, struct VtRagdollDesc **desc);
 
-// Reads a ragdoll description from TOML text (UTF-8, NUL-terminated).
-// Refused with the line and field of the first problem.
+// Reads a ragdoll description from TOML text (UTF-8, NUL-terminated, at
+// most `MAX_FILE_BYTES` = 1 MiB: a longer text is refused before it is
+// read). Refused with the line and field of the first problem.
 //
 // # Safety
 // `toml` is a NUL-terminated string; `desc` is writable.
@@ -1402,7 +1403,8 @@ enum VtResult vt_skeleton_reference(struct VtSkeleton **skeleton);
 // `path` is a NUL-terminated string; `skeleton` is writable.
 enum VtResult vt_skeleton_from_file(const char *path, struct VtSkeleton **skeleton);
 
-// Reads a skeleton from TOML text (NUL-terminated UTF-8).
+// Reads a skeleton from TOML text (NUL-terminated UTF-8, at most
+// `MAX_FILE_BYTES` = 1 MiB: a longer text is refused before it is read).
 //
 // # Safety
 // `toml` is a NUL-terminated string; `skeleton` is writable.

@@ -234,6 +234,36 @@ pub(crate) unsafe fn text<'a>(ptr: *const c_char, what: &str) -> Result<&'a str,
         .map_err(|e| Failure::new(VtResult::NotUtf8, format!("{what} is not UTF-8: {e}")))
 }
 
+/// The NUL-terminated UTF-8 string at `ptr` of at most `max` bytes: a
+/// longer one is refused with `too_long()` having read no more than its
+/// first `max + 1` bytes (neither measured to its end nor checked as
+/// UTF-8), for the strings whose length bounds the work done on them (a
+/// ragdoll or skeleton text, `MAX_FILE_BYTES` as a file).
+///
+/// # Safety
+/// `ptr` is null or points to a NUL-terminated string.
+pub(crate) unsafe fn bounded_text<'a>(
+    ptr: *const c_char,
+    what: &str,
+    max: usize,
+    too_long: impl FnOnce() -> Failure,
+) -> Result<&'a str, Failure> {
+    check(ptr, what)?;
+    let mut len = 0;
+    // SAFETY: NUL-terminated by the contract, so every byte up to the NUL
+    // is readable, and the scan stops at the NUL (or at byte `max`).
+    while unsafe { *ptr.add(len) } != 0 {
+        if len == max {
+            return Err(too_long());
+        }
+        len += 1;
+    }
+    // SAFETY: the `len` bytes before the NUL were just read.
+    let bytes = unsafe { std::slice::from_raw_parts(ptr.cast::<u8>(), len) };
+    std::str::from_utf8(bytes)
+        .map_err(|e| Failure::new(VtResult::NotUtf8, format!("{what} is not UTF-8: {e}")))
+}
+
 /// Writes into `index` where `find` finds the name at `name` (a
 /// NUL-terminated UTF-8 string); `find` says why it does not.
 ///

@@ -6,13 +6,15 @@ use std::path::Path;
 
 use vertebra_collide::Collisions;
 use vertebra_ragdoll::{
-    BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMode, Strength,
+    BuildOptions, DriveSettings, MAX_FILE_BYTES, Pose, Ragdoll, RagdollDesc, RagdollError,
+    SpineMode, Strength,
 };
 
 use crate::collide::VtCollisions;
 use crate::error::{Failure, VtResult};
 use crate::ffi::{
-    Object, boxed, call, copy_text, enter, free, index_of, optional, out, read, shared, slice, text,
+    Object, bounded_text, boxed, call, copy_text, enter, free, index_of, optional, out, read,
+    shared, slice, text,
 };
 use crate::types::{VtBody, VtTransform, VtVec3, flag, pick};
 use crate::world::VtWorld;
@@ -199,8 +201,29 @@ pub unsafe extern "C" fn vt_ragdoll_desc_from_file(
     })
 }
 
-/// Reads a ragdoll description from TOML text (UTF-8, NUL-terminated).
-/// Refused with the line and field of the first problem.
+/// A ragdoll, generator or skeleton text (`file` names which) from C: a
+/// NUL-terminated UTF-8 string of at most `MAX_FILE_BYTES`, as a file; a
+/// longer one is refused before it is read whole
+/// (`RagdollError::TooLarge`, `VT_RESULT_RAGDOLL`).
+///
+/// # Safety
+/// `toml` is null or points to a NUL-terminated string.
+pub(crate) unsafe fn toml_text<'a>(
+    toml: *const core::ffi::c_char,
+    file: &'static str,
+) -> Result<&'a str, Failure> {
+    let max = usize::try_from(MAX_FILE_BYTES).unwrap_or(usize::MAX);
+    // SAFETY: the function's contract.
+    unsafe {
+        bounded_text(toml, "toml", max, || {
+            Failure::from(RagdollError::TooLarge { file })
+        })
+    }
+}
+
+/// Reads a ragdoll description from TOML text (UTF-8, NUL-terminated, at
+/// most `MAX_FILE_BYTES` = 1 MiB: a longer text is refused before it is
+/// read). Refused with the line and field of the first problem.
 ///
 /// # Safety
 /// `toml` is a NUL-terminated string; `desc` is writable.
@@ -211,7 +234,7 @@ pub unsafe extern "C" fn vt_ragdoll_desc_from_string(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (toml, place) = unsafe { (text(toml, "toml")?, out(desc, "desc")) };
+        let (toml, place) = unsafe { (toml_text(toml, "ragdoll")?, out(desc, "desc")) };
         made(RagdollDesc::from_toml(toml).map_err(Failure::from), place)
     })
 }

@@ -12,7 +12,7 @@ use crate::error::{Failure, VtResult};
 use crate::ffi::{
     Out, boxed, call, copy_text, enter, free, index_of, out, shared, slice, slice_mut, text,
 };
-use crate::ragdoll::{VtRagdoll, VtRagdollDesc, write_pose};
+use crate::ragdoll::{VtRagdoll, VtRagdollDesc, toml_text, write_pose};
 use crate::types::{VtTransform, pick};
 use crate::world::VtWorld;
 
@@ -103,7 +103,8 @@ pub unsafe extern "C" fn vt_skeleton_from_file(
     })
 }
 
-/// Reads a skeleton from TOML text (NUL-terminated UTF-8).
+/// Reads a skeleton from TOML text (NUL-terminated UTF-8, at most
+/// `MAX_FILE_BYTES` = 1 MiB: a longer text is refused before it is read).
 ///
 /// # Safety
 /// `toml` is a NUL-terminated string; `skeleton` is writable.
@@ -114,7 +115,7 @@ pub unsafe extern "C" fn vt_skeleton_from_string(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (toml, place) = unsafe { (text(toml, "toml")?, out(skeleton, "skeleton")) };
+        let (toml, place) = unsafe { (toml_text(toml, "skeleton")?, out(skeleton, "skeleton")) };
         made(Skeleton::from_toml(toml), place)
     })
 }

@@ -2924,3 +2924,39 @@ fn a_pose_mapped_in_place_equals_one_mapped_into_another_array() {
     // SAFETY: made above, freed once.
     unsafe { vt_skeleton_mapper_destroy(mapper) };
 }
+
+/// Issue 31, item 7: the C ABI's string entry points read any length
+/// (the Rust loaders behind them then parsed it). A string longer than
+/// `MAX_FILE_BYTES` is refused before it is parsed, with the Rust API's
+/// message; nothing is written.
+#[test]
+fn a_string_longer_than_a_file_may_be_is_refused_before_it_is_parsed() {
+    let cap = vertebra_ragdoll::MAX_FILE_BYTES as usize;
+    let mut long = String::from("[[[ not toml\n");
+    long.push_str(&"#".repeat(cap + 1 - long.len()));
+    let long = CString::new(long).expect("no NUL");
+    let (mut desc, mut skeleton) = (null_mut(), null_mut());
+    // SAFETY: NUL-terminated strings; writable places.
+    let (d, s) = unsafe {
+        (
+            vt_ragdoll_desc_from_string(long.as_ptr(), &mut desc),
+            vt_skeleton_from_string(long.as_ptr(), &mut skeleton),
+        )
+    };
+    refused(
+        s,
+        VtResult::Ragdoll,
+        &[
+            "the skeleton text is larger than MAX_FILE_BYTES (1048576 bytes) and is refused before it is parsed",
+        ],
+    );
+    assert_eq!(d, VtResult::Ragdoll);
+    assert!(desc.is_null() && skeleton.is_null());
+    let refusal = desc_from(long.to_str().unwrap()).err().unwrap();
+    assert!(
+        refusal.1.starts_with(
+            "the ragdoll text is larger than MAX_FILE_BYTES (1048576 bytes) and is refused before it is parsed"
+        ),
+        "{refusal:?}"
+    );
+}
