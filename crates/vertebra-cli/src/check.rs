@@ -3,11 +3,10 @@
 //! by content, and prints what it holds, or every problem found.
 
 use std::fmt::Write as _;
-use std::io::Read as _;
 use std::path::Path;
 
 use vertebra_ragdoll::{
-    MAX_FILE_BYTES, RagdollDesc, RagdollError, RagdollGenerator, Skeleton, Strength,
+    RagdollDesc, RagdollError, RagdollGenerator, Skeleton, Strength, read_text,
 };
 use vertebra_world::{JointKind, LimitSoftness, Swing};
 
@@ -16,7 +15,11 @@ use vertebra_world::{JointKind, LimitSoftness, Swing};
 /// file a generator file is read against (the reference skeleton without
 /// one); it is refused for other files.
 pub fn check(path: &Path, skeleton: Option<&Path>) -> Result<String, String> {
-    let kind = kind(path);
+    // Through the loaders' one reader (a regular file within the size cap,
+    // checked before it is opened): a FIFO, a device or a directory is
+    // refused, never opened.
+    let text = read_text(path, "ragdoll").map_err(|e| e.to_string())?;
+    let kind = kind(&text);
     if skeleton.is_some() && !matches!(kind, Kind::Generator) {
         return Err(format!(
             "{}: --skeleton is for a generator file ([[body]] tables that name a bone and no body name)",
@@ -73,17 +76,10 @@ enum Kind {
 /// A ragdoll file has `[[body]]` tables, each with a `name`; a generator
 /// file has `[[body]]` tables that name a `bone` and none a `name` (a
 /// generated body is named after its bone); a skeleton file has `[[bone]]`
-/// tables only. A file that cannot be read or parsed is read as a ragdoll
-/// file, unless its text has `[[bone]]` and no `[[body]]`: the loader then
-/// names the problem.
-fn kind(path: &Path) -> Kind {
-    let mut bytes = Vec::new();
-    let read = std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
-        .is_ok();
-    let Some(text) = read.then(|| String::from_utf8(bytes).ok()).flatten() else {
-        return Kind::Ragdoll;
-    };
+/// tables only. Text that cannot be parsed is read as a ragdoll file,
+/// unless it has `[[bone]]` and no `[[body]]`: the loader then names the
+/// problem.
+fn kind(text: &str) -> Kind {
     match text.parse::<toml::Table>() {
         Ok(table) => match table.get("body") {
             Some(toml::Value::Array(bodies)) if bodies.iter().all(generator_body) => {

@@ -1044,3 +1044,80 @@ fn reproduce_writes_figure_1_and_every_ragdoll_and_no_progress_into_a_pipe() {
     assert_eq!(drop.len(), 30, "{drop:?}");
     assert_eq!(bending, ["blue", "red"].map(String::from).into());
 }
+
+/// `vertebra ARGS` with a guard: a run still going after `limit` is
+/// killed and reported as `None` (a hang fails the test instead of
+/// hanging it); otherwise its exit code and stderr.
+fn vertebra_guarded(args: &[&str], limit: std::time::Duration) -> Option<(i32, String)> {
+    use std::io::Read as _;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_vertebra"))
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("waits") {
+            let mut stderr = String::new();
+            child
+                .stderr
+                .take()
+                .expect("piped")
+                .read_to_string(&mut stderr)
+                .unwrap();
+            return Some((status.code().unwrap_or(-1), stderr));
+        }
+        if start.elapsed() > limit {
+            child.kill().ok();
+            child.wait().ok();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
+/// Issue 31, item 5: `vertebra check` opened its file (to tell a ragdoll
+/// from a skeleton file) before the loaders' reader checked its type, so
+/// `check` on a FIFO waited for a writer for ever. Every path of the
+/// command that reads a file (`check FILE`, `check --skeleton FILE`,
+/// `scene --ragdoll FILE`) goes through the one reader, which refuses
+/// anything but a regular file without opening it.
+#[test]
+fn every_file_the_command_reads_is_refused_when_it_is_a_fifo() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("f.toml");
+    let made = Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success(), "mkfifo {}", fifo.display());
+    let fifo = fifo.to_str().unwrap().to_owned();
+    let generator = dir.join("generator.toml");
+    std::fs::write(
+        &generator,
+        "name = \"g\"\n[[body]]\nbone = \"hips\"\nradius = 0.1\nmass = 10.0\nlength = 0.2\n",
+    )
+    .unwrap();
+    let generator = generator.to_str().unwrap().to_owned();
+    let scene = scene_with(&["--ragdoll", &fifo]);
+    let cases: [(Vec<&str>, &str); 3] = [
+        (vec!["check", &fifo], "ragdoll"),
+        (vec!["check", &generator, "--skeleton", &fifo], "skeleton"),
+        (scene.iter().map(String::as_str).collect(), "ragdoll"),
+    ];
+    for (args, file) in &cases {
+        let ran = vertebra_guarded(args, std::time::Duration::from_secs(60));
+        let Some((code, stderr)) = ran else {
+            std::fs::remove_dir_all(&dir).ok();
+            panic!("{args:?} still ran after a minute: it opened the FIFO");
+        };
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        let expected = format!(
+            "vertebra: {fifo}: cannot read the {file} file: not a regular file (a directory, a device or a pipe)"
+        );
+        assert_eq!(stderr.trim(), expected, "{args:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

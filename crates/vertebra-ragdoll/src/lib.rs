@@ -161,5 +161,5 @@ pub use ragdoll::{BuildOptions, JointAnchors, Ragdoll, RodRest, SpineMode, body_
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
 pub use skeleton_file::REFERENCE_SKELETON;
 pub use spec::{BodyShape, BodySpec, RagdollBuilder, SpineSpec};
-pub use text::MAX_FILE_BYTES;
+pub use text::{MAX_FILE_BYTES, read_text};
 pub use transition::Transition;
