@@ -35,7 +35,9 @@ typedef enum VtResult {
   VT_RESULT_DEGENERATE_SHAPE = 9,
   // A joint or rod between a body and itself.
   VT_RESULT_SAME_BODY = 10,
-  // A handle whose item was removed, or that never existed.
+  // A handle whose item was removed, or that never existed; a ragdoll
+  // removed from its world (`vt_ragdoll_remove`), by every call but its
+  // destroy.
   VT_RESULT_STALE_HANDLE = 11,
   // A handle issued by another world.
   VT_RESULT_FOREIGN_HANDLE = 12,
@@ -1252,7 +1254,9 @@ void vt_ragdoll_destroy(struct VtRagdoll *ragdoll);
 
 // Takes a ragdoll's bodies, joints and rod out of `world` (and their
 // colliders out of `collisions`, unless null). Refused, with nothing
-// removed, if any of them is already gone.
+// removed, if any of them is already gone. A removed ragdoll is refused
+// by every call on it but `vt_ragdoll_destroy` (`VT_RESULT_STALE_HANDLE`,
+// naming the ragdoll): build a new one.
 //
 // # Safety
 // `ragdoll` and `world` are live; `collisions` is null or live.
@@ -1263,6 +1267,8 @@ enum VtResult vt_ragdoll_remove(struct VtRagdoll *ragdoll,
 // Writes the handle of described body `index` into `body` and 1 into
 // `present`; or 0 into `present` for a body the ragdoll has no body for
 // (a spine interior body of a rod-spine ragdoll: an animation-only bone).
+// A removed ragdoll is refused (`VT_RESULT_STALE_HANDLE`), as by every
+// call on it.
 //
 // # Safety
 // `ragdoll` is live; `body` and `present` are writable.

@@ -38,7 +38,9 @@ pub enum VtResult {
     DegenerateShape = 9,
     /// A joint or rod between a body and itself.
     SameBody = 10,
-    /// A handle whose item was removed, or that never existed.
+    /// A handle whose item was removed, or that never existed; a ragdoll
+    /// removed from its world (`vt_ragdoll_remove`), by every call but its
+    /// destroy.
     StaleHandle = 11,
     /// A handle issued by another world.
     ForeignHandle = 12,
@@ -134,11 +136,12 @@ impl From<Error> for Failure {
 
 impl From<RagdollError> for Failure {
     /// A ragdoll error that wraps one of the world's keeps the world's
-    /// code (a stale handle stays a stale handle); the rest are
-    /// [`VtResult::Ragdoll`].
+    /// code (a stale handle stays a stale handle); a removed ragdoll is a
+    /// stale handle too; the rest are [`VtResult::Ragdoll`].
     fn from(error: RagdollError) -> Self {
         let code = match &error {
             RagdollError::World { error, .. } => code(error),
+            RagdollError::Removed { .. } => VtResult::StaleHandle,
             _ => VtResult::Ragdoll,
         };
         Self::new(code, error.to_string())

@@ -456,7 +456,9 @@ pub unsafe extern "C" fn vt_ragdoll_destroy(ragdoll: *mut VtRagdoll) {
 
 /// Takes a ragdoll's bodies, joints and rod out of `world` (and their
 /// colliders out of `collisions`, unless null). Refused, with nothing
-/// removed, if any of them is already gone.
+/// removed, if any of them is already gone. A removed ragdoll is refused
+/// by every call on it but `vt_ragdoll_destroy` (`VT_RESULT_STALE_HANDLE`,
+/// naming the ragdoll): build a new one.
 ///
 /// # Safety
 /// `ragdoll` and `world` are live; `collisions` is null or live.
@@ -501,6 +503,8 @@ unsafe fn with_ragdoll(
 /// Writes the handle of described body `index` into `body` and 1 into
 /// `present`; or 0 into `present` for a body the ragdoll has no body for
 /// (a spine interior body of a rod-spine ragdoll: an animation-only bone).
+/// A removed ragdoll is refused (`VT_RESULT_STALE_HANDLE`), as by every
+/// call on it.
 ///
 /// # Safety
 /// `ragdoll` is live; `body` and `present` are writable.
@@ -520,6 +524,7 @@ pub unsafe extern "C" fn vt_ragdoll_body(
                 out(present, "present")?,
             )
         };
+        ragdoll.ragdoll.check_not_removed()?;
         let bodies = &ragdoll.ragdoll.bodies;
         let slot = bodies.get(index).ok_or_else(|| {
             let n = bodies.len();

@@ -2112,23 +2112,33 @@ fn a_ragdoll_is_removed_with_and_without_its_collision_layer() {
     // SAFETY: a live world; asking the number.
     let _ = unsafe { vt_world_contacts(c.world.0, null_mut(), 0, &mut count) };
     assert_eq!(count, 0);
-    // Removed again: nothing left to remove.
+    // Removed again: refused by name, as every call on a removed ragdoll
+    // is (issue 31, item 4), with nothing written.
     let removed = c.world.bytes();
     // SAFETY: live objects.
-    ok(unsafe { vt_ragdoll_remove(c.ragdoll, c.world.0, null_mut()) });
+    let again = unsafe { vt_ragdoll_remove(c.ragdoll, c.world.0, null_mut()) };
+    refused(
+        again,
+        VtResult::StaleHandle,
+        &["ragdoll `reference-humanoid`"],
+    );
     assert!(removed == c.world.bytes());
     let mut body = bits_body();
     let mut present = 9u32;
-    // SAFETY: live objects; writable places.
-    ok(unsafe { vt_ragdoll_body(c.ragdoll, 0, &mut body, &mut present) });
-    assert_eq!((present, body), (0, bits_body()));
-    // SAFETY: as above; an index past the end.
-    let r = unsafe { vt_ragdoll_body(c.ragdoll, 13, &mut body, &mut present) };
-    refused(r, VtResult::OutOfRange, &["13"]);
-    // SAFETY: as above; usize::MAX.
-    let r = unsafe { vt_ragdoll_body(c.ragdoll, usize::MAX, &mut body, &mut present) };
-    refused(r, VtResult::OutOfRange, &[]);
-    assert_eq!(present, 0);
+    for index in [0, 13, usize::MAX] {
+        // SAFETY: live objects; writable places.
+        let r = unsafe { vt_ragdoll_body(c.ragdoll, index, &mut body, &mut present) };
+        refused(r, VtResult::StaleHandle, &["has been removed"]);
+    }
+    assert_eq!((present, body), (9, bits_body()));
+    // A built one names an index past the end.
+    let built = Drop_::new(VtSpineMode::Rod);
+    for index in [13, usize::MAX] {
+        // SAFETY: live objects; writable places.
+        let r = unsafe { vt_ragdoll_body(built.ragdoll, index, &mut body, &mut present) };
+        refused(r, VtResult::OutOfRange, &["of a ragdoll of 13"]);
+    }
+    assert_eq!(present, 9);
 
     // Without the layer: the layer keeps its colliders (the layer's to remove).
     let d = Drop_::new(VtSpineMode::Sockets);
@@ -2959,4 +2969,197 @@ fn a_string_longer_than_a_file_may_be_is_refused_before_it_is_parsed() {
         ),
         "{refusal:?}"
     );
+}
+
+/// Issue 31, item 4: a removed ragdoll mapped onto the skeleton as `Ok`
+/// (`vt_skeleton_mapper_map_to_skeleton`, `vt_transition_skeleton_pose`),
+/// every bone at the world origin, and the drives and a second removal
+/// took it as `Ok`. Every call that takes it is refused as a stale
+/// handle, naming the ragdoll, with the world, the layer and every output
+/// as they were.
+#[test]
+fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
+    let c = Drop_::new(VtSpineMode::Rod);
+    c.step(3);
+    let skeleton = CSkeleton::reference();
+    let mut mapper = null_mut();
+    // SAFETY: live objects; writable.
+    ok(unsafe {
+        vt_skeleton_mapper_create(skeleton.0, c.desc.0, VtSpineMode::Rod as u32, &mut mapper)
+    });
+    let animation: Vec<VtTransform> = Skeleton::reference()
+        .bind_pose()
+        .bones
+        .iter()
+        .map(|&t| t.into())
+        .collect();
+    let place: VtTransform = Transform::IDENTITY.into();
+    let mut transition = null_mut();
+    // SAFETY: live objects; `count` readable transforms; writable place.
+    ok(unsafe {
+        vt_transition_create(
+            mapper,
+            c.ragdoll,
+            c.world.0,
+            animation.as_ptr(),
+            animation.len(),
+            place,
+            VtSpineMapping::Arc as u32,
+            0.3,
+            &mut transition,
+        )
+    });
+    // SAFETY: live objects.
+    ok(unsafe { vt_ragdoll_remove(c.ragdoll, c.world.0, c.layer.0) });
+    let (world, layer) = (c.world.bytes(), c.layer.bytes());
+    let sentinel = VtTransform {
+        position: v(9.0, 9.0, 9.0),
+        rotation: IDENTITY,
+    };
+    let mut bones = vec![sentinel; animation.len()];
+    let pose = lifted_bind(&c.desc, 0.0);
+    let settings = VtDriveSettings {
+        strength: VtStrength {
+            kind: 0,
+            a: 0.0,
+            b: 0.0,
+        },
+        damping: 0.0,
+        max_torque: INF,
+    };
+    let name = CString::new("chest").expect("a name");
+    let (r, w, l) = (c.ragdoll, c.world.0, c.layer.0);
+    let (mut body, mut present, mut again) = (bits_body(), 7u32, null_mut());
+    let (mut root, mut low) = (sentinel, v(9.0, 9.0, 9.0));
+    // SAFETY: every call's objects are live, each pointer valid for its
+    // type and length.
+    let calls: Vec<(&str, VtResult)> = unsafe {
+        vec![
+            (
+                "vt_skeleton_mapper_map_to_skeleton",
+                vt_skeleton_mapper_map_to_skeleton(
+                    mapper,
+                    r,
+                    w,
+                    animation.as_ptr(),
+                    place,
+                    VtSpineMapping::Arc as u32,
+                    bones.as_mut_ptr(),
+                    bones.len(),
+                ),
+            ),
+            (
+                "vt_transition_skeleton_pose",
+                vt_transition_skeleton_pose(
+                    transition,
+                    mapper,
+                    r,
+                    w,
+                    animation.as_ptr(),
+                    place,
+                    0.1,
+                    bones.as_mut_ptr(),
+                    bones.len(),
+                ),
+            ),
+            (
+                "vt_transition_create",
+                vt_transition_create(
+                    mapper,
+                    r,
+                    w,
+                    animation.as_ptr(),
+                    animation.len(),
+                    place,
+                    VtSpineMapping::Arc as u32,
+                    0.3,
+                    &mut again,
+                ),
+            ),
+            (
+                "vt_ragdoll_drive_to",
+                vt_ragdoll_drive_to(r, w, pose.as_ptr(), pose.len(), &settings),
+            ),
+            (
+                "vt_ragdoll_drive_following",
+                vt_ragdoll_drive_following(
+                    r,
+                    w,
+                    pose.as_ptr(),
+                    pose.as_ptr(),
+                    pose.len(),
+                    DT,
+                    &settings,
+                ),
+            ),
+            ("vt_ragdoll_release_drives", vt_ragdoll_release_drives(r, w)),
+            (
+                "vt_ragdoll_apply_impulse",
+                vt_ragdoll_apply_impulse(r, w, name.as_ptr(), v(1.0, 0.0, 0.0), null()),
+            ),
+            (
+                "vt_ragdoll_set_velocity",
+                vt_ragdoll_set_velocity(r, w, v(1.0, 0.0, 0.0), v(0.0, 0.0, 0.0)),
+            ),
+            (
+                "vt_ragdoll_set_body_kinematic",
+                vt_ragdoll_set_body_kinematic(r, w, name.as_ptr(), 1),
+            ),
+            (
+                "vt_ragdoll_placement",
+                vt_ragdoll_placement(r, w, &mut root, &mut low, null_mut()),
+            ),
+            (
+                "vt_ragdoll_body",
+                vt_ragdoll_body(r, 0, &mut body, &mut present),
+            ),
+            ("vt_ragdoll_remove", vt_ragdoll_remove(r, w, l)),
+            (
+                "vt_collisions_set_ragdoll_groups",
+                vt_collisions_set_ragdoll_groups(l, r, 1, 1),
+            ),
+            (
+                "vt_collisions_set_ragdoll_self_collision",
+                vt_collisions_set_ragdoll_self_collision(l, r, 0),
+            ),
+        ]
+    };
+    for (call, result) in calls {
+        assert_eq!(result, VtResult::StaleHandle, "{call}");
+    }
+    // The last message is the last call's; each names the ragdoll (the
+    // Rust error's text, checked in vertebra-ragdoll's tests/removed.rs).
+    assert!(
+        message().contains("ragdoll `reference-humanoid` has been removed from the world"),
+        "{}",
+        message()
+    );
+    // SAFETY: as above.
+    let mapped = unsafe {
+        vt_skeleton_mapper_map_to_skeleton(
+            mapper,
+            r,
+            w,
+            animation.as_ptr(),
+            place,
+            VtSpineMapping::Arc as u32,
+            bones.as_mut_ptr(),
+            bones.len(),
+        )
+    };
+    refused(
+        mapped,
+        VtResult::StaleHandle,
+        &["ragdoll `reference-humanoid` has been removed from the world"],
+    );
+    assert!(bones.iter().all(|b| b.position == sentinel.position));
+    assert_eq!((root.position, low), (sentinel.position, v(9.0, 9.0, 9.0)));
+    assert_eq!((present, body), (7, bits_body()));
+    assert!(again.is_null());
+    assert!(world == c.world.bytes() && layer == c.layer.bytes());
+    // SAFETY: made above, freed once.
+    unsafe {
+        vt_transition_destroy(transition);
+        vt_skeleton_mapper_destroy(mapper);
+    }
 }

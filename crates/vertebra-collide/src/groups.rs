@@ -12,7 +12,7 @@
 //! - `a.membership & b.filter != 0` and `b.membership & a.filter != 0`;
 //! - not two bodies of one ragdoll whose self-collision is off.
 
-use vertebra_ragdoll::Ragdoll;
+use vertebra_ragdoll::{Ragdoll, RagdollError};
 use vertebra_world::{BodyHandle, Error};
 
 use crate::{CollisionGroups, Collisions};
@@ -43,13 +43,15 @@ impl Collisions {
     /// a player's ragdoll that the player's own weapons pass through).
     /// All or nothing: refused, with nothing changed, when a body of the
     /// ragdoll has no collider in the set (add it with
-    /// [`Collisions::add_ragdoll`] first) or the ragdoll has no bodies.
+    /// [`Collisions::add_ragdoll`] first), and for a removed ragdoll
+    /// (`RagdollError::Removed`, naming it).
     pub fn set_ragdoll_groups(
         &mut self,
         ragdoll: &Ragdoll,
         groups: CollisionGroups,
-    ) -> Result<(), Error> {
-        self.set_groups(&ragdoll_bodies(ragdoll), groups)
+    ) -> Result<(), RagdollError> {
+        ragdoll.check_not_removed()?;
+        Ok(self.set_groups(&ragdoll_bodies(ragdoll), groups)?)
     }
 
     /// Whether the bodies of `ragdoll` that no joint joins collide with
@@ -67,7 +69,8 @@ impl Collisions {
         &mut self,
         ragdoll: &Ragdoll,
         collide: bool,
-    ) -> Result<(), Error> {
+    ) -> Result<(), RagdollError> {
+        ragdoll.check_not_removed()?;
         let bodies = ragdoll_bodies(ragdoll);
         self.check_colliders(&bodies)?;
         // Every group below the counter may be in use: one more is the

@@ -342,10 +342,13 @@ impl Collisions {
     }
 
     /// Adds a ragdoll's capsules (one per body, default friction and
-    /// groups), its jointed pairs never tested. All or nothing.
-    pub fn add_ragdoll(&mut self, ragdoll: &Ragdoll) -> Result<(), Error> {
+    /// groups), its jointed pairs never tested. All or nothing; a removed
+    /// ragdoll (which has no bodies to add) is refused, naming it
+    /// (`RagdollError::Removed`).
+    pub fn add_ragdoll(&mut self, ragdoll: &Ragdoll) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
-        self.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())
+        ragdoll.check_not_removed()?;
+        Ok(self.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())?)
     }
 
     /// Builds a ragdoll in `world` (see `Ragdoll::build`) and adds its

@@ -214,17 +214,28 @@ fn refused_group_settings_change_nothing() {
     let mut gone = inside.clone();
     let before = c.snapshot(&w).unwrap();
     let no_collider = Err(Error::StaleHandle("collider body"));
+    let ragdoll_without = Err(RagdollError::from(Error::StaleHandle("collider body")));
     let groups = CollisionGroups::default();
     assert_eq!(c.set_body_groups(bare, groups), no_collider);
-    assert_eq!(c.set_ragdoll_groups(&outside, groups), no_collider);
-    assert_eq!(c.set_ragdoll_self_collision(&outside, false), no_collider);
+    assert_eq!(c.set_ragdoll_groups(&outside, groups), ragdoll_without);
+    assert_eq!(
+        c.set_ragdoll_self_collision(&outside, false),
+        ragdoll_without
+    );
     assert_eq!(c.snapshot(&w).unwrap(), before);
     c.set_ragdoll_self_collision(&inside, false).unwrap();
     c.remove_ragdoll(&mut w, &mut gone).unwrap();
     inside.bodies.iter_mut().for_each(|b| *b = None);
     let before = c.snapshot(&w).unwrap();
-    assert_eq!(c.set_ragdoll_self_collision(&inside, true), no_collider);
-    assert_eq!(c.set_ragdoll_groups(&gone, groups), no_collider);
+    // A removed ragdoll is refused by name (issue 31, item 4): by every
+    // call on it, adding its colliders again included (it has none).
+    let removed = Err(RagdollError::Removed {
+        ragdoll: desc.name.clone(),
+    });
+    assert_eq!(c.set_ragdoll_self_collision(&inside, true), removed);
+    assert_eq!(c.set_ragdoll_groups(&gone, groups), removed);
+    assert_eq!(c.add_ragdoll(&gone), removed);
+    assert_eq!(c.remove_ragdoll(&mut w, &mut gone), removed);
     assert_eq!(c.snapshot(&w).unwrap(), before);
 }
 

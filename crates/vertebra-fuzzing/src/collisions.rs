@@ -143,7 +143,7 @@ impl Scene {
         let ragdoll = if input.pick(2) == 0 {
             let ragdoll = Ragdoll::build(&mut self.world, &self.desc, options, &pose, None)
                 .map_err(refused)?;
-            self.collisions.add_ragdoll(&ragdoll)?;
+            self.collisions.add_ragdoll(&ragdoll).map_err(refused)?;
             ragdoll
         } else {
             self.collisions
@@ -171,11 +171,13 @@ impl Scene {
             (0, Some(body), _) => self.collisions.set_body_groups(body, groups),
             (1, _, Some(k)) => self
                 .collisions
-                .set_ragdoll_groups(&self.ragdolls[k], groups),
+                .set_ragdoll_groups(&self.ragdolls[k], groups)
+                .map_err(|_| Error::InvalidConfig("ragdoll groups refused")),
             (2, _, Some(k)) => {
                 let collide = input.pick(2) == 0;
                 self.collisions
                     .set_ragdoll_self_collision(&self.ragdolls[k], collide)
+                    .map_err(|_| Error::InvalidConfig("ragdoll self-collision refused"))
             }
             _ => Ok(()),
         }

@@ -193,6 +193,7 @@ impl Ragdoll {
         settings: &DriveSettings,
     ) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
+        self.check_not_removed()?;
         prev.validate(&self.desc)?;
         if !(dt.is_finite() && dt >= vertebra_world::MIN_TIME_STEP) {
             return Err(RagdollError::OutOfRange {
@@ -214,6 +215,7 @@ impl Ragdoll {
         from: Option<(&Pose, f32)>,
         settings: &DriveSettings,
     ) -> Result<(), RagdollError> {
+        self.check_not_removed()?;
         target.validate(&self.desc)?;
         settings.validate(self.desc.joints.len())?;
         let relative = |pose: &Pose, j: &crate::JointDef| {
@@ -284,6 +286,7 @@ impl Ragdoll {
     /// Turns every drive off: sockets without drives, the rod back to its
     /// rest shape and passive stiffness.
     pub fn release_drives(&self, world: &mut World) -> Result<(), RagdollError> {
+        self.check_not_removed()?;
         for (socket, j) in self.joints.iter().zip(&self.desc.joints) {
             if let Some(socket) = socket {
                 world

@@ -105,6 +105,14 @@ pub enum RagdollError {
         /// The world's error, which names the field.
         error: vertebra_world::Error,
     },
+    /// A call on a ragdoll that [`Ragdoll::remove`](crate::Ragdoll::remove)
+    /// took out of its world (or that a removal through the collision
+    /// layer did): it has no bodies, joints or rod left to act on, read or
+    /// remove. Build a new one.
+    Removed {
+        /// The ragdoll's description's name.
+        ragdoll: String,
+    },
     /// A ragdoll that cannot be removed as it is (nothing was removed).
     NotRemovable {
         /// The item, e.g. `body `hips`` or `joint `knee_l``.
@@ -174,6 +182,10 @@ impl fmt::Display for RagdollError {
             RagdollError::BadPose(m) => write!(f, "bad pose: {m}"),
             RagdollError::World { context, error } if context.is_empty() => write!(f, "{error}"),
             RagdollError::World { context, error } => write!(f, "{context}: {error}"),
+            RagdollError::Removed { ragdoll } => write!(
+                f,
+                "ragdoll `{ragdoll}` has been removed from the world; build it again"
+            ),
             RagdollError::NotRemovable { item, reason } => {
                 write!(f, "the ragdoll cannot be removed: {item} {reason}")
             }

@@ -389,7 +389,10 @@ impl SkeletonMapper {
     /// Every bone's world transform from the ragdoll's bodies in `world`
     /// and the animation's current local pose (for the bones without a
     /// body that follow their parents or the model frame). `ragdoll` must
-    /// be built from the mapper's description and spine mode.
+    /// be built from the mapper's description and spine mode, and still be
+    /// in `world`: a removed ragdoll is refused
+    /// ([`RagdollError::Removed`], naming it), and so is one whose body or
+    /// rod is no longer in `world` (naming the body or rod).
     pub fn map_to_skeleton(
         &self,
         ragdoll: &Ragdoll,
@@ -445,6 +448,9 @@ impl SkeletonMapper {
 
     /// The bodies' world poses and the rod's frames, read from `world`.
     pub(crate) fn read(&self, ragdoll: &Ragdoll, world: &World) -> Result<Bodies, RagdollError> {
+        // A removed ragdoll has no bodies to read: refused by name, where
+        // it used to map with every body at the world origin.
+        ragdoll.check_not_removed()?;
         if ragdoll.options.spine != self.spine
             || ragdoll.desc.name != self.desc.name
             || ragdoll.desc.bodies.len() != self.desc.bodies.len()

@@ -138,8 +138,7 @@ impl Ragdoll {
             .iter()
             .position(|b| b.name == name)
             .ok_or_else(|| unknown(call.to_owned()))?;
-        self.root()
-            .map_err(|_| self.removed(&format!("{call}: {}", self.body_context(k))))?;
+        self.check_not_removed()?;
         let handle = self.bodies[k].ok_or_else(|| {
             unknown(format!(
                 "{call} (an interior spine bone of a simplified ragdoll has no body)"
@@ -148,18 +147,27 @@ impl Ragdoll {
         Ok((k, handle))
     }
 
-    /// The root body's handle; a removed ragdoll has none.
+    /// The root body's handle; a removed ragdoll has none
+    /// ([`RagdollError::Removed`]).
     pub(crate) fn root(&self) -> Result<BodyHandle, RagdollError> {
-        self.bodies[self.desc.root].ok_or_else(|| self.removed(&self.body_context(self.desc.root)))
+        self.bodies[self.desc.root].ok_or_else(|| self.removed())
     }
 
-    /// The error for a call about `item` (e.g. `body `hips``) of a removed
-    /// ragdoll: its bodies are no longer in the world.
-    fn removed(&self, item: &str) -> RagdollError {
-        RagdollError::world(
-            &format!("{item} (the ragdoll has been removed from the world)"),
-            vertebra_world::Error::StaleHandle("body"),
-        )
+    /// `Ok` unless the ragdoll has been removed from its world
+    /// ([`Ragdoll::remove`], or `vertebra_collide::Collisions::remove_ragdoll`):
+    /// then [`RagdollError::Removed`], naming it. Every call that takes a
+    /// ragdoll refuses a removed one this way, before anything else (a
+    /// removed ragdoll has no bodies, joints or rod: mapped, it would put
+    /// every bone at the world origin).
+    pub fn check_not_removed(&self) -> Result<(), RagdollError> {
+        self.root().map(drop)
+    }
+
+    /// The error for a call on a removed ragdoll.
+    fn removed(&self) -> RagdollError {
+        RagdollError::Removed {
+            ragdoll: self.desc.name.clone(),
+        }
     }
 
     /// Every body the ragdoll has, with its described index.

@@ -134,6 +134,7 @@ impl Ragdoll {
         dt: f32,
     ) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
+        self.check_not_removed()?;
         pose.validate(&self.desc)?;
         if !(MIN_TIME_STEP..=MAX_TIME_STEP).contains(&dt) {
             return Err(RagdollError::OutOfRange {

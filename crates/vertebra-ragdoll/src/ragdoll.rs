@@ -373,8 +373,11 @@ impl Ragdoll {
     /// world restored to before the ragdoll was built) or a joint that is
     /// not the ragdoll's still holds one of its bodies (remove that joint
     /// first). A collision layer's colliders on its bodies are the layer's
-    /// (`vertebra_collide::Collisions::remove_ragdoll` removes both).
+    /// (`vertebra_collide::Collisions::remove_ragdoll` removes both). A
+    /// ragdoll already removed is refused ([`RagdollError::Removed`]), as
+    /// every later call on it is.
     pub fn remove(&mut self, world: &mut World) -> Result<(), RagdollError> {
+        self.check_not_removed()?;
         self.check_removable(world)?;
         if let Some(rod) = self.rod.take() {
             world
@@ -450,7 +453,8 @@ impl Ragdoll {
     /// physics): the old bodies and joints go, new ones come, the rod
     /// re-instantiated to hold exactly at the new pose. On error (a bad
     /// pose, a world refusal, an old ragdoll that [`Ragdoll::remove`] would
-    /// refuse) the ragdoll and the world are unchanged.
+    /// refuse, a removed one: build a new one) the ragdoll and the world
+    /// are unchanged.
     pub fn recreate(
         &mut self,
         world: &mut World,
@@ -458,6 +462,7 @@ impl Ragdoll {
         previous: Option<(&Pose, f32)>,
     ) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
+        self.check_not_removed()?;
         pose.validate(&self.desc)?;
         self.check_removable(world)?;
         let fresh = Self::build(world, &self.desc.clone(), self.options, pose, previous)?;

@@ -219,9 +219,8 @@ fn refused_ragdoll_calls_change_nothing() {
     let mut gone = ragdoll.clone();
     gone.remove(&mut w).unwrap();
     let removed = w.state_hash();
-    let no_root = RagdollError::World {
-        context: "body `hips` (the ragdoll has been removed from the world)".to_owned(),
-        error: Error::StaleHandle("body"),
+    let no_root = RagdollError::Removed {
+        ragdoll: "reference-humanoid".to_owned(),
     };
     assert_eq!(gone.root_transform(&w), Err(no_root.clone()));
     assert_eq!(gone.bounds(&w), Err(no_root.clone()));

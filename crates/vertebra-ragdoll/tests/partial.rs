@@ -11,7 +11,7 @@ use common::{angle, walking};
 use glam::{Quat, Vec3};
 use separation::worst_separation;
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
-use vertebra_world::{Error, SolverConfig, World};
+use vertebra_world::{SolverConfig, World};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -283,9 +283,8 @@ fn refused_partial_calls_name_the_item_and_change_nothing() {
     let removed = ragdoll.set_kinematic(&mut w, &legs).unwrap_err();
     assert_eq!(
         removed,
-        RagdollError::World {
-            context: "body `hips` (the ragdoll has been removed from the world)".to_owned(),
-            error: Error::StaleHandle("body")
+        RagdollError::Removed {
+            ragdoll: desc.name.clone()
         }
     );
     let one = ragdoll
@@ -293,8 +292,7 @@ fn refused_partial_calls_name_the_item_and_change_nothing() {
         .unwrap_err();
     assert_eq!(
         one.to_string(),
-        "set_body_kinematic: body `hips` (the ragdoll has been removed from the world): \
-         stale or unknown body handle"
+        "ragdoll `reference-humanoid` has been removed from the world; build it again"
     );
     assert!(ragdoll.kinematic(&w).is_err());
     assert_eq!(w.state_hash(), hash);
