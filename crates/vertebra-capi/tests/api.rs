@@ -3163,3 +3163,53 @@ fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
         vt_skeleton_mapper_destroy(mapper);
     }
 }
+
+/// Issue 31, item 11: a rod spine asked of a description without a
+/// `[spine]` through the C ABI (`vt_ragdoll_build`, with and without the
+/// collision layer, and `vt_skeleton_mapper_create`) is refused by name.
+#[test]
+fn a_rod_spine_of_a_description_without_a_spine_is_refused_through_c() {
+    let reference = vertebra_ragdoll::REFERENCE_HUMANOID;
+    let no_spine = desc_from(&reference[..reference.find("\n[spine]").unwrap()])
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let expected = "ragdoll `reference-humanoid`: spine is a rod (SpineMode::Rod), but the \
+                    description has no [spine] for one to replace";
+    let world = CWorld::new();
+    let layer = CLayer::new();
+    let (before, layer_before) = (world.bytes(), layer.bytes());
+    let pose = lifted_bind(&no_spine, 0.0);
+    let options = VtBuildOptions {
+        spine: VtSpineMode::Rod as u32,
+        at_switch: 0,
+        stabilise: 0,
+        stabilise_ratio: 1.0,
+    };
+    for collisions in [null_mut(), layer.0] {
+        let mut ragdoll = null_mut();
+        // SAFETY: live objects; readable options and pose; writable place.
+        let built = unsafe {
+            vt_ragdoll_build(
+                world.0,
+                collisions,
+                no_spine.0,
+                &options,
+                pose.as_ptr(),
+                null(),
+                pose.len(),
+                DT,
+                &mut ragdoll,
+            )
+        };
+        refused(built, VtResult::Ragdoll, &[expected]);
+        assert!(ragdoll.is_null());
+    }
+    assert!(before == world.bytes() && layer_before == layer.bytes());
+    let skeleton = CSkeleton::reference();
+    let mut mapper = null_mut();
+    // SAFETY: live objects; writable.
+    let made = unsafe {
+        vt_skeleton_mapper_create(skeleton.0, no_spine.0, VtSpineMode::Rod as u32, &mut mapper)
+    };
+    refused(made, VtResult::Ragdoll, &[expected]);
+    assert!(mapper.is_null());
+}

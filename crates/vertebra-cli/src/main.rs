@@ -17,7 +17,7 @@ use std::process::ExitCode;
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
-use vertebra_ragdoll::{RagdollDesc, SpineMode};
+use vertebra_ragdoll::{RagdollDesc, RagdollError, SpineMode};
 use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, SceneRun, Seeded};
 use vertebra_world::{JointSolver, SleepSettings};
 
@@ -245,7 +245,17 @@ fn execute(command: Command) -> Result<(), String> {
                 _ => {}
             }
             let ragdoll = ragdoll
-                .map(|path| RagdollDesc::from_file(&path))
+                .map(|path| {
+                    let desc = RagdollDesc::from_file(&path)?;
+                    // A rod asked of a file without a [spine]: named with
+                    // the file here, as the build would refuse it.
+                    desc.check_spine(spine.into())
+                        .map_err(|e| RagdollError::File {
+                            path: path.display().to_string(),
+                            error: Box::new(e),
+                        })
+                        .map(|()| desc)
+                })
                 .transpose()
                 .map_err(|e| e.to_string())?;
             let mut config = SceneConfig::new(scene, spine.into());

@@ -1121,3 +1121,46 @@ fn every_file_the_command_reads_is_refused_when_it_is_a_fifo() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 31, item 11: `--spine rod` on a ragdoll without a `[spine]` ran
+/// the standard ragdoll and said nothing; it is refused naming the file,
+/// the description and the missing table. A scene whose own ragdoll has
+/// no spine (the heavy chain) is refused the same way, by name.
+#[test]
+fn a_rod_spine_of_a_ragdoll_without_a_spine_is_refused_by_name() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-nospine-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let reference = include_str!("../../vertebra-ragdoll/models/humanoid.toml");
+    let at = reference.find("\n[spine]").expect("a [spine] table");
+    let file = dir.join("no-spine.toml");
+    std::fs::write(&file, &reference[..at]).unwrap();
+    let name = file.to_str().unwrap();
+    let args = scene_with(&["--ragdoll", name, "--frames", "2"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    fails_with(
+        &args,
+        &format!(
+            "{name}: ragdoll `reference-humanoid`: spine is a rod (SpineMode::Rod), but the \
+             description has no [spine] for one to replace; build it with SpineMode::Sockets, \
+             or give it a [spine]"
+        ),
+    );
+    let sockets = [
+        "scene",
+        "passive-bending",
+        "--spine",
+        "sockets",
+        "--ragdoll",
+        name,
+        "--frames",
+        "2",
+    ];
+    let (code, _, stderr) = vertebra(&sockets);
+    assert_eq!(code, 0, "{stderr}");
+    fails_with(
+        &["scene", "heavy-chain", "--spine", "rod", "--frames", "2"],
+        "ragdoll `heavy chain`: spine is a rod (SpineMode::Rod), but the description has no \
+         [spine] for one to replace",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

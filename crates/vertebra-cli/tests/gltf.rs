@@ -459,7 +459,7 @@ fn a_scene_that_maps_onto_no_skeleton_has_its_bodies_and_no_skin() {
         "scene",
         "heavy-chain",
         "--spine",
-        "rod",
+        "sockets",
         "--frames",
         "10",
         "--gltf",
@@ -468,7 +468,7 @@ fn a_scene_that_maps_onto_no_skeleton_has_its_bodies_and_no_skin() {
     assert_eq!(code, 0, "{stderr}");
     assert!(stderr.contains("no skin"), "{stderr}");
     let file = load(&path);
-    let expected = simulate(Scene::HeavyChain, SpineMode::Rod, frames);
+    let expected = simulate(Scene::HeavyChain, SpineMode::Sockets, frames);
     check_bodies(&file, &expected, frames);
     assert_eq!(file.doc.skins().count(), 0);
     std::fs::remove_file(path).ok();

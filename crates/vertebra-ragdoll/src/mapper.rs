@@ -94,7 +94,9 @@ impl SkeletonMapper {
     /// humanoids' bodies are `hips`, `spine_lower`, `spine_upper`, `chest`,
     /// `head`, `upper_arm_l`, `forearm_l`, ...) at the offset the two bind
     /// poses give. Refused, naming the body, when the skeleton has no such
-    /// bone, and for a description that fails [`RagdollDesc::validate`].
+    /// bone, for a description that fails [`RagdollDesc::validate`], and
+    /// for a rod spine of a description without a `[spine]`
+    /// ([`RagdollDesc::check_spine`]).
     pub fn new(
         skeleton: &Skeleton,
         desc: &RagdollDesc,
@@ -166,6 +168,7 @@ impl SkeletonMapper {
         authored: &[Option<Transform>],
     ) -> Result<Self, RagdollError> {
         desc.validate()?;
+        desc.check_spine(spine)?;
         let count = skeleton.len();
         if bones.len() != desc.bodies.len() {
             return Err(RagdollError::OutOfRange {

@@ -153,12 +153,14 @@ pub struct Ragdoll {
 
 /// Masses per described body for `options` (interior spine masses moved to
 /// the ends in rod mode; stabilised if asked), total unchanged. Refused
-/// for a description that fails [`RagdollDesc::validate`] or options that
-/// fail [`BuildOptions::validate`].
+/// for a description that fails [`RagdollDesc::validate`], options that
+/// fail [`BuildOptions::validate`], and a rod spine of a description
+/// without a `[spine]` ([`RagdollDesc::check_spine`]).
 pub fn body_masses(desc: &RagdollDesc, options: &BuildOptions) -> Result<Vec<f32>, RagdollError> {
     let _mode = DefaultFloatMode::enter();
     desc.validate()?;
     options.validate()?;
+    desc.check_spine(options.spine)?;
     Ok(masses_of(desc, options))
 }
 
@@ -217,8 +219,9 @@ impl Ragdoll {
     /// put back as it was (its state, and so its state hash: the world
     /// restores a snapshot taken before the first body went in); only the
     /// handles the refused build drew are never issued again. A description
-    /// that fails [`RagdollDesc::validate`] (one edited by hand) is refused
-    /// before anything is built. With a collision layer, `vertebra_collide::Collisions::build_ragdoll`
+    /// that fails [`RagdollDesc::validate`] (one edited by hand), or asked
+    /// for a rod spine without a `[spine]` ([`RagdollDesc::check_spine`]),
+    /// is refused before anything is built. With a collision layer, `vertebra_collide::Collisions::build_ragdoll`
     /// builds it and adds its colliders in one call.
     pub fn build(
         world: &mut World,
@@ -230,6 +233,7 @@ impl Ragdoll {
         let _mode = DefaultFloatMode::enter();
         options.validate()?;
         desc.validate()?;
+        desc.check_spine(options.spine)?;
         pose.validate(desc)?;
         if let Some((p, dt)) = previous {
             p.validate(desc)?;
@@ -544,6 +548,24 @@ fn pivot_on_parent(
     anchor_b: Vec3,
 ) -> Vec3 {
     parent_q.inverse() * ((child - parent) + child_q * anchor_b)
+}
+
+impl RagdollDesc {
+    /// Whether a ragdoll of this description can be built (or mapped) with
+    /// `spine`: a rod spine ([`SpineMode::Rod`]) replaces the `[spine]`
+    /// chain, so a description without one is refused, naming it and the
+    /// missing table (it would otherwise build the standard ragdoll, with
+    /// no rod, and say nothing). Sockets always can.
+    pub fn check_spine(&self, spine: SpineMode) -> Result<(), RagdollError> {
+        match (spine, &self.spine) {
+            (SpineMode::Rod, None) => Err(RagdollError::OutOfRange {
+                context: format!("ragdoll `{}`", self.name),
+                field: "spine",
+                reason: "is a rod (SpineMode::Rod), but the description has no [spine] for one to replace; build it with SpineMode::Sockets, or give it a [spine]".to_owned(),
+            }),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// How errors name a simplified ragdoll's spine rod: by its end bodies.

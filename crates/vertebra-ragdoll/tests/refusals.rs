@@ -220,6 +220,59 @@ fn the_time_between_two_poses_is_at_least_the_shortest_step() {
     }
 }
 
+/// The reference humanoid's file without its `[spine]` table (the last
+/// table of the file).
+fn without_spine() -> String {
+    let at = REFERENCE_HUMANOID
+        .find("\n[spine]")
+        .expect("a [spine] table");
+    REFERENCE_HUMANOID[..at].to_owned()
+}
+
+/// Issue 31, item 11: a rod spine asked of a description without a
+/// `[spine]` built the standard ragdoll (no rod) and said nothing.
+/// Refused by the description's name and the missing table, by the build
+/// (with nothing added to the world) and by the mapper, which would map
+/// a rod that is not there.
+#[test]
+fn a_rod_spine_of_a_description_without_a_spine_is_refused_by_name() {
+    let desc = RagdollDesc::from_toml(&without_spine()).unwrap();
+    assert_eq!(desc.spine, None);
+    let expected = "ragdoll `reference-humanoid`: spine is a rod (SpineMode::Rod), but the \
+                    description has no [spine] for one to replace; build it with \
+                    SpineMode::Sockets, or give it a [spine]";
+    let fresh = World::new(SolverConfig::default()).unwrap().state_hash();
+    for options in [
+        BuildOptions::new(SpineMode::Rod),
+        BuildOptions::at_switch(SpineMode::Rod),
+    ] {
+        let (world, built) = build(&desc, options, &Pose::bind(&desc));
+        assert_eq!(built.unwrap_err().to_string(), expected);
+        assert_eq!(world.state_hash(), fresh, "nothing was added");
+    }
+    let skeleton = vertebra_ragdoll::Skeleton::reference();
+    let mapper = vertebra_ragdoll::SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod);
+    assert_eq!(mapper.unwrap_err().to_string(), expected);
+    // The sockets build it, and the reference humanoid (with its spine)
+    // builds both ways.
+    assert!(
+        build(
+            &desc,
+            BuildOptions::new(SpineMode::Sockets),
+            &Pose::bind(&desc)
+        )
+        .1
+        .is_ok()
+    );
+    let reference = RagdollDesc::reference_humanoid();
+    let (_, rod) = build(
+        &reference,
+        BuildOptions::new(SpineMode::Rod),
+        &Pose::bind(&reference),
+    );
+    assert!(rod.unwrap().rod.is_some());
+}
+
 /// A string whose first bytes are no TOML, `len` bytes long in all.
 fn long_text(len: usize) -> String {
     let mut text = String::from("[[[ not toml\n");

@@ -3,6 +3,8 @@
 use core::fmt;
 use core::str::FromStr;
 
+use vertebra_ragdoll::SpineMode;
+
 /// A scene: the paper's three, two on the anatomical humanoid, and a
 /// chain with a large mass ratio.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -22,7 +24,8 @@ pub enum Scene {
     AnatomicalDrop,
     /// A chain of 1 kg links hanging from a fixed anchor with a 1000 kg
     /// body at its end ([`crate::heavy_chain`]): a 1:1000 mass ratio
-    /// across a joint. No spine, so both spines build the same chain.
+    /// across a joint. No spine: built with sockets only (a rod spine is
+    /// refused, naming the chain's description).
     HeavyChain,
 }
 
@@ -60,6 +63,16 @@ impl Scene {
     /// (the others are on the anatomical one).
     pub fn is_paper(self) -> bool {
         Scene::PAPER.contains(&self)
+    }
+
+    /// The spines its ragdolls are built with: both, but only sockets for
+    /// the heavy chain, whose description has no `[spine]` for a rod to
+    /// replace (`SpineMode::Rod` is refused for it).
+    pub fn spines(self) -> &'static [SpineMode] {
+        match self {
+            Scene::HeavyChain => &[SpineMode::Sockets],
+            _ => &[SpineMode::Sockets, SpineMode::Rod],
+        }
     }
 
     /// Frames the paper's figure runs (the new scenes: 4 s, 10 s and 5 s).

@@ -51,8 +51,15 @@ fn the_direct_solve_holds_the_heavy_chain_together() {
 
 #[test]
 fn the_heavy_chain_counts_every_joint_and_refuses_another_ragdoll() {
-    let mut config = SceneConfig::new(Scene::HeavyChain, SpineMode::Rod);
-    // No spine: the rod spine builds the same chain of sockets.
+    // No spine: a rod spine is refused by the chain's name.
+    let rod = SceneConfig::new(Scene::HeavyChain, SpineMode::Rod);
+    let refused = build(&rod).err().unwrap().to_string();
+    assert!(
+        refused.starts_with("ragdoll `heavy chain`: spine is a rod"),
+        "{refused}"
+    );
+    assert_eq!(Scene::HeavyChain.spines(), [SpineMode::Sockets]);
+    let mut config = SceneConfig::new(Scene::HeavyChain, SpineMode::Sockets);
     let mut scene = build(&config).unwrap();
     assert_eq!(scene.ragdolls[0].rod, None);
     let r = scene.world.measure_residuals();
