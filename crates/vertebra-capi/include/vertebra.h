@@ -54,7 +54,8 @@ typedef enum VtResult {
   VT_RESULT_INVALID_LIMIT = 17,
   // A solver setting out of its range.
   VT_RESULT_INVALID_CONFIG = 18,
-  // A joint setting its kind does not take.
+  // A joint or rod setting it does not take (a drive on a fixed joint,
+  // other bodies for a rod).
   VT_RESULT_INVALID_JOINT = 19,
   // A finite value beyond what the solver works with.
   VT_RESULT_OUT_OF_RANGE = 20,

@@ -57,7 +57,8 @@ pub enum VtResult {
     InvalidLimit = 17,
     /// A solver setting out of its range.
     InvalidConfig = 18,
-    /// A joint setting its kind does not take.
+    /// A joint or rod setting it does not take (a drive on a fixed joint,
+    /// other bodies for a rod).
     InvalidJoint = 19,
     /// A finite value beyond what the solver works with.
     OutOfRange = 20,

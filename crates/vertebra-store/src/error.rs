@@ -46,7 +46,8 @@ pub enum Error {
     InvalidLimit(&'static str),
     /// A solver setting out of its range.
     InvalidConfig(&'static str),
-    /// A joint setting its kind does not take (a drive on a fixed joint).
+    /// A joint or rod setting it does not take: a drive on a fixed joint,
+    /// other bodies for a rod in `set_rod` (a rod's bodies cannot change).
     InvalidJoint(&'static str),
     /// A finite value beyond what the solver can work with: a coordinate
     /// beyond [`MAX_COORDINATE`], a time step above [`MAX_TIME_STEP`].

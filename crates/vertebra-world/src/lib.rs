@@ -406,12 +406,17 @@ impl World {
 
     /// Changes a rod's rest shape, stiffness and limits in place (its bodies
     /// must stay the same, and may both be kinematic by now): how a powered
-    /// ragdoll drives its spine.
+    /// ragdoll drives its spine. Other bodies (or the same two swapped:
+    /// `body_a` is the rod's base) are refused with
+    /// [`Error::InvalidJoint`], naming the rod's bodies: remove the rod and
+    /// add one between the new bodies.
     pub fn set_rod(&mut self, handle: RodHandle, desc: RodDesc) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         let old = self.rod(handle)?;
         if (old.body_a, old.body_b) != (desc.body_a, desc.body_b) {
-            return Err(Error::InvalidConfig("set_rod cannot change a rod's bodies"));
+            return Err(Error::InvalidJoint(
+                "rod bodies (body_a, body_b) cannot change; remove the rod and add one between the new bodies",
+            ));
         }
         desc.validate()?;
         self.rods[handle.index()] = Some(desc);

@@ -626,6 +626,40 @@ fn bad_rest_rates_are_refused_by_name_and_change_nothing() {
     w.step(1.0 / 60.0).unwrap();
 }
 
+/// Issue 31, item 8: `set_rod` with other bodies was refused as an
+/// "invalid solver setting". It is refused naming the rod and saying its
+/// bodies cannot change, with the world as it was; the same bodies in the
+/// other order are other bodies too (`body_a` is the rod's base).
+#[test]
+fn set_rod_refuses_other_bodies_naming_the_rod() {
+    use vertebra_world::RodDesc;
+    let (mut w, a, b, _) = world();
+    let c = w
+        .add_body(BodyDesc::dynamic(unit_mass()).with_position(Vec3::new(0.0, 0.5, 0.0)))
+        .unwrap();
+    let rod = RodDesc::from_pose(w.bodies(), b, c, &[]).unwrap();
+    let handle = w.add_rod(rod).unwrap();
+    let expected = Error::InvalidJoint(
+        "rod bodies (body_a, body_b) cannot change; remove the rod and add one between the new bodies",
+    );
+    for (body_a, body_b) in [(a, c), (b, a), (c, b)] {
+        let before = (w.snapshot(), w.state_hash());
+        let moved = RodDesc {
+            body_a,
+            body_b,
+            ..rod
+        };
+        assert_eq!(w.set_rod(handle, moved), Err(expected.clone()));
+        assert_eq!((w.snapshot(), w.state_hash()), before);
+    }
+    assert_eq!(
+        expected.to_string(),
+        "invalid joint: rod bodies (body_a, body_b) cannot change; remove the rod and add one \
+         between the new bodies"
+    );
+    w.set_rod(handle, rod.with_bend_limit(0.5)).unwrap();
+}
+
 #[test]
 fn a_body_with_a_rod_cannot_be_removed_until_the_rod_is() {
     use vertebra_world::RodDesc;
