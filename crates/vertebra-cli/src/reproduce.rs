@@ -37,6 +37,14 @@ pub fn default_out(joints: JointSolver) -> PathBuf {
 /// Runs every scene both ways from seeds `0 .. seeds`, the joints solved
 /// by `joints`, and writes everything under `out`.
 pub fn reproduce(out: &Path, seeds: u64, joints: JointSolver) -> Result<(), String> {
+    // Everything the command is given, checked before anything is
+    // written: a refused run leaves no output directory behind.
+    for scene in Scene::PAPER {
+        for spine in [SpineMode::Sockets, SpineMode::Rod] {
+            let config = SceneConfig::new(scene, spine);
+            Seeded::check(&config, seeds).map_err(|e| e.to_string())?;
+        }
+    }
     std::fs::create_dir_all(out).map_err(|e| io(format!("{}: {e}", out.display())))?;
     let fonts = font_options();
     let mut document = Vec::new();

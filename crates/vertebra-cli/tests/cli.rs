@@ -1164,3 +1164,21 @@ fn a_rod_spine_of_a_ragdoll_without_a_spine_is_refused_by_name() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 31, item 8: a refused `reproduce` (`--seeds 0`, or more than a
+/// run may take) left an empty output directory behind. Everything the
+/// command is given is checked before anything is written.
+#[test]
+fn a_refused_reproduce_leaves_no_output_directory() {
+    let dir = std::env::temp_dir().join(format!("vertebra-cli-refused-{}", std::process::id()));
+    for seeds in ["0", "10001"] {
+        let out = dir.join(format!("seeds-{seeds}"));
+        let out_name = out.to_str().unwrap();
+        fails_with(
+            &["reproduce", "--seeds", seeds, "--out", out_name],
+            &format!("seeds is {seeds} from seed 0; must be 1 to 10000"),
+        );
+        assert!(!out.exists(), "--seeds {seeds} made {out_name}");
+    }
+    assert!(!dir.exists(), "{}", dir.display());
+}

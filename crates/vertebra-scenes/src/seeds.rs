@@ -26,6 +26,30 @@ pub struct Seeded {
 }
 
 impl Seeded {
+    /// Whether [`Seeded::run`] takes `count` seeds of `config`: 1 to
+    /// [`MAX_SEEDS`], the last seed at most `u64::MAX`, and seeds times
+    /// frames at most [`MAX_SEEDED_FRAMES`]; refused naming the field, as
+    /// `run` refuses it (for a caller that checks before it writes
+    /// anything, as `vertebra reproduce` does).
+    pub fn check(config: &SceneConfig, count: u64) -> Result<(), RagdollError> {
+        let frames = config.frames.unwrap_or(config.scene.default_frames());
+        let within = (1..=MAX_SEEDS).contains(&count)
+            && config.seed.checked_add(count - 1).is_some()
+            && (count as usize).saturating_mul(frames) <= MAX_SEEDED_FRAMES;
+        if within {
+            return Ok(());
+        }
+        Err(RagdollError::OutOfRange {
+            context: "scene".to_owned(),
+            field: "seeds",
+            reason: format!(
+                "is {count} from seed {}; must be 1 to {MAX_SEEDS}, end at most at seed {}, and seeds x frames ({frames}) at most {MAX_SEEDED_FRAMES}",
+                config.seed,
+                u64::MAX
+            ),
+        })
+    }
+
     /// Runs `config` from seeds `config.seed .. config.seed + count`,
     /// independent runs spread over rayon's global pool (each run is
     /// deterministic, so the result does not depend on how many run at
@@ -36,21 +60,7 @@ impl Seeded {
         count: u64,
         progress: impl Fn(usize, usize) + Sync,
     ) -> Result<Self, RagdollError> {
-        let frames = config.frames.unwrap_or(config.scene.default_frames());
-        let within = (1..=MAX_SEEDS).contains(&count)
-            && config.seed.checked_add(count - 1).is_some()
-            && (count as usize).saturating_mul(frames) <= MAX_SEEDED_FRAMES;
-        if !within {
-            return Err(RagdollError::OutOfRange {
-                context: "scene".to_owned(),
-                field: "seeds",
-                reason: format!(
-                    "is {count} from seed {}; must be 1 to {MAX_SEEDS}, end at most at seed {}, and seeds x frames ({frames}) at most {MAX_SEEDED_FRAMES}",
-                    config.seed,
-                    u64::MAX
-                ),
-            });
-        }
+        Self::check(config, count)?;
         let done = AtomicUsize::new(0);
         let runs = (0..count)
             .into_par_iter()
