@@ -3011,7 +3011,7 @@ fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
     });
     // SAFETY: live objects.
     ok(unsafe { vt_ragdoll_remove(c.ragdoll, c.world.0, c.layer.0) });
-    let (world, layer) = (c.world.bytes(), c.layer.bytes());
+    let (world, layer) = (c.world.bytes(), c.layer.bytes(&c.world));
     let sentinel = VtTransform {
         position: v(9.0, 9.0, 9.0),
         rotation: IDENTITY,
@@ -3156,7 +3156,7 @@ fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
     assert_eq!((root.position, low), (sentinel.position, v(9.0, 9.0, 9.0)));
     assert_eq!((present, body), (7, bits_body()));
     assert!(again.is_null());
-    assert!(world == c.world.bytes() && layer == c.layer.bytes());
+    assert!(world == c.world.bytes() && layer == c.layer.bytes(&c.world));
     // SAFETY: made above, freed once.
     unsafe {
         vt_transition_destroy(transition);
@@ -3176,7 +3176,7 @@ fn a_rod_spine_of_a_description_without_a_spine_is_refused_through_c() {
                     description has no [spine] for one to replace";
     let world = CWorld::new();
     let layer = CLayer::new();
-    let (before, layer_before) = (world.bytes(), layer.bytes());
+    let (before, layer_before) = (world.bytes(), layer.bytes(&world));
     let pose = lifted_bind(&no_spine, 0.0);
     let options = VtBuildOptions {
         spine: VtSpineMode::Rod as u32,
@@ -3203,7 +3203,7 @@ fn a_rod_spine_of_a_description_without_a_spine_is_refused_through_c() {
         refused(built, VtResult::Ragdoll, &[expected]);
         assert!(ragdoll.is_null());
     }
-    assert!(before == world.bytes() && layer_before == layer.bytes());
+    assert!(before == world.bytes() && layer_before == layer.bytes(&world));
     let skeleton = CSkeleton::reference();
     let mut mapper = null_mut();
     // SAFETY: live objects; writable.

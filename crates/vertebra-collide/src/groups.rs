@@ -82,7 +82,7 @@ impl Collisions {
             let next = self.next_apart.checked_add(1);
             match next.filter(|&n| n <= MAX_SELF_COLLISION_GROUPS) {
                 Some(next) => Some((self.next_apart, next)),
-                None => return Err(self.groups_exhausted(bodies[0])),
+                None => return Err(self.groups_exhausted(bodies[0]).into()),
             }
         };
         for body in &bodies {

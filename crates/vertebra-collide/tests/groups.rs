@@ -364,7 +364,8 @@ fn a_crafted_group_counter_is_refused_and_a_group_is_never_given_twice() {
             reason: Box::new(Error::OutOfRange(
                 "ragdoll self-collision group (all 2^48 given)"
             )),
-        })
+        }
+        .into())
     );
     assert_eq!(c.snapshot(&w).unwrap(), at_limit, "refused, unchanged");
     assert!(c.ragdoll_self_collision(&b));
