@@ -6,6 +6,11 @@
 //! flush-to-zero with denormals-are-zero, against the default mode.
 #![cfg(target_arch = "x86_64")]
 
+#[path = "../../vertebra-world/tests/mxcsr/mod.rs"]
+mod mxcsr;
+
+use mxcsr::{read_mxcsr, write_mxcsr};
+
 use glam::{Quat, Vec3};
 use vertebra_collide::{Collider, ColliderShape, Collisions};
 use vertebra_ragdoll::{
@@ -28,22 +33,6 @@ const MODES: [(&str, u32); 4] = [
     ("round toward zero", DEFAULT | 0x6000),
     ("flush to zero, denormals are zero", DEFAULT | 0x8040),
 ];
-
-fn read_mxcsr() -> u32 {
-    let mut value = 0u32;
-    // SAFETY: stores MXCSR to a writable u32.
-    unsafe {
-        core::arch::asm!("stmxcsr [{}]", in(reg) &mut value, options(nostack, preserves_flags));
-    }
-    value
-}
-
-fn write_mxcsr(value: u32) {
-    // SAFETY: loads MXCSR from a readable u32 holding only valid bits.
-    unsafe {
-        core::arch::asm!("ldmxcsr [{}]", in(reg) &value, options(nostack, preserves_flags, readonly));
-    }
-}
 
 /// Runs `f` in `mode`, as a host would, and checks it got its mode back.
 fn in_mode<T>(mode: u32, f: impl FnOnce() -> T) -> T {

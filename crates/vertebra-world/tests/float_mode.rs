@@ -3,6 +3,10 @@
 //! engines do), on its own thread and on the threads it creates.
 #![cfg(target_arch = "x86_64")]
 
+mod mxcsr;
+
+use mxcsr::{read_mxcsr, write_mxcsr};
+
 use glam::Vec3;
 use vertebra_world::{
     BodyDesc, BodyHandle, JointDesc, MassProperties, RodDesc, RodStiffness, Shape, SolverConfig,
@@ -11,22 +15,6 @@ use vertebra_world::{
 
 /// MXCSR's flush-to-zero (bit 15) and denormals-are-zero (bit 6).
 const FTZ_DAZ: u32 = 0x8040;
-
-fn read_mxcsr() -> u32 {
-    let mut value = 0u32;
-    // SAFETY: stores MXCSR to a writable u32.
-    unsafe {
-        core::arch::asm!("stmxcsr [{}]", in(reg) &mut value, options(nostack, preserves_flags));
-    }
-    value
-}
-
-fn write_mxcsr(value: u32) {
-    // SAFETY: loads MXCSR from a readable u32 holding only valid bits.
-    unsafe {
-        core::arch::asm!("ldmxcsr [{}]", in(reg) &value, options(nostack, preserves_flags, readonly));
-    }
-}
 
 /// Runs `f` with FTZ and DAZ set on this thread, as a host would.
 fn as_a_host_with_ftz_daz<T>(f: impl FnOnce() -> T) -> T {
