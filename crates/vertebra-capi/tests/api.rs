@@ -2113,7 +2113,7 @@ fn a_ragdoll_is_removed_with_and_without_its_collision_layer() {
     let _ = unsafe { vt_world_contacts(c.world.0, null_mut(), 0, &mut count) };
     assert_eq!(count, 0);
     // Removed again: refused by name, as every call on a removed ragdoll
-    // is (issue 31, item 4), with nothing written.
+    // is, with nothing written.
     let removed = c.world.bytes();
     // SAFETY: live objects.
     let again = unsafe { vt_ragdoll_remove(c.ragdoll, c.world.0, null_mut()) };

@@ -3,10 +3,9 @@
 //! A set keeps its own state about a world's bodies: their colliders,
 //! excluded pairs, groups and self-collision settings. A world that
 //! restored a snapshot without its set (or with the set's snapshot of
-//! another moment) may have bodies the set knows nothing of; before this
-//! was checked, a ragdoll restored that way had no colliders and fell
-//! through the ground with no error (issue 31, item 10). So the two are
-//! tied, cheaply:
+//! another moment) may have bodies the set knows nothing of: a ragdoll
+//! restored that way has no colliders and falls through the ground. So the
+//! two are tied, cheaply:
 //!
 //! - **The set records the world's [`Timeline`](vertebra_world::Timeline)** (a run of states: a world
 //!   begins one when made and a new one with every snapshot it restores)

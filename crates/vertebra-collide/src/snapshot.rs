@@ -15,7 +15,7 @@
 //! [`Collisions::add`] builds it.
 //!
 //! Format versions: 1, without the self-collision settings; 2, with them;
-//! 3, with the world's bodies (issue 31, item 10).
+//! 3, with the world's bodies.
 //!
 //! The bytes are untrusted input: the checksum only catches accidents (it
 //! is not keyed), so [`Collisions::restore`] checks every value as

@@ -227,7 +227,7 @@ fn refused_group_settings_change_nothing() {
     c.remove_ragdoll(&mut w, &mut gone).unwrap();
     inside.bodies.iter_mut().for_each(|b| *b = None);
     let before = c.snapshot(&w).unwrap();
-    // A removed ragdoll is refused by name (issue 31, item 4): by every
+    // A removed ragdoll is refused by name: by every
     // call on it, adding its colliders again included (it has none).
     let removed = Err(RagdollError::Removed {
         ragdoll: desc.name.clone(),

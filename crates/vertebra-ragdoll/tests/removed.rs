@@ -1,8 +1,7 @@
 //! A removed ragdoll is refused by every call that takes it, naming the
-//! ragdoll, with the world as it was (issue 31, item 4: the skeleton
-//! mapper and the transition mapped a removed ragdoll as `Ok`, every bone
-//! of its bodies at the world origin, and the drives took it as `Ok`
-//! doing nothing).
+//! ragdoll, with the world as it was: mapped onto a skeleton it would put
+//! every bone of its bodies at the world origin, and driven it would do
+//! nothing.
 
 use glam::{Quat, Vec3};
 use vertebra_ragdoll::{
