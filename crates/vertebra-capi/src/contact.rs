@@ -8,7 +8,11 @@ use crate::ffi::{out, slice, slice_mut};
 use crate::types::{VtBody, VtVec3};
 use crate::world::{VtWorld, with_world};
 
-/// A contact between two bodies for the next step.
+/// A contact between two bodies for the next step. The normal's sign is
+/// the contact's meaning: it points out of `body_a` into `body_b`. Some
+/// engines give theirs the other way: exchanging the bodies means flipping
+/// the normal too, or the contact pushes the bodies into each other (the
+/// world cannot tell: it does not know the bodies' shapes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct VtContact {
@@ -18,7 +22,8 @@ pub struct VtContact {
     pub body_b: VtBody,
     /// The contact point, midway between the surfaces (m, world).
     pub point: VtVec3,
-    /// The normal from a to b (unit, world).
+    /// The normal out of `body_a` into `body_b`: the direction the contact
+    /// pushes `body_b` (unit, world).
     pub normal: VtVec3,
     /// Penetration depth along the normal (m); negative for a gap.
     pub depth: f32,
@@ -73,13 +78,7 @@ pub unsafe extern "C" fn vt_world_set_contacts(
     unsafe {
         with_world(world, |w| {
             let contacts: Vec<Contact> = contacts?.iter().map(Contact::from).collect();
-            w.set_contacts(&contacts).map_err(|error| {
-                let k = contacts
-                    .iter()
-                    .position(|c| c.validate_with(w.bodies()).is_err());
-                let Failure { code, message } = error.into();
-                Failure::new(code, format!("contact {}: {message}", k.unwrap_or(0)))
-            })
+            w.set_contacts(&contacts).map_err(Failure::from)
         })
     }
 }

@@ -103,7 +103,8 @@ impl Failure {
     }
 }
 
-/// The code of one of the world's errors.
+/// The code of one of the world's errors (a refused contact's is its
+/// reason's: the message names the contact).
 fn code(error: &Error) -> VtResult {
     match error {
         Error::NonFinite(_) => VtResult::NonFinite,
@@ -125,6 +126,7 @@ fn code(error: &Error) -> VtResult {
         Error::IncompatibleSnapshot(_) => VtResult::IncompatibleSnapshot,
         Error::CorruptSnapshot(_) => VtResult::CorruptSnapshot,
         Error::Collider { .. } => VtResult::Collider,
+        Error::Contact { reason, .. } => code(reason),
         Error::WorldMismatch(_) => VtResult::WorldMismatch,
     }
 }

@@ -19,7 +19,7 @@ pub enum Error {
     InvalidInertia,
     /// A shape with no volume (a zero radius or extent).
     DegenerateShape(&'static str),
-    /// A joint between a body and itself.
+    /// A joint, rod or contact between a body and itself.
     SameBody,
     /// A handle whose body or constraint was removed, or that never existed.
     StaleHandle(&'static str),
@@ -31,7 +31,8 @@ pub enum Error {
     ForeignHandle(&'static str),
     /// A body that other constraints still reference.
     BodyInUse,
-    /// A joint between two bodies neither of which is dynamic.
+    /// A joint, rod or contact between two bodies neither of which is
+    /// dynamic.
     NoDynamicBody,
     /// A call that only a dynamic body takes (an impulse), made on a
     /// static or kinematic one: their mass is infinite, so no impulse
@@ -70,6 +71,15 @@ pub enum Error {
         /// Why.
         reason: Box<Error>,
     },
+    /// A contact refused by the world's `set_contacts` or `swap_contacts`:
+    /// the first in the list that is wrong, by its index in the list, and
+    /// why.
+    Contact {
+        /// Its index in the list given.
+        index: usize,
+        /// Why.
+        reason: Box<Error>,
+    },
     /// A companion of a world (a collision set) used with, or restored for,
     /// a world it does not serve: one that restored a snapshot since the
     /// companion last served it (without the companion's own snapshot taken
@@ -87,14 +97,14 @@ impl fmt::Display for Error {
             Error::NonPositive(what) => write!(f, "{what} must be positive"),
             Error::InvalidInertia => write!(f, "inertia must be symmetric positive definite"),
             Error::DegenerateShape(why) => write!(f, "degenerate shape: {why}"),
-            Error::SameBody => write!(f, "a joint needs two different bodies"),
+            Error::SameBody => write!(f, "a joint, rod or contact needs two different bodies"),
             Error::StaleHandle(what) => write!(f, "stale or unknown {what} handle"),
             Error::ForeignHandle(what) => write!(f, "{what} handle of another world"),
             Error::BodyInUse => write!(
                 f,
                 "the body is still used by a joint; remove the joint first"
             ),
-            Error::NoDynamicBody => write!(f, "a joint needs at least one dynamic body"),
+            Error::NoDynamicBody => write!(f, "a joint, rod or contact needs at least one dynamic body"),
             Error::NotDynamic(what) => write!(
                 f,
                 "{what} needs a dynamic body (static and kinematic bodies have infinite mass)"
@@ -111,6 +121,7 @@ impl fmt::Display for Error {
                 body,
                 reason,
             } => write!(f, "collider {index} on body {body:?}: {reason}"),
+            Error::Contact { index, reason } => write!(f, "contact {index}: {reason}"),
             Error::WorldMismatch(why) => write!(f, "world mismatch: {why}"),
         }
     }

@@ -15,6 +15,17 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_point, check_
 use crate::bins::Bins;
 
 /// A contact between two bodies for the next step.
+///
+/// **The normal's sign is the contact's meaning**: `normal` points out of
+/// `body_a` into `body_b`, the direction the contact pushes `body_b` (and
+/// `-normal` pushes `body_a`). Engines differ here: some give the normal
+/// from the first shape to the second, some the reverse. A contact with
+/// its bodies exchanged and its normal not flipped (or the reverse) pushes
+/// the bodies into each other; the world cannot tell, because it does not
+/// know the bodies' shapes (the sign of `(centre_b - centre_a) . normal`
+/// proves nothing for a hollow body: a ball resting in a bowl, a ragdoll
+/// in a car). Exchange the bodies with [`Contact::reversed`], which flips
+/// the normal with them.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Contact {
     /// The first body.
@@ -23,7 +34,8 @@ pub struct Contact {
     pub body_b: BodyHandle,
     /// The contact point, midway between the two surfaces (m, world).
     pub point: Vec3,
-    /// The normal from a to b (unit, world).
+    /// The normal out of `body_a` into `body_b`: the direction the contact
+    /// pushes `body_b` (unit, world). See the type's docs on its sign.
     pub normal: Vec3,
     /// Penetration depth along the normal (m); negative for a gap. At most
     /// [`MAX_COORDINATE`](vertebra_store::MAX_COORDINATE) either way: no
@@ -37,6 +49,19 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// The same contact with its bodies exchanged: `body_a` and `body_b`
+    /// swapped and the normal flipped, so it pushes each body as `self`
+    /// does. The point, depth, friction and restitution are the pair's and
+    /// stay.
+    pub fn reversed(self) -> Self {
+        Self {
+            body_a: self.body_b,
+            body_b: self.body_a,
+            normal: -self.normal,
+            ..self
+        }
+    }
+
     /// Checks every field but the bodies' liveness.
     pub fn validate(&self) -> Result<(), Error> {
         if self.body_a == self.body_b {
@@ -363,8 +388,15 @@ impl ContactFill<'_> {
 
 /// Checks a whole contact list (bodies live, at least one dynamic) before
 /// any is used.
+/// Checks a list as [`World::set_contacts`](crate::World::set_contacts)
+/// does: the first wrong contact's error, with its index in the list.
 pub(crate) fn validate_all(contacts: &[Contact], bodies: &BodyStore) -> Result<(), Error> {
-    contacts.iter().try_for_each(|c| c.validate_with(bodies))
+    contacts.iter().enumerate().try_for_each(|(index, c)| {
+        c.validate_with(bodies).map_err(|reason| Error::Contact {
+            index,
+            reason: Box::new(reason),
+        })
+    })
 }
 
 #[cfg(test)]

@@ -605,7 +605,7 @@ mod tests {
                     let rod = s.rods[0].as_mut().unwrap();
                     rod.body_b = rod.body_a;
                 }),
-                "rod 0: a joint needs two different bodies",
+                "rod 0: a joint, rod or contact needs two different bodies",
             ),
             (
                 Box::new(|s| {
@@ -689,7 +689,7 @@ mod tests {
             ),
             (
                 Box::new(|s| s.contacts[0].body_b = s.contacts[0].body_a),
-                "contact 0: a joint needs two different bodies",
+                "contact 0: a joint, rod or contact needs two different bodies",
             ),
             (
                 Box::new(|s| {

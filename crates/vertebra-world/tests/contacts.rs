@@ -2,7 +2,7 @@
 //! collision detection would): boxes on the plane y = 0.
 
 use glam::{Quat, Vec3};
-use vertebra_world::{BodyDesc, BodyHandle, Contact, Shape, SolverConfig, World};
+use vertebra_world::{BodyDesc, BodyHandle, Contact, Error, Shape, SolverConfig, World};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -258,4 +258,76 @@ fn a_refused_swap_leaves_both_lists_as_they_were() {
     assert_eq!(w.contacts(), &contacts[..2]);
     assert_eq!(bad.len(), 4);
     assert_eq!(bad[..3], contacts[..3]);
+}
+
+/// A refused list names its first wrong contact by its index in the list,
+/// whichever way it is handed over, and leaves the world's list as it was.
+#[test]
+fn a_refused_contact_is_named_by_its_index_in_the_list() {
+    let (mut w, contacts) = resting_box();
+    w.set_contacts(&contacts[..1]).unwrap();
+    let mut bad = contacts.clone();
+    bad[2].point = Vec3::NAN;
+    bad[3].friction = -1.0;
+    let named = Err(Error::Contact {
+        index: 2,
+        reason: Box::new(Error::NonFinite("contact point")),
+    });
+    assert_eq!(w.set_contacts(&bad), named);
+    assert_eq!(w.swap_contacts(&mut bad.clone()), named);
+    assert_eq!(
+        w.set_contacts(&bad).unwrap_err().to_string(),
+        "contact 2: contact point is not finite"
+    );
+    assert_eq!(w.contacts(), &contacts[..1]);
+    // A body removed since: the same, by index.
+    let (mut w, contacts) = resting_box();
+    let gone = w
+        .add_body(BodyDesc::dynamic(
+            Shape::Sphere { radius: 0.1 }.mass_properties(1.0).unwrap(),
+        ))
+        .unwrap();
+    w.remove_body(gone).unwrap();
+    let mut stale = contacts.clone();
+    stale[1].body_b = gone;
+    let error = w.set_contacts(&stale).unwrap_err();
+    assert!(
+        matches!(&error, Error::Contact { index: 1, reason } if matches!(**reason, Error::StaleHandle(_))),
+        "{error:?}"
+    );
+}
+
+/// The box of [`box_world`] dropped 5 cm onto the ground for a second,
+/// each frame's corner contacts passed through `convention`: its lowest
+/// corner's height at the end (m).
+fn dropped_with(convention: impl Fn(Contact) -> Contact) -> f32 {
+    let (mut w, ground, body, half) = box_world(1);
+    for _ in 0..60 {
+        let contacts: Vec<Contact> = corner_contacts(&w, ground, body, half, 0.6, Vec3::Y)
+            .into_iter()
+            .map(&convention)
+            .collect();
+        w.set_contacts(&contacts).unwrap();
+        w.step(DT).unwrap();
+    }
+    w.body(body).unwrap().position.y - half.y
+}
+
+/// The normal's sign is the contact's meaning: a contact reversed (bodies
+/// exchanged, normal flipped) holds the box up as the original does; the
+/// bodies exchanged alone pull it into the ground, which no check of the
+/// world can see (it does not know the bodies' shapes).
+#[test]
+fn a_reversed_contact_pushes_as_the_original_and_its_bodies_alone_exchanged_do_not() {
+    let original = dropped_with(|c| c);
+    let reversed = dropped_with(Contact::reversed);
+    let exchanged = dropped_with(|c| Contact {
+        body_a: c.body_b,
+        body_b: c.body_a,
+        ..c
+    });
+    eprintln!("lowest corner: {original:+.5} m, reversed {reversed:+.5} m, exchanged {exchanged:+.5} m");
+    assert!(original.abs() < 2e-3 && reversed.abs() < 2e-3);
+    assert!((reversed - original).abs() < 1e-4);
+    assert!(exchanged < -0.05, "the exchanged contacts sank it {exchanged} m");
 }
