@@ -299,7 +299,8 @@ fn a_refused_contact_is_named_by_its_index_in_the_list() {
 
 /// The box of [`box_world`] dropped 5 cm onto the ground for a second,
 /// each frame's corner contacts passed through `convention`: its lowest
-/// corner's height at the end (m).
+/// corner's height at the end (m), or when the world first refused a
+/// frame's contacts.
 fn dropped_with(convention: impl Fn(Contact) -> Contact) -> f32 {
     let (mut w, ground, body, half) = box_world(1);
     for _ in 0..60 {
@@ -307,7 +308,9 @@ fn dropped_with(convention: impl Fn(Contact) -> Contact) -> f32 {
             .into_iter()
             .map(&convention)
             .collect();
-        w.set_contacts(&contacts).unwrap();
+        if w.set_contacts(&contacts).is_err() {
+            break;
+        }
         w.step(DT).unwrap();
     }
     w.body(body).unwrap().position.y - half.y
@@ -315,8 +318,8 @@ fn dropped_with(convention: impl Fn(Contact) -> Contact) -> f32 {
 
 /// The normal's sign is the contact's meaning: a contact reversed (bodies
 /// exchanged, normal flipped) holds the box up as the original does; the
-/// bodies exchanged alone pull it into the ground, which no check of the
-/// world can see (it does not know the bodies' shapes).
+/// bodies exchanged alone pull it into the ground, deeper each frame, which
+/// no check of the world can see (it does not know the bodies' shapes).
 #[test]
 fn a_reversed_contact_pushes_as_the_original_and_its_bodies_alone_exchanged_do_not() {
     let original = dropped_with(|c| c);
@@ -329,5 +332,5 @@ fn a_reversed_contact_pushes_as_the_original_and_its_bodies_alone_exchanged_do_n
     eprintln!("lowest corner: {original:+.5} m, reversed {reversed:+.5} m, exchanged {exchanged:+.5} m");
     assert!(original.abs() < 2e-3 && reversed.abs() < 2e-3);
     assert!((reversed - original).abs() < 1e-4);
-    assert!(exchanged < -0.05, "the exchanged contacts sank it {exchanged} m");
+    assert!(exchanged < -1.0, "the exchanged contacts sank it {exchanged} m");
 }
