@@ -7,9 +7,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
-    AngularDrive, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointHandle, JointKind,
-    LimitSoftness, RodDesc, RodHandle, RodStiffness, Snapshot, SolverConfig, Swing, SwingTwist,
-    World,
+    AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointHandle,
+    JointKind, LimitSoftness, RodDesc, RodHandle, RodStiffness, Shape, Snapshot, SolverConfig,
+    Swing, SwingTwist, World,
 };
 
 use crate::input::Input;
@@ -498,7 +498,44 @@ fn build(input: &mut Input) -> World {
         let _ = world.remove_body(seen.bodies[input.pick(seen.bodies.len())]);
     }
     let _ = set_contacts(&mut world, &seen, input);
+    if input.flag() {
+        world = asleep(&world, &seen);
+    }
     world
+}
+
+/// `world` moved into a world without gravity, its bodies stopped, two
+/// more still ones added (a ball, and a pair held by a socket), and
+/// stepped for a second: the two and every island of `world`'s that its
+/// drives and rest shapes leave still fall asleep, so the snapshot carries
+/// a real sleep state (asleep and awake islands, stillness, anchors) for
+/// the changes to break.
+fn asleep(world: &World, seen: &Seen) -> World {
+    let config = SolverConfig {
+        gravity: Vec3::ZERO,
+        ..SolverConfig::default()
+    };
+    let mut calm = World::new(config).expect("a valid config");
+    calm.restore(&world.snapshot())
+        .expect("a world's own snapshot restores");
+    for &body in &seen.bodies {
+        let _ = calm.set_body_velocity(body, Vec3::ZERO, Vec3::ZERO);
+    }
+    let ball = Shape::Sphere { radius: 0.1 }
+        .mass_properties_with_mass(1.0)
+        .expect("a valid ball");
+    let [_, a, b] = [-2.0f32, 2.0, 2.3].map(|x| {
+        calm.add_body(BodyDesc::dynamic(ball).with_position(Vec3::new(x, 5.0, 0.0)))
+            .expect("a valid body")
+    });
+    let socket =
+        JointDesc::socket_at_world_anchor(calm.bodies(), a, b, Vec3::new(2.15, 5.0, 0.0), Vec3::X)
+            .expect("a valid socket");
+    calm.add_joint(socket).expect("a valid joint");
+    for _ in 0..60 {
+        calm.step(1.0 / 60.0).expect("a valid time step");
+    }
+    calm
 }
 
 /// The rod's rest shape set moving (fixed rates: reading them from the
@@ -525,7 +562,7 @@ fn still(world: &mut World, joint: JointHandle) -> Result<(), vertebra_world::Er
 fn continues_bit_for_bit(world: &mut World, snapshot: &Snapshot) {
     let mut copies: Vec<World> = Vec::new();
     for k in 0..4 {
-        let mut copy = World::new(SolverConfig::default()).expect("a valid config");
+        let mut copy = World::new(*world.config()).expect("a valid config");
         let taken = if k == 0 {
             snapshot.clone()
         } else {
@@ -596,7 +633,7 @@ pub fn snapshot(data: &[u8]) {
         }
         sealed(header, &postcard::to_allocvec(&state).expect("encodes"))
     };
-    let fresh = World::new(SolverConfig::default()).expect("a valid config");
+    let fresh = World::new(*world.config()).expect("a valid config");
     for mut target in [world, fresh] {
         let before = target.snapshot();
         match target.restore(&crafted) {
@@ -615,5 +652,39 @@ pub fn snapshot(data: &[u8]) {
                 assert_eq!(target.repaired_bodies(), 0, "the NaN guard fired");
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+
+    /// The corpus's sleep seeds build worlds with islands asleep and awake
+    /// (the target's changes then break a real sleep state).
+    #[test]
+    fn the_sleep_seeds_reach_a_sleep_state() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus/snapshot");
+        let mut seeds = 0;
+        let mut some_awake = false;
+        for entry in std::fs::read_dir(dir).expect("the corpus") {
+            let path = entry.expect("an entry").path();
+            if !path.to_string_lossy().contains("seed-sleep") {
+                continue;
+            }
+            let data = std::fs::read(&path).expect("a seed");
+            let world = build(&mut Input::new(&data));
+            let (islands, asleep) = world.island_count();
+            assert!(
+                asleep >= 2,
+                "{}: {asleep} of {islands} islands asleep",
+                path.display()
+            );
+            some_awake |= asleep < islands;
+            seeds += 1;
+        }
+        assert!(seeds >= 8, "{seeds} sleep seeds");
+        assert!(some_awake, "no sleep seed keeps an island awake");
     }
 }
