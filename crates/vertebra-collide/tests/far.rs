@@ -36,9 +36,7 @@ fn pile(offset: f32) -> Settled {
     .unwrap();
     let mut collisions = Collisions::new();
     let at = Vec3::new(offset, 0.0, offset);
-    let ground = world
-        .add_body(BodyDesc::fixed().with_position(at))
-        .unwrap();
+    let ground = world.add_body(BodyDesc::fixed().with_position(at)).unwrap();
     collisions
         .add(Collider::new(ground, ColliderShape::Plane(Vec3::Y)))
         .unwrap();
@@ -85,7 +83,10 @@ fn pile(offset: f32) -> Settled {
 fn a_pile_settles_sleeps_and_holds_its_joints_out_to_ten_kilometres() {
     let origin = pile(0.0);
     eprintln!("origin: {origin:?}");
-    assert_eq!(origin.asleep, origin.bodies, "the pile sleeps at the origin");
+    assert_eq!(
+        origin.asleep, origin.bodies,
+        "the pile sleeps at the origin"
+    );
     for offset in [1.0e3, 1.0e4] {
         let far = pile(offset);
         eprintln!("{offset} m: {far:?}");

@@ -104,7 +104,9 @@ impl fmt::Display for Error {
                 f,
                 "the body is still used by a joint; remove the joint first"
             ),
-            Error::NoDynamicBody => write!(f, "a joint, rod or contact needs at least one dynamic body"),
+            Error::NoDynamicBody => {
+                write!(f, "a joint, rod or contact needs at least one dynamic body")
+            }
             Error::NotDynamic(what) => write!(
                 f,
                 "{what} needs a dynamic body (static and kinematic bodies have infinite mass)"

@@ -329,8 +329,13 @@ fn a_reversed_contact_pushes_as_the_original_and_its_bodies_alone_exchanged_do_n
         body_b: c.body_a,
         ..c
     });
-    eprintln!("lowest corner: {original:+.5} m, reversed {reversed:+.5} m, exchanged {exchanged:+.5} m");
+    eprintln!(
+        "lowest corner: {original:+.5} m, reversed {reversed:+.5} m, exchanged {exchanged:+.5} m"
+    );
     assert!(original.abs() < 2e-3 && reversed.abs() < 2e-3);
     assert!((reversed - original).abs() < 1e-4);
-    assert!(exchanged < -1.0, "the exchanged contacts sank it {exchanged} m");
+    assert!(
+        exchanged < -1.0,
+        "the exchanged contacts sank it {exchanged} m"
+    );
 }
