@@ -535,7 +535,11 @@ typedef struct VtCollider {
   uint32_t filter;
 } VtCollider;
 
-// A contact between two bodies for the next step.
+// A contact between two bodies for the next step. The normal's sign is
+// the contact's meaning: it points out of `body_a` into `body_b`. Some
+// engines give theirs the other way: exchanging the bodies means flipping
+// the normal too, or the contact pushes the bodies into each other (the
+// world cannot tell: it does not know the bodies' shapes).
 typedef struct VtContact {
   // The first body.
   struct VtBody body_a;
@@ -543,7 +547,8 @@ typedef struct VtContact {
   struct VtBody body_b;
   // The contact point, midway between the surfaces (m, world).
   struct VtVec3 point;
-  // The normal from a to b (unit, world).
+  // The normal out of `body_a` into `body_b`: the direction the contact
+  // pushes `body_b` (unit, world).
   struct VtVec3 normal;
   // Penetration depth along the normal (m); negative for a gap.
   float depth;

@@ -342,7 +342,7 @@ fn contact_restitution_beyond_zero_to_one_is_refused_in_words() {
         let e = world.set_contacts(&[bouncy]).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "contact restitution (0 to 1) is out of range"
+            "contact 0: contact restitution (0 to 1) is out of range"
         );
     }
 }
@@ -354,7 +354,10 @@ fn contact_depths_beyond_the_coordinate_range_are_refused() {
     for depth in [1e30, -1e30, MAX_COORDINATE * 1.01] {
         assert_eq!(
             world.set_contacts(&[contact(a, b, depth)]),
-            Err(Error::OutOfRange("contact depth (at most 1e6 m)"))
+            Err(Error::Contact {
+                index: 0,
+                reason: Box::new(Error::OutOfRange("contact depth (at most 1e6 m)"))
+            })
         );
     }
     // The deepest accepted overlap pushes the bodies apart by at most it.

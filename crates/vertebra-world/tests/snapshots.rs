@@ -124,7 +124,10 @@ fn another_worlds_handles_are_refused() {
     };
     assert_eq!(
         ours.set_contacts(&[contact]),
-        Err(Error::ForeignHandle("body"))
+        Err(Error::Contact {
+            index: 0,
+            reason: Box::new(Error::ForeignHandle("body"))
+        })
     );
     assert_eq!(ours.snapshot(), before, "nothing changed");
     theirs.step(DT).unwrap();
