@@ -1,12 +1,14 @@
 //! Precision far from the origin with collision detection: where a pile
 //! of ragdolls on the ground still settles, sleeps and holds its joints
-//! as it does at the origin (docs/robustness.md, "The real range").
+//! as it does at the origin (docs/robustness.md, "Where it ends for
+//! collisions").
 //!
 //! Detection works on the bodies' `f32` world poses and gives `f32` world
 //! contact points (the world's [`vertebra_world::Contact`]), so each
 //! contact's depth and lever arm are resolved to the coordinate's last
-//! digit there: 0.06 mm at 1 km, 7.8 mm at 100 km, 6.25 cm at 1,000 km. Motion and joints themselves are as
-//! precise anywhere inside `MAX_COORDINATE` (crates/vertebra-world/tests/far.rs).
+//! digit there: 0.06 mm at 1 km, 7.8 mm at 100 km, 6.25 cm at 1,000 km.
+//! Motion and joints themselves are as precise anywhere inside
+//! `MAX_COORDINATE` (crates/vertebra-world/tests/far.rs).
 
 use glam::{Quat, Vec3};
 use vertebra_collide::{Collider, ColliderShape, Collisions};
@@ -20,6 +22,7 @@ const DT: f32 = 1.0 / 60.0;
 struct Settled {
     /// Bodies asleep at the end, of all the ragdolls' bodies.
     asleep: usize,
+    /// The ragdolls' bodies.
     bodies: usize,
     /// The summed linear joint error (cm), averaged over the last second.
     eps_lin_cm: f32,
@@ -75,7 +78,7 @@ fn pile(offset: f32) -> Settled {
 }
 
 /// The precise range for collisions ends between 10 and 100 km
-/// (docs/robustness.md, "The real range"): out to 10 km the pile sleeps and
+/// (docs/robustness.md, "Where it ends for collisions"): out to 10 km the pile sleeps and
 /// its joints hold as at the origin (0.38 cm at the origin, 0.25 at 1 km,
 /// 0.42 at 10 km); at 100 km, where an `f32` resolves 7.8 mm, the contacts'
 /// rounding keeps every body awake.
