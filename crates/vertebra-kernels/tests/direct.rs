@@ -19,7 +19,7 @@ use vertebra_kernels::direct::ldl::{self, MAX, PACKED, at};
 use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows, SwingRows};
 use vertebra_kernels::direct::{
     JointLane, NONE, NodeKind, PositionPass, StartPass, SubstepScale, Topology, TopologyError,
-    TreeBlock,
+    TreeBlock, split,
 };
 use vertebra_kernels::limited::LimitLane;
 use vertebra_kernels::parts::limit::Softness;
@@ -983,7 +983,7 @@ impl Scene {
         };
         let node = self.topology.nodes.iter().position(|n| n.kind == body);
         let x = block.scratch[node.expect("every body is a node")]
-            .rhs
+            .x
             .map(|v| v[0]);
         (GVec3::new(x[0], x[1], x[2]), GVec3::new(x[3], x[4], x[5]))
     }
@@ -1299,11 +1299,16 @@ const KINDS: [JointRows; 6] = [
 /// Static bodies at the end of the rows, shared by every lane.
 const STATICS: usize = 2;
 
-/// A random tree shape of 1 to 7 bodies: each body after the first (in a
-/// random order) joined to one before it, either way round, by a random
-/// kind; sometimes one joint to a static body; the joints shuffled.
+/// A random tree shape of 1 to 7 bodies ([`random_shape_of`]).
 fn random_shape(r: &mut StdRng) -> (usize, Shape) {
-    let n = r.random_range(1..=7);
+    random_shape_of(r, 1..=7)
+}
+
+/// A random tree shape of `bodies` bodies: each body after the first (in
+/// a random order) joined to one before it, either way round, by a random
+/// kind; sometimes one joint to a static body; the joints shuffled.
+fn random_shape_of(r: &mut StdRng, bodies: core::ops::RangeInclusive<usize>) -> (usize, Shape) {
+    let n = r.random_range(bodies);
     let mut order: Vec<u32> = (0..n as u32).collect();
     shuffle(r, &mut order);
     let kind = |r: &mut StdRng| KINDS[r.random_range(0..KINDS.len())];
@@ -1350,7 +1355,11 @@ fn random_lane(
     lane: usize,
     first_row: usize,
     adversarial: bool,
-) {
+) -> LaneData {
+    let mut data = LaneData {
+        bodies: Vec::new(),
+        joints: Vec::new(),
+    };
     let chance = |r: &mut StdRng, p: f64| adversarial && r.random_bool(p);
     let together = chance(r, 0.2);
     // The offset from the start pose (m, rad): none, small or large.
@@ -1385,6 +1394,7 @@ fn random_lane(
             BodyRows::velocity_row(vec(r, 1.0), vec(r, 1.0)),
         ];
         node.set(lane, row as u32, true, body.mass, body.inertia);
+        data.bodies.push((row as u32, body.mass, body.inertia));
         poses.push((x, q));
     }
     let statics = raw.len() - STATICS;
@@ -1411,9 +1421,7 @@ fn random_lane(
         } else {
             StartLane::new(xa, qa, anchor_a, xb, qb, anchor_b)
         };
-        node.set(
-            lane,
-            &JointLane {
+        let joint = JointLane {
                 body_a: row_a as u32,
                 body_b: row_b as u32,
                 anchor_a,
@@ -1437,12 +1445,21 @@ fn random_lane(
                     let compliance = log_uniform(r, -6.0, -1.0);
                     common::limit_softness(r, compliance)
                 },
-            },
-        );
+            };
+        node.set(lane, &joint);
         node.bodies.set_start(lane, &start);
         block.soft |= node.is_soft(lane);
+        data.joints.push((joint, start));
     }
     block.padding &= !(1 << lane);
+    data
+}
+
+/// What [`random_lane`] wrote into a lane: each body's row, mass and
+/// inertia, and each joint's lane and start of step.
+struct LaneData {
+    bodies: Vec<(u32, f32, Mat3)>,
+    joints: Vec<(JointLane, StartLane)>,
 }
 
 /// An elliptical cone's semi-axis (swing sines): any, none (1), or
@@ -1536,7 +1553,7 @@ fn run_trees(backend: Backend, raw: &RawRows, trees: &[Trees]) -> Vec<f32> {
                     NodeKind::Body { .. } => 6,
                     NodeKind::Joint { rows, .. } => rows.count(),
                 };
-                out.extend(scratch.rhs[..size].iter().map(|v| v[lane]));
+                out.extend(scratch.x[..size].iter().map(|v| v[lane]));
             }
             for joint in &block.joints {
                 let limits = joint.limit_lambda.iter().chain(&joint.limit_start);
@@ -1560,6 +1577,141 @@ fn adversarial_trees_agree_on_every_backend_and_stay_finite() {
 #[test]
 fn blocks_of_one_to_eight_trees_agree_on_every_backend() {
     common::padded_blocks_agree(400..410, tree_scene, clear_lane, run_trees);
+}
+
+// ---------------------------------------------------------------------------
+// Trees cut into pieces (`split`): the whole trees' bits.
+// ---------------------------------------------------------------------------
+
+/// `count` trees of one random shape of 3 to 10 bodies, random (or
+/// adversarial) in every lane, laid out whole (one block) and cut at the
+/// joints whose subtrees hold at most a random `most` nodes (the pieces
+/// pooled by shape across the trees, `split::lay_out`).
+struct Cut {
+    raw: RawRows,
+    whole: Trees,
+    topologies: Vec<Topology>,
+    blocks: Vec<TreeBlock>,
+    placed: Vec<Vec<split::Placed>>,
+}
+
+fn cut_scene(seed: u64, adversarial: bool) -> Cut {
+    let mut r = StdRng::seed_from_u64(seed);
+    let (n, shape) = random_shape_of(&mut r, 3..=10);
+    let topology = Topology::new(n, &shape).expect("a tree");
+    let count = r.random_range(1..=BLOCK_LANES);
+    let mut raw = vec![BodyRows::null_raw(); 1 + n * BLOCK_LANES + STATICS];
+    for row in &mut raw[1 + n * BLOCK_LANES..] {
+        row[0] = BodyRows::pose_row(GVec3::ZERO, 0.0, unit_quat(&mut r));
+    }
+    let mut block = TreeBlock::padding(0, &topology);
+    let lanes: Vec<LaneData> = (0..count)
+        .map(|lane| {
+            let first = 1 + lane * n;
+            random_lane(&mut r, &mut raw, &mut block, &shape, lane, first, adversarial)
+        })
+        .collect();
+    let sizes = topology.subtree_sizes();
+    let most = sizes[r.random_range(0..sizes.len() - 1)];
+    let cuts = topology.cuts(most);
+    let trees: Vec<(&Topology, Vec<u32>)> = (0..count).map(|_| (&topology, cuts.clone())).collect();
+    let mut topologies: Vec<Topology> = Vec::new();
+    let (mut blocks, placed) = split::lay_out(&trees, &mut |piece: &Topology| {
+        let known = topologies.iter().position(|t| t == piece);
+        known.unwrap_or_else(|| {
+            topologies.push(piece.clone());
+            topologies.len() - 1
+        }) as u32
+    });
+    for (data, pieces) in lanes.iter().zip(&placed) {
+        for p in pieces {
+            let b = &mut blocks[p.block];
+            b.padding &= !(1 << p.lane);
+            for (k, &i) in p.piece.bodies.iter().enumerate() {
+                let (row, mass, inertia) = data.bodies[i as usize];
+                b.bodies[k].set(p.lane, row, true, mass, inertia);
+            }
+            for (k, &j) in p.piece.joints.iter().enumerate() {
+                let (joint, start) = data.joints[j as usize];
+                b.joints[k].set(p.lane, &joint);
+                b.joints[k].bodies.set_start(p.lane, &start);
+                b.soft |= b.joints[k].is_soft(p.lane);
+            }
+        }
+    }
+    Cut {
+        raw,
+        whole: Trees { block, topology },
+        topologies,
+        blocks,
+        placed,
+    }
+}
+
+/// A start pass and two passes of the whole trees, or of their pieces
+/// solved together: every row, then every tree's joints' multipliers
+/// (whole-tree joint order) and limit multipliers.
+fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
+    let rows = to_rows(&cut.raw);
+    let (mut blocks, topologies) = if pieces {
+        (cut.blocks.clone(), cut.topologies.clone())
+    } else {
+        (vec![cut.whole.block.clone()], vec![cut.whole.topology.clone()])
+    };
+    start_pass(backend, &rows, &mut blocks, &topologies);
+    for _ in 0..2 {
+        pass(backend, &rows, &mut blocks, &topologies);
+    }
+    let mut out = flatten(&rows);
+    for (tree, placed) in cut.placed.iter().enumerate() {
+        for j in 0..cut.whole.topology.joints as u32 {
+            let (block, lane, topology, index) = if pieces {
+                let p = (placed.iter())
+                    .find(|p| p.piece.joints.contains(&j))
+                    .expect("every joint in a piece");
+                let k = p.piece.joints.iter().position(|&x| x == j).expect("there") as u32;
+                (&blocks[p.block], p.lane, &cut.topologies[blocks[p.block].topology as usize], k)
+            } else {
+                (&blocks[0], tree, &cut.whole.topology, j)
+            };
+            let node = (topology.nodes.iter())
+                .position(|n| matches!(n.kind, NodeKind::Joint { index: i, .. } if i == index))
+                .expect("every joint is a node");
+            let NodeKind::Joint { rows: kind, .. } = topology.nodes[node].kind else {
+                unreachable!()
+            };
+            out.extend(block.scratch[node].x[..kind.count()].iter().map(|v| v[lane]));
+            let limits = &block.joints[index as usize].limit_lambda;
+            out.extend(limits.iter().map(|v| v[lane]));
+        }
+    }
+    out
+}
+
+#[test]
+fn cut_trees_give_the_whole_trees_bits_on_every_backend() {
+    let mut cut_some = 0;
+    for (seeds, adversarial) in [(0..60, false), (500..560, true)] {
+        for seed in seeds {
+            let cut = cut_scene(seed, adversarial);
+            cut_some += usize::from(cut.blocks.iter().any(|b| !b.ports.is_empty()));
+            let whole = run_cut(Backend::Scalar, &cut, false);
+            for backend in Backend::available() {
+                for pieces in [false, true] {
+                    let got = run_cut(backend, &cut, pieces);
+                    let k = (0..whole.len()).find(|&k| !vertebra_math::check::same_bits(whole[k], got[k]));
+                    if let Some(k) = k {
+                        panic!(
+                            "seed {seed}: {backend} (pieces: {pieces}) differs at float {k}: \
+                             {:e} vs whole scalar {:e}",
+                            got[k], whole[k]
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(cut_some > 60, "only {cut_some} of 120 scenes were cut");
 }
 
 // ---------------------------------------------------------------------------

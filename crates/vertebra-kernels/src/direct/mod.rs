@@ -32,6 +32,7 @@
 pub mod ldl;
 pub mod rows;
 mod solve;
+pub mod split;
 
 use bytemuck::{Pod, Zeroable};
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
@@ -79,6 +80,16 @@ pub enum NodeKind {
     },
 }
 
+/// A node's child: another node of its tree, or a port (a subtree laid
+/// out in another block, whose Schur complement the block copies in).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Child {
+    /// Node `index` of the same topology.
+    Node(u32),
+    /// Port `index` of the block ([`TreeBlock::ports`]).
+    Port(u32),
+}
+
 /// A tree's shape: its nodes leaves first, each after its children, the
 /// root last.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -89,6 +100,16 @@ pub struct Topology {
     pub bodies: usize,
     /// How many joints.
     pub joints: usize,
+    /// Every node's children, in the order their complements are taken
+    /// (a body's joints by joint index, ports among them where the
+    /// joints they stand for were; a joint's one body): node `n`'s are
+    /// `children[starts[n]..starts[n + 1]]`.
+    pub children: Vec<Child>,
+    /// Where each node's children start in `children` (one more entry
+    /// than nodes).
+    pub starts: Vec<u32>,
+    /// How many ports.
+    pub ports: usize,
 }
 
 /// Why a set of joints is not a tree.
@@ -188,11 +209,46 @@ impl Topology {
                 parent: if up == NONE { NONE } else { place[up as usize] },
             });
         }
-        Ok(Self {
+        let keys: Vec<u32> = nodes
+            .iter()
+            .map(|node| match node.kind {
+                NodeKind::Joint { index, .. } => index,
+                NodeKind::Body { .. } => 0,
+            })
+            .collect();
+        let children = children_in_order(&nodes, &keys, &[]);
+        Ok(Self::with_children(nodes, bodies, joints.len(), children, 0))
+    }
+
+    /// A topology from its nodes and their children (as
+    /// [`children_in_order`] gives them).
+    pub(crate) fn with_children(
+        nodes: Vec<Node>,
+        bodies: usize,
+        joints: usize,
+        children: Vec<Vec<Child>>,
+        ports: usize,
+    ) -> Self {
+        let mut starts = vec![0u32];
+        let mut flat = Vec::new();
+        for list in children {
+            flat.extend(list);
+            starts.push(flat.len() as u32);
+        }
+        Self {
             nodes,
             bodies,
-            joints: joints.len(),
-        })
+            joints,
+            children: flat,
+            starts,
+            ports,
+        }
+    }
+
+    /// Node `n`'s children, in the order its block takes them.
+    #[inline(always)]
+    pub fn children(&self, n: usize) -> &[Child] {
+        &self.children[self.starts[n] as usize..self.starts[n + 1] as usize]
     }
 
     /// A node's unknowns: 6 for a body, its rows for a joint.
@@ -202,6 +258,34 @@ impl Topology {
             NodeKind::Joint { rows, .. } => rows.count(),
         }
     }
+}
+
+/// Every node's children in the order the solve takes them: a body's
+/// joints by `keys` (each node's joint index in the whole tree; `ports`:
+/// `(body node, joint index, port)`, a port in place of a joint laid out
+/// elsewhere), a joint's one child body. The order is part of the
+/// arithmetic: a tree gives the same bits however it is laid out.
+pub(crate) fn children_in_order(
+    nodes: &[Node],
+    keys: &[u32],
+    ports: &[(u32, u32, u32)],
+) -> Vec<Vec<Child>> {
+    let mut keyed: Vec<Vec<(u32, Child)>> = vec![Vec::new(); nodes.len()];
+    for (n, node) in nodes.iter().enumerate() {
+        if node.parent != NONE {
+            keyed[node.parent as usize].push((keys[n], Child::Node(n as u32)));
+        }
+    }
+    for &(node, joint, index) in ports {
+        keyed[node as usize].push((joint, Child::Port(index)));
+    }
+    for list in keyed.iter_mut() {
+        list.sort_by_key(|&(key, _)| key);
+    }
+    keyed
+        .into_iter()
+        .map(|list| list.into_iter().map(|(_, c)| c).collect())
+        .collect()
 }
 
 /// The node of body `i` (`NONE` for none: static or kinematic).
@@ -439,21 +523,30 @@ pub struct SubstepScale {
 /// Values a node's measured block holds ([`NodeScratch::measured`]).
 pub const MEASURED: usize = 7;
 
-/// A node's working values in each lane, rewritten every iteration.
+/// A node's working values in each lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(32))]
 pub struct NodeScratch {
-    /// The diagonal block (packed lower triangle), then its factors.
-    pub diagonal: [[f32; BLOCK_LANES]; PACKED],
-    /// The right-hand side, then the node's unknowns.
-    pub rhs: [[f32; BLOCK_LANES]; MAX],
-    /// The block as the solve measured it, from which each of its passes
-    /// starts: a body's mass and world inertia (`m, xx, xy, xz, yy, yz,
-    /// zz`), a joint's errors up to its limit rows (theirs are in
-    /// `limits`).
+    /// The block's factors (packed lower triangle: `L` below the
+    /// diagonal, `1 / D` on it), kept while the node is clean.
+    pub factors: [[f32; BLOCK_LANES]; PACKED],
+    /// The right-hand side, its children's taken (kept with the factors).
+    pub b: [[f32; BLOCK_LANES]; MAX],
+    /// The node's unknowns after the substitution: a body's `(dp,
+    /// dtheta)` (m, rad, world), a joint's multipliers.
+    pub x: [[f32; BLOCK_LANES]; MAX],
+    /// Minus the Schur complement the node passes to its parent (packed,
+    /// the parent's size): the parent adds it to its block.
+    pub minus: [[f32; BLOCK_LANES]; PACKED],
+    /// Minus what the node adds to its parent's right-hand side.
+    pub minus_b: [[f32; BLOCK_LANES]; MAX],
+    /// The block as the solve measured it: a body's mass and world
+    /// inertia (`m, xx, xy, xz, yy, yz, zz`), a joint's errors up to its
+    /// limit rows (theirs are in `limits`).
     pub measured: [[f32; BLOCK_LANES]; MEASURED],
-    /// The block coupling it to its parent: the joint's rows (of the
-    /// node or of its parent) against the body's six unknowns, row by row.
+    /// The Jacobian coupling the node to its parent: a joint's rows on
+    /// its parent body (for the root joint, on its static or kinematic
+    /// side), or a body's parent joint's rows on the body, row by row.
     pub coupling: [[f32; BLOCK_LANES]; MAX * 6],
     /// A joint's limit rows as measured (held or not): each row's signed
     /// distance past its limit, its angular Jacobians on a and b and its
@@ -463,16 +556,19 @@ pub struct NodeScratch {
     /// A joint's limit rows held in this solve (1) or not (0): the active
     /// set.
     pub active: [[f32; BLOCK_LANES]; MAX_LIMITS],
-    /// The active set the last settle chose, held in the next pass only
-    /// by a lane where a row crossed, and the next solve's start.
+    /// The active set the last settle chose: a crossing lane's next
+    /// pass, and the next solve's start.
     pub next: [[f32; BLOCK_LANES]; MAX_LIMITS],
 }
 
 impl NodeScratch {
     /// All zero.
     pub const ZERO: Self = Self {
-        diagonal: [[0.0; BLOCK_LANES]; PACKED],
-        rhs: [[0.0; BLOCK_LANES]; MAX],
+        factors: [[0.0; BLOCK_LANES]; PACKED],
+        b: [[0.0; BLOCK_LANES]; MAX],
+        x: [[0.0; BLOCK_LANES]; MAX],
+        minus: [[0.0; BLOCK_LANES]; PACKED],
+        minus_b: [[0.0; BLOCK_LANES]; MAX],
         measured: [[0.0; BLOCK_LANES]; MEASURED],
         coupling: [[0.0; BLOCK_LANES]; MAX * 6],
         limits: [[0.0; BLOCK_LANES]; MAX_LIMITS * LIMIT_RECORD],
@@ -481,7 +577,49 @@ impl NodeScratch {
     };
 }
 
-/// Up to eight trees of one [`Topology`], one per lane.
+/// Where a lane's value comes from in another block of the same pass:
+/// the block's place in the pass's blocks, its lane and its node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Source {
+    /// The block (an index into [`PositionPass::blocks`]).
+    pub block: u32,
+    /// The lane.
+    pub lane: u8,
+    /// The node.
+    pub node: u32,
+}
+
+/// A port: where a body's child subtree, laid out in another block (an
+/// earlier one of the same pass), hands it its Schur complement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Port {
+    /// Each lane's subtree root (a joint node), `None` for a lane
+    /// without one.
+    pub source: [Option<Source>; BLOCK_LANES],
+    /// Its `NodeScratch::minus`, copied in before the block is
+    /// eliminated.
+    pub minus: [[f32; BLOCK_LANES]; PACKED],
+    /// Its `NodeScratch::minus_b`.
+    pub minus_b: [[f32; BLOCK_LANES]; MAX],
+    /// The lanes whose subtree was eliminated again this pass.
+    pub dirty: u8,
+}
+
+impl Port {
+    /// A port with no subtree in any lane.
+    pub fn empty() -> Self {
+        Self {
+            source: [None; BLOCK_LANES],
+            minus: [[0.0; BLOCK_LANES]; PACKED],
+            minus_b: [[0.0; BLOCK_LANES]; MAX],
+            dirty: 0,
+        }
+    }
+}
+
+/// Up to eight trees of one [`Topology`], one per lane; or up to eight
+/// pieces of trees (a subtree and the trunk it hangs from laid out in
+/// blocks of their own, joined by [`Port`]s and [`TreeBlock::parent`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TreeBlock {
     /// Which topology (the world's list).
@@ -501,6 +639,22 @@ pub struct TreeBlock {
     pub joints: Vec<JointNode>,
     /// One per node.
     pub scratch: Vec<NodeScratch>,
+    /// Per node, the lanes whose block must be factored again this pass
+    /// (a limit row taken or let go, in it or below it).
+    pub dirty: Vec<u8>,
+    /// Per joint node, the lanes holding each limit row this pass.
+    pub held: Vec<[u8; MAX_LIMITS]>,
+    /// The lanes whose active set crossed in the last settle.
+    pub crossing: [f32; BLOCK_LANES],
+    /// The topology's ports, each lane's subtree.
+    pub ports: Vec<Port>,
+    /// Where each lane's root joint's parent body is solved, for a piece
+    /// hanging from a trunk laid out in a later block (`None`: a static
+    /// or kinematic body, which does not move).
+    pub parent: [Option<Source>; BLOCK_LANES],
+    /// That parent body's unknowns, copied in before the block's
+    /// substitution (zero for none).
+    pub parent_x: [[f32; BLOCK_LANES]; 6],
 }
 
 impl TreeBlock {
@@ -514,11 +668,24 @@ impl TreeBlock {
             bodies: vec![BodyNode::padding(); shape.bodies],
             joints: vec![JointNode::padding(); shape.joints],
             scratch: vec![NodeScratch::ZERO; shape.nodes.len()],
+            dirty: vec![0; shape.nodes.len()],
+            held: vec![[0; MAX_LIMITS]; shape.nodes.len()],
+            crossing: [0.0; BLOCK_LANES],
+            ports: vec![Port::empty(); shape.ports],
+            parent: [None; BLOCK_LANES],
+            parent_x: [[0.0; BLOCK_LANES]; 6],
         }
+    }
+
+    /// The lanes holding a tree (or a piece of one).
+    pub fn live(&self) -> u8 {
+        !(self.padding as u8)
     }
 }
 
-/// One direct solve of every tree in `blocks`.
+/// One direct solve of every tree in `blocks`, which are solved together:
+/// a block's ports and parent name earlier and later blocks of the same
+/// slice (pieces of trees come before the trunks they hang from).
 pub struct PositionPass<'a> {
     /// The blocks.
     pub blocks: &'a mut [TreeBlock],
@@ -539,16 +706,45 @@ impl LaneKernel for PositionPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.padding;
-            let mut slices = Slices {
-                topology: &self.topologies[block.topology as usize],
-                block,
-                rows: self.rows,
-                scale: self.scale,
-                passes: self.passes,
-            };
-            for_live_slices::<L, _>(padding, &mut slices);
+        let PositionPass {
+            blocks,
+            topologies,
+            rows,
+            scale,
+            passes,
+        } = self;
+        for block in blocks.iter_mut() {
+            run_phase::<L>(block, topologies, rows, scale, Phase::Measure);
+            let live = block.live();
+            block.dirty.fill(live);
+        }
+        for pass in 1..=passes.max(1) {
+            for block in blocks.iter_mut() {
+                solve::hold(block, &topologies[block.topology as usize], pass == 1);
+            }
+            for k in 0..blocks.len() {
+                solve::take_ports(blocks, k);
+                run_phase::<L>(&mut blocks[k], topologies, rows, scale, Phase::Eliminate);
+            }
+            for k in (0..blocks.len()).rev() {
+                solve::take_parent(blocks, k);
+                run_phase::<L>(&mut blocks[k], topologies, rows, scale, Phase::Substitute);
+            }
+            for block in blocks.iter_mut() {
+                block.dirty.fill(0);
+                block.crossing = [0.0; BLOCK_LANES];
+                run_phase::<L>(block, topologies, rows, scale, Phase::Settle);
+            }
+            if !solve::join_crossings(blocks) || pass >= passes {
+                break;
+            }
+            for block in blocks.iter_mut() {
+                solve::take_crossings(block, &topologies[block.topology as usize]);
+            }
+        }
+        for block in blocks.iter_mut() {
+            solve::adopt(block);
+            run_phase::<L>(block, topologies, rows, scale, Phase::Finish);
             block.fresh = false;
         }
     }
@@ -559,33 +755,65 @@ impl LaneKernel for PositionPass<'_> {
 /// up to this many less one.
 pub const MAX_PASSES: usize = 4;
 
-/// One block of a [`PositionPass`].
+/// A step of a [`PositionPass`], run on every live slice of a block.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// Each node's block and rows where the tree stands.
+    Measure,
+    /// Leaves first: each dirty node's block factored and its complement
+    /// passed up.
+    Eliminate,
+    /// Root first: every node's unknowns.
+    Substitute,
+    /// The limits' next active set and the lanes where it crossed.
+    Settle,
+    /// The held limits' multipliers kept, the bodies moved.
+    Finish,
+}
+
+/// Runs `phase` on every live slice of `block`.
+#[inline(always)]
+fn run_phase<L: Lane>(
+    block: &mut TreeBlock,
+    topologies: &[Topology],
+    rows: &BodyRows,
+    scale: SubstepScale,
+    phase: Phase,
+) {
+    let padding = block.padding;
+    let mut slices = Slices {
+        topology: &topologies[block.topology as usize],
+        block,
+        rows,
+        scale,
+        phase,
+    };
+    for_live_slices::<L, _>(padding, &mut slices);
+}
+
+/// One block of a [`PositionPass`] phase.
 struct Slices<'a> {
     topology: &'a Topology,
     block: &'a mut TreeBlock,
     rows: &'a BodyRows,
     scale: SubstepScale,
-    passes: usize,
+    phase: Phase,
 }
 
 impl LaneSlices for Slices<'_> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
         let (topology, rows, scale) = (self.topology, self.rows, self.scale);
-        let mut first = self.block.fresh;
-        solve::measure::<L>(self.block, topology, rows, start, scale);
-        for pass in 1..=self.passes.max(1) {
-            solve::hold::<L>(self.block, topology, start, scale, first);
-            solve::eliminate::<L>(self.block, topology, start);
-            solve::substitute::<L>(self.block, topology, start);
-            first = false;
-            if !solve::settle::<L>(self.block, topology, start) || pass >= self.passes {
-                break;
+        match self.phase {
+            Phase::Measure => solve::measure::<L>(self.block, topology, rows, start, scale),
+            Phase::Eliminate => solve::eliminate::<L>(self.block, topology, start, scale),
+            Phase::Substitute => solve::substitute::<L>(self.block, topology, start),
+            Phase::Settle => solve::settle::<L>(self.block, topology, start),
+            Phase::Finish => {
+                solve::accumulate::<L>(self.block, topology, start);
+                solve::apply::<L>(self.block, topology, rows, start);
             }
         }
-        solve::adopt::<L>(self.block, start);
-        solve::accumulate::<L>(self.block, topology, start);
-        solve::apply::<L>(self.block, topology, rows, start);
     }
 }
 

@@ -1,20 +1,53 @@
-//! One direct solve of one slice of a [`TreeBlock`]: assemble every
-//! node's block, eliminate leaves first, substitute root first, move the
-//! bodies (the steps of `super`'s documentation).
+//! One direct solve's phases on one slice of a [`TreeBlock`]: measure
+//! every node, eliminate leaves first, substitute root first, settle the
+//! limits' active set, move the bodies (the steps of `super`'s
+//! documentation); and the bookkeeping between the phases, in plain code
+//! over the lanes: the active set held, ports and parents copied between
+//! the blocks of one pass, crossings joined per tree.
 //!
-//! Every block size is a constant of its function (a body's 6, a joint's
-//! 5 or 6 rows: [`JointRows::count`]), chosen per node by a `match` on the
-//! topology (the same in every lane), so that the dense loops unroll and
-//! stay in registers.
+//! **Pulled complements.** Each node leaves minus its Schur complement
+//! and right-hand side in its own scratch (`minus`, `minus_b`), and a
+//! parent takes its children's in a fixed order (`Topology::children`)
+//! when it is eliminated. So a node whose inputs did not change keeps its
+//! factors and its complement from the pass before: a re-pass (a limit
+//! row taken or let go) factors only the nodes on the paths from the
+//! changed joints to the root (`TreeBlock::dirty`), and a subtree laid
+//! out in another block hands its complement over by a copy (a
+//! [`super::Port`]) with the same bits.
+//!
+//! **Limit rows.** A joint's equality rows are always solved; its limit
+//! rows only where held ([`ldl::Held`]): a row no lane of the slice holds
+//! costs nothing, and in a lane that does not hold it the row leaves
+//! `+0` everywhere (`ldl`'s documentation), so a lane's bits never depend
+//! on its neighbours.
+//!
+//! Every block size is a constant of its function (a body's 6; a joint's
+//! equality and limit rows, [`JointRows::first_limit`] and
+//! [`JointRows::count`]), chosen per node by a `match` on the topology
+//! (the same in every lane), so that the dense loops unroll and stay in
+//! registers.
 
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Lane, Mask, Sym3, Vec3};
 
-use super::ldl::{self, MAX, PACKED, at};
-use super::rows::{FREE, JointRows, LIMIT_RECORD as RECORD, MAX_LIMITS, Rows};
-use super::{JointNode, MEASURED, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
+use super::ldl::{self, Held, MAX, PACKED, at};
+use super::rows::{FREE, JointRows, LIMIT_RECORD as RECORD, MAX_LIMITS, Rows, SwingRows};
+use super::{Child, JointNode, MEASURED, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
 use crate::body::{BodyLanes, BodyRows};
 use crate::parts::limit::Softness;
+
+/// Calls `$f::<$L, E, K>($args)` with a joint kind's `E` equality rows and
+/// `K` limit rows as constants.
+macro_rules! by_rows {
+    ($kind:expr, $f:ident::<$L:ty>($($arg:expr),* $(,)?)) => {
+        match $kind {
+            JointRows::Socket(SwingRows::Pyramid) => $f::<$L, 3, 3>($($arg),*),
+            JointRows::Socket(_) | JointRows::Rod => $f::<$L, 3, 2>($($arg),*),
+            JointRows::Hinge => $f::<$L, 5, 1>($($arg),*),
+            JointRows::Fixed => $f::<$L, 6, 0>($($arg),*),
+        }
+    };
+}
 
 /// Loads lane values from scratch arrays.
 #[inline(always)]
@@ -34,11 +67,43 @@ fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
     }
 }
 
-/// Measures every node's block where the tree stands (bodies do not move
-/// between a solve's passes, so only its first measures): a body's mass
-/// matrix (world) and a joint's errors into `measured`, each joint's
-/// Jacobians where the tree couples it to each body (its limit rows' are
-/// [`hold`]'s), and each limit row's record.
+/// The bits of the lanes of the slice from `start`.
+#[inline(always)]
+fn slice_bits<L: Lane>(start: usize) -> u8 {
+    (((1u32 << L::WIDTH) - 1) << start) as u8
+}
+
+/// Joint node `n`'s limit rows: which lanes hold each (its active set),
+/// and whether any lane of the slice does.
+#[inline(always)]
+fn held<L: Lane, const E: usize, const K: usize>(
+    block: &TreeBlock,
+    n: usize,
+    start: usize,
+) -> Held<L, K> {
+    let zero = L::splat(0.0);
+    let bits = slice_bits::<L>(start);
+    let mut held = Held {
+        lanes: [zero.gt(zero); K],
+        any: [false; K],
+    };
+    for o in 0..K {
+        held.lanes[o] = L::load(&block.scratch[n].active[o][start..]).gt(zero);
+        held.any[o] = block.held[n][o] & bits != 0;
+    }
+    held
+}
+
+// ---------------------------------------------------------------------------
+// Measure.
+// ---------------------------------------------------------------------------
+
+/// Measures every node where the tree stands (bodies do not move between
+/// a solve's passes, so only its first measures): a body's mass matrix
+/// (world) and a joint's errors into `measured`, each joint's Jacobians
+/// where the tree couples it to each body (its parent side at the joint,
+/// its child side at the child body; the root joint's parent side is its
+/// static, kinematic or other block's body), and each limit row's record.
 #[inline(always)]
 pub(super) fn measure<L: Lane>(
     block: &mut TreeBlock,
@@ -78,28 +143,34 @@ pub(super) fn measure<L: Lane>(
                 let joint = &block.joints[index as usize];
                 let (body_a, body_b) = joint.bodies.gather::<L>(rows, start);
                 let geometry = joint.geometry(start, scale);
-                let rows = Rows::measure(kind, &body_a, &body_b, &geometry);
+                let measured_rows = Rows::measure(kind, &body_a, &body_b, &geometry);
                 let first = kind.first_limit();
-                measured[..first].copy_from_slice(&rows.c[..first]);
+                measured[..first].copy_from_slice(&measured_rows.c[..first]);
                 record_limits(
                     &mut block.scratch[n],
                     kind,
-                    &rows,
+                    &measured_rows,
                     (&body_a, &body_b),
                     start,
                 );
-                for (side, jacobian) in [(a, &rows.ja), (b, &rows.jb)] {
-                    if side == NONE {
-                        continue;
-                    }
-                    let mut flat = [zero; MAX * 6];
-                    for (r, row) in jacobian.iter().take(first).enumerate() {
-                        flat[r * 6..r * 6 + 6].copy_from_slice(row);
-                    }
-                    let holder = holder(n, node.parent, side);
+                // The parent side: the parent body, or the root joint's
+                // side with no node.
+                let b_is_parent = b == node.parent || (node.parent == NONE && b == NONE);
+                let (parent, child, child_node) = if b_is_parent {
+                    (&measured_rows.jb, &measured_rows.ja, a)
+                } else {
+                    (&measured_rows.ja, &measured_rows.jb, b)
+                };
+                let count = kind.count();
+                store(
+                    parent[..count].as_flattened(),
+                    &mut block.scratch[n].coupling,
+                    start,
+                );
+                if child_node != NONE {
                     store(
-                        &flat[..first * 6],
-                        &mut block.scratch[holder].coupling,
+                        child[..count].as_flattened(),
+                        &mut block.scratch[child_node as usize].coupling,
                         start,
                     );
                 }
@@ -109,16 +180,9 @@ pub(super) fn measure<L: Lane>(
     }
 }
 
-/// Which node holds the coupling of joint node `n` (parent `parent`) to
-/// its body node `side`: whichever of the two is the other's child.
-#[inline(always)]
-fn holder(n: usize, parent: u32, side: u32) -> usize {
-    if parent == side { n } else { side as usize }
-}
-
-/// Records a joint's limit rows as measured (for [`hold`] and [`settle`]:
-/// each row's signed distance, its angular Jacobians and its generalised
-/// inverse mass `w = j_a^T I_a^-1 j_a + j_b^T I_b^-1 j_b`).
+/// Records a joint's limit rows as measured (for the active set and
+/// [`settle`]: each row's signed distance, its angular Jacobians and its
+/// generalised inverse mass `w = j_a^T I_a^-1 j_a + j_b^T I_b^-1 j_b`).
 #[inline(always)]
 fn record_limits<L: Lane>(
     scratch: &mut super::NodeScratch,
@@ -144,128 +208,396 @@ fn record_limits<L: Lane>(
     }
 }
 
-/// Every node's starting block from what [`measure`] left: a body's mass
-/// matrix, a joint's zero (hard rows; a soft limit's compliance) with its
-/// errors on the right. A limit row is held where the active set says
-/// (`first`: the limits violated now), its Jacobians written where the
-/// tree couples it; else it is zeroed (dropped by the factorisation).
+/// `j^T I^-1 j` for a world axis `j` (the body's inverse inertia is in its
+/// own frame).
 #[inline(always)]
-pub(super) fn hold<L: Lane>(
+fn inverse_mass<L: Lane>(body: &BodyLanes<L>, j: Vec3<L>) -> L {
+    let local = body.q.inverse_rotate(j);
+    local.dot(body.inv_inertia.mul_vec(local))
+}
+
+// ---------------------------------------------------------------------------
+// The active set between the phases (plain code over the lanes).
+// ---------------------------------------------------------------------------
+
+/// Chooses which limit rows each lane holds in this pass: in a fresh
+/// solve's first pass those violated now (`c > 0`), else the set the last
+/// settle left; and records, per joint node, the lanes holding each row.
+pub(super) fn hold(block: &mut TreeBlock, topology: &Topology, first_pass: bool) {
+    let fresh = block.fresh && first_pass;
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let NodeKind::Joint { rows: kind, .. } = node.kind else {
+            continue;
+        };
+        let scratch = &mut block.scratch[n];
+        let mut bits = [0u8; MAX_LIMITS];
+        for (o, lane_bits) in bits
+            .iter_mut()
+            .enumerate()
+            .take(kind.count() - kind.first_limit())
+        {
+            for lane in 0..BLOCK_LANES {
+                if fresh {
+                    let c = scratch.limits[o * RECORD][lane];
+                    scratch.active[o][lane] = if c > 0.0 { 1.0 } else { 0.0 };
+                }
+                *lane_bits |= u8::from(scratch.active[o][lane] > 0.0) << lane;
+            }
+        }
+        block.held[n] = bits;
+    }
+}
+
+/// After a settle in which some tree crossed: every lane of such a tree
+/// takes the set the settle chose, and marks for factoring again each
+/// joint whose set changed and the body below it (their ancestors follow
+/// in the elimination).
+pub(super) fn take_crossings(block: &mut TreeBlock, topology: &Topology) {
+    let crossing = block.crossing;
+    for (n, node) in topology.nodes.iter().enumerate() {
+        let NodeKind::Joint { rows: kind, a, b, .. } = node.kind else {
+            continue;
+        };
+        let limits = kind.count() - kind.first_limit();
+        let scratch = &mut block.scratch[n];
+        let mut changed = 0u8;
+        for lane in (0..BLOCK_LANES).filter(|&l| crossing[l] != 0.0) {
+            for o in 0..limits {
+                if scratch.next[o][lane] != scratch.active[o][lane] {
+                    changed |= 1 << lane;
+                    scratch.active[o][lane] = scratch.next[o][lane];
+                }
+            }
+        }
+        block.dirty[n] |= changed;
+        for side in [a, b] {
+            if side != NONE && side != node.parent {
+                block.dirty[side as usize] |= changed;
+            }
+        }
+    }
+}
+
+/// The set the last settle chose, releases included, as the next
+/// solve's start.
+pub(super) fn adopt(block: &mut TreeBlock) {
+    for scratch in block.scratch.iter_mut() {
+        scratch.active = scratch.next;
+    }
+}
+
+/// Joins each tree's crossings across the blocks its pieces take: a trunk
+/// crosses where a piece hanging from it does, and every piece where its
+/// trunk does. Returns whether any tree crossed.
+pub(super) fn join_crossings(blocks: &mut [TreeBlock]) -> bool {
+    for k in 0..blocks.len() {
+        let (before, rest) = blocks.split_at_mut(k);
+        let block = &mut rest[0];
+        for port in &block.ports {
+            for (lane, source) in port.source.iter().enumerate() {
+                if let Some(s) = source
+                    && before[s.block as usize].crossing[s.lane as usize] != 0.0
+                {
+                    block.crossing[lane] = 1.0;
+                }
+            }
+        }
+    }
+    for k in (0..blocks.len()).rev() {
+        let (head, after) = blocks.split_at_mut(k + 1);
+        let block = &mut head[k];
+        for (lane, source) in block.parent.iter().enumerate() {
+            if let Some(s) = source {
+                let parent = &after[s.block as usize - k - 1];
+                if parent.crossing[s.lane as usize] != 0.0 {
+                    block.crossing[lane] = 1.0;
+                }
+            }
+        }
+    }
+    blocks
+        .iter()
+        .any(|b| b.crossing.iter().any(|&c| c != 0.0))
+}
+
+/// Copies into block `k`'s ports their subtrees' complements (and which
+/// lanes were eliminated again), from the earlier blocks they lie in.
+pub(super) fn take_ports(blocks: &mut [TreeBlock], k: usize) {
+    let (before, rest) = blocks.split_at_mut(k);
+    let block = &mut rest[0];
+    for port in block.ports.iter_mut() {
+        port.dirty = 0;
+        for (lane, source) in port.source.iter().enumerate() {
+            let Some(s) = source else {
+                continue;
+            };
+            let from = &before[s.block as usize];
+            let scratch = &from.scratch[s.node as usize];
+            let at = s.lane as usize;
+            for (to, from) in port.minus.iter_mut().zip(&scratch.minus) {
+                to[lane] = from[at];
+            }
+            for (to, from) in port.minus_b.iter_mut().zip(&scratch.minus_b) {
+                to[lane] = from[at];
+            }
+            port.dirty |= ((from.dirty[s.node as usize] >> at) & 1) << lane;
+        }
+    }
+}
+
+/// Copies into block `k` each lane's parent body's unknowns, from the
+/// later block its trunk lies in.
+pub(super) fn take_parent(blocks: &mut [TreeBlock], k: usize) {
+    let (head, after) = blocks.split_at_mut(k + 1);
+    let block = &mut head[k];
+    for (lane, source) in block.parent.iter().enumerate() {
+        let Some(s) = source else {
+            continue;
+        };
+        let from = &after[s.block as usize - k - 1].scratch[s.node as usize];
+        for (to, x) in block.parent_x.iter_mut().zip(&from.x) {
+            to[lane] = x[s.lane as usize];
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Eliminate.
+// ---------------------------------------------------------------------------
+
+/// Leaves first: every node with a lane of the slice to factor again (its
+/// own set changed, or a child's block) takes its children's complements,
+/// is factored, and leaves its own for its parent.
+#[inline(always)]
+pub(super) fn eliminate<L: Lane>(
     block: &mut TreeBlock,
     topology: &Topology,
     start: usize,
     scale: SubstepScale,
-    first: bool,
 ) {
-    let zero = L::splat(0.0);
+    let bits = slice_bits::<L>(start);
     for (n, node) in topology.nodes.iter().enumerate() {
-        let measured = load::<L, MEASURED>(&block.scratch[n].measured, start);
-        let mut diagonal = [zero; PACKED];
-        let mut rhs = [zero; MAX];
+        let mut dirty = block.dirty[n];
+        for &child in topology.children(n) {
+            dirty |= match child {
+                Child::Node(c) => block.dirty[c as usize],
+                Child::Port(p) => block.ports[p as usize].dirty,
+            };
+        }
+        block.dirty[n] = dirty;
+        if dirty & bits == 0 {
+            continue;
+        }
         match node.kind {
             NodeKind::Body { .. } => {
-                let [mass, xx, xy, xz, yy, yz, zz] = measured;
-                for k in 0..3 {
-                    diagonal[at(k, k)] = mass;
+                let factors = body_block::<L>(block, topology, n, start);
+                if node.parent != NONE {
+                    let p = node.parent as usize;
+                    let NodeKind::Joint { rows, .. } = topology.nodes[p].kind else {
+                        unreachable!("a body's parent is a joint");
+                    };
+                    by_rows!(rows, body_out::<L>(block, n, p, &factors, start));
                 }
-                diagonal[at(3, 3)] = xx;
-                diagonal[at(4, 3)] = xy;
-                diagonal[at(5, 3)] = xz;
-                diagonal[at(4, 4)] = yy;
-                diagonal[at(5, 4)] = yz;
-                diagonal[at(5, 5)] = zz;
             }
-            NodeKind::Joint {
-                index,
-                rows: kind,
-                a,
-                b,
-            } => {
-                let limits = kind.first_limit();
-                rhs[..limits].copy_from_slice(&measured[..limits]);
-                let held = hold_limits::<L>(block, n, (kind, node.parent), (a, b), start, first);
-                for (l, k) in (limits..kind.count()).enumerate() {
-                    rhs[k] = L::select(held.active[l], held.c[l], zero);
-                }
-                if block.soft {
-                    let joint = &block.joints[index as usize];
-                    let softness =
-                        joint
-                            .softness
-                            .lanes(start, L::splat(scale.inv_h), L::splat(scale.inv_h2));
-                    soften(
-                        joint,
-                        kind,
-                        &softness,
-                        &held,
-                        start,
-                        (&mut diagonal, &mut rhs),
-                    );
-                }
+            NodeKind::Joint { rows, .. } => {
+                by_rows!(rows, joint_node::<L>(block, topology, n, start, scale));
             }
         }
-        let scratch = &mut block.scratch[n];
-        store(&diagonal, &mut scratch.diagonal, start);
-        store(&rhs, &mut scratch.rhs, start);
     }
 }
 
-/// A joint's limit rows in one solve's pass: which are held, and each
-/// row's measured distance and `w`.
-struct Held<L: Lane> {
-    active: [L::Mask; MAX_LIMITS],
-    c: [L; MAX_LIMITS],
-    weights: [L; MAX_LIMITS],
+/// Body node `n`'s block: its mass matrix and its children's complements,
+/// factored; returns the factors (also kept, with its right-hand side).
+#[inline(always)]
+fn body_block<L: Lane>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    n: usize,
+    start: usize,
+) -> [L; PACKED] {
+    let zero = L::splat(0.0);
+    let [mass, xx, xy, xz, yy, yz, zz] = load::<L, MEASURED>(&block.scratch[n].measured, start);
+    let mut d = [zero; PACKED];
+    for k in 0..3 {
+        d[at(k, k)] = mass;
+    }
+    (d[at(3, 3)], d[at(4, 3)], d[at(5, 3)]) = (xx, xy, xz);
+    (d[at(4, 4)], d[at(5, 4)], d[at(5, 5)]) = (yy, yz, zz);
+    let mut b = [zero; MAX];
+    for &child in topology.children(n) {
+        let (minus, minus_b) = match child {
+            Child::Node(c) => {
+                let s = &block.scratch[c as usize];
+                (&s.minus, &s.minus_b)
+            }
+            Child::Port(p) => {
+                let port = &block.ports[p as usize];
+                (&port.minus, &port.minus_b)
+            }
+        };
+        let minus = load::<L, PACKED>(minus, start);
+        let minus_b = load::<L, MAX>(minus_b, start);
+        for (d, m) in d.iter_mut().zip(minus) {
+            *d += m;
+        }
+        for (b, m) in b.iter_mut().zip(minus_b) {
+            *b -= m;
+        }
+    }
+    ldl::factor::<L, 6>(&mut d);
+    let scratch = &mut block.scratch[n];
+    store(&d, &mut scratch.factors, start);
+    store(&b, &mut scratch.b, start);
+    d
 }
 
-/// Chooses which of joint node `n`'s limit rows are held (`first`: those
-/// violated now, else the active set [`settle`] left), records the set,
-/// and writes each row's Jacobians where the tree couples it to each body
-/// (zero for a row not held).
+/// Body node `n`'s complement for its parent joint `p` of `E + K` rows:
+/// with `A` the joint's rows on the body and `w = L^-1 A^T` (forward
+/// solves), `A D^-1 A^T = w^T D^-1 w` and `A D^-1 b = w^T D^-1 L^-1 b`.
+/// A limit row no lane of the slice holds is left out (the joint never
+/// reads it there).
 #[inline(always)]
-fn hold_limits<L: Lane>(
+fn body_out<L: Lane, const E: usize, const K: usize>(
     block: &mut TreeBlock,
     n: usize,
-    (kind, parent): (JointRows, u32),
-    (a, b): (u32, u32),
+    p: usize,
+    factors: &[L; PACKED],
     start: usize,
-    first: bool,
-) -> Held<L> {
-    let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    let mut held = Held {
-        active: [zero.gt(zero); MAX_LIMITS],
-        c: [zero; MAX_LIMITS],
-        weights: [zero; MAX_LIMITS],
-    };
-    for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
-        let scratch = &mut block.scratch[n];
-        let record = load::<L, RECORD>(&scratch.limits[l * RECORD..(l + 1) * RECORD], start);
-        let c = record[0];
-        let active = if first {
-            c.gt(zero)
-        } else {
-            L::load(&scratch.active[l][start..]).gt(zero)
-        };
-        L::select(active, one, zero).store(&mut scratch.active[l][start..]);
-        (held.active[l], held.c[l], held.weights[l]) = (active, c, record[7]);
-        // A limit's row has no linear part: `J_a`'s is `-0`, `J_b`'s `0`
-        // (`rows::Rows::limit`).
-        let minus = L::splat(-0.0);
-        let ja = [minus, minus, minus, record[1], record[2], record[3]];
-        let jb = [zero, zero, zero, record[4], record[5], record[6]];
-        for (side, jacobian) in [(a, ja), (b, jb)] {
-            if side == NONE {
-                continue;
-            }
-            let mut row = [zero; 6];
-            for (r, j) in row.iter_mut().zip(jacobian) {
-                *r = L::select(active, j, zero);
-            }
-            let coupling = &mut block.scratch[holder(n, parent, side)].coupling;
-            store(&row, &mut coupling[k * 6..k * 6 + 6], start);
+) {
+    let zero = L::splat(0.0);
+    let held = held::<L, E, K>(block, p, start);
+    let scratch = &block.scratch[n];
+    let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
+    let mut z = load::<L, MAX>(&scratch.b, start);
+    ldl::forward::<L, 6>(factors, &mut z);
+    let mut w = [[zero; MAX]; MAX];
+    let mut scaled = [[zero; MAX]; MAX];
+    for i in 0..E + K {
+        if !held.computed(E, i) {
+            continue;
+        }
+        w[i].copy_from_slice(&coupling[i * 6..i * 6 + 6]);
+        ldl::forward::<L, 6>(factors, &mut w[i]);
+        for k in 0..6 {
+            scaled[i][k] = w[i][k] * factors[at(k, k)];
         }
     }
-    held
+    let scratch = &mut block.scratch[n];
+    for i in 0..E + K {
+        if !held.computed(E, i) {
+            continue;
+        }
+        for j in 0..=i {
+            if !held.computed(E, j) {
+                continue;
+            }
+            let mut m = zero;
+            for k in 0..6 {
+                m -= scaled[i][k] * w[j][k];
+            }
+            m.store(&mut scratch.minus[at(i, j)][start..]);
+        }
+        let mut m = zero;
+        for k in 0..6 {
+            m -= scaled[i][k] * z[k];
+        }
+        m.store(&mut scratch.minus_b[i][start..]);
+    }
+}
+
+/// Joint node `n` of `E` equality and `K` limit rows: its block (zero for
+/// hard rows, a soft limit's compliance) and right-hand side (its errors)
+/// with its child body's complement, factored with the rows each lane
+/// holds; then its complement for its parent body (for the root joint,
+/// the body its static, kinematic or other block's side stands for):
+/// with `A` its rows on that body and `w = L^-1 A`, `A^T D^-1 A = w^T
+/// D^-1 w`.
+#[inline(always)]
+fn joint_node<L: Lane, const E: usize, const K: usize>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    n: usize,
+    start: usize,
+    scale: SubstepScale,
+) {
+    let zero = L::splat(0.0);
+    let held = held::<L, E, K>(block, n, start);
+    let NodeKind::Joint { index, .. } = topology.nodes[n].kind else {
+        unreachable!("a joint node");
+    };
+    let mut d = [zero; PACKED];
+    let mut b = [zero; MAX];
+    {
+        let scratch = &block.scratch[n];
+        let measured = load::<L, MEASURED>(&scratch.measured, start);
+        b[..E].copy_from_slice(&measured[..E]);
+        for o in 0..K {
+            if held.any[o] {
+                b[E + o] = L::load(&scratch.limits[o * RECORD][start..]);
+            }
+        }
+    }
+    if block.soft && K > 0 {
+        let NodeKind::Joint { rows: kind, .. } = topology.nodes[n].kind else {
+            unreachable!("a joint node");
+        };
+        let joint = &block.joints[index as usize];
+        soften::<L, E, K>(block, (n, kind), joint, &held, (start, scale), (&mut d, &mut b));
+    }
+    for &child in topology.children(n) {
+        let Child::Node(c) = child else {
+            unreachable!("a joint's child is a body of its block");
+        };
+        let s = &block.scratch[c as usize];
+        for i in 0..E + K {
+            if !held.computed(E, i) {
+                continue;
+            }
+            for j in 0..=i {
+                if held.computed(E, j) {
+                    d[at(i, j)] += L::load(&s.minus[at(i, j)][start..]);
+                }
+            }
+            b[i] -= L::load(&s.minus_b[i][start..]);
+        }
+    }
+    ldl::factor_held::<L, E, K>(&mut d, &held);
+    let scratch = &mut block.scratch[n];
+    store(&d[..at(E + K, 0)], &mut scratch.factors, start);
+    store(&b[..E + K], &mut scratch.b, start);
+    let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
+    ldl::forward_held::<L, E, K>(&d, &mut b, &held);
+    let mut scaled = [[zero; MAX]; 6];
+    let mut w = [[zero; MAX]; 6];
+    for c in 0..6 {
+        for i in 0..E + K {
+            w[c][i] = coupling[i * 6 + c];
+        }
+        ldl::forward_held::<L, E, K>(&d, &mut w[c], &held);
+        for i in 0..E + K {
+            if held.computed(E, i) {
+                scaled[c][i] = w[c][i] * d[at(i, i)];
+            }
+        }
+    }
+    for r in 0..6 {
+        for s in 0..=r {
+            let mut m = zero;
+            for i in 0..E + K {
+                if held.computed(E, i) {
+                    m -= scaled[r][i] * w[s][i];
+                }
+            }
+            m.store(&mut scratch.minus[at(r, s)][start..]);
+        }
+        let mut m = zero;
+        for i in 0..E + K {
+            if held.computed(E, i) {
+                m -= scaled[r][i] * b[i];
+            }
+        }
+        m.store(&mut scratch.minus_b[r][start..]);
+    }
 }
 
 /// A soft limit's row (`parts::limit`, whose header derives the step):
@@ -276,41 +608,141 @@ fn hold_limits<L: Lane>(
 /// diagonal, the right-hand side over `1 + gamma`. Zero compliance and
 /// damping leave the hard row as it was, bit for bit.
 #[inline(always)]
-fn soften<L: Lane>(
+fn soften<L: Lane, const E: usize, const K: usize>(
+    block: &TreeBlock,
+    (n, kind): (usize, JointRows),
     joint: &JointNode,
-    kind: JointRows,
-    soft: &Softness<L>,
-    held: &Held<L>,
-    start: usize,
-    (diagonal, rhs): (&mut [L; PACKED], &mut [L; MAX]),
+    held: &Held<L, K>,
+    (start, scale): (usize, SubstepScale),
+    (d, b): (&mut [L; PACKED], &mut [L; MAX]),
 ) {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
-        let active = held.active[l];
-        let (c, w) = (held.c[l], held.weights[l]);
+    let soft = joint
+        .softness
+        .lanes(start, L::splat(scale.inv_h), L::splat(scale.inv_h2));
+    let soft: &Softness<L> = &soft;
+    for o in 0..K {
+        if !held.any[o] {
+            continue;
+        }
+        let k = E + o;
+        let active = held.lanes[o];
+        let record = &block.scratch[n].limits[o * RECORD..(o + 1) * RECORD];
+        let (c, w) = (L::load(&record[0][start..]), L::load(&record[7][start..]));
         let quarter = if kind.is_sine_row(k) {
             L::splat(0.25)
         } else {
             one
         };
         let alpha = soft.alpha_tilde * quarter + soft.spring * w;
-        let lambda = L::select(active, L::load(&joint.limit_lambda[l][start..]), zero);
-        let c0 = L::load(&joint.limit_start[l][start..]);
+        let lambda = L::select(active, L::load(&joint.limit_lambda[o][start..]), zero);
+        let c0 = L::load(&joint.limit_start[o][start..]);
         let damping = L::select(active, soft.gamma * (c - c0), zero);
         let inv = one / (one + soft.gamma);
         let damped = (soft.alpha_tilde + soft.spring + soft.gamma).gt(zero) & active;
-        rhs[k] = L::select(damped, (c + alpha * lambda + damping) * inv, rhs[k]);
-        diagonal[at(k, k)] = L::select(damped, -(alpha * inv), diagonal[at(k, k)]);
+        b[k] = L::select(damped, (c + alpha * lambda + damping) * inv, b[k]);
+        d[at(k, k)] = L::select(damped, -(alpha * inv), d[at(k, k)]);
     }
 }
 
-/// `j^T I^-1 j` for a world axis `j` (the body's inverse inertia is in its
-/// own frame).
+// ---------------------------------------------------------------------------
+// Substitute.
+// ---------------------------------------------------------------------------
+
+/// Root first: each node's unknowns from its factors, its right-hand side
+/// and its parent's unknowns (`x = D^-1 (b + J x_p)` for a joint, `D^-1
+/// (b + J^T x_p)` for a body; a root joint's parent is
+/// `TreeBlock::parent_x`, zero for a static or kinematic body).
 #[inline(always)]
-fn inverse_mass<L: Lane>(body: &BodyLanes<L>, j: Vec3<L>) -> L {
-    let local = body.q.inverse_rotate(j);
-    local.dot(body.inv_inertia.mul_vec(local))
+pub(super) fn substitute<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
+    for (n, node) in topology.nodes.iter().enumerate().rev() {
+        match node.kind {
+            NodeKind::Body { .. } => {
+                if node.parent == NONE {
+                    body_unknowns::<L, 0, 0>(block, n, None, start);
+                } else {
+                    let p = node.parent as usize;
+                    let NodeKind::Joint { rows, .. } = topology.nodes[p].kind else {
+                        unreachable!("a body's parent is a joint");
+                    };
+                    by_rows!(rows, body_unknowns::<L>(block, n, Some(p), start));
+                }
+            }
+            NodeKind::Joint { rows, .. } => {
+                by_rows!(rows, joint_unknowns::<L>(block, n, node.parent, start));
+            }
+        }
+    }
 }
+
+/// Body node `n`'s unknowns, from its parent joint `p`'s multipliers
+/// (`E + K` rows; a limit row taken only where held).
+#[inline(always)]
+fn body_unknowns<L: Lane, const E: usize, const K: usize>(
+    block: &mut TreeBlock,
+    n: usize,
+    parent: Option<usize>,
+    start: usize,
+) {
+    let scratch = &block.scratch[n];
+    let factors = load::<L, PACKED>(&scratch.factors, start);
+    let mut y = load::<L, MAX>(&scratch.b, start);
+    if let Some(p) = parent {
+        let held = held::<L, E, K>(block, p, start);
+        let xp = load::<L, MAX>(&block.scratch[p].x, start);
+        let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
+        for i in 0..E {
+            for c in 0..6 {
+                y[c] += coupling[i * 6 + c] * xp[i];
+            }
+        }
+        for o in 0..K {
+            if !held.any[o] {
+                continue;
+            }
+            let i = E + o;
+            for c in 0..6 {
+                y[c] = L::select(held.lanes[o], y[c] + coupling[i * 6 + c] * xp[i], y[c]);
+            }
+        }
+    }
+    ldl::solve::<L, 6>(&factors, &mut y);
+    store(&y, &mut block.scratch[n].x, start);
+}
+
+/// Joint node `n`'s multipliers, from its parent body's unknowns (the
+/// block's `parent_x` for the root joint).
+#[inline(always)]
+fn joint_unknowns<L: Lane, const E: usize, const K: usize>(
+    block: &mut TreeBlock,
+    n: usize,
+    parent: u32,
+    start: usize,
+) {
+    let held = held::<L, E, K>(block, n, start);
+    let xp = if parent == NONE {
+        load::<L, 6>(&block.parent_x, start)
+    } else {
+        load::<L, 6>(&block.scratch[parent as usize].x, start)
+    };
+    let scratch = &block.scratch[n];
+    let factors = load::<L, PACKED>(&scratch.factors, start);
+    let mut y = load::<L, MAX>(&scratch.b, start);
+    let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
+    for i in 0..E + K {
+        if held.computed(E, i) {
+            for c in 0..6 {
+                y[i] += coupling[i * 6 + c] * xp[c];
+            }
+        }
+    }
+    ldl::solve_held::<L, E, K>(&factors, &mut y, &held);
+    store(&y[..E + K], &mut block.scratch[n].x, start);
+}
+
+// ---------------------------------------------------------------------------
+// Settle.
+// ---------------------------------------------------------------------------
 
 /// The active set's hysteresis (rad, or swing sines for an ellipse): how
 /// far past its limit a step must carry a row not held before [`settle`]
@@ -327,16 +759,16 @@ const CROSSING: f32 = 1.0e-4;
 /// for a soft row's accumulated `lambda`, `w dlambda` for a hard row's:
 /// the step moves it toward the limit) is released; a row not held that
 /// the step would carry past its limit (`c + J_a dx_a + J_b dx_b >
-/// CROSSING`, linearised) is held. The set is kept as the next solve's
-/// start ([`adopt`]). Only a crossing makes the tree worth factoring
-/// again: a held row that pulls violates nothing, it only holds its joint
-/// on the boundary until the next solve releases it. So a lane where some
-/// row crosses takes its new set for another pass, and every other lane
-/// keeps the set it had, which gives it the same bits again; returns
-/// whether any lane crossed. A lane's result is then its own, whatever
-/// its slice's other lanes do (every backend, bit for bit).
+/// CROSSING`, linearised) is held. The set is kept in `next`, the next
+/// solve's start ([`adopt`]), and the lanes where a row crossed are
+/// marked in `TreeBlock::crossing`. Only a crossing makes the tree worth
+/// factoring again: a held row that pulls violates nothing, it only holds
+/// its joint on the boundary until the next solve releases it. So a tree
+/// where some row crosses takes its new set for another pass
+/// ([`take_crossings`]), and every other keeps the set it had, which
+/// gives it the same bits again.
 #[inline(always)]
-pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) -> bool {
+pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
     let mut crossed = zero.gt(zero);
     for (n, node) in topology.nodes.iter().enumerate() {
@@ -353,7 +785,7 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
         if limits == kind.count() {
             continue;
         }
-        let dlambda = load::<L, MAX>(&block.scratch[n].rhs, start);
+        let dlambda = load::<L, MAX>(&block.scratch[n].x, start);
         let turn_a = turn_of(block, a, start);
         let turn_b = turn_of(block, b, start);
         let joint = &block.joints[index as usize];
@@ -373,45 +805,30 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
             L::select(now, one, zero).store(&mut block.scratch[n].next[l][start..]);
         }
     }
-    for scratch in block.scratch.iter_mut() {
-        for (active, next) in scratch.active.iter_mut().zip(&scratch.next) {
-            let held = L::load(&active[start..]);
-            L::select(crossed, L::load(&next[start..]), held).store(&mut active[start..]);
-        }
-    }
-    let mut lanes = [0.0f32; BLOCK_LANES];
-    L::select(crossed, one, zero).store(&mut lanes);
-    let mut any = false;
-    for lane in &lanes[..L::WIDTH] {
-        any |= *lane != 0.0;
-    }
-    any
+    L::select(crossed, one, zero).store(&mut block.crossing[start..]);
 }
 
-/// The set the last [`settle`] chose, releases included, as the next
-/// solve's start.
-#[inline(always)]
-pub(super) fn adopt<L: Lane>(block: &mut TreeBlock, start: usize) {
-    for scratch in block.scratch.iter_mut() {
-        for (active, next) in scratch.active.iter_mut().zip(&scratch.next) {
-            L::load(&next[start..]).store(&mut active[start..]);
-        }
-    }
-}
-
-/// Body node `n`'s turn from the solve (zero for none: static or
-/// kinematic).
+/// Body node `n`'s turn from the solve (for none, the side of the root
+/// joint with no node: its parent's, zero for a static or kinematic
+/// body).
 #[inline(always)]
 fn turn_of<L: Lane>(block: &TreeBlock, n: u32, start: usize) -> Vec3<L> {
-    if n == NONE {
-        return Vec3::zero();
-    }
-    let x = load::<L, MAX>(&block.scratch[n as usize].rhs, start);
+    let x = if n == NONE {
+        load::<L, 6>(&block.parent_x, start)
+    } else {
+        load::<L, 6>(&block.scratch[n as usize].x, start)
+    };
     Vec3::new(x[3], x[4], x[5])
 }
 
+// ---------------------------------------------------------------------------
+// Finish.
+// ---------------------------------------------------------------------------
+
 /// Adds each held limit row's multiplier to its joint's substep total
-/// (a soft limit's spring force; zero for a row not held).
+/// (a soft limit's spring force; zero for a row not held), in the lanes
+/// whose limits are soft (a hard row's is never read: so what shares its
+/// block changes nothing).
 #[inline(always)]
 pub(super) fn accumulate<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
     if !block.soft {
@@ -424,11 +841,12 @@ pub(super) fn accumulate<L: Lane>(block: &mut TreeBlock, topology: &Topology, st
         else {
             continue;
         };
-        let dlambda = load::<L, MAX>(&block.scratch[n].rhs, start);
+        let dlambda = load::<L, MAX>(&block.scratch[n].x, start);
         let joint = &mut block.joints[index as usize];
+        let soft = joint.soft_lanes::<L>(start);
         for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
-            let total = L::load(&joint.limit_lambda[l][start..]) + dlambda[k];
-            total.store(&mut joint.limit_lambda[l][start..]);
+            let lambda = L::load(&joint.limit_lambda[l][start..]);
+            L::select(soft, lambda + dlambda[k], lambda).store(&mut joint.limit_lambda[l][start..]);
         }
     }
 }
@@ -463,185 +881,6 @@ pub(super) fn start_limits<L: Lane>(
     }
 }
 
-/// Leaves first: each node's block factored, its Schur complement and its
-/// right-hand side passed to its parent. For a joint child with rows `J`
-/// against its parent body, `D_p -= J^T D^-1 J` and `b_p += J^T D^-1 b`;
-/// for a body child against its parent joint's rows `J`,
-/// `D_p -= J D^-1 J^T` and `b_p += J D^-1 b` (the coupling block is `-J`).
-#[inline(always)]
-pub(super) fn eliminate<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
-    for (n, node) in topology.nodes.iter().enumerate() {
-        let parent = (node.parent != NONE).then_some(node.parent as usize);
-        match (node.kind, parent_size(topology, parent)) {
-            (NodeKind::Body { .. }, Some(5)) => body_child::<L, 5>(block, n, parent, start),
-            (NodeKind::Body { .. }, Some(6)) => body_child::<L, 6>(block, n, parent, start),
-            (NodeKind::Body { .. }, _) => body_child::<L, 6>(block, n, None, start),
-            (NodeKind::Joint { rows, .. }, _) if rows.count() == 5 => {
-                joint_child::<L, 5>(block, n, parent, start)
-            }
-            (NodeKind::Joint { .. }, _) => joint_child::<L, 6>(block, n, parent, start),
-        }
-    }
-}
-
-/// The size of a node's parent's block (none for the root). A `match`,
-/// not `Option::map`: lane code has no closures (`tests/tidy.rs`).
-#[inline(always)]
-#[allow(clippy::manual_map)]
-fn parent_size(topology: &Topology, parent: Option<usize>) -> Option<usize> {
-    match parent {
-        Some(p) => Some(topology.size(p)),
-        None => None,
-    }
-}
-
-/// Factors node `n`'s `N x N` block in place; returns the factors.
-#[inline(always)]
-fn factor<L: Lane, const N: usize>(block: &mut TreeBlock, n: usize, start: usize) -> [L; PACKED] {
-    let mut factors = load::<L, PACKED>(&block.scratch[n].diagonal, start);
-    ldl::factor::<L, N>(&mut factors);
-    store(&factors, &mut block.scratch[n].diagonal, start);
-    factors
-}
-
-/// Passes node `n`'s Schur complement to its parent `p`: with `A = L D
-/// L^T` its factors and `u_r` the `R` columns of its coupling (`N`
-/// entries each), `D_p -= U^T A^-1 U` and `b_p += U^T A^-1 b`, each as
-/// `w^T D^-1 v` of forward solves `w = L^-1 u` ([`ldl::forward`]).
-#[inline(always)]
-fn complement<L: Lane, const N: usize, const R: usize>(
-    block: &mut TreeBlock,
-    (n, p): (usize, usize),
-    factors: &[L; PACKED],
-    columns: &mut [[L; MAX]; R],
-    start: usize,
-) {
-    let mut z = load::<L, MAX>(&block.scratch[n].rhs, start);
-    ldl::forward::<L, N>(factors, &mut z);
-    let mut scaled = [[L::splat(0.0); MAX]; R];
-    for (column, scaled) in columns.iter_mut().zip(scaled.iter_mut()) {
-        ldl::forward::<L, N>(factors, column);
-        for i in 0..N {
-            scaled[i] = column[i] * factors[ldl::at(i, i)];
-        }
-    }
-    let mut d = load::<L, PACKED>(&block.scratch[p].diagonal, start);
-    let mut b = load::<L, MAX>(&block.scratch[p].rhs, start);
-    for r in 0..R {
-        for s in 0..=r {
-            let mut sum = scaled[r][0] * columns[s][0];
-            for i in 1..N {
-                sum += scaled[r][i] * columns[s][i];
-            }
-            d[at(r, s)] -= sum;
-        }
-        let mut sum = scaled[r][0] * z[0];
-        for i in 1..N {
-            sum += scaled[r][i] * z[i];
-        }
-        b[r] += sum;
-    }
-    store(&d, &mut block.scratch[p].diagonal, start);
-    store(&b, &mut block.scratch[p].rhs, start);
-}
-
-/// A joint node of `N` rows: factored, and its complement passed to its
-/// parent body (`J^T D^-1 J`: the coupling's six columns).
-#[inline(always)]
-fn joint_child<L: Lane, const N: usize>(
-    block: &mut TreeBlock,
-    n: usize,
-    parent: Option<usize>,
-    start: usize,
-) {
-    let factors = factor::<L, N>(block, n, start);
-    let Some(p) = parent else {
-        return;
-    };
-    let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
-    let mut columns = [[L::splat(0.0); MAX]; 6];
-    for (c, column) in columns.iter_mut().enumerate() {
-        for r in 0..N {
-            column[r] = j[r * 6 + c];
-        }
-    }
-    complement::<L, N, 6>(block, (n, p), &factors, &mut columns, start);
-}
-
-/// A body node: factored, and its complement passed to its parent joint
-/// of `N` rows (`J D^-1 J^T`: the joint's `N` rows; none: the root).
-#[inline(always)]
-fn body_child<L: Lane, const N: usize>(
-    block: &mut TreeBlock,
-    n: usize,
-    parent: Option<usize>,
-    start: usize,
-) {
-    let factors = factor::<L, 6>(block, n, start);
-    let Some(p) = parent else {
-        return;
-    };
-    let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
-    let mut columns = [[L::splat(0.0); MAX]; N];
-    for (r, column) in columns.iter_mut().enumerate() {
-        column.copy_from_slice(&j[r * 6..r * 6 + 6]);
-    }
-    complement::<L, 6, N>(block, (n, p), &factors, &mut columns, start);
-}
-
-/// Root first: each node's unknowns from its factored block, its
-/// right-hand side and its parent's unknowns (`x = D^-1 (b + J x_p)` for
-/// a joint, `D^-1 (b + J^T x_p)` for a body), kept in `rhs`.
-#[inline(always)]
-pub(super) fn substitute<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
-    for (n, node) in topology.nodes.iter().enumerate().rev() {
-        let parent = (node.parent != NONE).then_some(node.parent as usize);
-        match (node.kind, parent_size(topology, parent)) {
-            (NodeKind::Body { .. }, Some(5)) => unknowns::<L, 6, 5>(block, n, parent, false, start),
-            (NodeKind::Body { .. }, _) => unknowns::<L, 6, 6>(block, n, parent, false, start),
-            (NodeKind::Joint { rows, .. }, _) if rows.count() == 5 => {
-                unknowns::<L, 5, 6>(block, n, parent, true, start)
-            }
-            (NodeKind::Joint { .. }, _) => unknowns::<L, 6, 6>(block, n, parent, true, start),
-        }
-    }
-}
-
-/// Node `n`'s `N` unknowns, from its parent's `P` (`joint`: `n` holds the
-/// rows, else the parent does).
-#[inline(always)]
-fn unknowns<L: Lane, const N: usize, const P: usize>(
-    block: &mut TreeBlock,
-    n: usize,
-    parent: Option<usize>,
-    joint: bool,
-    start: usize,
-) {
-    let factors = load::<L, PACKED>(&block.scratch[n].diagonal, start);
-    let mut x = load::<L, MAX>(&block.scratch[n].rhs, start);
-    if let Some(p) = parent {
-        let xp = load::<L, MAX>(&block.scratch[p].rhs, start);
-        let j = load::<L, { MAX * 6 }>(&block.scratch[n].coupling, start);
-        if joint {
-            // x += J x_p: N rows against the body's 6.
-            for (r, xr) in x.iter_mut().enumerate().take(N) {
-                for c in 0..6 {
-                    *xr += j[r * 6 + c] * xp[c];
-                }
-            }
-        } else {
-            // x += J^T x_p: the parent's P rows against this body's 6.
-            for r in 0..P {
-                for c in 0..6 {
-                    x[c] += j[r * 6 + c] * xp[r];
-                }
-            }
-        }
-    }
-    ldl::solve::<L, N>(&factors, &mut x);
-    store(&x[..N], &mut block.scratch[n].rhs, start);
-}
-
 /// The largest turn one solve gives a body (rad).
 const MAX_TURN: f32 = 1.0;
 
@@ -661,7 +900,7 @@ pub(super) fn apply<L: Lane>(
         };
         let body = &block.bodies[index as usize];
         let mut lanes = BodyLanes::<L>::gather(rows, &body.row[start..]);
-        let x = load::<L, MAX>(&block.scratch[n].rhs, start);
+        let x = load::<L, MAX>(&block.scratch[n].x, start);
         // A trust region: the rows are linear in the turn, so a turn of
         // more than a radian (a tree of near-dependent rows across a
         // million-to-one inertia ratio) is not a step the linearisation
@@ -678,10 +917,13 @@ pub(super) fn apply<L: Lane>(
     }
 }
 
-/// Every joint's rows count is 5 or 6 (the sizes above).
+/// Every joint's rows count is 5 or 6, its equality rows 3, 5 or 6 (the
+/// sizes `by_rows!` names).
 const _: () = {
     use super::rows::SwingRows::{Cone, Ellipse, Pyramid};
     assert!(JointRows::Socket(Cone).count() == 5 && JointRows::Socket(Ellipse).count() == 5);
     assert!(JointRows::Rod.count() == 5 && JointRows::Socket(Pyramid).count() == 6);
     assert!(JointRows::Hinge.count() == 6 && JointRows::Fixed.count() == 6);
+    assert!(JointRows::Socket(Cone).first_limit() == 3 && JointRows::Rod.first_limit() == 3);
+    assert!(JointRows::Hinge.first_limit() == 5 && JointRows::Fixed.first_limit() == 6);
 };
