@@ -20,6 +20,7 @@ use vertebra_kernels::fixed::{FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{HingeBlock, HingeLane};
 use vertebra_kernels::rod::{RodBlock, RodLane};
 use vertebra_kernels::socket::{ShapedLimits, SocketBlock, SocketLane};
+use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::{Colouring, MAX_COLOURS};
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
@@ -148,6 +149,10 @@ pub(crate) struct Bin {
     /// The bin's tree blocks (`Layout::trees`; none unless the direct
     /// solve is on).
     pub trees: Range<usize>,
+    /// The bin's trees are cut into pieces laid out across its blocks,
+    /// which are then solved together (one chunk); else each block is a
+    /// solve of its own.
+    pub trees_joined: bool,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -172,8 +177,8 @@ impl Layout {
     /// Lays out every coloured joint; `joints[slot]`, `rods[slot]` are
     /// `Some` when live. The joints of bin `k` (their awake dynamic
     /// body's, `bins`; all of them in bin 0 when `bins` is empty) go to
-    /// `bins[k]`, colour by colour. With `direct`, each bin's trees too
-    /// (`trees.rs`), laid out first so that the joints they hold take
+    /// `bins[k]`, colour by colour. With `direct` (the backend the trees
+    /// are laid out for), each bin's trees too (`trees.rs`), laid out first so that the joints they hold take
     /// blocks of their own, which are marked so (`BodyPairs::direct`).
     pub fn build(
         colouring: &Colouring,
@@ -181,7 +186,7 @@ impl Layout {
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
         asleep: &[bool],
-        (bins, direct): (&Bins, bool),
+        (bins, direct): (&Bins, Option<Backend>),
     ) -> Self {
         let mut layout = Self::default();
         let awake = |a: BodyHandle, b: BodyHandle| !(asleep[a.index()] || asleep[b.index()]);
@@ -201,8 +206,8 @@ impl Layout {
                 .collect();
             let mut bin = Bin::default();
             // The trees first: their joints take blocks of their own.
-            if direct {
-                bin.trees = layout.trees.append(&joints, &rods, bodies);
+            if let Some(backend) = direct {
+                (bin.trees, bin.trees_joined) = layout.trees.append(&joints, &rods, bodies, backend);
             }
             for (c, used) in used.iter_mut().enumerate() {
                 let group = layout.append(colouring.colour(c), &joints, &rods, bodies);

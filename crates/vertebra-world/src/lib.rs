@@ -569,7 +569,10 @@ impl World {
                 &self.rods,
                 &self.bodies,
                 self.islands.asleep(),
-                (&self.bins, self.config.joints == JointSolver::Direct),
+                (
+                    &self.bins,
+                    (self.config.joints == JointSolver::Direct).then_some(self.backend),
+                ),
             );
             self.layout_dirty = false;
         }

@@ -92,7 +92,7 @@ pub(crate) fn residuals(world: &mut World) {
             &world.rods,
             &world.bodies,
             &awake,
-            (&crate::bins::Bins::default(), false),
+            (&crate::bins::Bins::default(), None),
         )
         .started(&world.bodies);
         &everything

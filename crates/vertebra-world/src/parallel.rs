@@ -129,7 +129,7 @@ mod tests {
             &world.rods,
             &world.bodies,
             asleep,
-            (&crate::bins::Bins::default(), false),
+            (&crate::bins::Bins::default(), None),
         );
         assert_eq!(layout.bins[0].colours.len(), 1);
         assert!(!layout.disjoint);

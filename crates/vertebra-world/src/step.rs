@@ -458,8 +458,10 @@ trait Pass: Sync {
     fn rods(&self, blocks: &mut [RodBlock], rows: &BodyRows, backend: Backend);
     /// Contacts.
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend);
-    /// The direct solve's trees (nothing but in the position pass).
-    fn trees(&self, _: &mut [TreeBlock], _: &[Topology], _: &BodyRows, _: Backend) {}
+    /// The direct solve's trees (nothing but in the position pass):
+    /// `joined`, all of `blocks` are one solve (trees cut into pieces),
+    /// else each block is.
+    fn trees(&self, _: &mut [TreeBlock], _: &[Topology], _: &BodyRows, _: Backend, _: bool) {}
 }
 
 /// The position iteration.
@@ -546,19 +548,27 @@ impl Pass for Positions {
         topologies: &[Topology],
         rows: &BodyRows,
         backend: Backend,
+        joined: bool,
     ) {
         let scale = direct::SubstepScale {
             inv_h: self.inv_h,
             inv_h2: self.inv_h2,
         };
-        for block in blocks.chunks_mut(1) {
-            backend_for_tree(backend, &block[0]).dispatch(direct::PositionPass {
-                blocks: block,
+        let solve = |blocks: &mut [TreeBlock], backend: Backend| {
+            backend.dispatch(direct::PositionPass {
+                blocks,
                 topologies,
                 rows,
                 scale,
                 passes: self.passes,
             });
+        };
+        if joined {
+            solve(blocks, backend);
+        } else {
+            for block in blocks.chunks_mut(1) {
+                solve(block, backend_for_tree(backend, &block[0]));
+            }
         }
     }
 }
@@ -869,9 +879,10 @@ impl Substep<'_> {
     fn trees_stage(&self, cursor: &mut Cursor, joints: &Bin, pass: &impl Pass) {
         let range = &joints.trees;
         if !range.is_empty() {
-            let size = self.chunk_size(self.trees_disjoint, range.len());
+            let joined = joints.trees_joined;
+            let size = self.chunk_size(self.trees_disjoint && !joined, range.len());
             let run = |c: &mut [TreeBlock]| {
-                pass.trees(c, self.topologies, self.rows.rows(), self.backend)
+                pass.trees(c, self.topologies, self.rows.rows(), self.backend, joined)
             };
             // SAFETY: the only part of its stage.
             let part = unsafe { BlockChunks::new(&self.trees, range.clone(), size, run) };
@@ -959,9 +970,10 @@ impl Substep<'_> {
         let Some(joints) = self.joint_bins.get(bin) else {
             return;
         };
-        let range = joints.trees.clone();
-        let run =
-            |c: &mut [TreeBlock]| pass.trees(c, self.topologies, self.rows.rows(), self.backend);
+        let (range, joined) = (joints.trees.clone(), joints.trees_joined);
+        let run = |c: &mut [TreeBlock]| {
+            pass.trees(c, self.topologies, self.rows.rows(), self.backend, joined)
+        };
         // SAFETY: a bin's blocks are its own (bins_stage hands each bin to
         // one worker).
         run_whole(unsafe { BlockChunks::new(&self.trees, range.clone(), range.len(), run) });

@@ -21,7 +21,9 @@ use vertebra_kernels::body::StartLane;
 use vertebra_kernels::direct::{
     BodyNode, JointLane, JointNode, JointRows, SwingRows, Topology, TreeBlock,
 };
+use vertebra_kernels::direct::{NodeKind, split};
 use vertebra_kernels::limited::LimitLane;
+use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 
@@ -67,6 +69,15 @@ enum Edge {
     Rod(usize),
 }
 
+/// Where a tree's piece goes: its block (in `Trees::blocks`) and lane,
+/// and the tree's body and edge of each of the piece's bodies and joints.
+struct Lane<'a> {
+    block: usize,
+    lane: usize,
+    bodies: &'a [u32],
+    joints: &'a [u32],
+}
+
 /// A tree found in a bin: its edges in key order and its bodies in the
 /// order they name them.
 struct Found {
@@ -77,35 +88,80 @@ struct Found {
 
 impl Trees {
     /// Lays out the trees of one bin's joints and rods (`Some` when awake
-    /// and in the bin); returns the range of blocks they take.
+    /// and in the bin) for `backend`; returns the range of blocks they
+    /// take and whether those blocks are solved together (the trees cut
+    /// into pieces, [`plan`]); else each block is solved on its own.
     pub fn append(
         &mut self,
         joints: &[Option<JointDesc>],
         rods: &[Option<RodDesc>],
         bodies: &BodyStore,
-    ) -> core::ops::Range<usize> {
+        backend: Backend,
+    ) -> (core::ops::Range<usize>, bool) {
         let first = self.blocks.len();
-        let mut by_shape: BTreeMap<usize, Vec<Found>> = BTreeMap::new();
-        for found in find(joints, rods, bodies) {
-            let next = self.topologies.len();
-            let topology = *self.shapes.entry(found.shape.clone()).or_insert(next);
-            if topology == next {
-                let shape = Topology::new(found.bodies.len(), &found.shape);
-                self.topologies.push(shape.expect("a found tree is a tree"));
+        let found = find(joints, rods, bodies);
+        let wholes: Vec<usize> = found.iter().map(|f| self.whole(f)).collect();
+        let descs = (joints, rods, bodies);
+        let Some(most) = plan(&self.topologies, &wholes, backend) else {
+            let mut by_shape: BTreeMap<usize, Vec<&Found>> = BTreeMap::new();
+            for (tree, &topology) in found.iter().zip(&wholes) {
+                by_shape.entry(topology).or_default().push(tree);
             }
-            by_shape.entry(topology).or_default().push(found);
-        }
-        for (topology, trees) in by_shape {
-            for chunk in trees.chunks(BLOCK_LANES) {
-                let shape = &self.topologies[topology];
-                let mut block = TreeBlock::padding(topology as u32, shape);
-                for (lane, tree) in chunk.iter().enumerate() {
-                    self.set_lane(&mut block, lane, tree, joints, rods, bodies);
+            for (topology, trees) in by_shape {
+                for chunk in trees.chunks(BLOCK_LANES) {
+                    let shape = &self.topologies[topology];
+                    let mut block = TreeBlock::padding(topology as u32, shape);
+                    let index = self.blocks.len();
+                    for (lane, tree) in chunk.iter().enumerate() {
+                        let whole = Lane {
+                            block: index,
+                            lane,
+                            bodies: &(0..tree.bodies.len() as u32).collect::<Vec<_>>(),
+                            joints: &(0..tree.edges.len() as u32).collect::<Vec<_>>(),
+                        };
+                        self.set_lane(&mut block, &whole, tree, descs);
+                    }
+                    self.blocks.push(block);
                 }
-                self.blocks.push(block);
+            }
+            return (first..self.blocks.len(), false);
+        };
+        let cut: Vec<(Topology, Vec<u32>)> = (wholes.iter())
+            .map(|&t| (self.topologies[t].clone(), self.topologies[t].cuts(most)))
+            .collect();
+        let trees: Vec<(&Topology, Vec<u32>)> = cut.iter().map(|(t, c)| (t, c.clone())).collect();
+        let topologies = &mut self.topologies;
+        let (mut blocks, placed) = split::lay_out(&trees, &mut |piece: &Topology| {
+            let known = topologies.iter().position(|t| t == piece);
+            known.unwrap_or_else(|| {
+                topologies.push(piece.clone());
+                topologies.len() - 1
+            }) as u32
+        });
+        for (tree, pieces) in found.iter().zip(&placed) {
+            for p in pieces {
+                let lane = Lane {
+                    block: first + p.block,
+                    lane: p.lane,
+                    bodies: &p.piece.bodies,
+                    joints: &p.piece.joints,
+                };
+                self.set_lane(&mut blocks[p.block], &lane, tree, descs);
             }
         }
-        first..self.blocks.len()
+        self.blocks.append(&mut blocks);
+        (first..self.blocks.len(), true)
+    }
+
+    /// The topology of a whole found tree (added if new).
+    fn whole(&mut self, found: &Found) -> usize {
+        let next = self.topologies.len();
+        let topology = *self.shapes.entry(found.shape.clone()).or_insert(next);
+        if topology == next {
+            let shape = Topology::new(found.bodies.len(), &found.shape);
+            self.topologies.push(shape.expect("a found tree is a tree"));
+        }
+        topology
     }
 
     /// Checks that no row is written by two lanes (the trees are apart by
@@ -119,29 +175,30 @@ impl Trees {
             .all(|w| written.insert(w));
     }
 
+    /// Writes a tree's piece (or the whole tree) into its lane: each of
+    /// the piece's bodies and joints from the tree's.
     fn set_lane(
         &mut self,
         block: &mut TreeBlock,
-        lane: usize,
+        at: &Lane,
         tree: &Found,
-        joints: &[Option<JointDesc>],
-        rods: &[Option<RodDesc>],
-        bodies: &BodyStore,
+        (joints, rods, bodies): (&[Option<JointDesc>], &[Option<RodDesc>], &BodyStore),
     ) {
+        let lane = at.lane;
         block.padding &= !(1 << lane);
-        for (k, &i) in tree.bodies.iter().enumerate() {
+        for (k, &i) in at.bodies.iter().enumerate() {
             let node = &mut block.bodies[k];
-            node.set(lane, i as u32 + 1, true, 1.0, glam::Mat3::IDENTITY);
+            let row = tree.bodies[i as usize] as u32 + 1;
+            node.set(lane, row, true, 1.0, glam::Mat3::IDENTITY);
             set_mass(node, lane, bodies);
         }
-        let index = self.blocks.len();
-        for (k, edge) in tree.edges.iter().enumerate() {
+        for (k, &j) in at.joints.iter().enumerate() {
             let place = Some(Place {
-                block: index,
+                block: at.block,
                 joint: k,
                 lane,
             });
-            let lane_data = match *edge {
+            let lane_data = match tree.edges[j as usize] {
                 Edge::Joint(slot) => {
                     put(&mut self.joints, slot, place);
                     joint_lane(joints[slot].as_ref().expect("a tree's joint is awake"))
@@ -180,6 +237,83 @@ impl Trees {
     pub fn has_rod(&self, slot: usize) -> bool {
         matches!(self.rods.get(slot), Some(Some(_)))
     }
+}
+
+/// What one node of a block costs per solve, in instructions, on a
+/// slice of up to four lanes (the scalar path's one, SSE4.1's four,
+/// AVX2's half) and of eight (AVX2): the reference humanoid's direct
+/// solve measured by callgrind (`docs/performance.md`, "Lanes within one
+/// ragdoll"). Only their ratio and the port's matter.
+const NODE_NARROW: u64 = 1_900;
+/// See [`NODE_NARROW`].
+const NODE_WIDE: u64 = 2_300;
+/// What a port costs per lane and solve (a piece's complement copied in,
+/// its parent's unknowns out).
+const PORT: u64 = 150;
+
+/// Whether to cut a bin's trees into pieces (their limbs side by side in
+/// lanes), and where: `Some(most)` cuts every tree at the joints whose
+/// subtrees hold at most `most` nodes (`Topology::cuts`), `None` lays
+/// each tree out whole (eight of a shape to a block, a crowd's layout).
+/// The choice is the cheapest by [`cost`] of every `most` the trees'
+/// subtrees offer; the results are the same bits either way.
+fn plan(topologies: &[Topology], trees: &[usize], backend: Backend) -> Option<usize> {
+    let width = backend.lanes();
+    if width == 1 {
+        return None;
+    }
+    let mut counts: BTreeMap<usize, usize> = BTreeMap::new();
+    for &t in trees {
+        *counts.entry(t).or_default() += 1;
+    }
+    let whole = (counts.iter())
+        .map(|(&t, &n)| cost(topologies[t].nodes.len(), n, width))
+        .sum::<u64>();
+    let mut candidates = std::collections::BTreeSet::new();
+    for &t in counts.keys() {
+        let sizes = topologies[t].subtree_sizes();
+        let joints = (topologies[t].nodes.iter().enumerate())
+            .filter(|(_, node)| matches!(node.kind, NodeKind::Joint { .. }));
+        candidates.extend(joints.map(|(n, _)| sizes[n]));
+    }
+    let mut best = (whole, None);
+    for most in candidates {
+        let mut shapes: Vec<(Topology, usize)> = Vec::new();
+        let mut ports = 0;
+        for (&t, &n) in &counts {
+            let cuts = topologies[t].cuts(most);
+            ports += cuts.len() * n;
+            for piece in topologies[t].split(&cuts) {
+                match shapes.iter_mut().find(|(s, _)| *s == piece.topology) {
+                    Some((_, count)) => *count += n,
+                    None => shapes.push((piece.topology, n)),
+                }
+            }
+        }
+        let total = (shapes.iter())
+            .map(|(s, n)| cost(s.nodes.len(), *n, width))
+            .sum::<u64>()
+            + ports as u64 * PORT;
+        if total < best.0 {
+            best = (total, Some(most));
+        }
+    }
+    best.1
+}
+
+/// What `count` trees (or pieces) of `nodes` nodes cost per solve, laid
+/// out eight to a block on a backend of `width` lanes.
+fn cost(nodes: usize, count: usize, width: usize) -> u64 {
+    let slices = |lanes: usize| -> u64 {
+        match width {
+            8 if lanes <= 4 => NODE_NARROW,
+            8 => NODE_WIDE,
+            _ => lanes.div_ceil(width) as u64 * NODE_NARROW,
+        }
+    };
+    let (full, rest) = (count / BLOCK_LANES, count % BLOCK_LANES);
+    let blocks = full as u64 * slices(BLOCK_LANES) + if rest > 0 { slices(rest) } else { 0 };
+    nodes as u64 * blocks
 }
 
 fn put(places: &mut Vec<Option<Place>>, slot: usize, place: Option<Place>) {
