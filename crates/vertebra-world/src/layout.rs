@@ -207,7 +207,8 @@ impl Layout {
             let mut bin = Bin::default();
             // The trees first: their joints take blocks of their own.
             if let Some(backend) = direct {
-                (bin.trees, bin.trees_joined) = layout.trees.append(&joints, &rods, bodies, backend);
+                (bin.trees, bin.trees_joined) =
+                    layout.trees.append(&joints, &rods, bodies, backend);
             }
             for (c, used) in used.iter_mut().enumerate() {
                 let group = layout.append(colouring.colour(c), &joints, &rods, bodies);

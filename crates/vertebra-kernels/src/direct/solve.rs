@@ -255,7 +255,10 @@ pub(super) fn hold(block: &mut TreeBlock, topology: &Topology, first_pass: bool)
 pub(super) fn take_crossings(block: &mut TreeBlock, topology: &Topology) {
     let crossing = block.crossing;
     for (n, node) in topology.nodes.iter().enumerate() {
-        let NodeKind::Joint { rows: kind, a, b, .. } = node.kind else {
+        let NodeKind::Joint {
+            rows: kind, a, b, ..
+        } = node.kind
+        else {
             continue;
         };
         let limits = kind.count() - kind.first_limit();
@@ -315,9 +318,7 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock]) -> bool {
             }
         }
     }
-    blocks
-        .iter()
-        .any(|b| b.crossing.iter().any(|&c| c != 0.0))
+    blocks.iter().any(|b| b.crossing.iter().any(|&c| c != 0.0))
 }
 
 /// Copies into block `k`'s ports their subtrees' complements (and which
@@ -542,7 +543,14 @@ fn joint_node<L: Lane, const E: usize, const K: usize>(
             unreachable!("a joint node");
         };
         let joint = &block.joints[index as usize];
-        soften::<L, E, K>(block, (n, kind), joint, &held, (start, scale), (&mut d, &mut b));
+        soften::<L, E, K>(
+            block,
+            (n, kind),
+            joint,
+            &held,
+            (start, scale),
+            (&mut d, &mut b),
+        );
     }
     for &child in topology.children(n) {
         let Child::Node(c) = child else {

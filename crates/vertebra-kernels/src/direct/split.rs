@@ -137,7 +137,8 @@ impl Topology {
                 .map(body_of)
                 .collect();
         }
-        let mut topology = Topology::new(bodies.len(), &shape).expect("a piece of a tree is a tree");
+        let mut topology =
+            Topology::new(bodies.len(), &shape).expect("a piece of a tree is a tree");
         let nodes: Vec<u32> = topology
             .nodes
             .iter()
@@ -161,7 +162,10 @@ impl Topology {
                 .enumerate()
                 .map(|(p, &cut)| {
                     let parent = self.nodes[cut as usize].parent;
-                    let at = nodes.iter().position(|&n| n == parent).expect("cut below the trunk");
+                    let at = nodes
+                        .iter()
+                        .position(|&n| n == parent)
+                        .expect("cut below the trunk");
                     let NodeKind::Joint { index, .. } = self.nodes[cut as usize].kind else {
                         unreachable!("a cut is a joint");
                     };
@@ -222,8 +226,8 @@ pub fn lay_out(
     shape: &mut dyn FnMut(&Topology) -> u32,
 ) -> (Vec<super::TreeBlock>, Vec<Vec<Placed>>) {
     use super::{Port, Source, TreeBlock};
-    use vertebra_math::block::BLOCK_LANES;
     use std::collections::BTreeMap;
+    use vertebra_math::block::BLOCK_LANES;
 
     let split: Vec<Vec<Piece>> = trees.iter().map(|(t, cuts)| t.split(cuts)).collect();
     // Shapes in order first met, pieces without ports before trunks.
@@ -260,7 +264,12 @@ pub fn lay_out(
     }
     let placed: Vec<Vec<Placed>> = placed
         .into_iter()
-        .map(|pieces| pieces.into_iter().map(|p| p.expect("every piece placed")).collect())
+        .map(|pieces| {
+            pieces
+                .into_iter()
+                .map(|p| p.expect("every piece placed"))
+                .collect()
+        })
         .collect();
     // Ports (trunk <- piece) and parents (piece <- trunk).
     for pieces in &placed {
