@@ -423,7 +423,7 @@ fn run(
         topologies: core::slice::from_ref(topology),
         rows: &rows,
     });
-    backend.dispatch(direct::PositionPass {
+    direct::PositionPass {
         blocks: &mut trees,
         topologies: core::slice::from_ref(topology),
         rows: &rows,
@@ -432,7 +432,8 @@ fn run(
             inv_h2,
         },
         passes: direct::MAX_PASSES,
-    });
+    }
+    .run(backend);
     (0..rows.pose.len())
         .flat_map(|i| rows.pose[i].get())
         .collect()

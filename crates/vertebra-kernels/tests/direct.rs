@@ -996,13 +996,14 @@ const SCALE: SubstepScale = SubstepScale {
 };
 
 fn pass(backend: Backend, rows: &BodyRows, blocks: &mut [TreeBlock], topologies: &[Topology]) {
-    backend.dispatch(PositionPass {
+    PositionPass {
         blocks,
         topologies,
         rows,
         scale: SCALE,
         passes: vertebra_kernels::direct::MAX_PASSES,
-    });
+    }
+    .run(backend);
 }
 
 /// A tree offset by `offsets`: its error before and after each of
@@ -1422,30 +1423,30 @@ fn random_lane(
             StartLane::new(xa, qa, anchor_a, xb, qb, anchor_b)
         };
         let joint = JointLane {
-                body_a: row_a as u32,
-                body_b: row_b as u32,
-                anchor_a,
-                anchor_b,
-                frame_a,
-                frame_b,
-                rest_length: if chance(r, 0.2) {
-                    1e-6
-                } else {
-                    r.random_range(0.1..2.0)
-                },
-                // Limits that bind (active rows) as often as not.
-                swing_max: r.random_range(0.0..core::f32::consts::PI),
-                twist: {
-                    let lo = r.random_range(-core::f32::consts::PI..0.0);
-                    [lo, r.random_range(lo..core::f32::consts::PI)]
-                },
-                ellipse: [semi_axis(r, adversarial), semi_axis(r, adversarial)],
-                pyramid: [range(r, adversarial), range(r, adversarial)],
-                softness: {
-                    let compliance = log_uniform(r, -6.0, -1.0);
-                    common::limit_softness(r, compliance)
-                },
-            };
+            body_a: row_a as u32,
+            body_b: row_b as u32,
+            anchor_a,
+            anchor_b,
+            frame_a,
+            frame_b,
+            rest_length: if chance(r, 0.2) {
+                1e-6
+            } else {
+                r.random_range(0.1..2.0)
+            },
+            // Limits that bind (active rows) as often as not.
+            swing_max: r.random_range(0.0..core::f32::consts::PI),
+            twist: {
+                let lo = r.random_range(-core::f32::consts::PI..0.0);
+                [lo, r.random_range(lo..core::f32::consts::PI)]
+            },
+            ellipse: [semi_axis(r, adversarial), semi_axis(r, adversarial)],
+            pyramid: [range(r, adversarial), range(r, adversarial)],
+            softness: {
+                let compliance = log_uniform(r, -6.0, -1.0);
+                common::limit_softness(r, compliance)
+            },
+        };
         node.set(lane, &joint);
         node.bodies.set_start(lane, &start);
         block.soft |= node.is_soft(lane);
@@ -1608,7 +1609,15 @@ fn cut_scene(seed: u64, adversarial: bool) -> Cut {
     let lanes: Vec<LaneData> = (0..count)
         .map(|lane| {
             let first = 1 + lane * n;
-            random_lane(&mut r, &mut raw, &mut block, &shape, lane, first, adversarial)
+            random_lane(
+                &mut r,
+                &mut raw,
+                &mut block,
+                &shape,
+                lane,
+                first,
+                adversarial,
+            )
         })
         .collect();
     let sizes = topology.subtree_sizes();
@@ -1656,7 +1665,10 @@ fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
     let (mut blocks, topologies) = if pieces {
         (cut.blocks.clone(), cut.topologies.clone())
     } else {
-        (vec![cut.whole.block.clone()], vec![cut.whole.topology.clone()])
+        (
+            vec![cut.whole.block.clone()],
+            vec![cut.whole.topology.clone()],
+        )
     };
     start_pass(backend, &rows, &mut blocks, &topologies);
     for _ in 0..2 {
@@ -1670,7 +1682,12 @@ fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
                     .find(|p| p.piece.joints.contains(&j))
                     .expect("every joint in a piece");
                 let k = p.piece.joints.iter().position(|&x| x == j).expect("there") as u32;
-                (&blocks[p.block], p.lane, &cut.topologies[blocks[p.block].topology as usize], k)
+                (
+                    &blocks[p.block],
+                    p.lane,
+                    &cut.topologies[blocks[p.block].topology as usize],
+                    k,
+                )
             } else {
                 (&blocks[0], tree, &cut.whole.topology, j)
             };
@@ -1680,7 +1697,11 @@ fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
             let NodeKind::Joint { rows: kind, .. } = topology.nodes[node].kind else {
                 unreachable!()
             };
-            out.extend(block.scratch[node].x[..kind.count()].iter().map(|v| v[lane]));
+            out.extend(
+                block.scratch[node].x[..kind.count()]
+                    .iter()
+                    .map(|v| v[lane]),
+            );
             let limits = &block.joints[index as usize].limit_lambda;
             out.extend(limits.iter().map(|v| v[lane]));
         }
@@ -1699,7 +1720,8 @@ fn cut_trees_give_the_whole_trees_bits_on_every_backend() {
             for backend in Backend::available() {
                 for pieces in [false, true] {
                     let got = run_cut(backend, &cut, pieces);
-                    let k = (0..whole.len()).find(|&k| !vertebra_math::check::same_bits(whole[k], got[k]));
+                    let k = (0..whole.len())
+                        .find(|&k| !vertebra_math::check::same_bits(whole[k], got[k]));
                     if let Some(k) = k {
                         panic!(
                             "seed {seed}: {backend} (pieces: {pieces}) differs at float {k}: \

@@ -555,13 +555,14 @@ impl Pass for Positions {
             inv_h2: self.inv_h2,
         };
         let solve = |blocks: &mut [TreeBlock], backend: Backend| {
-            backend.dispatch(direct::PositionPass {
+            direct::PositionPass {
                 blocks,
                 topologies,
                 rows,
                 scale,
                 passes: self.passes,
-            });
+            }
+            .run(backend);
         };
         if joined {
             solve(blocks, backend);

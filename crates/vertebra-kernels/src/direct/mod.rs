@@ -37,7 +37,7 @@ pub mod split;
 use bytemuck::{Pod, Zeroable};
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::row::NO_WRITE;
-use vertebra_math::{Lane, LaneKernel};
+use vertebra_math::{Backend, Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
 use crate::limited::{LimitLane, SoftnessBlock};
@@ -217,7 +217,13 @@ impl Topology {
             })
             .collect();
         let children = children_in_order(&nodes, &keys, &[]);
-        Ok(Self::with_children(nodes, bodies, joints.len(), children, 0))
+        Ok(Self::with_children(
+            nodes,
+            bodies,
+            joints.len(),
+            children,
+            0,
+        ))
     }
 
     /// A topology from its nodes and their children (as
@@ -702,10 +708,13 @@ pub struct PositionPass<'a> {
     pub passes: usize,
 }
 
-impl LaneKernel for PositionPass<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn run<L: Lane>(self) {
+impl PositionPass<'_> {
+    /// Runs the solve on `backend`. Each phase enters the backend on its
+    /// own ([`Backend::dispatch`] per block and phase): a phase is then a
+    /// function of its own for each instruction set, where one kernel
+    /// holding all five, every joint kind's rows unrolled in each, made one
+    /// function per backend that took the optimiser minutes to compile.
+    pub fn run(self, backend: Backend) {
         let PositionPass {
             blocks,
             topologies,
@@ -713,8 +722,11 @@ impl LaneKernel for PositionPass<'_> {
             scale,
             passes,
         } = self;
+        let phase = |block: &mut TreeBlock, phase: Phase| {
+            run_phase(backend, block, topologies, rows, scale, phase);
+        };
         for block in blocks.iter_mut() {
-            run_phase::<L>(block, topologies, rows, scale, Phase::Measure);
+            phase(block, Phase::Measure);
             let live = block.live();
             block.dirty.fill(live);
         }
@@ -724,16 +736,16 @@ impl LaneKernel for PositionPass<'_> {
             }
             for k in 0..blocks.len() {
                 solve::take_ports(blocks, k);
-                run_phase::<L>(&mut blocks[k], topologies, rows, scale, Phase::Eliminate);
+                phase(&mut blocks[k], Phase::Eliminate);
             }
             for k in (0..blocks.len()).rev() {
                 solve::take_parent(blocks, k);
-                run_phase::<L>(&mut blocks[k], topologies, rows, scale, Phase::Substitute);
+                phase(&mut blocks[k], Phase::Substitute);
             }
             for block in blocks.iter_mut() {
                 block.dirty.fill(0);
                 block.crossing = [0.0; BLOCK_LANES];
-                run_phase::<L>(block, topologies, rows, scale, Phase::Settle);
+                phase(block, Phase::Settle);
             }
             if !solve::join_crossings(blocks) || pass >= passes {
                 break;
@@ -744,7 +756,7 @@ impl LaneKernel for PositionPass<'_> {
         }
         for block in blocks.iter_mut() {
             solve::adopt(block);
-            run_phase::<L>(block, topologies, rows, scale, Phase::Finish);
+            phase(block, Phase::Finish);
             block.fresh = false;
         }
     }
@@ -771,45 +783,69 @@ enum Phase {
     Finish,
 }
 
-/// Runs `phase` on every live slice of `block`.
-#[inline(always)]
-fn run_phase<L: Lane>(
+/// The phases as [`PhaseRun`]'s constant.
+const MEASURE: u8 = 0;
+const ELIMINATE: u8 = 1;
+const SUBSTITUTE: u8 = 2;
+const SETTLE: u8 = 3;
+const FINISH: u8 = 4;
+
+/// Runs `phase` on every live slice of `block`, on `backend`.
+fn run_phase(
+    backend: Backend,
     block: &mut TreeBlock,
     topologies: &[Topology],
     rows: &BodyRows,
     scale: SubstepScale,
     phase: Phase,
 ) {
-    let padding = block.padding;
-    let mut slices = Slices {
-        topology: &topologies[block.topology as usize],
-        block,
-        rows,
-        scale,
-        phase,
-    };
-    for_live_slices::<L, _>(padding, &mut slices);
+    let topology = &topologies[block.topology as usize];
+    macro_rules! run {
+        ($p:expr) => {
+            backend.dispatch(PhaseRun::<{ $p }> {
+                topology,
+                block,
+                rows,
+                scale,
+            })
+        };
+    }
+    match phase {
+        Phase::Measure => run!(MEASURE),
+        Phase::Eliminate => run!(ELIMINATE),
+        Phase::Substitute => run!(SUBSTITUTE),
+        Phase::Settle => run!(SETTLE),
+        Phase::Finish => run!(FINISH),
+    }
 }
 
-/// One block of a [`PositionPass`] phase.
-struct Slices<'a> {
+/// Phase `P` of a [`PositionPass`] on one block: a kernel of its own.
+struct PhaseRun<'a, const P: u8> {
     topology: &'a Topology,
     block: &'a mut TreeBlock,
     rows: &'a BodyRows,
     scale: SubstepScale,
-    phase: Phase,
 }
 
-impl LaneSlices for Slices<'_> {
+impl<const P: u8> LaneKernel for PhaseRun<'_, P> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(mut self) {
+        let padding = self.block.padding;
+        for_live_slices::<L, _>(padding, &mut self);
+    }
+}
+
+impl<const P: u8> LaneSlices for PhaseRun<'_, P> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
         let (topology, rows, scale) = (self.topology, self.rows, self.scale);
-        match self.phase {
-            Phase::Measure => solve::measure::<L>(self.block, topology, rows, start, scale),
-            Phase::Eliminate => solve::eliminate::<L>(self.block, topology, start, scale),
-            Phase::Substitute => solve::substitute::<L>(self.block, topology, start),
-            Phase::Settle => solve::settle::<L>(self.block, topology, start),
-            Phase::Finish => {
+        match P {
+            MEASURE => solve::measure::<L>(self.block, topology, rows, start, scale),
+            ELIMINATE => solve::eliminate::<L>(self.block, topology, start, scale),
+            SUBSTITUTE => solve::substitute::<L>(self.block, topology, start),
+            SETTLE => solve::settle::<L>(self.block, topology, start),
+            _ => {
                 solve::accumulate::<L>(self.block, topology, start);
                 solve::apply::<L>(self.block, topology, rows, start);
             }
