@@ -457,6 +457,8 @@ fn body_block<L: Lane>(
 /// solves), `A D^-1 A^T = w^T D^-1 w` and `A D^-1 b = w^T D^-1 L^-1 b`.
 /// A limit row no lane of the slice holds is left out (the joint never
 /// reads it there).
+// Row indices address several arrays and the packed block (`at(i, j)`).
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn body_out<L: Lane, const E: usize, const K: usize>(
     block: &mut TreeBlock,
@@ -513,6 +515,8 @@ fn body_out<L: Lane, const E: usize, const K: usize>(
 /// the body its static, kinematic or other block's side stands for):
 /// with `A` its rows on that body and `w = L^-1 A`, `A^T D^-1 A = w^T
 /// D^-1 w`.
+// Row indices address several arrays and the packed block (`at(i, j)`).
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn joint_node<L: Lane, const E: usize, const K: usize>(
     block: &mut TreeBlock,
