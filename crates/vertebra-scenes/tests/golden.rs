@@ -116,8 +116,8 @@ fn anatomical_drop_direct() {
 // elliptical sockets, hinges and rod through both solves.
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
-const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0xc656_e349_9e78_23bd;
-const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x6845_d290_5437_24b7;
+const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x5fff_c5e6_5fb8_46f4;
+const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x8945_505a_0832_3883;
 
 // The direct solve's, set by the commit that introduced them;
 // all four moved when every limit row joined the solve with
@@ -141,11 +141,18 @@ const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x6845_d290_5437_24b7;
 // lane where a limit row crossed, not for a release alone: they were
 // 0xda85_7ec1_6e55_e66b and 0xbcb6_8235_7f1e_88a9 (bending),
 // 0x3160_b8fa_7c1a_7d0d and 0x32a4_83fc_f651_bae2 (drop), and
-// 0x50c8_df1a_1a03_746b and 0x979c_19ca_4c81_984d (anatomical).
-const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x54c3_20a6_97c2_c911;
-const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x7ac9_2204_2740_dfc5;
-const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3634_643b_ea27_12fe;
-const GOLDEN_DROP_ROD_DIRECT: u64 = 0xbcd9_d34d_fee2_a132;
+// 0x50c8_df1a_1a03_746b and 0x979c_19ca_4c81_984d (anatomical). Then all
+// six by the up-looking elimination (each node pulls its children's
+// complements, only the rows its joint kind has) and a lone ragdoll's
+// subtrees laid out as pieces in lanes of their own, joined through
+// ports: the same sums in another order. They were 0x54c3_20a6_97c2_c911
+// and 0x7ac9_2204_2740_dfc5 (bending), 0x3634_643b_ea27_12fe and
+// 0xbcd9_d34d_fee2_a132 (drop), and 0xc656_e349_9e78_23bd and
+// 0x6845_d290_5437_24b7 (anatomical).
+const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x2636_906e_671c_b1e1;
+const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x3fe6_911f_8645_7cc7;
+const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3070_1f12_587a_75ea;
+const GOLDEN_DROP_ROD_DIRECT: u64 = 0xaede_52fc_ecea_722f;
 
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision
