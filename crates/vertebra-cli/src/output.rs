@@ -46,6 +46,7 @@ fn figures(run: &SceneRun) -> Vec<(String, f64)> {
         out.push((format!("recovery_frames_{name}"), frames));
     }
     out.push(("ms_per_step".to_owned(), run.ms_per_step));
+    out.push(("frame_ms".to_owned(), run.frame_ms));
     out
 }
 
@@ -169,7 +170,7 @@ pub fn seeded_json(config: &SceneConfig, seeded: &Seeded) -> Value {
 pub fn print_summary(config: &SceneConfig, run: &SceneRun) {
     let (lin, ang) = (run.stats(Quantity::EpsLin), run.stats(Quantity::EpsAng));
     println!(
-        "{} ({}, {} joints): mean eps_lin {:.4} cm, max {:.4} cm; mean eps_ang {:.5} rad, max {:.5} rad; {:.3} ms/step on {}; state {:016x}",
+        "{} ({}, {} joints): mean eps_lin {:.4} cm, max {:.4} cm; mean eps_ang {:.5} rad, max {:.5} rad; {:.3} ms/step ({:.3} ms the frame alone) on {}; state {:016x}",
         config.scene,
         spine_name(config.spine),
         joints_name(config.joints),
@@ -178,6 +179,7 @@ pub fn print_summary(config: &SceneConfig, run: &SceneRun) {
         ang.mean,
         ang.max,
         run.ms_per_step,
+        run.frame_ms,
         run.backend,
         run.state_hash
     );

@@ -160,6 +160,7 @@ fn write_table(table: &mut String, scene: Scene, runs: &[(SpineMode, Seeded)]) {
             .chain(&[Quantity::EpsLin, Quantity::EpsAng])
             .any(|q| name.ends_with(q.key()))
             || name == "ms_per_step"
+            || name == "frame_ms"
     };
     for ((name, s), (_, r)) in sockets.iter().zip(&rod).filter(|(s, _)| shown(&s.0)) {
         writeln!(

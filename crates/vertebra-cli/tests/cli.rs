@@ -59,6 +59,7 @@ fn scene_json_has_every_field() {
         "mean_eps_ang_rad",
         "max_eps_ang_rad",
         "ms_per_step",
+        "frame_ms",
     ] {
         assert!(v["summary"][field].is_number(), "summary.{field}");
     }

@@ -17,13 +17,14 @@ pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
     let desc = config.description()?;
     let drive = config.drive()?;
     let world = config.world()?;
-    match config.scene {
+    let built = match config.scene {
         Scene::PassiveBending => passive_bending::build(world, &desc, config),
         Scene::Controllability => controllability::build(world, &desc, config),
         Scene::RagdollDrop | Scene::AnatomicalDrop => ragdoll_drop::build(world, &desc, config),
         Scene::HitReaction => hit_reaction::build(world, &desc, config, &drive),
         Scene::HeavyChain => heavy_chain::build(world, &desc, config),
-    }
+    };
+    Ok(built?.watching(config.measure_residuals))
 }
 
 /// A ragdoll at `pose` whose root body (the hips) is held where it is.

@@ -44,13 +44,15 @@ pub struct SceneConfig {
     /// The hit-reaction drive's torque limit per joint (N m; infinity is
     /// unlimited, not negative).
     pub max_torque: f32,
-    /// Whether the world measures its residuals at the end of every step
-    /// (`SolverConfig::measure_residuals`): every figure of a scene is
-    /// measured from them, so [`SceneConfig::new`] turns it on; off only
-    /// to time the step alone (and then [`SceneWorld::measure`] needs
+    /// Whether the scene measures its residuals after every frame
+    /// (`World::measure_residuals`, outside the frame's own cost:
+    /// [`SceneWorld::advance`]): every figure of a scene is measured from
+    /// them, so [`SceneConfig::new`] turns it on; off only to time the
+    /// step alone (and then [`SceneWorld::measure`] needs
     /// `World::measure_residuals` first).
     ///
     /// [`SceneWorld::measure`]: crate::SceneWorld::measure
+    /// [`SceneWorld::advance`]: crate::SceneWorld::advance
     pub measure_residuals: bool,
     /// When islands fall asleep (`SolverConfig::sleep`). Off (`None`) in
     /// [`SceneConfig::new`]: the paper's figures, and the engines they are
@@ -121,7 +123,6 @@ impl SceneConfig {
             joints: self.joints,
             backend: self.backend,
             threads: self.threads,
-            measure_residuals: self.measure_residuals,
             sleep: self.sleep,
             ..SolverConfig::default()
         };

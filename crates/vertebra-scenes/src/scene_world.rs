@@ -36,6 +36,8 @@ pub struct SceneWorld {
     rods: HashSet<RodHandle>,
     /// The contact list the detection fills and swaps into the world.
     contacts: Vec<Contact>,
+    /// Whether [`Self::advance`] measures the residuals after the frame.
+    watching: bool,
 }
 
 impl SceneWorld {
@@ -61,7 +63,14 @@ impl SceneWorld {
             joints,
             rods,
             contacts: Vec::new(),
+            watching: false,
         }
+    }
+
+    /// Measuring the residuals after every frame ([`Self::advance`]) or not.
+    pub(crate) fn watching(mut self, watching: bool) -> Self {
+        self.watching = watching;
+        self
     }
 
     /// Also counting `joints` (not the ragdolls' own) in the residual
@@ -90,10 +99,29 @@ impl SceneWorld {
         Ok(())
     }
 
-    /// Frame `frame` of the scene, `dt` seconds: collision detection, the
-    /// push of figure 7 (controllability, frames 30 to 90), the hits due
-    /// this frame, the step.
+    /// Frame `frame` of the scene, `dt` seconds, then (when the scene's
+    /// config measures residuals) `World::measure_residuals` on its poses,
+    /// for [`Self::measure`].
     pub fn advance(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
+        self.frame(scene, frame, dt)?;
+        self.watch();
+        Ok(())
+    }
+
+    /// Measures the residuals of the world's poses (`World::measure_residuals`)
+    /// when the scene's config asks for them, for [`Self::measure`].
+    pub fn watch(&mut self) {
+        if self.watching {
+            let _mode = DefaultFloatMode::enter();
+            self.world.measure_residuals();
+        }
+    }
+
+    /// Frame `frame` of the scene, `dt` seconds, and nothing that watches
+    /// it: collision detection, the push of figure 7 (controllability,
+    /// frames 30 to 90), the hits due this frame, the step. What a game
+    /// pays for the frame ([`SceneRun::frame_ms`](crate::SceneRun::frame_ms)).
+    pub fn frame(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
         self.detect(dt)?;
         if let (Some((body, force)), Scene::Controllability, true) =
@@ -115,7 +143,8 @@ impl SceneWorld {
     ///
     /// # Panics
     /// If `world`'s residuals were not measured since its last step: a
-    /// scene's world measures them every step unless its config turned
+    /// scene measures them after every frame ([`Self::advance`]) unless its
+    /// config turned
     /// [`SceneConfig::measure_residuals`](crate::SceneConfig::measure_residuals)
     /// off.
     pub fn measure(&self, world: &World) -> Frame {

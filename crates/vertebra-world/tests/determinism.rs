@@ -20,13 +20,17 @@ fn build(backend: Backend, threads: usize) -> World {
 
 /// [`build`]'s world with its joints solved by `joints`.
 fn build_solved(backend: Backend, threads: usize, joints: JointSolver) -> World {
-    let config = SolverConfig {
+    build_with(SolverConfig {
         backend: BackendChoice::Forced(backend),
         threads,
         parallel_min_blocks: 1,
         joints,
         ..SolverConfig::default()
-    };
+    })
+}
+
+/// [`build`]'s bodies and joints in a world of `config`.
+fn build_with(config: SolverConfig) -> World {
     let mut w = World::new(config).unwrap();
     let ground = w.add_body(BodyDesc::fixed()).unwrap();
     for tree in 0..30 {
@@ -310,5 +314,59 @@ fn worlds_of_one_to_nine_chains_give_the_same_bits_on_every_backend() {
                 "{backend} differs from scalar with {count} chain(s)"
             );
         }
+    }
+}
+
+/// Measured after a step (`World::measure_residuals`, as the scenes do,
+/// outside the frame's own cost), the residuals are the step's own: each
+/// joint's equals what a world measuring in every step reports, up to
+/// the rounding of the committed poses (the step measures its rows as
+/// they left the solve; after it they are built again from the bodies:
+/// a few ulps of a position, 1e-4 cm or rad),
+/// and measuring changes nothing the next step does.
+#[test]
+fn residuals_measured_after_a_step_are_the_steps_own() {
+    for joints in [JointSolver::Iterative, JointSolver::Direct] {
+        let config = |measure_residuals| SolverConfig {
+            joints,
+            measure_residuals,
+            ..SolverConfig::default()
+        };
+        let (mut during, mut after) = (build_with(config(true)), build_with(config(false)));
+        for frame in 0..90 {
+            if frame < 30 {
+                for w in [&mut during, &mut after] {
+                    let bodies: Vec<_> = (0..w.bodies().capacity())
+                        .filter_map(|i| w.bodies().handle_at(i))
+                        .collect();
+                    let b = bodies[(frame * 7) % bodies.len()];
+                    w.add_force(b, Vec3::new(20.0, 0.0, -10.0)).unwrap();
+                }
+            }
+            during.step(1.0 / 60.0).unwrap();
+            after.step(1.0 / 60.0).unwrap();
+            let stepped = during.residuals().expect("measured in the step").clone();
+            let asked = after.measure_residuals();
+            let values = |r: &vertebra_world::Residuals| -> Vec<f32> {
+                let joints = r
+                    .joints
+                    .iter()
+                    .map(|j| [j.linear_cm, j.angular_rad, j.limit_rad]);
+                let rods = r
+                    .rods
+                    .iter()
+                    .map(|j| [j.linear_cm, j.angular_rad, j.limit_rad]);
+                joints.chain(rods).flatten().collect()
+            };
+            let (stepped, asked) = (values(&stepped), values(asked));
+            assert_eq!(stepped.len(), asked.len());
+            for (k, (s, a)) in stepped.iter().zip(&asked).enumerate() {
+                assert!(
+                    (s - a).abs() <= 1e-4 * s.abs().max(a.abs()) + 1e-4,
+                    "{joints:?}, frame {frame}, value {k}: {s:e} in the step, {a:e} after"
+                );
+            }
+        }
+        assert_eq!(during.state_hash(), after.state_hash(), "{joints:?}");
     }
 }
