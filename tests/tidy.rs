@@ -218,7 +218,10 @@ fn lane_code_has_no_closures() {
             .any(|f| path.starts_with(&format!("crates/vertebra-math/src/{f}")))
     };
     for (path, text) in sources() {
-        if !lane_code(&path) {
+        // A kernels file that names no lane type (the trees' layout into
+        // pieces) holds no lane code.
+        let generic = !path.starts_with("crates/vertebra-kernels/") || text.contains("L: Lane");
+        if !lane_code(&path) || !generic {
             continue;
         }
         for (n, line) in text.lines().enumerate() {

@@ -82,7 +82,7 @@ pub enum NodeKind {
 
 /// A node's child: another node of its tree, or a port (a subtree laid
 /// out in another block, whose Schur complement the block copies in).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Child {
     /// Node `index` of the same topology.
     Node(u32),
@@ -209,13 +209,13 @@ impl Topology {
                 parent: if up == NONE { NONE } else { place[up as usize] },
             });
         }
-        let keys: Vec<u32> = nodes
-            .iter()
-            .map(|node| match node.kind {
+        let mut keys = Vec::with_capacity(nodes.len());
+        for node in &nodes {
+            keys.push(match node.kind {
                 NodeKind::Joint { index, .. } => index,
                 NodeKind::Body { .. } => 0,
-            })
-            .collect();
+            });
+        }
         let children = children_in_order(&nodes, &keys, &[]);
         Ok(Self::with_children(
             nodes,
@@ -285,13 +285,17 @@ pub(crate) fn children_in_order(
     for &(node, joint, index) in ports {
         keyed[node as usize].push((joint, Child::Port(index)));
     }
-    for list in keyed.iter_mut() {
-        list.sort_by_key(|&(key, _)| key);
+    let mut children = Vec::with_capacity(keyed.len());
+    for mut list in keyed {
+        // Keys are joint indices, distinct among a node's children.
+        list.sort_unstable();
+        let mut ordered = Vec::with_capacity(list.len());
+        for (_, child) in list {
+            ordered.push(child);
+        }
+        children.push(ordered);
     }
-    keyed
-        .into_iter()
-        .map(|list| list.into_iter().map(|(_, c)| c).collect())
-        .collect()
+    children
 }
 
 /// The node of body `i` (`NONE` for none: static or kinematic).
@@ -722,11 +726,9 @@ impl PositionPass<'_> {
             scale,
             passes,
         } = self;
-        let phase = |block: &mut TreeBlock, phase: Phase| {
-            run_phase(backend, block, topologies, rows, scale, phase);
-        };
+        let on = (backend, topologies, rows, scale);
         for block in blocks.iter_mut() {
-            phase(block, Phase::Measure);
+            run_phase(on, block, Phase::Measure);
             let live = block.live();
             block.dirty.fill(live);
         }
@@ -736,16 +738,16 @@ impl PositionPass<'_> {
             }
             for k in 0..blocks.len() {
                 solve::take_ports(blocks, k);
-                phase(&mut blocks[k], Phase::Eliminate);
+                run_phase(on, &mut blocks[k], Phase::Eliminate);
             }
             for k in (0..blocks.len()).rev() {
                 solve::take_parent(blocks, k);
-                phase(&mut blocks[k], Phase::Substitute);
+                run_phase(on, &mut blocks[k], Phase::Substitute);
             }
             for block in blocks.iter_mut() {
                 block.dirty.fill(0);
                 block.crossing = [0.0; BLOCK_LANES];
-                phase(block, Phase::Settle);
+                run_phase(on, block, Phase::Settle);
             }
             if !solve::join_crossings(blocks) || pass >= passes {
                 break;
@@ -756,7 +758,7 @@ impl PositionPass<'_> {
         }
         for block in blocks.iter_mut() {
             solve::adopt(block);
-            phase(block, Phase::Finish);
+            run_phase(on, block, Phase::Finish);
             block.fresh = false;
         }
     }
@@ -792,11 +794,8 @@ const FINISH: u8 = 4;
 
 /// Runs `phase` on every live slice of `block`, on `backend`.
 fn run_phase(
-    backend: Backend,
+    (backend, topologies, rows, scale): (Backend, &[Topology], &BodyRows, SubstepScale),
     block: &mut TreeBlock,
-    topologies: &[Topology],
-    rows: &BodyRows,
-    scale: SubstepScale,
     phase: Phase,
 ) {
     let topology = &topologies[block.topology as usize];

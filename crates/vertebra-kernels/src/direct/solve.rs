@@ -264,7 +264,10 @@ pub(super) fn take_crossings(block: &mut TreeBlock, topology: &Topology) {
         let limits = kind.count() - kind.first_limit();
         let scratch = &mut block.scratch[n];
         let mut changed = 0u8;
-        for lane in (0..BLOCK_LANES).filter(|&l| crossing[l] != 0.0) {
+        for (lane, &crossed) in crossing.iter().enumerate() {
+            if crossed == 0.0 {
+                continue;
+            }
             for o in 0..limits {
                 if scratch.next[o][lane] != scratch.active[o][lane] {
                     changed |= 1 << lane;
@@ -318,7 +321,14 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock]) -> bool {
             }
         }
     }
-    blocks.iter().any(|b| b.crossing.iter().any(|&c| c != 0.0))
+    for block in blocks.iter() {
+        for &c in &block.crossing {
+            if c != 0.0 {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 /// Copies into block `k`'s ports their subtrees' complements (and which
