@@ -75,6 +75,19 @@ pub struct ContactBlock {
     /// Accumulated tangential multiplier (a world vector in the tangent
     /// plane), reset every substep.
     pub lambda_t: Vec3Block,
+    /// `lambda_n` of the step's substeps before this one, summed (kg m):
+    /// what the position level pushed (read by [`ContactBlock::impulse`];
+    /// never read by the solve).
+    pub pushed_n: [f32; BLOCK_LANES],
+    /// `lambda_t` of the step's substeps before this one, summed (kg m,
+    /// world).
+    pub pushed_t: Vec3Block,
+    /// The velocity pass's normal impulses (restitution) of the step,
+    /// summed (N s, along the normal; never read by the solve).
+    pub kicked_n: [f32; BLOCK_LANES],
+    /// The velocity pass's friction impulses on b of the step, summed (N s,
+    /// world).
+    pub kicked_t: Vec3Block,
 }
 
 /// One contact's solver data.
@@ -134,15 +147,52 @@ impl ContactBlock {
         self.allowance[lane] = c.overlap;
         self.lambda_n[lane] = 0.0;
         self.lambda_t.set(lane, GVec3::ZERO);
+        self.pushed_n[lane] = 0.0;
+        self.pushed_t.set(lane, GVec3::ZERO);
+        self.kicked_n[lane] = 0.0;
+        self.kicked_t.set(lane, GVec3::ZERO);
     }
 
     /// Starts a substep: the multipliers reset, and the overlap allowed at
     /// its end set to `remaining` (in [0, 1]) of the contact's overlap.
     pub fn start_substep(&mut self, remaining: f32) {
+        // What the substep before pushed, kept for `impulse`.
+        for lane in 0..BLOCK_LANES {
+            self.pushed_n[lane] += self.lambda_n[lane];
+            let pushed_t = self.pushed_t.get(lane) + self.lambda_t.get(lane);
+            self.pushed_t.set(lane, pushed_t);
+        }
         self.lambda_n = [0.0; BLOCK_LANES];
         self.lambda_t = Vec3Block::default();
         for (allowed, overlap) in self.allowance.iter_mut().zip(self.overlap) {
             *allowed = overlap * remaining;
+        }
+    }
+}
+
+/// What one contact did in its step: the impulses it applied to body b
+/// (body a took their opposite).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactImpulse {
+    /// Along the normal (N s, at least 0: a contact pushes, never pulls):
+    /// the position level's push over every substep and the velocity
+    /// pass's restitution.
+    pub normal: f32,
+    /// Friction, in the tangent plane (N s, world): the position level's
+    /// static friction and the velocity pass's dynamic friction.
+    pub friction: GVec3,
+}
+
+impl ContactBlock {
+    /// The impulses `lane`'s contact applied over the step so far, for
+    /// substeps of `h` seconds (a multiplier `lambda` in kg m is the
+    /// impulse `lambda / h`).
+    pub fn impulse(&self, lane: usize, h: f32) -> ContactImpulse {
+        let pushed_n = self.pushed_n[lane] + self.lambda_n[lane];
+        let pushed_t = self.pushed_t.get(lane) + self.lambda_t.get(lane);
+        ContactImpulse {
+            normal: pushed_n / h + self.kicked_n[lane],
+            friction: pushed_t / h + self.kicked_t.get(lane),
         }
     }
 }
@@ -264,8 +314,8 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
 
 /// The velocity pass: dynamic friction and restitution.
 pub struct VelocityPass<'a> {
-    /// The blocks.
-    pub blocks: &'a [ContactBlock],
+    /// The blocks (their `kicked_n` and `kicked_t` written).
+    pub blocks: &'a mut [ContactBlock],
     /// Body rows: poses and inertia read, velocities read and written.
     pub rows: &'a BodyRows,
     /// The substep `h` (s).
@@ -278,21 +328,22 @@ impl LaneKernel for VelocityPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
-        for block in self.blocks {
+        for block in self.blocks.iter_mut() {
+            let padding = block.bodies.padding;
             let mut velocities = Velocities {
                 block,
                 rows: self.rows,
                 h: self.h,
                 resting_speed: self.resting_speed,
             };
-            for_live_slices::<L, _>(block.bodies.padding, &mut velocities);
+            for_live_slices::<L, _>(padding, &mut velocities);
         }
     }
 }
 
 /// One block of a [`VelocityPass`].
 struct Velocities<'a> {
-    block: &'a ContactBlock,
+    block: &'a mut ContactBlock,
     rows: &'a BodyRows,
     h: f32,
     resting_speed: f32,
@@ -327,7 +378,7 @@ fn kick<L: Lane>(
 
 #[inline(always)]
 fn solve_velocities<L: Lane>(
-    block: &ContactBlock,
+    block: &mut ContactBlock,
     start: usize,
     rows: &BodyRows,
     h: L,
@@ -355,6 +406,8 @@ fn solve_velocities<L: Lane>(
     let impulse = stop.min(budget);
     let friction = t.scale(L::select(touching, -impulse, zero));
     kick(&a, &b, &mut va, &mut vb, ra, rb, friction);
+    let kicked_t = block.kicked_t.load::<L>(start) + friction;
+    block.kicked_t.store(start, kicked_t);
 
     let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
     let approach = L::load(&block.approach[start..]);
@@ -366,15 +419,9 @@ fn solve_velocities<L: Lane>(
     );
     let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
     let change = L::select(touching, (target - relative.dot(n)).max(zero), zero);
-    kick(
-        &a,
-        &b,
-        &mut va,
-        &mut vb,
-        ra,
-        rb,
-        n.scale(safe_ratio(change, wn)),
-    );
+    let restitution = safe_ratio(change, wn);
+    kick(&a, &b, &mut va, &mut vb, ra, rb, n.scale(restitution));
+    (L::load(&block.kicked_n[start..]) + restitution).store(&mut block.kicked_n[start..]);
 
     va.scatter(rows, &pairs.write_a[start..]);
     vb.scatter(rows, &pairs.write_b[start..]);

@@ -70,7 +70,7 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[ContactBlock]) -> Vec<f32> {
         });
     }
     backend.dispatch(VelocityPass {
-        blocks: &blocks,
+        blocks: &mut blocks,
         rows: &rows,
         h: 1.0 / 60.0,
         resting_speed: 0.33,
@@ -78,9 +78,10 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[ContactBlock]) -> Vec<f32> {
     let mut out = flatten(&rows);
     for b in &blocks {
         out.extend(b.lambda_n);
-        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
-            &b.lambda_t,
-        )));
+        out.extend(b.kicked_n);
+        for v in [&b.lambda_t, &b.kicked_t] {
+            out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(v)));
+        }
     }
     out
 }

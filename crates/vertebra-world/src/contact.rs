@@ -7,7 +7,7 @@ use core::ops::Range;
 
 use glam::Vec3;
 use vertebra_kernels::body::{BodyPairs, StartLane};
-use vertebra_kernels::contact::{ContactBlock, ContactLane};
+use vertebra_kernels::contact::{ContactBlock, ContactImpulse, ContactLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::MAX_COLOURS;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_point, check_unit_vec};
@@ -291,6 +291,21 @@ impl ContactLayout {
         self.disjoint = self.colours.iter().all(|r| {
             crate::parallel::colour_is_disjoint(blocks[r.clone()].iter().map(|b| &b.bodies), reads)
         });
+    }
+
+    /// Each of the step's `count` contacts' impulses (in the order they
+    /// were set; zero for one left out, between sleeping bodies) into
+    /// `out` (its capacity kept), for substeps of `h` seconds: read from
+    /// the blocks after the step's last substep.
+    pub fn impulses(&self, count: usize, h: f32, out: &mut Vec<ContactImpulse>) {
+        out.clear();
+        out.resize(count, ContactImpulse::default());
+        for (block, keys) in self.blocks.iter().zip(&self.block_keys) {
+            let contacts = &self.order[keys.start as usize..keys.end as usize];
+            for (lane, &key) in contacts.iter().enumerate() {
+                out[key as usize] = block.impulse(lane, h);
+            }
+        }
     }
 
     /// The body pairs of every block of bin `bin`.

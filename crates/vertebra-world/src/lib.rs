@@ -69,6 +69,7 @@ pub use snapshot::{Snapshot, Timeline};
 #[cfg(feature = "stage-timing")]
 pub use stages::timing as stage_timing;
 pub use tasks::{RayonTasks, SingleThreaded, TaskSystem};
+pub use vertebra_kernels::contact::ContactImpulse;
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
@@ -100,6 +101,13 @@ pub struct World {
     layout: layout::Layout,
     layout_dirty: bool,
     contacts: Vec<Contact>,
+    /// The contacts the last step solved (no part of the state: the
+    /// step's output, with `impulses`).
+    solved: Vec<Contact>,
+    /// The impulse each of `solved` applied.
+    impulses: Vec<ContactImpulse>,
+    /// Steps taken since the world was made (no part of the state).
+    step_count: u64,
     contact_layout: contact::ContactLayout,
     rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
@@ -155,6 +163,9 @@ impl World {
             layout: layout::Layout::default(),
             layout_dirty: false,
             contacts: Vec::new(),
+            solved: Vec::new(),
+            impulses: Vec::new(),
+            step_count: 0,
             contact_layout: contact::ContactLayout::default(),
             rows: parallel::Scratch::default(),
             previous: Vec::new(),
@@ -546,6 +557,35 @@ impl World {
         &self.contacts
     }
 
+    /// The contacts the last step solved: the list set for it, in its
+    /// order (empty before the first step and after a restore). With
+    /// [`World::contact_impulses`], what a game reads after a step for
+    /// sounds and damage (Box2D v3's contact events; the collision layer
+    /// turns them into began and ended events per pair of bodies). Copied
+    /// into a buffer the world keeps: a steady step allocates nothing for
+    /// them.
+    pub fn solved_contacts(&self) -> &[Contact] {
+        &self.solved
+    }
+
+    /// The impulse each of [`World::solved_contacts`] applied over the
+    /// last step, index for index: along its normal (N s, pushing
+    /// `body_b`; 0 for a gap that never closed, or a contact left out
+    /// between sleeping bodies) and its friction (N s, world, on
+    /// `body_b`); `body_a` took their opposite. Reading them changes
+    /// nothing: the solve never reads what it records here.
+    pub fn contact_impulses(&self) -> &[ContactImpulse] {
+        &self.impulses
+    }
+
+    /// How many steps this world object has taken since it was made
+    /// (restores included, refused steps not): with the world's
+    /// [`Timeline`], which step a companion's record belongs to. No part
+    /// of the state (not in snapshots or the state hash).
+    pub fn step_count(&self) -> u64 {
+        self.step_count
+    }
+
     /// Measures the residual joint error of the current poses, without
     /// stepping (e.g. right after building a ragdoll, or after a step of a
     /// world that does not measure every step:
@@ -690,13 +730,22 @@ impl World {
         // Each substep launches the task system's workers once
         // (step::solve_substep).
         step::step(self, dt, workers);
+        let h = dt / self.config.substeps as f32;
+        self.contact_layout
+            .impulses(self.contacts.len(), h, &mut self.impulses);
         if let Some(settings) = &self.config.sleep {
             let links = islands::links(&self.joints, &self.rods);
             self.layout_dirty |=
                 self.islands
                     .settle(settings, dt, &mut self.bodies, links, &self.contacts);
         }
+        // The solved list is the step's output, copied (so the list a
+        // caller swapped in comes back at the next swap, as documented;
+        // no allocation once `solved` has grown).
+        self.solved.clear();
+        self.solved.extend_from_slice(&self.contacts);
         self.contacts.clear();
+        self.step_count += 1;
         self.residuals_measured = self.config.measure_residuals;
         if self.residuals_measured {
             metrics::residuals(self);

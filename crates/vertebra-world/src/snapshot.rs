@@ -343,6 +343,8 @@ impl World {
         self.islands = state.islands;
         self.islands.derive();
         self.contacts = state.contacts;
+        self.solved.clear();
+        self.impulses.clear();
         self.layout_dirty = true;
         self.timeline = Timeline::begin(true);
         self.measure_residuals();
