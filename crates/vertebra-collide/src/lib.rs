@@ -30,8 +30,12 @@
 //! taken with. Restore both, the world first; [`Collisions::attach`]
 //! declares a set right for a world as it is.
 
+mod continuous;
+mod events;
+mod frame;
 mod groups;
 mod pairing;
+mod query;
 mod snapshot;
 
 use std::collections::{HashMap, HashSet};
@@ -51,8 +55,21 @@ use vertebra_world::{
     BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, Timeline, World,
 };
 
+pub use events::{ContactEnded, ContactEvents, Touching};
 pub use groups::MAX_SELF_COLLISION_GROUPS;
+pub use query::{Overlap, QueryFilter, QueryHit, QueryShape};
 pub use snapshot::CollisionSnapshot;
+
+/// Which ragdoll and bone a body is, in hits and events.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub struct RagdollPart {
+    /// The ragdoll, named by its first body (`Ragdoll::first_body`).
+    pub ragdoll: BodyHandle,
+    /// The body's index in the ragdoll's description
+    /// (`Ragdoll::description().bodies[bone]`, whose `name` is the
+    /// bone's).
+    pub bone: u32,
+}
 
 /// Which colliders may touch (Rapier's `InteractionGroups`): a pair is
 /// tested when each one's `membership` meets the other's `filter` (both
@@ -204,6 +221,27 @@ pub struct Collisions {
     apart: HashMap<BodyHandle, u64>,
     /// The group the next ragdoll whose self-collision goes off gets.
     next_apart: u64,
+    /// The ragdoll and bone of every ragdoll body the set added
+    /// (`build_ragdoll`, `add_ragdoll`).
+    parts: HashMap<BodyHandle, RagdollPart>,
+    /// The pairs of bodies touching after the last step the events saw,
+    /// in ascending order (`events.rs`).
+    touching: Vec<(BodyHandle, BodyHandle)>,
+    /// Counts every change to the colliders (added, removed, moved to
+    /// other bodies, restored): with the world's, when the query tree and
+    /// a detection's record still hold. Not part of the set's state.
+    version: u64,
+    /// What the last `find_contacts_into` found, for `after_step`
+    /// (`frame.rs`). Not part of the set's state.
+    found: frame::Found,
+    /// The last step's events (`events.rs`). Output, not state.
+    events: ContactEvents,
+    /// The scene queries' tree (`query.rs`). Not part of the set's state.
+    tree: query::QueryTree,
+    /// The list [`Collisions::step`] finds contacts into (working memory).
+    frame_contacts: Vec<Contact>,
+    /// Scratch of continuous collision: the bodies it puts back.
+    moves: Vec<(BodyHandle, Vec3, Quat)>,
     /// The world's run of states the set serves, once it has served one
     /// (`pairing.rs`). Not part of the set's state: never saved; a clone
     /// serves the same world.
@@ -309,6 +347,7 @@ impl Collisions {
             .geometry()
             .map_err(|e| collider.refused(index, e))?;
         self.colliders.push((collider, shape));
+        self.version += 1;
         Ok(index)
     }
 
@@ -335,6 +374,7 @@ impl Collisions {
             })
             .collect::<Result<Vec<_>, _>>()?;
         self.colliders.extend(checked);
+        self.version += 1;
         for &(a, b) in excluded {
             self.exclude(a, b);
         }
@@ -348,7 +388,9 @@ impl Collisions {
     pub fn add_ragdoll(&mut self, ragdoll: &Ragdoll) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
         ragdoll.check_not_removed()?;
-        Ok(self.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())?)
+        self.add_jointed(&ragdoll.collision_shapes(), &ragdoll.non_colliding_pairs())?;
+        self.register_parts(ragdoll);
+        Ok(())
     }
 
     /// Builds a ragdoll in `world` (see `Ragdoll::build`) and adds its
@@ -390,6 +432,8 @@ impl Collisions {
         for (a, b) in ragdoll.non_colliding_pairs() {
             self.exclude(a, b);
         }
+        self.version += 1;
+        self.register_parts(&ragdoll);
         self.serve(world);
         Ok(ragdoll)
     }
@@ -449,6 +493,16 @@ impl Collisions {
             .map(|&(a, b)| ordered(to(a), to(b)))
             .collect();
         self.apart = self.apart.iter().map(|(&b, &g)| (to(b), g)).collect();
+        self.parts = (self.parts.iter())
+            .map(|(&b, p)| {
+                let part = RagdollPart {
+                    ragdoll: to(p.ragdoll),
+                    bone: p.bone,
+                };
+                (to(b), part)
+            })
+            .collect();
+        self.version += 1;
         self.serve(world);
         Ok(())
     }
@@ -482,6 +536,28 @@ impl Collisions {
         self.colliders.retain(|c| c.0.body != body);
         self.excluded.retain(|&(a, b)| a != body && b != body);
         self.apart.remove(&body);
+        self.parts.remove(&body);
+        self.version += 1;
+    }
+
+    /// Records `ragdoll`'s bodies as its parts (hits and events name them
+    /// by it).
+    fn register_parts(&mut self, ragdoll: &Ragdoll) {
+        let Some(first) = ragdoll.first_body() else {
+            return;
+        };
+        for (bone, body) in ragdoll.bodies.iter().enumerate() {
+            if let Some(body) = *body {
+                let bone = bone as u32;
+                self.parts.insert(
+                    body,
+                    RagdollPart {
+                        ragdoll: first,
+                        bone,
+                    },
+                );
+            }
+        }
     }
 
     /// Every contact between the colliders at the bodies' current poses, in
@@ -526,6 +602,9 @@ impl Collisions {
         self.scratch = scratch;
         if found.is_ok() {
             self.serve(world);
+            let mut record = core::mem::take(&mut self.found);
+            record.record(self, world, contacts);
+            self.found = record;
         }
         found
     }

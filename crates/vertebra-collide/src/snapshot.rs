@@ -7,7 +7,10 @@
 //! prediction margin,
 //! every collider as it was added (body, shape, friction, restitution,
 //! groups) in the set's order, the excluded pairs in a canonical order
-//! (so equal sets give equal bytes), then the ragdolls' self-collision
+//! (so equal sets give equal bytes), the ragdolls' parts (each ragdoll
+//! body with its ragdoll and bone, in a canonical order), the pairs of
+//! bodies touching (ascending, as the contact events keep them), then the
+//! ragdolls' self-collision
 //! settings: every body whose self-collision is off with its ragdoll's
 //! group (u64), in a canonical order, and the next group to be given (at
 //! most [`MAX_SELF_COLLISION_GROUPS`]). The
@@ -15,7 +18,8 @@
 //! [`Collisions::add`] builds it.
 //!
 //! Format versions: 1, without the self-collision settings; 2, with them;
-//! 3, with the world's bodies.
+//! 3, with the world's bodies; 4, with the ragdolls' parts and the pairs
+//! touching.
 //!
 //! The bytes are untrusted input: the checksum only catches accidents (it
 //! is not keyed), so [`Collisions::restore`] checks every value as
@@ -26,11 +30,13 @@ use serde::{Deserialize, Serialize};
 use vertebra_world::{BodyHandle, Error, World};
 
 use crate::pairing::{OTHER_BODIES, census};
-use crate::{Collider, Collisions, MAX_SELF_COLLISION_GROUPS, check_prediction, ordered};
+use crate::{
+    Collider, Collisions, MAX_SELF_COLLISION_GROUPS, RagdollPart, check_prediction, ordered,
+};
 use vertebra_math::DefaultFloatMode;
 
 const MAGIC: &[u8; 8] = b"VTBCOLLS";
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 const HEADER: usize = 20;
 
 /// A collision set's full state at one instant, with the identity of the
@@ -59,6 +65,8 @@ struct State {
     prediction: f32,
     colliders: Vec<Collider>,
     excluded: Vec<(BodyHandle, BodyHandle)>,
+    parts: Vec<(BodyHandle, RagdollPart)>,
+    touching: Vec<(BodyHandle, BodyHandle)>,
     apart: Vec<(BodyHandle, u64)>,
     next_apart: u64,
 }
@@ -75,11 +83,15 @@ impl Collisions {
         excluded.sort_by_cached_key(encode);
         let mut apart: Vec<_> = self.apart.iter().map(|(&b, &g)| (b, g)).collect();
         apart.sort_by_cached_key(encode);
+        let mut parts: Vec<_> = self.parts.iter().map(|(&b, &p)| (b, p)).collect();
+        parts.sort_by_cached_key(|(b, _)| encode(b));
         let state = State {
             census: census(world),
             prediction: self.prediction,
             colliders: self.colliders().copied().collect(),
             excluded,
+            parts,
+            touching: self.touching.clone(),
             apart,
             next_apart: self.next_apart,
         };
@@ -149,9 +161,40 @@ impl Collisions {
             })?;
             restored.apart.insert(body, group);
         }
+        check_canonical(
+            "ragdoll part",
+            &state.parts.iter().map(|(b, _)| *b).collect::<Vec<_>>(),
+        )?;
+        for (k, &(body, part)) in state.parts.iter().enumerate() {
+            if !restored.colliders().any(|c| c.body == body) {
+                return Err(Error::CorruptSnapshot(format!(
+                    "ragdoll part {k}: a body without a collider"
+                )));
+            }
+            restored.parts.insert(body, part);
+        }
+        for (k, &(a, b)) in state.touching.iter().enumerate() {
+            if ordered(a, b) != (a, b) || a == b {
+                return Err(Error::CorruptSnapshot(format!(
+                    "touching pair {k}: its bodies out of order or the same"
+                )));
+            }
+        }
+        if let Some(k) = state
+            .touching
+            .windows(2)
+            .position(|w| (w[0].0.to_raw(), w[0].1.to_raw()) >= (w[1].0.to_raw(), w[1].1.to_raw()))
+        {
+            return Err(Error::CorruptSnapshot(format!(
+                "touching pair {}: out of order or repeated",
+                k + 1
+            )));
+        }
+        restored.touching = state.touching;
         if state.census != census(world) {
             return Err(Error::WorldMismatch(OTHER_BODIES));
         }
+        restored.version = self.version + 1;
         restored.serve(world);
         *self = restored;
         Ok(())

@@ -240,7 +240,7 @@ fn refused_group_settings_change_nothing() {
 }
 
 /// `bytes` with its payload checksum made right again (the format is
-/// documented: magic 8, version 4, xxh3 8, payload).
+/// documented: magic 8, version 4 bytes, xxh3 8, payload).
 fn resealed(mut bytes: Vec<u8>) -> CollisionSnapshot {
     let sum = xxhash_rust::xxh3::xxh3_64(&bytes[20..]);
     bytes[12..20].copy_from_slice(&sum.to_le_bytes());

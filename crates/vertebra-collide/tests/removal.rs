@@ -4,7 +4,7 @@
 
 use glam::{Quat, Vec3};
 use vertebra_collide::{
-    Collider, ColliderShape, CollisionSnapshot, Collisions, MAX_COLLIDER_EXTENT,
+    Collider, ColliderShape, CollisionSnapshot, Collisions, MAX_COLLIDER_EXTENT, RagdollPart,
 };
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
 use vertebra_world::{BodyDesc, BodyHandle, Error, JointDesc, Shape, SolverConfig, World};
@@ -367,7 +367,7 @@ fn damaged_and_foreign_collision_snapshots_are_refused_with_nothing_changed() {
         corrupt("not a collision-set snapshot"),
     );
     let mut newer = good.clone();
-    newer[8] = 4;
+    newer[8] = 5;
     assert_refused(
         &CollisionSnapshot::from_bytes(newer),
         Some(Error::IncompatibleSnapshot(
@@ -467,13 +467,15 @@ fn crafted_collision_snapshots_never_panic_nor_admit_a_bad_value() {
     assert!(accepted > 0 && refusals > 0);
 }
 
-/// The payload's layout, as `docs/contacts.md` documents it (format 3).
+/// The payload's layout, as `docs/contacts.md` documents it (format 4).
 #[derive(serde::Serialize, serde::Deserialize)]
 struct Payload {
     census: u64,
     prediction: f32,
     colliders: Vec<Collider>,
     excluded: Vec<(BodyHandle, BodyHandle)>,
+    parts: Vec<(BodyHandle, RagdollPart)>,
+    touching: Vec<(BodyHandle, BodyHandle)>,
     apart: Vec<(BodyHandle, u64)>,
     next_apart: u64,
 }
@@ -503,7 +505,7 @@ fn lists_the_set_could_not_have_written_are_refused_by_name() {
     let good = c.snapshot(&w).unwrap();
     assert_eq!(crafted(&good, |_| {}), good, "the layout is the set's");
     let corrupt = |why: &str| Err(Error::CorruptSnapshot(why.into()));
-    let cases: [(&str, Change); 5] = [
+    let cases: [(&str, Change); 9] = [
         (
             "excluded pair 1: out of order or repeated",
             Box::new(|p| p.excluded.insert(0, p.excluded[0])),
@@ -526,6 +528,25 @@ fn lists_the_set_could_not_have_written_are_refused_by_name() {
         (
             "self-collision entry 1: out of order or repeated",
             Box::new(|p| p.apart.insert(0, p.apart[0])),
+        ),
+        (
+            "ragdoll part 1: out of order or repeated",
+            Box::new(|p| p.parts.swap(0, 1)),
+        ),
+        (
+            "ragdoll part 1: out of order or repeated",
+            Box::new(|p| p.parts.insert(0, p.parts[0])),
+        ),
+        (
+            "touching pair 0: its bodies out of order or the same",
+            Box::new(|p| {
+                let (a, b) = p.excluded[0];
+                p.touching = vec![(b, a)];
+            }),
+        ),
+        (
+            "touching pair 1: out of order or repeated",
+            Box::new(|p| p.touching = vec![p.excluded[0], p.excluded[0]]),
         ),
     ];
     for (why, change) in cases {

@@ -474,6 +474,23 @@ impl Ragdoll {
         old.remove(world)
     }
 
+    /// Its first body (the first described body it has): the name the
+    /// collision layer gives it in hits and events
+    /// (`vertebra_collide::RagdollPart::ragdoll`). `None` once removed. A
+    /// handle is never issued twice, so no other ragdoll of the world is
+    /// ever named so; [`Ragdoll::recreate`] moves the name to the new
+    /// first body (and the collision layer with it).
+    pub fn first_body(&self) -> Option<BodyHandle> {
+        self.bodies.iter().flatten().next().copied()
+    }
+
+    /// Which of its described bodies `body` is (its index in
+    /// `description().bodies`, whose `name` is the bone's), or `None` for
+    /// a body that is not the ragdoll's.
+    pub fn bone_of(&self, body: BodyHandle) -> Option<usize> {
+        self.bodies.iter().position(|&b| b == Some(body))
+    }
+
     /// The description it was built from.
     pub fn description(&self) -> &RagdollDesc {
         &self.desc

@@ -73,7 +73,7 @@ pub use vertebra_kernels::contact::ContactImpulse;
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
-    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, SIZE_RANGE, Shape, check_coordinate,
+    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, SIZE_RANGE, Shape, check_coordinate, check_point,
     check_positive, check_unit_quat, check_unit_vec,
 };
 
@@ -108,6 +108,9 @@ pub struct World {
     impulses: Vec<ContactImpulse>,
     /// Steps taken since the world was made (no part of the state).
     step_count: u64,
+    /// Counts every call that may have moved a body or changed which
+    /// bodies there are (no part of the state).
+    pose_version: u64,
     contact_layout: contact::ContactLayout,
     rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
@@ -166,6 +169,7 @@ impl World {
             solved: Vec::new(),
             impulses: Vec::new(),
             step_count: 0,
+            pose_version: 0,
             contact_layout: contact::ContactLayout::default(),
             rows: parallel::Scratch::default(),
             previous: Vec::new(),
@@ -213,6 +217,7 @@ impl World {
     pub fn add_body(&mut self, desc: BodyDesc) -> Result<BodyHandle, Error> {
         let _mode = DefaultFloatMode::enter();
         let handle = self.bodies.insert(&desc)?;
+        self.pose_version += 1;
         if self.joints_at.len() < self.bodies.capacity() {
             self.joints_at.resize(self.bodies.capacity(), 0);
         }
@@ -234,6 +239,7 @@ impl World {
         }
         self.layout_dirty |= self.islands.take_out(i);
         self.bodies.remove(handle)?;
+        self.pose_version += 1;
         self.contacts
             .retain(|c| c.body_a != handle && c.body_b != handle);
         Ok(())
@@ -253,6 +259,7 @@ impl World {
     ) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         self.bodies.set_pose(handle, position, orientation)?;
+        self.pose_version += 1;
         self.stir(handle);
         Ok(())
     }
@@ -578,6 +585,15 @@ impl World {
         &self.impulses
     }
 
+    /// A number that changes whenever a body may have moved or a body was
+    /// added or removed (a step, a pose set, a body added or removed, a
+    /// snapshot restored), and at no other call: with the world's
+    /// [`Timeline`], when a cache of the bodies' poses (the collision
+    /// layer's query tree) is still right. No part of the state.
+    pub fn pose_version(&self) -> u64 {
+        self.pose_version
+    }
+
     /// How many steps this world object has taken since it was made
     /// (restores included, refused steps not): with the world's
     /// [`Timeline`], which step a companion's record belongs to. No part
@@ -672,15 +688,7 @@ impl World {
     /// system past `workers`; the step's own code does not panic on any
     /// state the API accepts, so nothing needs putting back there.)
     pub fn step(&mut self, dt: f32) -> Result<(), Error> {
-        vertebra_store::check_positive("time step", dt)?;
-        if dt > vertebra_store::MAX_TIME_STEP {
-            return Err(Error::OutOfRange("time step (at most 1 s)"));
-        }
-        if dt / (self.config.substeps as f32) < vertebra_store::MIN_TIME_STEP {
-            return Err(Error::OutOfRange(
-                "time step (each substep at least 1e-6 s)",
-            ));
-        }
+        self.check_time_step(dt)?;
         let _mode = DefaultFloatMode::enter();
         // Asked once, before anything changes: a task system whose answer
         // changes from call to call, or that panics here, changes nothing.
@@ -695,6 +703,22 @@ impl World {
         if let Err(panic) = catch_unwind(AssertUnwindSafe(|| self.advance(dt, workers))) {
             self.roll_back();
             resume_unwind(panic);
+        }
+        Ok(())
+    }
+
+    /// Whether [`World::step`] takes `dt` (s): finite, positive, at most
+    /// [`MAX_TIME_STEP`], each substep at least [`MIN_TIME_STEP`]; the
+    /// refusal `step` gives otherwise.
+    pub fn check_time_step(&self, dt: f32) -> Result<(), Error> {
+        vertebra_store::check_positive("time step", dt)?;
+        if dt > vertebra_store::MAX_TIME_STEP {
+            return Err(Error::OutOfRange("time step (at most 1 s)"));
+        }
+        if dt / (self.config.substeps as f32) < vertebra_store::MIN_TIME_STEP {
+            return Err(Error::OutOfRange(
+                "time step (each substep at least 1e-6 s)",
+            ));
         }
         Ok(())
     }
@@ -746,6 +770,7 @@ impl World {
         self.solved.extend_from_slice(&self.contacts);
         self.contacts.clear();
         self.step_count += 1;
+        self.pose_version += 1;
         self.residuals_measured = self.config.measure_residuals;
         if self.residuals_measured {
             metrics::residuals(self);

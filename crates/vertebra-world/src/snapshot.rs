@@ -345,6 +345,7 @@ impl World {
         self.contacts = state.contacts;
         self.solved.clear();
         self.impulses.clear();
+        self.pose_version += 1;
         self.layout_dirty = true;
         self.timeline = Timeline::begin(true);
         self.measure_residuals();

@@ -1,0 +1,221 @@
+//! Contact events per pair of bodies, from what each step solved (Box2D
+//! v3's begin and end touch events, Jolt's `ContactListener`): which pairs
+//! began touching, with how hard they met, which stopped, and every pair
+//! touching with the impulse of the step. For sounds, damage, "which bone
+//! hit the floor how hard".
+//!
+//! **Touching.** A pair begins touching in the first step its contacts
+//! push (a positive normal impulse, `World::contact_impulses`), and stays
+//! touching while it has contacts (within the detection's margin: a gap
+//! opening for a step between a limb and the floor is no new hit), or
+//! while all of its moving bodies sleep (a pile asleep keeps its pairs, as
+//! Box2D's sleeping islands keep their contacts). It ends in the first
+//! step after which it has no contact and a body of it is awake, or a
+//! body of it is gone (removed, or a collider's body). So a resting pair
+//! gives one `began` and, when it parts, one `ended`: not one a frame.
+//!
+//! **Deterministic, and saved.** Pairs are in ascending order of their
+//! bodies' slots (each pair's bodies so ordered, its normal turned to
+//! match); the touching pairs are part of the set's snapshot, so a run
+//! restored from snapshots gives the events the original did.
+//!
+//! **No allocation in steady state**: the lists are the set's, cleared
+//! and refilled each step.
+
+use glam::Vec3;
+use vertebra_world::{BodyHandle, BodyKind, World};
+
+use crate::{Collisions, RagdollPart, ordered};
+
+/// A pair of bodies touching in a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Touching {
+    /// The first body (the lower slot).
+    pub body_a: BodyHandle,
+    /// The second body.
+    pub body_b: BodyHandle,
+    /// `body_a`'s ragdoll and bone, if it is a ragdoll's.
+    pub part_a: Option<RagdollPart>,
+    /// `body_b`'s ragdoll and bone, if it is a ragdoll's.
+    pub part_b: Option<RagdollPart>,
+    /// The step's normal impulse over all of the pair's contacts (N s,
+    /// at least 0): how hard they met. The mean force over the step is
+    /// this over `dt`.
+    pub impulse: f32,
+    /// The friction impulse on `body_b` over the step (N s, world).
+    pub friction: Vec3,
+    /// The point of the contact that pushed hardest (m, world).
+    pub point: Vec3,
+    /// Its normal, out of `body_a` into `body_b` (unit, world).
+    pub normal: Vec3,
+    /// How fast the two closed along their normals when the contacts were
+    /// found, the fastest of the pair's points (m/s, at least 0): the
+    /// speed of the hit.
+    pub closing_speed: f32,
+}
+
+/// A pair of bodies that stopped touching.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ContactEnded {
+    /// The first body (the lower slot); may be gone.
+    pub body_a: BodyHandle,
+    /// The second body; may be gone.
+    pub body_b: BodyHandle,
+    /// `body_a`'s ragdoll and bone, if the set still knows it.
+    pub part_a: Option<RagdollPart>,
+    /// `body_b`'s ragdoll and bone, if the set still knows it.
+    pub part_b: Option<RagdollPart>,
+}
+
+/// The last step's contact events ([`Collisions::events`]).
+#[derive(Clone, Debug, Default)]
+pub struct ContactEvents {
+    began: Vec<Touching>,
+    ended: Vec<ContactEnded>,
+    touching: Vec<Touching>,
+    /// Scratch: each solved contact's pair and index, sorted.
+    order: Vec<((BodyHandle, BodyHandle), u32)>,
+    /// Scratch: the pairs touching after the step.
+    next: Vec<(BodyHandle, BodyHandle)>,
+}
+
+impl ContactEvents {
+    /// The pairs that began touching in the step, in pair order.
+    pub fn began(&self) -> &[Touching] {
+        &self.began
+    }
+
+    /// The pairs that stopped touching in the step, in pair order.
+    pub fn ended(&self) -> &[ContactEnded] {
+        &self.ended
+    }
+
+    /// Every pair touching with contacts the step solved (those that
+    /// began included), with the step's impulses, in pair order. Pairs
+    /// kept touching while asleep are not in it (nothing was solved).
+    pub fn touching(&self) -> &[Touching] {
+        &self.touching
+    }
+}
+
+/// Where `key` would go in the sorted `pairs`, and whether it is there.
+fn find(pairs: &[(BodyHandle, BodyHandle)], key: (BodyHandle, BodyHandle)) -> Result<usize, usize> {
+    pairs.binary_search_by(|p| slots(*p).cmp(&slots(key)))
+}
+
+/// A pair's order: its bodies' slots, lineages and generations (two
+/// handles of one slot are of different generations).
+type PairOrder = ((u32, u32, u64), (u32, u32, u64));
+
+fn slots((a, b): (BodyHandle, BodyHandle)) -> PairOrder {
+    (a.to_raw(), b.to_raw())
+}
+
+impl Collisions {
+    /// The contact events of the last step that [`Collisions::after_step`]
+    /// (or [`Collisions::step`]) followed.
+    pub fn events(&self) -> &ContactEvents {
+        &self.events
+    }
+
+    /// The events of `world`'s last step (its contacts checked to be the
+    /// ones this set found: `Found::check`).
+    pub(crate) fn update_events(&mut self, world: &World) {
+        let mut events = core::mem::take(&mut self.events);
+        events.began.clear();
+        events.ended.clear();
+        events.touching.clear();
+        events.next.clear();
+        let solved = world.solved_contacts();
+        events.order.clear();
+        events.order.extend(
+            solved
+                .iter()
+                .enumerate()
+                .map(|(k, c)| (ordered(c.body_a, c.body_b), k as u32)),
+        );
+        events
+            .order
+            .sort_unstable_by(|x, y| slots(x.0).cmp(&slots(y.0)).then(x.1.cmp(&y.1)));
+        let mut run = 0;
+        while run < events.order.len() {
+            let key = events.order[run].0;
+            let end = run
+                + events.order[run..]
+                    .iter()
+                    .take_while(|(k, _)| *k == key)
+                    .count();
+            let pair = self.pair_of(key, &events.order[run..end], world);
+            run = end;
+            let was = find(&self.touching, key).is_ok();
+            if pair.impulse > 0.0 || was {
+                events.next.push(key);
+                events.touching.push(pair);
+                if !was {
+                    events.began.push(pair);
+                }
+            }
+        }
+        // The pairs touching before that had no contact this step: kept
+        // while every moving body of theirs sleeps, else ended.
+        for &key in &self.touching {
+            if find(&events.next, key).is_ok() {
+                continue;
+            }
+            let sleeping = |b: BodyHandle| match world.is_asleep(b) {
+                Ok(asleep) => asleep || world.bodies().kind[b.index()] != BodyKind::Dynamic,
+                Err(_) => false,
+            };
+            if sleeping(key.0) && sleeping(key.1) {
+                events.next.push(key);
+            } else {
+                events.ended.push(ContactEnded {
+                    body_a: key.0,
+                    body_b: key.1,
+                    part_a: self.part(key.0),
+                    part_b: self.part(key.1),
+                });
+            }
+        }
+        events.next.sort_unstable_by_key(|p| slots(*p));
+        core::mem::swap(&mut self.touching, &mut events.next);
+        self.events = events;
+    }
+
+    /// One pair's step from its contacts (`entries`: each solved
+    /// contact's index, all of this pair).
+    fn pair_of(
+        &self,
+        key: (BodyHandle, BodyHandle),
+        entries: &[((BodyHandle, BodyHandle), u32)],
+        world: &World,
+    ) -> Touching {
+        let (solved, impulses) = (world.solved_contacts(), world.contact_impulses());
+        let mut pair = Touching {
+            body_a: key.0,
+            body_b: key.1,
+            part_a: self.part(key.0),
+            part_b: self.part(key.1),
+            impulse: 0.0,
+            friction: Vec3::ZERO,
+            point: Vec3::ZERO,
+            normal: Vec3::ZERO,
+            closing_speed: 0.0,
+        };
+        let mut strongest = -1.0;
+        for &(_, k) in entries {
+            let (c, i) = (&solved[k as usize], &impulses[k as usize]);
+            // Turned to the pair's order: out of body_a into body_b.
+            let sign = if c.body_a == key.0 { 1.0 } else { -1.0 };
+            pair.impulse += i.normal;
+            pair.friction += i.friction * sign;
+            pair.closing_speed = pair.closing_speed.max(self.found.closing[k as usize]);
+            if i.normal > strongest {
+                strongest = i.normal;
+                pair.point = c.point;
+                pair.normal = c.normal * sign;
+            }
+        }
+        pair
+    }
+}
