@@ -81,8 +81,11 @@ fn intrinsics_only_in_lane_types_and_gather_scatter() {
 /// body rows (not `Sync`) may be shared by the threads solving a colour,
 /// with the check that makes it sound (docs/architecture.md, invariants),
 /// and that a stage's blocks are lent to one worker at a time (the solver
-/// stages, and the step's colours made into stages).
-const SHARED_FILES: [&str; 3] = [
+/// stages, and the step's colours made into stages); and the one lifetime
+/// the step's task is lent under to an engine's persistent threads
+/// (`lend.rs`: the gate that outlives no borrow, so engines need none).
+const SHARED_FILES: [&str; 4] = [
+    "crates/vertebra-world/src/lend.rs",
     "crates/vertebra-world/src/parallel.rs",
     "crates/vertebra-world/src/stages.rs",
     "crates/vertebra-world/src/step.rs",

@@ -21,7 +21,7 @@
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::partitioning::{Bvh, BvhBuildStrategy, TraversalAction};
+use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace, TraversalAction};
 use parry3d::query::{Ray, ShapeCastOptions};
 use parry3d::shape::{Ball, Capsule, Shape as ParryShape};
 use vertebra_math::DefaultFloatMode;
@@ -128,6 +128,11 @@ pub(crate) struct QueryTree {
     /// Each leaf's collider index (leaves are numbered densely: parry's
     /// tree of one or two leaves assumes so).
     leaves: Vec<usize>,
+    /// The collider version the tree's leaves are of (refit while it
+    /// holds, built anew when it changes).
+    built_for: Option<u64>,
+    /// parry's working memory for a refit.
+    workspace: BvhWorkspace,
 }
 
 /// The longest query (m): twice the world's range.
@@ -231,7 +236,18 @@ impl Collisions {
                 leaves.push(index);
             }
         }
-        self.tree.bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &bounds);
+        if self.tree.built_for == Some(self.version) {
+            // The same leaves, moved: refit (no allocation once grown).
+            for (leaf, aabb) in bounds.iter().enumerate() {
+                self.tree
+                    .bvh
+                    .insert_or_update_partially(*aabb, leaf as u32, 0.0);
+            }
+            self.tree.bvh.refit(&mut self.tree.workspace);
+        } else {
+            self.tree.bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &bounds);
+            self.tree.built_for = Some(self.version);
+        }
         (self.tree.bounds, self.tree.leaves) = (bounds, leaves);
         self.tree.stamp = Some(stamp);
         Ok(())

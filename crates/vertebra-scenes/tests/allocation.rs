@@ -120,4 +120,35 @@ fn a_settled_drop_allocates_nothing_per_frame_but_rayons_queue_blocks() {
             "{spine:?}, {joints:?}, 2 threads: {allocations} allocations in {FRAMES} frames"
         );
     }
+    // The frame a game runs: `Collisions::step` (detection, step,
+    // continuous collision, events, the query tree), the events read and
+    // a ray cast at the pile, from the drop's start.
+    let mut config = SceneConfig::new(Scene::RagdollDrop, SpineMode::Rod);
+    config.joints = JointSolver::Direct;
+    let mut scene = build(&config).expect("the drop");
+    let game_frame = |scene: &mut SceneWorld| {
+        let set = scene.collisions.as_mut().expect("the drop collides");
+        set.step(&mut scene.world, DT).expect("a frame");
+        let hit = set
+            .cast_ray(
+                &scene.world,
+                glam::Vec3::new(0.0, 3.0, 0.0),
+                -glam::Vec3::Y,
+                10.0,
+                &vertebra_collide::QueryFilter::default(),
+            )
+            .expect("a query");
+        set.events().touching().len() + usize::from(hit.is_some())
+    };
+    for _ in 0..SETTLE {
+        game_frame(&mut scene);
+    }
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let touching = (0..FRAMES)
+        .map(|_| game_frame(&mut scene))
+        .min()
+        .unwrap_or(0);
+    let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    assert!(touching > 100, "the pile's pairs touch: {touching}");
+    assert_eq!(allocations, 0, "Collisions::step: {FRAMES} frames");
 }

@@ -33,6 +33,7 @@ mod joint;
 mod joint_wire;
 mod kinematic;
 mod layout;
+mod lend;
 mod metrics;
 mod parallel;
 mod rod;
@@ -63,6 +64,7 @@ pub use drive::{
 };
 pub use islands::SleepSettings;
 pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist};
+pub use lend::{TaskLoan, lend};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
 pub use snapshot::{Snapshot, Timeline};
