@@ -319,9 +319,27 @@ pub struct BodyNode {
     pub mass: [f32; BLOCK_LANES],
     /// Inertia in the body frame (kg m^2): `xx yy zz xy xz yz`.
     pub inertia: [[f32; BLOCK_LANES]; 6],
+    /// How far the tree's solves moved the body this step (never read by
+    /// the solve): the sum of every applied `dp` (m, world) and turn (rad,
+    /// world), from which the world reads each joint's force and torque.
+    pub moved: [[f32; BLOCK_LANES]; 6],
 }
 
 impl BodyNode {
+    /// Zeroes `moved`, as a step begins.
+    pub fn reset_moved(&mut self) {
+        self.moved = [[0.0; BLOCK_LANES]; 6];
+    }
+
+    /// `lane`'s `moved`: the displacement (m) and turn (rad), world.
+    pub fn moved(&self, lane: usize) -> (glam::Vec3, glam::Vec3) {
+        let m = |k: usize| self.moved[k][lane];
+        (
+            glam::Vec3::new(m(0), m(1), m(2)),
+            glam::Vec3::new(m(3), m(4), m(5)),
+        )
+    }
+
     /// Padding: the null row, written nowhere, a unit mass and inertia
     /// (so that its blocks stay regular).
     pub fn padding() -> Self {

@@ -932,10 +932,19 @@ pub(super) fn apply<L: Lane>(
         let turn = Vec3::new(x[3], x[4], x[5]);
         let (cap, angle) = (L::splat(MAX_TURN), turn.length());
         let scale = L::select(angle.gt(cap), cap / angle.max(cap), L::splat(1.0));
-        lanes.p += Vec3::new(x[0], x[1], x[2]).scale(scale);
-        let turn = lanes.q.inverse_rotate(turn.scale(scale));
+        let (dp, world_turn) = (Vec3::new(x[0], x[1], x[2]).scale(scale), turn.scale(scale));
+        lanes.p += dp;
+        let turn = lanes.q.inverse_rotate(world_turn);
         lanes.q = lanes.q.integrate_local(turn, L::splat(1.0));
         lanes.scatter_pose(rows, &body.write[start..]);
+        // What moved it, for the joints' forces (never read by the solve).
+        let moved = &mut block.bodies[index as usize].moved;
+        for (k, v) in [dp.x, dp.y, dp.z, world_turn.x, world_turn.y, world_turn.z]
+            .into_iter()
+            .enumerate()
+        {
+            (L::load(&moved[k][start..]) + v).store(&mut moved[k][start..]);
+        }
     }
 }
 
