@@ -302,6 +302,7 @@ impl TryFrom<&VtJointDesc> for JointDesc {
             frame_b: d.frame_b.into(),
             kind,
             drive,
+            breaking: None,
         })
     }
 }

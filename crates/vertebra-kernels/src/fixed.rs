@@ -8,6 +8,7 @@ use vertebra_math::{Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows};
 use crate::parts::{lock, point};
+use crate::reaction::ReactionBlock;
 use crate::residual::{Measured, Residual};
 
 /// Eight fixed joints, field by field.
@@ -24,6 +25,9 @@ pub struct FixedBlock {
     pub frame_a: QuatBlock,
     /// Joint frame in b's body frame (held equal to a's in the world).
     pub frame_b: QuatBlock,
+    /// What each fixed joint did to its bodies this step (its force and
+    /// torque; never read by the solve).
+    pub reaction: ReactionBlock,
 }
 
 /// One fixed joint's solver data (one lane of a block).
@@ -128,8 +132,9 @@ impl LaneSlices for Positions<'_> {
 }
 
 #[inline(always)]
-fn solve_positions<L: Lane>(block: &FixedBlock, start: usize, rows: &BodyRows) {
+fn solve_positions<L: Lane>(block: &mut FixedBlock, start: usize, rows: &BodyRows) {
     let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
+    let before = (a, b);
     let frame_a = block.frame_a.load::<L>(start);
     let frame_b = block.frame_b.load::<L>(start);
     lock::solve(&mut a, &mut b, frame_a, frame_b);
@@ -140,6 +145,9 @@ fn solve_positions<L: Lane>(block: &FixedBlock, start: usize, rows: &BodyRows) {
         block.anchor_b.load(start),
         &block.bodies.start(start),
     );
+    block
+        .reaction
+        .record(start, (&before.0, &before.1), (&a, &b));
     block.bodies.scatter(rows, start, &a, &b);
 }
 

@@ -21,6 +21,7 @@ use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{hinge_axis, limit, point, swing, twist};
+use crate::reaction::ReactionBlock;
 use crate::residual::{Measured, Residual};
 
 /// Eight hinges, field by field.
@@ -51,6 +52,9 @@ pub struct HingeBlock {
     pub limit_start: [f32; BLOCK_LANES],
     /// The angular drives.
     pub drive: DriveBlock,
+    /// What each hinge did to its bodies this step (its force and torque;
+    /// never read by the solve).
+    pub reaction: ReactionBlock,
 }
 
 /// One hinge's solver data (one lane of a block).
@@ -218,6 +222,7 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
     inv_h2: L,
 ) {
     let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
+    let before = (a, b);
     let frame_a = block.frame_a.load::<L>(start);
     let frame_b = block.frame_b.load::<L>(start);
 
@@ -252,6 +257,9 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
         );
     }
 
+    block
+        .reaction
+        .record(start, (&before.0, &before.1), (&a, &b));
     block.bodies.scatter(rows, start, &a, &b);
 }
 

@@ -30,6 +30,7 @@ pub mod fixed;
 pub mod hinge;
 pub mod limited;
 pub mod parts;
+pub mod reaction;
 pub mod residual;
 pub mod rod;
 pub mod socket;

@@ -22,6 +22,7 @@ use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{ellipse, limit, point, pyramid, swing, swing_direction, twist};
+use crate::reaction::ReactionBlock;
 use crate::residual::{Measured, Residual};
 
 /// Eight sockets, field by field.
@@ -66,6 +67,9 @@ pub struct SocketBlock {
     /// Shaped path: accumulated multipliers of the ellipse, the pyramid's
     /// two angles and the twist range, reset every substep.
     pub limit_lambda: [[f32; BLOCK_LANES]; 4],
+    /// What each socket did to its bodies this step (its force and
+    /// torque; never read by the solve).
+    pub reaction: ReactionBlock,
 }
 
 /// A socket's shaped limits (one lane), the shaped path's settings.
@@ -247,6 +251,7 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
     inv_h2: L,
 ) {
     let (mut a, mut b) = block.bodies.gather::<L>(rows, start);
+    let before = (a, b);
     let frame_a = block.frame_a.load::<L>(start);
     let frame_b = block.frame_b.load::<L>(start);
 
@@ -286,6 +291,9 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
         );
     }
 
+    block
+        .reaction
+        .record(start, (&before.0, &before.1), (&a, &b));
     block.bodies.scatter(rows, start, &a, &b);
 }
 

@@ -1560,6 +1560,10 @@ fn run_trees(backend: Backend, raw: &RawRows, trees: &[Trees]) -> Vec<f32> {
                 let limits = joint.limit_lambda.iter().chain(&joint.limit_start);
                 out.extend(limits.map(|v| v[lane]));
             }
+            // How far the solves moved each body: the joints' forces.
+            for body in &block.bodies {
+                out.extend(body.moved.iter().map(|v| v[lane]));
+            }
         }
     }
     out

@@ -503,6 +503,7 @@ fn joint(
         frame,
         kind: body.joint,
         drive: None,
+        breaking: None,
     })
 }
 

@@ -8,8 +8,8 @@ use std::collections::HashMap;
 use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::Deserialize;
 use vertebra_world::{
-    JointKind, LimitSoftness, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY,
-    Swing, SwingTwist, check_coordinate, check_unit_quat,
+    JointBreaking, JointKind, LimitSoftness, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
+    MIN_DRIVE_FREQUENCY, Swing, SwingTwist, check_coordinate, check_unit_quat,
 };
 
 use crate::description::{finite, range};
@@ -39,6 +39,10 @@ pub struct JointDef {
     /// The joint's own drive strength (the file's `drive = { ... }`), over
     /// the ragdoll's `[drive]` one; `None` takes the ragdoll's.
     pub drive: Option<Strength>,
+    /// When it breaks (the file's `break_force`, N, and `break_torque`,
+    /// N m; either alone leaves the other infinite): see
+    /// `vertebra_world::JointBreaking`. `None`: never.
+    pub breaking: Option<JointBreaking>,
 }
 
 impl JointDef {
@@ -66,6 +70,8 @@ pub(crate) struct RawJoint {
     range: Option<[f32; 2]>,
     softness: Option<RawSoftness>,
     drive: Option<RawStrength>,
+    break_force: Option<f32>,
+    break_torque: Option<f32>,
 }
 
 /// `softness = 0.001` (a compliance), `softness = { compliance = 0.001,
@@ -122,6 +128,8 @@ pub struct JointSpec {
     pub kind: JointKind,
     /// The joint's own drive strength, over the ragdoll's `[drive]` one.
     pub drive: Option<Strength>,
+    /// When it breaks; `None`: never.
+    pub breaking: Option<JointBreaking>,
 }
 
 /// How a [`JointSpec`] gives its frame at bind pose (world).
@@ -200,6 +208,7 @@ impl JointSpec {
             frame: JointFrame::Axis { axis, normal: None },
             kind,
             drive: None,
+            breaking: None,
         }
     }
 
@@ -221,6 +230,13 @@ impl JointSpec {
     /// With its own drive strength.
     pub fn with_drive(mut self, strength: Strength) -> Self {
         self.drive = Some(strength);
+        self
+    }
+
+    /// Breaking past `force` (N) or `torque` (N m; infinity: never by
+    /// it): a limb that tears off (`vertebra_world::JointBreaking`).
+    pub fn with_breaking(mut self, force: f32, torque: f32) -> Self {
+        self.breaking = Some(JointBreaking { force, torque });
         self
     }
 }
@@ -273,6 +289,10 @@ pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, Ragdo
         j.softness.as_ref(),
     )?;
     let drive = j.drive.map(|d| d.read(context)).transpose()?;
+    let breaking = (j.break_force.is_some() || j.break_torque.is_some()).then(|| JointBreaking {
+        force: j.break_force.unwrap_or(f32::INFINITY),
+        torque: j.break_torque.unwrap_or(f32::INFINITY),
+    });
     let frame = match (j.frame, j.axis, j.normal) {
         (Some(q), None, None) => JointFrame::Rotation(Quat::from_array(q)),
         (Some(_), _, _) => {
@@ -296,6 +316,7 @@ pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, Ragdo
         frame,
         kind,
         drive,
+        breaking,
     })
 }
 
@@ -466,6 +487,7 @@ pub(crate) fn resolve(
         frame,
         kind: j.kind,
         drive: j.drive,
+        breaking: j.breaking,
     };
     check_joint(&def, index.len(), context)?;
     Ok(def)
@@ -494,6 +516,11 @@ pub(crate) fn check_joint(j: &JointDef, bodies: usize, context: &str) -> Result<
     }
     finite(context, "anchor", &j.anchor.to_array())?;
     check_coordinate("anchor", j.anchor).map_err(|e| RagdollError::world(context, e))?;
+    if let Some(breaking) = &j.breaking {
+        breaking
+            .validate()
+            .map_err(|e| RagdollError::world(context, e))?;
+    }
     check_unit_quat("frame", j.frame).map_err(|e| RagdollError::world(context, e))?;
     match j.kind {
         JointKind::Socket(limits) => {

@@ -332,6 +332,7 @@ impl Ragdoll {
                 frame_b: j.frame,
                 kind: j.kind,
                 drive: None,
+                breaking: j.breaking,
             };
             self.joints[k] = Some(
                 world

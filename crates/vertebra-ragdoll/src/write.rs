@@ -186,6 +186,14 @@ fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
     if let Some(s) = j.drive {
         out.push_str(&format!("drive = {{ {} }}\n", strength(s).join(", ")));
     }
+    if let Some(b) = j.breaking {
+        // An infinite threshold is the one not written.
+        for (key, value) in [("break_force", b.force), ("break_torque", b.torque)] {
+            if value.is_finite() {
+                out.push_str(&format!("{key} = {}\n", float(value)));
+            }
+        }
+    }
     out.push('\n');
 }
 

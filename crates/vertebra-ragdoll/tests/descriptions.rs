@@ -355,6 +355,7 @@ fn built() -> RagdollDesc {
             frame: JointFrame::Rotation(j.frame),
             kind: j.kind,
             drive: None,
+            breaking: j.breaking,
         };
         if let Some(s) = j.drive {
             spec = spec.with_drive(s);

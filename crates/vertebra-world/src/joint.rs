@@ -223,6 +223,41 @@ pub struct JointDesc {
     pub kind: JointKind,
     /// The angular drive, if any (sockets and hinges).
     pub drive: Option<AngularDrive>,
+    /// When the joint breaks, if ever ([`JointBreaking`]).
+    pub breaking: Option<JointBreaking>,
+}
+
+/// How strong a joint is: it breaks (the world removes it at the end of
+/// the step and names it in [`World::broken_joints`](crate::World::broken_joints))
+/// in the first step whose mean force on it exceeds `force` or whose mean
+/// torque exceeds `torque` ([`World::joint_force`](crate::World::joint_force)):
+/// a limb torn off, a ragdoll torn from its rope (PhysX's break force and
+/// torque, Jolt's breakable constraints).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JointBreaking {
+    /// The largest force it holds (N, positive; infinity: never by force).
+    pub force: f32,
+    /// The largest torque it holds (N m, positive; infinity: never by
+    /// torque).
+    pub torque: f32,
+}
+
+impl JointBreaking {
+    /// Checks both thresholds: positive, not NaN (infinity is allowed).
+    pub fn validate(&self) -> Result<(), Error> {
+        for (value, what) in [
+            (self.force, "joint break force"),
+            (self.torque, "joint break torque"),
+        ] {
+            if value.is_nan() {
+                return Err(Error::NonFinite(what));
+            }
+            if value <= 0.0 {
+                return Err(Error::NonPositive(what));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Both bodies' current poses and the frames that put the joint frame at
@@ -247,6 +282,7 @@ fn frames_at(
         frame_b: b.orientation.inverse() * joint,
         kind,
         drive: None,
+        breaking: None,
     })
 }
 
@@ -353,7 +389,17 @@ impl JointDesc {
         check_unit_quat("frame a", self.frame_a)?;
         check_unit_quat("frame b", self.frame_b)?;
         validate_kind(&self.kind)?;
+        if let Some(breaking) = &self.breaking {
+            breaking.validate()?;
+        }
         validate_drive_for(&self.kind, self.drive.as_ref())
+    }
+
+    /// The joint, breaking past `force` (N) or `torque` (N m): see
+    /// [`JointBreaking`] (checked when the joint is added).
+    pub fn with_breaking(mut self, force: f32, torque: f32) -> Self {
+        self.breaking = Some(JointBreaking { force, torque });
+        self
     }
 
     /// Checks the bodies too: live, and at least one dynamic.

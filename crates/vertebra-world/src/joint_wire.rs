@@ -9,13 +9,16 @@
 //! encoded after a third tag. Postcard encodes an enum's variant as its
 //! index and an `Option` as 0 or 1 before the value, so variant 0 with the
 //! twist range is format 3's `None` swing limit, variant 1 its `Some`.
+//! The drive and the breaking thresholds follow the same rule: a joint
+//! without thresholds encodes its drive as the `Option` it always was
+//! (variants 0 and 1), one with them after a third tag.
 
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_store::BodyHandle;
 
 use crate::drive::AngularDrive;
-use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
+use crate::joint::{JointBreaking, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
 
 #[derive(Serialize, Deserialize)]
 pub(crate) struct JointWire {
@@ -26,7 +29,17 @@ pub(crate) struct JointWire {
     frame_a: Quat,
     frame_b: Quat,
     kind: KindWire,
-    drive: Option<AngularDrive>,
+    drive: DriveWire,
+}
+
+#[derive(Serialize, Deserialize)]
+enum DriveWire {
+    /// No drive, no thresholds (an `Option`'s `None`).
+    Free,
+    /// A drive, no thresholds (an `Option`'s `Some`).
+    Driven(AngularDrive),
+    /// Breaking thresholds, with the drive if any.
+    Breaking(Option<AngularDrive>, JointBreaking),
 }
 
 #[derive(Serialize, Deserialize)]
@@ -84,13 +97,22 @@ impl From<JointDesc> for JointWire {
             frame_a: d.frame_a,
             frame_b: d.frame_b,
             kind: d.kind.into(),
-            drive: d.drive,
+            drive: match (d.drive, d.breaking) {
+                (None, None) => DriveWire::Free,
+                (Some(drive), None) => DriveWire::Driven(drive),
+                (drive, Some(breaking)) => DriveWire::Breaking(drive, breaking),
+            },
         }
     }
 }
 
 impl From<JointWire> for JointDesc {
     fn from(w: JointWire) -> Self {
+        let (drive, breaking) = match w.drive {
+            DriveWire::Free => (None, None),
+            DriveWire::Driven(drive) => (Some(drive), None),
+            DriveWire::Breaking(drive, breaking) => (drive, Some(breaking)),
+        };
         Self {
             body_a: w.body_a,
             body_b: w.body_b,
@@ -99,7 +121,8 @@ impl From<JointWire> for JointDesc {
             frame_a: w.frame_a,
             frame_b: w.frame_b,
             kind: w.kind.into(),
-            drive: w.drive,
+            drive,
+            breaking,
         }
     }
 }

@@ -467,6 +467,7 @@ macro_rules! start_at_anchors {
                     let anchors = (self.anchor_a.get(lane), self.anchor_b.get(lane));
                     start_lane(&mut self.bodies, lane, anchors, bodies);
                 }
+                self.reaction.reset();
             }
         }
     )*};

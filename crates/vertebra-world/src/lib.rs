@@ -27,6 +27,7 @@ mod checks;
 mod config;
 mod contact;
 mod drive;
+mod forces;
 mod impulse;
 mod islands;
 mod joint;
@@ -62,8 +63,11 @@ pub use drive::{
     AngularDrive, DriveStrength, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
     MIN_DRIVE_FREQUENCY,
 };
+pub use forces::{BrokenJoint, JointForce};
 pub use islands::SleepSettings;
-pub use joint::{JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist};
+pub use joint::{
+    JointBreaking, JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist,
+};
 pub use lend::{TaskLoan, lend};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
@@ -110,6 +114,11 @@ pub struct World {
     impulses: Vec<ContactImpulse>,
     /// Steps taken since the world was made (no part of the state).
     step_count: u64,
+    /// Each joint slot's force and torque over the last step it was
+    /// solved in (`forces.rs`; output, not state).
+    joint_forces: Vec<JointForce>,
+    /// The joints the last step broke (output, not state).
+    broken: Vec<BrokenJoint>,
     /// Counts every call that may have moved a body or changed which
     /// bodies there are (no part of the state).
     pose_version: u64,
@@ -171,6 +180,8 @@ impl World {
             solved: Vec::new(),
             impulses: Vec::new(),
             step_count: 0,
+            joint_forces: Vec::new(),
+            broken: Vec::new(),
             pose_version: 0,
             contact_layout: contact::ContactLayout::default(),
             rows: parallel::Scratch::default(),
@@ -759,6 +770,8 @@ impl World {
         let h = dt / self.config.substeps as f32;
         self.contact_layout
             .impulses(self.contacts.len(), h, &mut self.impulses);
+        forces::read(self, h, dt);
+        forces::break_joints(self);
         if let Some(settings) = &self.config.sleep {
             let links = islands::links(&self.joints, &self.rods);
             self.layout_dirty |=

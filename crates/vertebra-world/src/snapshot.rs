@@ -345,6 +345,8 @@ impl World {
         self.contacts = state.contacts;
         self.solved.clear();
         self.impulses.clear();
+        self.joint_forces.clear();
+        self.broken.clear();
         self.pose_version += 1;
         self.layout_dirty = true;
         self.timeline = Timeline::begin(true);

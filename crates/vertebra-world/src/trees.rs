@@ -472,6 +472,9 @@ fn find(joints: &[Option<JointDesc>], rods: &[Option<RodDesc>], bodies: &BodySto
 /// the step begins, and its bodies' mass properties as they are now.
 impl crate::layout::StartBlock for TreeBlock {
     fn start(&mut self, bodies: &BodyStore) {
+        for node in &mut self.bodies {
+            node.reset_moved();
+        }
         for lane in (0..BLOCK_LANES).filter(|l| self.padding & (1 << l) == 0) {
             for node in &mut self.bodies {
                 set_mass(node, lane, bodies);

@@ -38,6 +38,7 @@ fn compound_pendulum_period_matches_the_closed_form() {
         frame_b: Quat::IDENTITY,
         kind: JointKind::Socket(SwingTwist::FREE),
         drive: None,
+        breaking: None,
     };
     w.add_joint(socket).unwrap();
     // I about the pivot = I_cm + m d^2 (about the z axis, across the rod).
