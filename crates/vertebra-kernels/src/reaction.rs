@@ -56,15 +56,7 @@ impl ReactionBlock {
         before: (&BodyLanes<L>, &BodyLanes<L>),
         after: (&BodyLanes<L>, &BodyLanes<L>),
     ) {
-        let zero = L::splat(0.0);
-        let moves_b = after.1.inv_mass.gt(zero);
-        let moved = |from: &BodyLanes<L>, to: &BodyLanes<L>| {
-            let dp = to.p - from.p;
-            let m = |d: L| safe_ratio(d, to.inv_mass);
-            let dq = to.q * from.q.conjugate();
-            let turn = dq.vector().scale(L::splat(2.0).copysign(dq.w));
-            (Vec3::new(m(dp.x), m(dp.y), m(dp.z)), turn)
-        };
+        let moves_b = after.1.inv_mass.gt(L::splat(0.0));
         let (pa, ta) = moved(before.0, after.0);
         let (pb, tb) = moved(before.1, after.1);
         let impulse = Vec3::select(moves_b, pb, -pa);
@@ -74,6 +66,21 @@ impl ReactionBlock {
         let sum = self.turn.load::<L>(start) + turn;
         self.turn.store(start, sum);
     }
+}
+
+/// A body's change between two poses as a positional impulse (`m dp`, kg
+/// m; 0 for a body that does not move) and a world turn (`2 vec(q'
+/// q*)`, rad, the shorter way).
+#[inline(always)]
+fn moved<L: Lane>(from: &BodyLanes<L>, to: &BodyLanes<L>) -> (Vec3<L>, Vec3<L>) {
+    let dp = to.p - from.p;
+    let impulse = Vec3::new(
+        safe_ratio(dp.x, to.inv_mass),
+        safe_ratio(dp.y, to.inv_mass),
+        safe_ratio(dp.z, to.inv_mass),
+    );
+    let dq = to.q * from.q.conjugate();
+    (impulse, dq.vector().scale(L::splat(2.0).copysign(dq.w)))
 }
 
 /// The mean force (N) and torque (N m) over a step of `dt` seconds in

@@ -245,7 +245,9 @@ fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32
         }
         out.extend(b.limit_lambda);
         out.extend(b.limit_start);
-        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(&b.reaction)));
+        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
+            &b.reaction,
+        )));
     }
     out.extend(residual.iter().flatten());
     out
@@ -269,7 +271,9 @@ fn run_fixed(backend: Backend, raw: &RawRows, blocks: &[FixedBlock]) -> Vec<f32>
     });
     let mut out = flatten(&rows);
     for b in &blocks {
-        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(&b.reaction)));
+        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
+            &b.reaction,
+        )));
     }
     out.extend(residual.iter().flatten());
     out

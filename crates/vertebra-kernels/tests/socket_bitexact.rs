@@ -228,7 +228,9 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
         out.extend(b.limit_lambda.iter().flatten());
         out.extend(b.limit_start.iter().flatten());
         // What each socket did to its bodies: its force and torque.
-        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(&b.reaction)));
+        out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
+            &b.reaction,
+        )));
     }
     out.extend(residual.iter().flatten());
     out

@@ -333,10 +333,10 @@ impl BodyNode {
 
     /// `lane`'s `moved`: the displacement (m) and turn (rad), world.
     pub fn moved(&self, lane: usize) -> (glam::Vec3, glam::Vec3) {
-        let m = |k: usize| self.moved[k][lane];
+        let m = &self.moved;
         (
-            glam::Vec3::new(m(0), m(1), m(2)),
-            glam::Vec3::new(m(3), m(4), m(5)),
+            glam::Vec3::new(m[0][lane], m[1][lane], m[2][lane]),
+            glam::Vec3::new(m[3][lane], m[4][lane], m[5][lane]),
         )
     }
 
