@@ -558,6 +558,77 @@ typedef struct VtContact {
   float restitution;
 } VtContact;
 
+// Which ragdoll and bone a body is.
+typedef struct VtRagdollPart {
+  // Non-zero: the body is a ragdoll's (the fields below hold).
+  uint32_t present;
+  // The ragdoll, named by its first body (`vt_ragdoll_first_body`).
+  struct VtBody ragdoll;
+  // The body's index in the ragdoll's description
+  // (`vt_ragdoll_desc_body_name` names its bone).
+  uint32_t bone;
+} VtRagdollPart;
+
+// A pair of bodies touching in the last step.
+typedef struct VtTouching {
+  // The first body (the lower slot).
+  struct VtBody body_a;
+  // The second body.
+  struct VtBody body_b;
+  // `body_a`'s ragdoll and bone, if a ragdoll's.
+  struct VtRagdollPart part_a;
+  // `body_b`'s ragdoll and bone, if a ragdoll's.
+  struct VtRagdollPart part_b;
+  // The step's normal impulse over the pair's contacts (N s).
+  float impulse;
+  // The friction impulse on `body_b` (N s, world).
+  struct VtVec3 friction;
+  // The point of the contact that pushed hardest (m, world).
+  struct VtVec3 point;
+  // Its normal, out of `body_a` into `body_b` (unit, world).
+  struct VtVec3 normal;
+  // How fast the pair closed when its contacts were found (m/s).
+  float closing_speed;
+} VtTouching;
+
+// A pair of bodies that stopped touching in the last step.
+typedef struct VtContactEnded {
+  // The first body (may be gone).
+  struct VtBody body_a;
+  // The second body (may be gone).
+  struct VtBody body_b;
+  // `body_a`'s ragdoll and bone, if the layer still knows it.
+  struct VtRagdollPart part_a;
+  // `body_b`'s ragdoll and bone, if the layer still knows it.
+  struct VtRagdollPart part_b;
+} VtContactEnded;
+
+// The impulses one contact applied over the last step.
+typedef struct VtContactImpulse {
+  // Along its normal, pushing `body_b` (N s, at least 0).
+  float normal;
+  // Friction on `body_b` (N s, world).
+  struct VtVec3 friction;
+} VtContactImpulse;
+
+// A joint of a world (as [`VtBody`]).
+typedef struct VtJoint {
+  // Slot index.
+  uint32_t index;
+  // The issuing world's lineage.
+  uint32_t lineage;
+  // Generation of the slot.
+  uint64_t generation;
+} VtJoint;
+
+// A joint's mean force and torque over the last step it was solved in.
+typedef struct VtJointForce {
+  // The force on `body_b` (N, world).
+  struct VtVec3 force;
+  // The torque on `body_b` about the anchor (N m, world).
+  struct VtVec3 torque;
+} VtJointForce;
+
 // A socket's swing limit (angles in rad); only the fields of its kind
 // are read.
 typedef struct VtSwing {
@@ -636,17 +707,88 @@ typedef struct VtJointDesc {
   uint32_t has_drive;
   // The drive.
   struct VtDrive drive;
+  // Non-zero: the joint breaks past `break_force` or `break_torque`
+  // (it is removed at the end of that step and listed by
+  // `vt_world_broken_joints`).
+  uint32_t has_breaking;
+  // The largest mean force it holds over a step (N, positive; infinity:
+  // never by force).
+  float break_force;
+  // The largest mean torque it holds over a step (N m, positive;
+  // infinity: never by torque).
+  float break_torque;
 } VtJointDesc;
 
-// A joint of a world (as [`VtBody`]).
-typedef struct VtJoint {
-  // Slot index.
-  uint32_t index;
-  // The issuing world's lineage.
-  uint32_t lineage;
-  // Generation of the slot.
-  uint64_t generation;
-} VtJoint;
+// A joint that broke in the last step.
+typedef struct VtBrokenJoint {
+  // Its handle (stale now).
+  struct VtJoint joint;
+  // Its description as it was.
+  struct VtJointDesc desc;
+  // The force and torque that broke it.
+  struct VtJointForce load;
+} VtBrokenJoint;
+
+// One joint's residual error.
+typedef struct VtJointResidual {
+  // Anchor separation (cm).
+  float linear_cm;
+  // Angular error (rad): limit overshoot and held rotations' error.
+  float angular_rad;
+  // The part of `angular_rad` that is limit overshoot (rad).
+  float limit_rad;
+} VtJointResidual;
+
+// Which colliders a query sees. Start from `vt_query_filter_default`
+// (sees everything); zeroed memory sees nothing (no group, no kind).
+typedef struct VtQueryFilter {
+  // The query's groups (a bit set): it sees a collider when
+  // `filter & collider.membership` and `collider.filter & membership`
+  // are both non-zero.
+  uint32_t membership;
+  // The groups it sees.
+  uint32_t filter;
+  // Non-zero: `exclude_body`'s colliders are passed through.
+  uint32_t has_exclude_body;
+  // A body passed through (the shooter's own).
+  struct VtBody exclude_body;
+  // Non-zero: the ragdoll named `exclude_ragdoll` is passed through.
+  uint32_t has_exclude_ragdoll;
+  // A ragdoll passed through, by its first body (`vt_ragdoll_first_body`).
+  struct VtBody exclude_ragdoll;
+  // Non-zero: static bodies' colliders are seen.
+  uint32_t static_bodies;
+  // Non-zero: kinematic bodies' colliders are seen.
+  uint32_t kinematic_bodies;
+  // Non-zero: dynamic bodies' colliders are seen.
+  uint32_t dynamic_bodies;
+} VtQueryFilter;
+
+// Where a ray or swept shape first touched a collider.
+typedef struct VtQueryHit {
+  // The collider's index in the layer.
+  size_t collider;
+  // Its body.
+  struct VtBody body;
+  // The body's ragdoll and bone, if a ragdoll's.
+  struct VtRagdollPart part;
+  // The point hit, on the collider's surface (m, world).
+  struct VtVec3 point;
+  // The collider's outward normal there (unit, world).
+  struct VtVec3 normal;
+  // How far along the direction (m).
+  float distance;
+} VtQueryHit;
+
+// A query's shape (posed by the call's transform).
+typedef struct VtQueryShape {
+  // A `VtQueryShapeKind`.
+  uint32_t kind;
+  // Radius (m, positive).
+  float radius;
+  // Capsule: half its core segment (m, query frame).
+  struct VtVec3 half_segment;
+} VtQueryShape;
 
 // A rigid transform: a position (m) and a rotation.
 typedef struct VtTransform {
@@ -655,6 +797,16 @@ typedef struct VtTransform {
   // Rotation (unit quaternion).
   struct VtQuat rotation;
 } VtTransform;
+
+// A collider a shape overlaps.
+typedef struct VtOverlap {
+  // The collider's index in the layer.
+  size_t collider;
+  // Its body.
+  struct VtBody body;
+  // The body's ragdoll and bone, if a ragdoll's.
+  struct VtRagdollPart part;
+} VtOverlap;
 
 // How a ragdoll is built (`BuildOptions` in Rust).
 typedef struct VtBuildOptions {
@@ -1116,6 +1268,112 @@ const char *vt_last_error_message(void);
 // string; "VT_RESULT_UNKNOWN" for a value that is not a code).
 const char *vt_result_name(uint32_t result);
 
+// A whole frame of `dt` seconds with the layer: the contacts found and
+// handed to the world, the world's step, then `vt_collisions_after_step`
+// (fast bodies swept against static geometry, the contact events, the
+// query tree). Refused before anything changes for a time step the world
+// refuses, a world the layer does not serve, a collider whose body is
+// gone. A steady frame allocates nothing.
+//
+// # Safety
+// `collisions` and `world` are live.
+enum VtResult vt_collisions_step(struct VtCollisions *collisions, struct VtWorld *world, float dt);
+
+// What follows a step whose contacts `vt_collisions_update` found:
+// continuous collision, the contact events and the query tree. Refused
+// (`VT_RESULT_WORLD_MISMATCH`), nothing changed, when the world's last
+// step did not solve the contacts the layer last found for it.
+//
+// # Safety
+// `collisions` and `world` are live.
+enum VtResult vt_collisions_after_step(struct VtCollisions *collisions, struct VtWorld *world);
+
+// The pairs that began touching in the last step (with the impulse and
+// speed of the hit) into `began` (room for `capacity`), their number into
+// `count`; `VT_RESULT_BUFFER_TOO_SMALL` (only `count` written) when they
+// do not fit.
+//
+// # Safety
+// `collisions` is live; `began` points to `capacity` writable items;
+// `count` is writable.
+enum VtResult vt_collisions_began(struct VtCollisions *collisions,
+                                  struct VtTouching *began,
+                                  size_t capacity,
+                                  size_t *count);
+
+// The pairs that stopped touching in the last step, as
+// `vt_collisions_began`.
+//
+// # Safety
+// As `vt_collisions_began`.
+enum VtResult vt_collisions_ended(struct VtCollisions *collisions,
+                                  struct VtContactEnded *ended,
+                                  size_t capacity,
+                                  size_t *count);
+
+// Every pair touching with contacts the last step solved, with the
+// step's impulses, as `vt_collisions_began`.
+//
+// # Safety
+// As `vt_collisions_began`.
+enum VtResult vt_collisions_touching(struct VtCollisions *collisions,
+                                     struct VtTouching *touching,
+                                     size_t capacity,
+                                     size_t *count);
+
+// The contacts the last step solved (in the order set) into `contacts`
+// and each one's impulses into `impulses` (both room for `capacity`),
+// their number into `count`; `VT_RESULT_BUFFER_TOO_SMALL` (only `count`
+// written) when they do not fit.
+//
+// # Safety
+// `world` is live; `contacts` and `impulses` each point to `capacity`
+// writable items; `count` is writable.
+enum VtResult vt_world_solved_contacts(struct VtWorld *world,
+                                       struct VtContact *contacts,
+                                       struct VtContactImpulse *impulses,
+                                       size_t capacity,
+                                       size_t *count);
+
+// Writes `joint`'s mean force and torque over the last step it was solved
+// in into `load` (zero before its first step).
+//
+// # Safety
+// `world` is live; `load` is writable.
+enum VtResult vt_world_joint_force(struct VtWorld *world,
+                                   struct VtJoint joint,
+                                   struct VtJointForce *load);
+
+// The joints the last step broke into `broken` (room for `capacity`),
+// their number into `count`, as `vt_collisions_began`.
+//
+// # Safety
+// `world` is live; `broken` points to `capacity` writable items; `count`
+// is writable.
+enum VtResult vt_world_broken_joints(struct VtWorld *world,
+                                     struct VtBrokenJoint *broken,
+                                     size_t capacity,
+                                     size_t *count);
+
+// Writes `joint`'s residual error at the world's poses now into
+// `residual` (measured on the spot unless the last step measured it).
+//
+// # Safety
+// `world` is live; `residual` is writable.
+enum VtResult vt_world_joint_residual(struct VtWorld *world,
+                                      struct VtJoint joint,
+                                      struct VtJointResidual *residual);
+
+// Writes `body`'s island into `island` and 1 into `present`, or 0 into
+// `present` for a body in none (static, or no island kept: sleeping off).
+//
+// # Safety
+// `world` is live; `island` and `present` are writable.
+enum VtResult vt_world_island(struct VtWorld *world,
+                              struct VtBody body,
+                              uint32_t *island,
+                              uint32_t *present);
+
 // Writes into `desc` a joint of `kind` (a `VtJointKind`) between two
 // bodies at their current poses, exactly satisfied now, without limits or
 // drive: its anchor at the world point `anchor` (m), its frame's +X along
@@ -1161,6 +1419,102 @@ enum VtResult vt_world_joint(struct VtWorld *world, struct VtJoint joint, struct
 enum VtResult vt_world_set_joint_drive(struct VtWorld *world,
                                        struct VtJoint joint,
                                        const struct VtDrive *drive);
+
+// Writes a filter that sees every collider into `filter`.
+//
+// # Safety
+// `filter` is writable.
+enum VtResult vt_query_filter_default(struct VtQueryFilter *filter);
+
+// Builds the layer's query tree from the world's poses now (queries until
+// a body moves prune through it; without it they test every collider,
+// with the same answers). `vt_collisions_step` and
+// `vt_collisions_after_step` refresh it.
+//
+// # Safety
+// `collisions` and `world` are live.
+enum VtResult vt_collisions_refresh_queries(struct VtCollisions *collisions, struct VtWorld *world);
+
+// Casts a ray from `origin` along `direction` (unit) up to `max_distance`
+// (m) through the colliders `filter` passes: the first hit into `hit`
+// and 1 into `found`, or 0 into `found`. Refused, unchanged, for an origin
+// out of range, a direction not unit, a negative or NaN distance, a world
+// the layer does not serve, a collider whose body is gone.
+//
+// # Safety
+// `collisions` and `world` are live; `filter` is readable; `hit` and
+// `found` are writable.
+enum VtResult vt_collisions_cast_ray(struct VtCollisions *collisions,
+                                     struct VtWorld *world,
+                                     struct VtVec3 origin,
+                                     struct VtVec3 direction,
+                                     float max_distance,
+                                     const struct VtQueryFilter *filter,
+                                     struct VtQueryHit *hit,
+                                     uint32_t *found);
+
+// Sweeps `shape`, posed at `pose`, along `direction` (unit) up to
+// `max_distance` (m): the first collider `filter` passes that it touches
+// into `hit` (distance 0 for one it starts in) and 1 into `found`, or 0.
+// Refused as `vt_collisions_cast_ray`, and for a shape of a bad kind or
+// size or a rotation not unit.
+//
+// # Safety
+// `collisions` and `world` are live; `shape` and `filter` are readable;
+// `hit` and `found` are writable.
+enum VtResult vt_collisions_cast_shape(struct VtCollisions *collisions,
+                                       struct VtWorld *world,
+                                       const struct VtQueryShape *shape,
+                                       struct VtTransform pose,
+                                       struct VtVec3 direction,
+                                       float max_distance,
+                                       const struct VtQueryFilter *filter,
+                                       struct VtQueryHit *hit,
+                                       uint32_t *found);
+
+// Every collider `filter` passes that `shape`, posed at `pose`, overlaps,
+// by collider index, into `overlaps` (room for `capacity`), their number
+// into `count`; refused (`VT_RESULT_BUFFER_TOO_SMALL`, only `count`
+// written) when they do not fit. Refused as `vt_collisions_cast_shape`.
+//
+// # Safety
+// `collisions` and `world` are live; `shape` and `filter` are readable;
+// `overlaps` points to `capacity` writable items; `count` is writable.
+enum VtResult vt_collisions_overlaps(struct VtCollisions *collisions,
+                                     struct VtWorld *world,
+                                     const struct VtQueryShape *shape,
+                                     struct VtTransform pose,
+                                     const struct VtQueryFilter *filter,
+                                     struct VtOverlap *overlaps,
+                                     size_t capacity,
+                                     size_t *count);
+
+// A shot: `vt_collisions_cast_ray`, and the impulse `impulse * direction`
+// (N s) applied to the dynamic body hit at the point hit, in one call (a
+// static or kinematic body stops the shot and takes nothing). Refused as
+// `vt_collisions_cast_ray`, and for a negative or non-finite impulse;
+// nothing changed on a refusal.
+//
+// # Safety
+// As `vt_collisions_cast_ray`.
+enum VtResult vt_collisions_shoot(struct VtCollisions *collisions,
+                                  struct VtWorld *world,
+                                  struct VtVec3 origin,
+                                  struct VtVec3 direction,
+                                  float max_distance,
+                                  float impulse,
+                                  const struct VtQueryFilter *filter,
+                                  struct VtQueryHit *hit,
+                                  uint32_t *found);
+
+// Writes which ragdoll and bone `body` is into `part` (`present` 0 for a
+// body the layer knows as no ragdoll's).
+//
+// # Safety
+// `collisions` is live; `part` is writable.
+enum VtResult vt_collisions_body_part(struct VtCollisions *collisions,
+                                      struct VtBody body,
+                                      struct VtRagdollPart *part);
 
 // Loads a ragdoll description from the TOML file at `path` (UTF-8); a
 // skeleton it names is read beside it. Refused with the file, line and
@@ -1358,6 +1712,55 @@ enum VtResult vt_ragdoll_placement(struct VtRagdoll *ragdoll,
                                    struct VtTransform *root,
                                    struct VtVec3 *min,
                                    struct VtVec3 *max);
+
+// Writes the number of described joints into `count`.
+//
+// # Safety
+// `desc` is live; `count` is writable.
+enum VtResult vt_ragdoll_desc_joint_count(const struct VtRagdollDesc *desc, size_t *count);
+
+// Writes the index of the joint named `name` into `index`.
+//
+// # Safety
+// `desc` is live; `name` is a NUL-terminated string; `index` is writable.
+enum VtResult vt_ragdoll_desc_joint_index(const struct VtRagdollDesc *desc,
+                                          const char *name,
+                                          size_t *index);
+
+// Copies the name of joint `index` with its NUL into `buffer` (`capacity`
+// bytes) and its length with the NUL into `length`, as
+// `vt_ragdoll_desc_body_name`.
+//
+// # Safety
+// `desc` is live; `buffer` points to `capacity` writable bytes; `length`
+// is writable.
+enum VtResult vt_ragdoll_desc_joint_name(const struct VtRagdollDesc *desc,
+                                         size_t index,
+                                         char *buffer,
+                                         size_t capacity,
+                                         size_t *length);
+
+// Writes the handle of described joint `index` into `joint` and 1 into
+// `present`; or 0 into `present` for a joint the ragdoll has no joint
+// for (a spine joint of a rod-spine ragdoll: the rod holds the spine). Its
+// drive, limits, force (`vt_world_joint_force`) and residual
+// (`vt_world_joint_residual`) are the world's, by this handle. A removed
+// ragdoll is refused (`VT_RESULT_STALE_HANDLE`).
+//
+// # Safety
+// `ragdoll` is live; `joint` and `present` are writable.
+enum VtResult vt_ragdoll_joint(struct VtRagdoll *ragdoll,
+                               size_t index,
+                               struct VtJoint *joint,
+                               uint32_t *present);
+
+// Writes the ragdoll's first body into `body`: the name the collision
+// layer's hits and events give the ragdoll (`VtRagdollPart::ragdoll`). A
+// removed ragdoll is refused (`VT_RESULT_STALE_HANDLE`).
+//
+// # Safety
+// `ragdoll` is live; `body` is writable.
+enum VtResult vt_ragdoll_first_body(struct VtRagdoll *ragdoll, struct VtBody *body);
 
 // Writes into `desc` a rod between two bodies that holds exactly at their
 // current poses: its arc through the middle of `through` (`count` world

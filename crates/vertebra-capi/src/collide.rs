@@ -20,6 +20,8 @@ pub struct VtCollisions {
     /// The contact list handed to the world and back each update, kept so
     /// that a steady update allocates nothing.
     contacts: Vec<Contact>,
+    /// The overlaps a query finds, kept likewise.
+    pub(crate) overlaps: Vec<vertebra_collide::Overlap>,
     poisoned: bool,
 }
 
@@ -137,7 +139,7 @@ pub unsafe extern "C" fn vt_collider_default(body: VtBody, collider: *mut VtColl
 ///
 /// # Safety
 /// `collisions` is null or live, used by no other call at once.
-unsafe fn with_layer(
+pub(crate) unsafe fn with_layer(
     collisions: *mut VtCollisions,
     body: impl FnOnce(&mut VtCollisions) -> Result<(), Failure>,
 ) -> VtResult {
@@ -159,6 +161,7 @@ pub unsafe extern "C" fn vt_collisions_create(collisions: *mut *mut VtCollisions
         unsafe { out(collisions, "collisions") }?.set(boxed(VtCollisions {
             collisions: Collisions::new(),
             contacts: Vec::new(),
+            overlaps: Vec::new(),
             poisoned: false,
         }));
         Ok(())

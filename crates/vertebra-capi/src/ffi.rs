@@ -309,6 +309,38 @@ pub(crate) unsafe fn copy_text(
     length.done(needed)
 }
 
+/// Copies `items` into the caller's array `place` (room for `capacity`)
+/// and writes their number into `count`; refused (`BufferTooSmall`, only
+/// `count` written) when they do not fit. A null `place` with `capacity`
+/// 0 asks the number.
+///
+/// # Safety
+/// `place` points to `capacity` writable items; `count` is writable.
+pub(crate) unsafe fn copy_out<T>(
+    items: impl ExactSizeIterator<Item = T>,
+    place: *mut T,
+    capacity: usize,
+    count: *mut usize,
+    what: &str,
+) -> Result<(), Failure> {
+    // SAFETY: the caller's contract.
+    let count = unsafe { out(count, "count") }?;
+    let needed = items.len();
+    if capacity < needed {
+        count.set(needed);
+        return Err(Failure::new(
+            VtResult::BufferTooSmall,
+            format!("{what} holds {capacity}; there are {needed}"),
+        ));
+    }
+    // SAFETY: the caller's contract: `capacity` >= `needed` writable items.
+    let place = unsafe { slice_mut(place, needed, what) }?;
+    for (to, from) in place.iter_mut().zip(items) {
+        *to = from;
+    }
+    count.done(needed)
+}
+
 /// A new object for C to own (freed by its destroy function).
 pub(crate) fn boxed<T>(value: T) -> *mut T {
     Box::into_raw(Box::new(value))

@@ -2,7 +2,8 @@
 //! softness and drives (`docs/joints.md` gives each kind's parts and units).
 
 use vertebra_world::{
-    AngularDrive, DriveStrength, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist,
+    AngularDrive, DriveStrength, JointBreaking, JointDesc, JointKind, LimitSoftness, Swing,
+    SwingTwist,
 };
 
 use crate::error::{Failure, VtResult};
@@ -135,6 +136,16 @@ pub struct VtJointDesc {
     pub has_drive: u32,
     /// The drive.
     pub drive: VtDrive,
+    /// Non-zero: the joint breaks past `break_force` or `break_torque`
+    /// (it is removed at the end of that step and listed by
+    /// `vt_world_broken_joints`).
+    pub has_breaking: u32,
+    /// The largest mean force it holds over a step (N, positive; infinity:
+    /// never by force).
+    pub break_force: f32,
+    /// The largest mean torque it holds over a step (N m, positive;
+    /// infinity: never by torque).
+    pub break_torque: f32,
 }
 
 impl TryFrom<VtSoftness> for LimitSoftness {
@@ -302,7 +313,10 @@ impl TryFrom<&VtJointDesc> for JointDesc {
             frame_b: d.frame_b.into(),
             kind,
             drive,
-            breaking: None,
+            breaking: flag(d.has_breaking).then_some(JointBreaking {
+                force: d.break_force,
+                torque: d.break_torque,
+            }),
         })
     }
 }
@@ -331,6 +345,9 @@ impl From<&JointDesc> for VtJointDesc {
             softness: softness.into(),
             has_drive: u32::from(d.drive.is_some()),
             drive: drive.into(),
+            has_breaking: u32::from(d.breaking.is_some()),
+            break_force: d.breaking.map_or(f32::INFINITY, |b| b.force),
+            break_torque: d.breaking.map_or(f32::INFINITY, |b| b.torque),
         }
     }
 }

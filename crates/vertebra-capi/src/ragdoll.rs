@@ -726,3 +726,135 @@ pub unsafe extern "C" fn vt_ragdoll_placement(
         })
     }
 }
+
+/// Writes the number of described joints into `count`.
+///
+/// # Safety
+/// `desc` is live; `count` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_ragdoll_desc_joint_count(
+    desc: *const VtRagdollDesc,
+    count: *mut usize,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (desc, count) = unsafe { (shared(desc, "desc")?, out(count, "count")?) };
+        count.done(desc.desc.joints.len())
+    })
+}
+
+/// Writes the index of the joint named `name` into `index`.
+///
+/// # Safety
+/// `desc` is live; `name` is a NUL-terminated string; `index` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_ragdoll_desc_joint_index(
+    desc: *const VtRagdollDesc,
+    name: *const core::ffi::c_char,
+    index: *mut usize,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let desc = unsafe { shared(desc, "desc") }?;
+        let find = |name: &str| {
+            let found = desc.desc.joint_index(name);
+            let why = || format!("the ragdoll has no joint `{name}`");
+            found.ok_or_else(|| Failure::new(VtResult::Ragdoll, why()))
+        };
+        // SAFETY: the function's contract.
+        unsafe { index_of(name, index, find) }
+    })
+}
+
+/// Copies the name of joint `index` with its NUL into `buffer` (`capacity`
+/// bytes) and its length with the NUL into `length`, as
+/// `vt_ragdoll_desc_body_name`.
+///
+/// # Safety
+/// `desc` is live; `buffer` points to `capacity` writable bytes; `length`
+/// is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_ragdoll_desc_joint_name(
+    desc: *const VtRagdollDesc,
+    index: usize,
+    buffer: *mut core::ffi::c_char,
+    capacity: usize,
+    length: *mut usize,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let desc = unsafe { shared(desc, "desc") }?;
+        let joint = desc.desc.joints.get(index).ok_or_else(|| {
+            let n = desc.desc.joints.len();
+            Failure::new(
+                VtResult::OutOfRange,
+                format!("joint {index} of a ragdoll of {n}"),
+            )
+        })?;
+        // SAFETY: the function's contract.
+        unsafe { copy_text(&joint.name, buffer, capacity, length) }
+    })
+}
+
+/// Writes the handle of described joint `index` into `joint` and 1 into
+/// `present`; or 0 into `present` for a joint the ragdoll has no joint
+/// for (a spine joint of a rod-spine ragdoll: the rod holds the spine). Its
+/// drive, limits, force (`vt_world_joint_force`) and residual
+/// (`vt_world_joint_residual`) are the world's, by this handle. A removed
+/// ragdoll is refused (`VT_RESULT_STALE_HANDLE`).
+///
+/// # Safety
+/// `ragdoll` is live; `joint` and `present` are writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_ragdoll_joint(
+    ragdoll: *mut VtRagdoll,
+    index: usize,
+    joint: *mut crate::types::VtJoint,
+    present: *mut u32,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (ragdoll, joint, present) = unsafe {
+            (
+                enter(ragdoll)?,
+                out(joint, "joint")?,
+                out(present, "present")?,
+            )
+        };
+        ragdoll.ragdoll.check_not_removed()?;
+        let joints = &ragdoll.ragdoll.joints;
+        let slot = joints.get(index).ok_or_else(|| {
+            let n = joints.len();
+            Failure::new(
+                VtResult::OutOfRange,
+                format!("joint {index} of a ragdoll of {n}"),
+            )
+        })?;
+        if let Some(handle) = *slot {
+            joint.set(handle.into());
+        }
+        present.done(u32::from(slot.is_some()))
+    })
+}
+
+/// Writes the ragdoll's first body into `body`: the name the collision
+/// layer's hits and events give the ragdoll (`VtRagdollPart::ragdoll`). A
+/// removed ragdoll is refused (`VT_RESULT_STALE_HANDLE`).
+///
+/// # Safety
+/// `ragdoll` is live; `body` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_ragdoll_first_body(
+    ragdoll: *mut VtRagdoll,
+    body: *mut VtBody,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (ragdoll, body) = unsafe { (enter(ragdoll)?, out(body, "body")?) };
+        ragdoll.ragdoll.check_not_removed()?;
+        let first = ragdoll.ragdoll.first_body().ok_or_else(|| {
+            Failure::new(VtResult::StaleHandle, "the ragdoll has no body".to_owned())
+        })?;
+        body.done(first.into())
+    })
+}

@@ -47,7 +47,7 @@ pub struct VtTransform {
 /// A body of a world. Any bits make a handle: a world refuses one it did
 /// not issue (`VT_RESULT_STALE_HANDLE`, `VT_RESULT_FOREIGN_HANDLE`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct VtBody {
     /// Slot index.
     pub index: u32,
@@ -59,7 +59,7 @@ pub struct VtBody {
 
 /// A joint of a world (as [`VtBody`]).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct VtJoint {
     /// Slot index.
     pub index: u32,

@@ -380,6 +380,11 @@ impl RagdollDesc {
         self.bodies.iter().position(|b| b.name == name)
     }
 
+    /// The index of the joint named `name`, if any.
+    pub fn joint_index(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
     /// The body that follows bone `bone` (an index into
     /// [`RagdollDesc::skeleton`]), if one does.
     pub fn body_on_bone(&self, bone: usize) -> Option<usize> {
