@@ -29,6 +29,117 @@
 //! set's snapshot is refused for a world whose bodies are not those it was
 //! taken with. Restore both, the world first; [`Collisions::attach`]
 //! declares a set right for a world as it is.
+//!
+//! # Quick start: a game's frame
+//!
+//! What a game wires in, from the switch to physics to a limb torn off
+//! (`README.md` shows the same example; `docs/contacts.md` and
+//! `docs/joints.md` say why each setting is what it is):
+//!
+//! ```
+//! use glam::{Quat, Vec3};
+//! use vertebra_collide::{Collider, ColliderShape, Collisions, QueryFilter};
+//! use vertebra_ragdoll::{
+//!     BuildOptions, DriveSettings, RagdollDesc, Skeleton, SkeletonMapper, SpineMapping,
+//!     SpineMode, Strength, Transform, Transition,
+//! };
+//! use vertebra_world::{BodyDesc, JointSolver, Shape, SleepSettings, SolverConfig, World};
+//!
+//! # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
+//! // The settings a game wants, said outright: every joint of a ragdoll
+//! // solved at once (exact through long chains and heavy hands), one
+//! // substep of four iterations, islands that fall asleep.
+//! let config = SolverConfig {
+//!     joints: JointSolver::Direct,
+//!     substeps: 1,
+//!     iterations: 4,
+//!     sleep: Some(SleepSettings::default()),
+//!     ..SolverConfig::default()
+//! };
+//! let mut world = World::new(config)?;
+//! let mut collisions = Collisions::new();
+//!
+//! // The level: a ground plane and a wall 10 cm thick, static.
+//! let ground = world.add_body(BodyDesc::fixed())?;
+//! collisions.add(Collider::new(ground, ColliderShape::Plane(Vec3::Y)))?;
+//! let wall = world.add_body(BodyDesc::fixed().with_position(Vec3::new(1.5, 1.0, 0.0)))?;
+//! let slab = Shape::Box { half_extents: Vec3::new(0.05, 1.0, 2.0) };
+//! collisions.add(Collider::new(wall, ColliderShape::Solid(slab)))?;
+//!
+//! // The switch from animation: the engine's skeleton (63 bones) at its
+//! // last two frames maps onto the ragdoll's bodies, which are built there
+//! // with the animation's velocities, joints made at that pose (no pop).
+//! let skeleton = Skeleton::reference();
+//! let mut desc = RagdollDesc::reference_humanoid();
+//! // The left elbow tears past 2 kN (the file's `break_force` says so too).
+//! let elbow = desc.joint_index("elbow_l").expect("an elbow");
+//! desc.joints[elbow].breaking = Some(vertebra_world::JointBreaking {
+//!     force: 2000.0,
+//!     torque: f32::INFINITY,
+//! });
+//! let mapper = SkeletonMapper::new(&skeleton, &desc, SpineMode::Rod)?;
+//! let place = Transform::new(Vec3::ZERO, Quat::IDENTITY);
+//! let dt = 1.0 / 60.0;
+//! let previous = skeleton.bind_pose();
+//! let mut current = previous.clone();
+//! current.bones[0].translation.x += 0.05; // stumbling toward the wall
+//! let bodies = |pose: &vertebra_ragdoll::LocalPose| {
+//!     mapper.map_to_ragdoll(&pose.to_model(&skeleton)?, place)
+//! };
+//! let (now, before) = (bodies(&current)?, bodies(&previous)?);
+//! let options = BuildOptions::at_switch(SpineMode::Rod);
+//! let ragdoll = collisions.build_ragdoll(&mut world, &desc, options, &now, Some((&before, dt)))?;
+//! let transition =
+//!     Transition::new(&mapper, &ragdoll, &world, &current, place, SpineMapping::Arc, 0.3)?;
+//! // Muscles: powered toward the animation's pose, weak enough to yield.
+//! ragdoll.drive_to(&mut world, &now, &DriveSettings::uniform(Strength::Compliance(1e-2)))?;
+//!
+//! let (mut thuds, mut torn) = (0, false);
+//! for frame in 1..=120 {
+//!     // The whole frame: contacts found, the step, fast limbs kept out
+//!     // of the wall, the contact events, the query tree.
+//!     collisions.step(&mut world, dt)?;
+//!     // Which bone hit the floor how hard: a thud per bone.
+//!     for hit in collisions.events().began() {
+//!         if let (true, Some(part)) = (hit.body_a == ground, hit.part_b) {
+//!             let bone = &desc.bodies[part.bone as usize].name;
+//!             assert!(hit.impulse > 0.0 && !bone.is_empty());
+//!             thuds += 1;
+//!         }
+//!     }
+//!     if frame == 30 {
+//!         // A bullet at the chest: the bone it hits, where, and its push.
+//!         let chest = ragdoll.bodies[desc.body_index("chest").expect("a chest")]
+//!             .expect("a body");
+//!         let aim = world.body(chest)?.position;
+//!         let hit = collisions.shoot(
+//!             &mut world,
+//!             aim - Vec3::X * 3.0,
+//!             Vec3::X,
+//!             10.0,
+//!             30.0, // N s
+//!             &QueryFilter::default(),
+//!         )?;
+//!         let part = hit.and_then(|h| h.part).expect("a bone was hit");
+//!         assert_eq!(Some(part.ragdoll), ragdoll.first_body());
+//!         // Then the left hand yanked hard: the elbow tears.
+//!         let hand = ragdoll.bodies[desc.body_index("forearm_l").expect("a forearm")]
+//!             .expect("a body");
+//!         world.apply_impulse(hand, Vec3::new(0.0, 120.0, 0.0))?;
+//!     }
+//!     for broken in world.broken_joints() {
+//!         assert_eq!(Some(broken.joint), ragdoll.joints[elbow]);
+//!         torn = true;
+//!     }
+//!     // The engine's skeleton read back, every one of its bones.
+//!     let since = frame as f32 * dt;
+//!     let pose = transition.skeleton_pose(&mapper, &ragdoll, &world, &current, place, since)?;
+//!     assert_eq!(pose.bones.len(), skeleton.bones().len());
+//! }
+//! assert!(thuds > 0 && torn);
+//! # Ok(())
+//! # }
+//! ```
 
 mod continuous;
 mod events;
