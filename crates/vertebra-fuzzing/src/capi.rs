@@ -115,7 +115,7 @@ impl Run {
         // SAFETY: live objects of this run and pointers to locals of the
         // lengths passed.
         unsafe {
-            match input.pick(14) {
+            match input.pick(15) {
                 0 | 1 => {
                     let mut desc = VtBodyDesc {
                         kind: tag(input, 3),
@@ -195,6 +195,9 @@ impl Run {
                         b: input.float(10.0),
                     };
                     desc.drive.max_torque = input.float(1e3);
+                    desc.has_breaking = u32::from(input.flag());
+                    desc.break_force = input.float(500.0);
+                    desc.break_torque = input.float(100.0);
                     let mut joint = std::mem::zeroed();
                     let result = vt_world_add_joint(world, &desc, &mut joint);
                     if result == VtResult::Ok {
@@ -362,6 +365,7 @@ impl Run {
                         ),
                     }
                 }
+                13 => self.game_call(input),
                 _ => {
                     // A snapshot taken and restored, or crafted bytes; the
                     // layer's restored after it, or not (then the layer
@@ -388,6 +392,140 @@ impl Run {
                         }
                     }
                     restored
+                }
+            }
+        }
+    }
+
+    /// One of the calls a game makes every frame: the frame in one call,
+    /// what follows a step, queries and shots with any filter and shape,
+    /// and the step's outputs read into arrays of any capacity.
+    fn game_call(&mut self, input: &mut Input) -> VtResult {
+        let (world, collisions) = (self.world, self.collisions);
+        let filter = VtQueryFilter {
+            membership: input.pick(usize::MAX) as u32,
+            filter: input.pick(usize::MAX) as u32,
+            has_exclude_body: u32::from(input.flag()),
+            exclude_body: self.body(input),
+            has_exclude_ragdoll: u32::from(input.flag()),
+            exclude_ragdoll: self.body(input),
+            static_bodies: u32::from(input.flag()),
+            kinematic_bodies: u32::from(input.flag()),
+            dynamic_bodies: u32::from(input.flag()),
+        };
+        let capacity = input.pick(8);
+        let mut count = 0;
+        // SAFETY: live objects of this run; output places on the stack or
+        // in vectors of `capacity` items (plain structs: zeroed is a
+        // value).
+        unsafe {
+            let (mut hit, mut found) = (std::mem::zeroed::<VtQueryHit>(), 0);
+            match input.pick(8) {
+                0 => vt_collisions_step(collisions, world, input.float(0.05)),
+                1 => vt_collisions_after_step(collisions, world),
+                2 => vt_collisions_cast_ray(
+                    collisions,
+                    world,
+                    v(input.vec3(5.0)),
+                    v(input.vec3(1.0)),
+                    input.float(20.0),
+                    &filter,
+                    &mut hit,
+                    &mut found,
+                ),
+                3 => vt_collisions_shoot(
+                    collisions,
+                    world,
+                    v(input.vec3(5.0)),
+                    v(input.vec3(1.0)),
+                    input.float(20.0),
+                    input.float(100.0),
+                    &filter,
+                    &mut hit,
+                    &mut found,
+                ),
+                4 | 5 => {
+                    let shape = VtQueryShape {
+                        kind: tag(input, 2),
+                        radius: input.float(1.0),
+                        half_segment: v(input.vec3(1.0)),
+                    };
+                    let pose = VtTransform::from((input.vec3(5.0), input.quat()));
+                    let mut out = vec![std::mem::zeroed::<VtOverlap>(); capacity];
+                    match input.flag() {
+                        true => vt_collisions_cast_shape(
+                            collisions,
+                            world,
+                            &shape,
+                            pose,
+                            v(input.vec3(1.0)),
+                            input.float(20.0),
+                            &filter,
+                            &mut hit,
+                            &mut found,
+                        ),
+                        false => vt_collisions_overlaps(
+                            collisions,
+                            world,
+                            &shape,
+                            pose,
+                            &filter,
+                            out.as_mut_ptr(),
+                            capacity,
+                            &mut count,
+                        ),
+                    }
+                }
+                6 => {
+                    let mut touching = vec![std::mem::zeroed::<VtTouching>(); capacity];
+                    let mut ended = vec![std::mem::zeroed::<VtContactEnded>(); capacity];
+                    let mut contacts = vec![std::mem::zeroed::<VtContact>(); capacity];
+                    let mut impulses = vec![std::mem::zeroed::<VtContactImpulse>(); capacity];
+                    let mut broken = vec![std::mem::zeroed::<VtBrokenJoint>(); capacity];
+                    match input.pick(5) {
+                        0 => vt_collisions_began(
+                            collisions,
+                            touching.as_mut_ptr(),
+                            capacity,
+                            &mut count,
+                        ),
+                        1 => vt_collisions_touching(
+                            collisions,
+                            touching.as_mut_ptr(),
+                            capacity,
+                            &mut count,
+                        ),
+                        2 => vt_collisions_ended(
+                            collisions,
+                            ended.as_mut_ptr(),
+                            capacity,
+                            &mut count,
+                        ),
+                        3 => vt_world_solved_contacts(
+                            world,
+                            contacts.as_mut_ptr(),
+                            impulses.as_mut_ptr(),
+                            capacity,
+                            &mut count,
+                        ),
+                        _ => {
+                            vt_world_broken_joints(world, broken.as_mut_ptr(), capacity, &mut count)
+                        }
+                    }
+                }
+                _ => {
+                    let joint = match self.joints.is_empty() {
+                        false => self.joints[input.pick(self.joints.len())],
+                        true => VtJoint::default(),
+                    };
+                    let (mut load, mut residual) =
+                        (std::mem::zeroed::<VtJointForce>(), std::mem::zeroed());
+                    let (mut island, mut present) = (0, 0);
+                    match input.pick(3) {
+                        0 => vt_world_joint_force(world, joint, &mut load),
+                        1 => vt_world_joint_residual(world, joint, &mut residual),
+                        _ => vt_world_island(world, self.body(input), &mut island, &mut present),
+                    }
                 }
             }
         }
