@@ -7,7 +7,7 @@ use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_collide::{
     Collider, ColliderShape, CollisionGroups, CollisionSnapshot, Collisions,
-    MAX_SELF_COLLISION_GROUPS,
+    MAX_SELF_COLLISION_GROUPS, RagdollPart,
 };
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
 use vertebra_world::{BodyDesc, BodyHandle, Error, Shape, Snapshot, SolverConfig, World};
@@ -38,7 +38,7 @@ type Fingerprint = (
 );
 
 /// The collision snapshot's payload, as `docs/contacts.md` documents it
-/// (format 3; the header is magic 8, version 4, xxh3 8). A valid snapshot
+/// (format 4; the header is magic 8, version 4, xxh3 8). A valid snapshot
 /// must round-trip through it, so a format change fails the corpus replay
 /// until this copy follows.
 #[derive(Serialize, Deserialize)]
@@ -47,6 +47,8 @@ struct Payload {
     prediction: f32,
     colliders: Vec<Collider>,
     excluded: Vec<(BodyHandle, BodyHandle)>,
+    parts: Vec<(BodyHandle, RagdollPart)>,
+    touching: Vec<(BodyHandle, BodyHandle)>,
     apart: Vec<(BodyHandle, u64)>,
     next_apart: u64,
 }
