@@ -300,16 +300,24 @@ fn the_readme_quick_start_is_the_doctest() {
     let root = root();
     let lib = std::fs::read_to_string(root.join("crates/vertebra-collide/src/lib.rs")).unwrap();
     let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-    let doc = &lib[lib.find("//! # Quick start").expect("the crate's quick start")..];
+    let doc = &lib[lib
+        .find("//! # Quick start")
+        .expect("the crate's quick start")..];
     let doc: Vec<&str> = doc
         .lines()
-        .map(|l| l.strip_prefix("//! ").or(l.strip_prefix("//!")).unwrap_or(l))
+        .map(|l| {
+            l.strip_prefix("//! ")
+                .or(l.strip_prefix("//!"))
+                .unwrap_or(l)
+        })
         .skip_while(|l| *l != "```")
         .skip(1)
         .take_while(|l| *l != "```")
         .filter(|l| !l.starts_with("# "))
         .collect();
-    let quick = &readme[readme.find("## Quick start").expect("the README's quick start")..];
+    let quick = &readme[readme
+        .find("## Quick start")
+        .expect("the README's quick start")..];
     let shown: Vec<&str> = quick
         .lines()
         .skip_while(|l| *l != "```rust")
@@ -317,5 +325,8 @@ fn the_readme_quick_start_is_the_doctest() {
         .take_while(|l| *l != "```")
         .collect();
     assert!(doc.len() > 50, "the doctest was found: {} lines", doc.len());
-    assert_eq!(shown, doc, "README.md's quick start differs from the doctest");
+    assert_eq!(
+        shown, doc,
+        "README.md's quick start differs from the doctest"
+    );
 }

@@ -73,7 +73,7 @@ impl Collisions {
     /// tools; the same sweep, nothing changed.
     pub fn continuous_bodies(&self, world: &World) -> Vec<(BodyHandle, Vec3, Quat)> {
         let mut out = Vec::new();
-        self.sweep(world, &mut out);
+        self.sweep(world, &mut out, &mut Vec::new());
         out
     }
 
@@ -81,7 +81,9 @@ impl Collisions {
     /// that would have passed into static geometry.
     pub(crate) fn sweep_fast_bodies(&mut self, world: &mut World) -> Result<(), Error> {
         let mut moves = core::mem::take(&mut self.moves);
-        self.sweep(world, &mut moves);
+        let mut statics = core::mem::take(&mut self.statics);
+        self.sweep(world, &mut moves, &mut statics);
+        self.statics = statics;
         let result = moves.iter().try_for_each(|&(body, position, orientation)| {
             world.set_body_pose(body, position, orientation)
         });
@@ -90,12 +92,32 @@ impl Collisions {
     }
 
     /// The first touch of each fast body's cores into `out` (emptied
-    /// first), in slot order.
-    fn sweep(&self, world: &World, out: &mut Vec<(BodyHandle, Vec3, Quat)>) {
+    /// first), in slot order; `statics` is working memory (the static
+    /// solids with their bounds and poses, gathered once).
+    fn sweep(
+        &self,
+        world: &World,
+        out: &mut Vec<(BodyHandle, Vec3, Quat)>,
+        statics: &mut Vec<(usize, Aabb, Pose)>,
+    ) {
         out.clear();
+        statics.clear();
         if self.found.version != self.version || self.found.before.len() != self.colliders.len() {
             // The colliders changed between detection and now: their
             // poses before the step are not known.
+            return;
+        }
+        for (k, (c, shape)) in self.colliders.iter().enumerate() {
+            let solid = matches!(c.shape, ColliderShape::Solid(_));
+            if !solid || world.bodies().kind[c.body.index()] != BodyKind::Static {
+                continue;
+            }
+            if let Ok(s) = world.body(c.body) {
+                let pose = Pose::from_parts(s.position, s.orientation);
+                statics.push((k, shape.compute_aabb(&pose), pose));
+            }
+        }
+        if statics.is_empty() {
             return;
         }
         let mut first: Vec<(BodyHandle, f32, NonlinearRigidMotion)> = Vec::new();
@@ -127,7 +149,7 @@ impl Collisions {
             );
             let end = Pose::from_parts(now.position, now.orientation);
             let swept = shape.compute_aabb(&start).merged(&shape.compute_aabb(&end));
-            if let Some(t) = self.first_touch(world, &solid, &motion, &swept) {
+            if let Some(t) = self.first_touch(statics, &solid, &motion, &swept) {
                 first.push((collider.body, t, motion));
             }
         }
@@ -145,23 +167,17 @@ impl Collisions {
     /// whose bounds meet `swept`.
     fn first_touch(
         &self,
-        world: &World,
+        statics: &[(usize, Aabb, Pose)],
         solid: &Shape,
         motion: &NonlinearRigidMotion,
         swept: &Aabb,
     ) -> Option<f32> {
         let mut first: Option<f32> = None;
-        for (c, shape) in &self.colliders {
-            if !matches!(c.shape, ColliderShape::Solid(_))
-                || world.bodies().kind[c.body.index()] != BodyKind::Static
-            {
+        for &(k, bounds, pose) in statics {
+            if !bounds.intersects(swept) {
                 continue;
             }
-            let Ok(s) = world.body(c.body) else { continue };
-            let pose = Pose::from_parts(s.position, s.orientation);
-            if !shape.compute_aabb(&pose).intersects(swept) {
-                continue;
-            }
+            let shape = &self.colliders[k].1;
             let fixed = NonlinearRigidMotion::constant_position(pose);
             let hit = with_core(solid, |core| {
                 parry3d::query::cast_shapes_nonlinear(

@@ -171,6 +171,44 @@ pub use groups::MAX_SELF_COLLISION_GROUPS;
 pub use query::{Overlap, QueryFilter, QueryHit, QueryShape};
 pub use snapshot::CollisionSnapshot;
 
+/// The ragdoll part of each body the set knows as a ragdoll's, by slot
+/// (looked up for every hit and every touching pair: an index and a
+/// handle compare, no hashing).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Parts {
+    by_slot: Vec<Option<(BodyHandle, RagdollPart)>>,
+}
+
+impl Parts {
+    /// `body`'s part, if the set knows it.
+    pub(crate) fn get(&self, body: BodyHandle) -> Option<RagdollPart> {
+        match self.by_slot.get(body.index()) {
+            Some(Some((b, part))) if *b == body => Some(*part),
+            _ => None,
+        }
+    }
+
+    /// Records `body`'s part.
+    pub(crate) fn insert(&mut self, body: BodyHandle, part: RagdollPart) {
+        if self.by_slot.len() <= body.index() {
+            self.by_slot.resize(body.index() + 1, None);
+        }
+        self.by_slot[body.index()] = Some((body, part));
+    }
+
+    /// Forgets `body`'s part (nothing to forget is not an error).
+    pub(crate) fn remove(&mut self, body: BodyHandle) {
+        if self.get(body).is_some() {
+            self.by_slot[body.index()] = None;
+        }
+    }
+
+    /// Every body's part, in slot order.
+    pub(crate) fn iter(&self) -> impl Iterator<Item = (BodyHandle, RagdollPart)> + '_ {
+        self.by_slot.iter().flatten().copied()
+    }
+}
+
 /// Which ragdoll and bone a body is, in hits and events.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct RagdollPart {
@@ -334,7 +372,7 @@ pub struct Collisions {
     next_apart: u64,
     /// The ragdoll and bone of every ragdoll body the set added
     /// (`build_ragdoll`, `add_ragdoll`).
-    parts: HashMap<BodyHandle, RagdollPart>,
+    parts: Parts,
     /// The pairs of bodies touching after the last step the events saw,
     /// in ascending order (`events.rs`).
     touching: Vec<(BodyHandle, BodyHandle)>,
@@ -353,6 +391,9 @@ pub struct Collisions {
     frame_contacts: Vec<Contact>,
     /// Scratch of continuous collision: the bodies it puts back.
     moves: Vec<(BodyHandle, Vec3, Quat)>,
+    /// Scratch of continuous collision: the static solids, their bounds
+    /// and poses.
+    statics: Vec<(usize, Aabb, Pose)>,
     /// The world's run of states the set serves, once it has served one
     /// (`pairing.rs`). Not part of the set's state: never saved; a clone
     /// serves the same world.
@@ -604,8 +645,8 @@ impl Collisions {
             .map(|&(a, b)| ordered(to(a), to(b)))
             .collect();
         self.apart = self.apart.iter().map(|(&b, &g)| (to(b), g)).collect();
-        self.parts = (self.parts.iter())
-            .map(|(&b, p)| {
+        let moved_parts: Vec<_> = (self.parts.iter())
+            .map(|(b, p)| {
                 let part = RagdollPart {
                     ragdoll: to(p.ragdoll),
                     bone: p.bone,
@@ -613,6 +654,10 @@ impl Collisions {
                 (to(b), part)
             })
             .collect();
+        self.parts = Parts::default();
+        for (body, part) in moved_parts {
+            self.parts.insert(body, part);
+        }
         self.version += 1;
         self.serve(world);
         Ok(())
@@ -647,7 +692,7 @@ impl Collisions {
         self.colliders.retain(|c| c.0.body != body);
         self.excluded.retain(|&(a, b)| a != body && b != body);
         self.apart.remove(&body);
-        self.parts.remove(&body);
+        self.parts.remove(body);
         self.version += 1;
     }
 

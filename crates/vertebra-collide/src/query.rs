@@ -207,7 +207,7 @@ impl Collisions {
     /// The ragdoll and bone `body` is, if the set knows it as a ragdoll's
     /// (`build_ragdoll`, `add_ragdoll`).
     pub fn part(&self, body: BodyHandle) -> Option<RagdollPart> {
-        self.parts.get(&body).copied()
+        self.parts.get(body)
     }
 
     /// Builds the query tree from the colliders at `world`'s poses now.
@@ -268,9 +268,14 @@ impl Collisions {
     }
 
     /// Refuses a world the set does not serve, or with a collider whose
-    /// body is gone (by its index).
+    /// body is gone (by its index). A fresh tree vouches for the bodies:
+    /// none was removed since it was built (that changes the world's pose
+    /// version), so only a query without one checks them all.
     fn check_queryable(&self, world: &World) -> Result<(), Error> {
         self.check_serves(world)?;
+        if self.tree_fresh(world) {
+            return Ok(());
+        }
         for (index, (c, _)) in self.colliders.iter().enumerate() {
             world.body(c.body).map_err(|e| c.refused(index, e))?;
         }

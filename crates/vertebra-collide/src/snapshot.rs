@@ -83,7 +83,7 @@ impl Collisions {
         excluded.sort_by_cached_key(encode);
         let mut apart: Vec<_> = self.apart.iter().map(|(&b, &g)| (b, g)).collect();
         apart.sort_by_cached_key(encode);
-        let mut parts: Vec<_> = self.parts.iter().map(|(&b, &p)| (b, p)).collect();
+        let mut parts: Vec<_> = self.parts.iter().collect();
         parts.sort_by_cached_key(|(b, _)| encode(b));
         let state = State {
             census: census(world),
