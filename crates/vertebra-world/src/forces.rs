@@ -16,7 +16,7 @@
 //! same step on every backend and thread count.
 
 use glam::{Mat3, Vec3};
-use vertebra_kernels::direct::{NONE, NodeKind};
+use vertebra_kernels::direct::{Child, NONE, NodeKind};
 use vertebra_kernels::reaction::force_and_torque;
 
 use crate::joint::{JointDesc, JointHandle, JointKind};
@@ -121,59 +121,94 @@ pub(crate) fn read(world: &mut World, h: f32, dt: f32) {
 /// side of the tree moved by the joint's impulse alone (every other joint
 /// among them pulls two of them, equal and opposite): its force is their
 /// summed `m dp`, its torque about the anchor their summed
-/// `I dtheta + (x - anchor) x m dp`, turned to `body_b`'s side.
+/// `I dtheta + (x - anchor) x m dp`, turned to `body_b`'s side. The
+/// child side may lie in pieces laid out in other blocks of the pass
+/// (`vertebra_kernels::direct::split`): their ports lead there.
 fn tree_load(world: &World, slot: usize, desc: &JointDesc, (h, dt): (f32, f32)) -> JointForce {
     let trees = &world.layout.trees;
     let Some(Some(place)) = trees.joints.get(slot) else {
         return JointForce::default();
     };
     let block = &trees.blocks[place.block];
-    let nodes = &trees.topologies[block.topology as usize].nodes;
-    let joint = nodes.iter().position(
+    let topology = &trees.topologies[block.topology as usize];
+    let joint = topology.nodes.iter().position(
         |node| matches!(node.kind, NodeKind::Joint { index, .. } if index as usize == place.joint),
     );
     let Some(joint) = joint else {
         return JointForce::default();
     };
-    let NodeKind::Joint { b, .. } = nodes[joint].kind else {
+    let NodeKind::Joint { b, .. } = topology.nodes[joint].kind else {
         return JointForce::default();
     };
-    let below = |mut node: usize| loop {
-        if node == joint {
-            return true;
-        }
-        match nodes[node].parent {
-            NONE => return false,
-            parent => node = parent as usize,
-        }
-    };
     let bodies = &world.bodies;
-    let (ib, lane) = (desc.body_b.index(), place.lane);
+    let ib = desc.body_b.index();
     let anchor = bodies.position[ib] + bodies.orientation[ib] * desc.anchor_b;
-    let (mut impulse, mut angular) = (Vec3::ZERO, Vec3::ZERO);
-    for (n, node) in nodes.iter().enumerate() {
-        let NodeKind::Body { index } = node.kind else {
-            continue;
-        };
-        if !below(n) {
-            continue;
-        }
-        let body = &block.bodies[index as usize];
-        let i = body.row[lane] as usize - 1;
-        let (dp, turn) = body.moved(lane);
-        let p = dp * bodies.mass[i];
-        impulse += p;
-        angular += world_inertia(world, i) * turn + (bodies.position[i] - anchor).cross(p);
-    }
-    let side = if b != NONE && below(b as usize) {
-        1.0
-    } else {
-        -1.0
+    // Port sources name blocks of the pass, which starts at its bin's
+    // first tree block.
+    let pass = (world.layout.bins.iter())
+        .find(|bin| bin.trees.contains(&place.block))
+        .map_or(0, |bin| bin.trees.start);
+    let mut sum = ChildSide {
+        world,
+        pass,
+        anchor,
+        impulse: Vec3::ZERO,
+        angular: Vec3::ZERO,
     };
+    sum.add_below(place.block, place.lane, joint);
+    // `body_b` is on the child side when it is the joint's child node.
+    let b_below = b != NONE && topology.children(joint).contains(&Child::Node(b));
+    let side = if b_below { 1.0 } else { -1.0 };
     let scale = side / (h * dt);
     JointForce {
-        force: impulse * scale,
-        torque: angular * scale,
+        force: sum.impulse * scale,
+        torque: sum.angular * scale,
+    }
+}
+
+/// The summed momentum the tree's solves gave the bodies below a node
+/// (`tree_load`).
+struct ChildSide<'a> {
+    world: &'a World,
+    /// The pass's first block (port sources count from it).
+    pass: usize,
+    /// The point the angular momentum is taken about (m, world).
+    anchor: Vec3,
+    /// Summed `m dp` (N s h).
+    impulse: Vec3,
+    /// Summed `I dtheta + (x - anchor) x m dp` about `anchor`.
+    angular: Vec3,
+}
+
+impl ChildSide<'_> {
+    /// Adds every body of node `n`'s subtree in `lane` of block `block`,
+    /// and of the pieces its ports lead to (a tree's depth bounds the
+    /// recursion).
+    fn add_below(&mut self, block: usize, lane: usize, n: usize) {
+        let trees = &self.world.layout.trees;
+        let tree_block = &trees.blocks[block];
+        let topology = &trees.topologies[tree_block.topology as usize];
+        if let NodeKind::Body { index } = topology.nodes[n].kind {
+            let bodies = &self.world.bodies;
+            let body = &tree_block.bodies[index as usize];
+            let i = body.row[lane] as usize - 1;
+            let (dp, turn) = body.moved(lane);
+            let p = dp * bodies.mass[i];
+            self.impulse += p;
+            self.angular +=
+                world_inertia(self.world, i) * turn + (bodies.position[i] - self.anchor).cross(p);
+        }
+        for &child in topology.children(n) {
+            match child {
+                Child::Node(c) => self.add_below(block, lane, c as usize),
+                Child::Port(p) => {
+                    if let Some(s) = tree_block.ports[p as usize].source[lane] {
+                        let at = self.pass + s.block as usize;
+                        self.add_below(at, s.lane as usize, s.node as usize);
+                    }
+                }
+            }
+        }
     }
 }
 

@@ -208,3 +208,56 @@ fn thresholds_are_checked_saved_and_change_no_bit_of_a_joint_without_them() {
     with.add_joint(desc).unwrap();
     assert_ne!(with.state_hash(), without, "the thresholds are hashed");
 }
+
+/// A hub hanging from an anchor with four arms of two links each, under
+/// the direct solve: a tree the SIMD backends cut into pieces (the arms
+/// side by side in lanes, the hub and its anchor joint in a trunk block).
+/// At rest every joint carries the weight below it: the anchor's the
+/// whole tree's, each arm's shoulder its arm's, on every backend.
+#[test]
+fn a_cut_trees_joints_carry_the_weight_below_them_in_every_piece() {
+    for backend in Backend::available() {
+        let config = SolverConfig {
+            backend: BackendChoice::Forced(backend),
+            ..config(JointSolver::Direct)
+        };
+        let mut w = World::new(config).unwrap();
+        let anchor = w.add_body(BodyDesc::fixed()).unwrap();
+        let hub = capsule(&mut w, 4.0, Vec3::new(0.0, -0.25, 0.0), Vec3::Y);
+        let top = JointDesc::socket_at_world_anchor(w.bodies(), anchor, hub, Vec3::ZERO, -Vec3::Y);
+        let top = w.add_joint(top.unwrap()).unwrap();
+        let mut shoulders = Vec::new();
+        for k in 0..4 {
+            let side = 0.05 * Vec3::new([1.0, -1.0, 0.0, 0.0][k], 0.0, [0.0, 0.0, 1.0, -1.0][k]);
+            let mut parent = hub;
+            for link in 0..2 {
+                let y = -0.5 - 0.5 * link as f32;
+                let body = capsule(&mut w, 1.0, side + Vec3::new(0.0, y - 0.25, 0.0), Vec3::Y);
+                let at = side + Vec3::new(0.0, y, 0.0);
+                let joint =
+                    JointDesc::socket_at_world_anchor(w.bodies(), parent, body, at, -Vec3::Y);
+                let joint = w.add_joint(joint.unwrap()).unwrap();
+                if link == 0 {
+                    shoulders.push(joint);
+                }
+                parent = body;
+            }
+        }
+        for _ in 0..60 {
+            w.step(DT).unwrap();
+        }
+        let weight = |kg: f32| Vec3::new(0.0, kg * G, 0.0);
+        let load = w.joint_force(top).unwrap();
+        assert!(
+            (load.force - weight(12.0)).length() < 0.01 * weight(12.0).length(),
+            "{backend}: the anchor's {load:?}"
+        );
+        for shoulder in &shoulders {
+            let load = w.joint_force(*shoulder).unwrap();
+            assert!(
+                (load.force - weight(2.0)).length() < 0.01 * weight(2.0).length(),
+                "{backend}: a shoulder's {load:?}"
+            );
+        }
+    }
+}
