@@ -73,8 +73,9 @@ pub struct ContactEvents {
     began: Vec<Touching>,
     ended: Vec<ContactEnded>,
     touching: Vec<Touching>,
-    /// Scratch: each solved contact's pair and index, sorted.
-    order: Vec<((BodyHandle, BodyHandle), u32)>,
+    /// Scratch: each solved contact's pair (by [`live_order`]) and index,
+    /// sorted.
+    order: Vec<(u64, u32)>,
     /// Scratch: the pairs touching after the step.
     next: Vec<(BodyHandle, BodyHandle)>,
 }
@@ -98,17 +99,19 @@ impl ContactEvents {
     }
 }
 
-/// Where `key` would go in the sorted `pairs`, and whether it is there.
-fn find(pairs: &[(BodyHandle, BodyHandle)], key: (BodyHandle, BodyHandle)) -> Result<usize, usize> {
-    pairs.binary_search_by(|p| slots(*p).cmp(&slots(key)))
-}
-
 /// A pair's order: its bodies' slots, lineages and generations (two
 /// handles of one slot are of different generations).
 type PairOrder = ((u32, u32, u64), (u32, u32, u64));
 
 fn slots((a, b): (BodyHandle, BodyHandle)) -> PairOrder {
     (a.to_raw(), b.to_raw())
+}
+
+/// A live pair's place in [`slots`]' order: its bodies' slots (two live
+/// bodies never share one, so among one step's pairs the slots alone
+/// order them as [`slots`] does).
+fn live_order((a, b): (BodyHandle, BodyHandle)) -> u64 {
+    (u64::from(a.index() as u32) << 32) | u64::from(b.index() as u32)
 }
 
 impl Collisions {
@@ -119,7 +122,10 @@ impl Collisions {
     }
 
     /// The events of `world`'s last step (its contacts checked to be the
-    /// ones this set found: `Found::check`).
+    /// ones this set found: `Found::check`). This step's pairs and the
+    /// pairs touching before are both in pair order, so one merge of the
+    /// two finds which began, which go on and which ended; the pairs
+    /// touching after come out in order.
     pub(crate) fn update_events(&mut self, world: &World) {
         let mut events = core::mem::take(&mut self.events);
         events.began.clear();
@@ -129,25 +135,33 @@ impl Collisions {
         let solved = world.solved_contacts();
         events.order.clear();
         events.order.extend(
-            solved
-                .iter()
-                .enumerate()
-                .map(|(k, c)| (ordered(c.body_a, c.body_b), k as u32)),
+            (solved.iter().enumerate())
+                .map(|(k, c)| (live_order(ordered(c.body_a, c.body_b)), k as u32)),
         );
-        events
-            .order
-            .sort_unstable_by(|x, y| slots(x.0).cmp(&slots(y.0)).then(x.1.cmp(&y.1)));
+        events.order.sort_unstable();
+        let mut before = 0;
         let mut run = 0;
         while run < events.order.len() {
-            let key = events.order[run].0;
+            let first = &solved[events.order[run].1 as usize];
+            let key = ordered(first.body_a, first.body_b);
             let end = run
-                + events.order[run..]
-                    .iter()
-                    .take_while(|(k, _)| *k == key)
+                + (events.order[run..].iter())
+                    .take_while(|(k, _)| *k == events.order[run].0)
                     .count();
+            // The pairs touching before, ahead of this one: no contact.
+            while let Some(&old) = self.touching.get(before)
+                && slots(old) < slots(key)
+            {
+                self.without_contact(old, world, &mut events);
+                before += 1;
+            }
+            let was = self
+                .touching
+                .get(before)
+                .is_some_and(|&old| slots(old) == slots(key));
+            before += usize::from(was);
             let pair = self.pair_of(key, &events.order[run..end], world);
             run = end;
-            let was = find(&self.touching, key).is_ok();
             if pair.impulse > 0.0 || was {
                 events.next.push(key);
                 events.touching.push(pair);
@@ -156,30 +170,35 @@ impl Collisions {
                 }
             }
         }
-        // The pairs touching before that had no contact this step: kept
-        // while every moving body of theirs sleeps, else ended.
-        for &key in &self.touching {
-            if find(&events.next, key).is_ok() {
-                continue;
-            }
-            let sleeping = |b: BodyHandle| match world.is_asleep(b) {
-                Ok(asleep) => asleep || world.bodies().kind[b.index()] != BodyKind::Dynamic,
-                Err(_) => false,
-            };
-            if sleeping(key.0) && sleeping(key.1) {
-                events.next.push(key);
-            } else {
-                events.ended.push(ContactEnded {
-                    body_a: key.0,
-                    body_b: key.1,
-                    part_a: self.part(key.0),
-                    part_b: self.part(key.1),
-                });
-            }
+        for &old in &self.touching[before..] {
+            self.without_contact(old, world, &mut events);
         }
-        events.next.sort_unstable_by_key(|p| slots(*p));
         core::mem::swap(&mut self.touching, &mut events.next);
         self.events = events;
+    }
+
+    /// A pair touching before that had no contact this step: kept while
+    /// every moving body of theirs sleeps, else ended.
+    fn without_contact(
+        &self,
+        key: (BodyHandle, BodyHandle),
+        world: &World,
+        events: &mut ContactEvents,
+    ) {
+        let sleeping = |b: BodyHandle| match world.is_asleep(b) {
+            Ok(asleep) => asleep || world.bodies().kind[b.index()] != BodyKind::Dynamic,
+            Err(_) => false,
+        };
+        if sleeping(key.0) && sleeping(key.1) {
+            events.next.push(key);
+        } else {
+            events.ended.push(ContactEnded {
+                body_a: key.0,
+                body_b: key.1,
+                part_a: self.part(key.0),
+                part_b: self.part(key.1),
+            });
+        }
     }
 
     /// One pair's step from its contacts (`entries`: each solved
@@ -187,7 +206,7 @@ impl Collisions {
     fn pair_of(
         &self,
         key: (BodyHandle, BodyHandle),
-        entries: &[((BodyHandle, BodyHandle), u32)],
+        entries: &[(u64, u32)],
         world: &World,
     ) -> Touching {
         let (solved, impulses) = (world.solved_contacts(), world.contact_impulses());
