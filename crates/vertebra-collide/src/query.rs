@@ -18,10 +18,12 @@
 //! collider in turn (`tests/queries.rs` checks it against a brute force
 //! over the 30-ragdoll pile).
 
+use core::cell::Cell;
+
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace, TraversalAction};
+use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNode, BvhWorkspace};
 use parry3d::query::{Ray, ShapeCastOptions};
 use parry3d::shape::{Ball, Capsule, Shape as ParryShape};
 use vertebra_math::DefaultFloatMode;
@@ -133,10 +135,59 @@ pub(crate) struct QueryTree {
     built_for: Option<u64>,
     /// parry's working memory for a refit.
     workspace: BvhWorkspace,
+    /// The planes (half spaces, in no tree), by collider index: every
+    /// query tests them.
+    planes: Vec<usize>,
 }
 
 /// The longest query (m): twice the world's range.
 const MAX_QUERY_DISTANCE: f32 = 2.0 * MAX_COORDINATE;
+
+/// How much the tree's leaves are loosened (m): a ray grazing a collider's
+/// surface where it meets its bounds still enters them, whatever the
+/// rounding of either, so pruning never drops a hit.
+const LEAF_MARGIN: f32 = 1.0e-4;
+
+/// A ray with its direction's reciprocals, for the tree's slab tests.
+struct SlabRay {
+    origin: Vec3,
+    inverse: Vec3,
+}
+
+impl SlabRay {
+    fn new(origin: Vec3, direction: Vec3) -> Self {
+        Self {
+            origin,
+            inverse: direction.recip(),
+        }
+    }
+
+    /// Where the ray enters `node`'s bounds (negative when it starts
+    /// inside), or `f32::MAX` when it misses them.
+    fn entry(&self, node: &BvhNode) -> f32 {
+        let (mins, maxs) = (node.mins(), node.maxs());
+        let (mut near, mut far) = (f32::NEG_INFINITY, f32::INFINITY);
+        for axis in 0..3 {
+            let (o, inv) = (self.origin[axis], self.inverse[axis]);
+            let (lo, hi) = (mins[axis], maxs[axis]);
+            if inv.is_infinite() {
+                // Parallel to the slab: inside it all along, or never.
+                if !(lo..=hi).contains(&o) {
+                    return f32::MAX;
+                }
+                continue;
+            }
+            let (a, b) = ((lo - o) * inv, (hi - o) * inv);
+            near = near.max(a.min(b));
+            far = far.min(a.max(b));
+        }
+        if near <= far && far >= 0.0 {
+            near
+        } else {
+            f32::MAX
+        }
+    }
+}
 
 impl QueryFilter {
     /// Whether the filter passes collider `index` of `set` in `world`.
@@ -229,11 +280,16 @@ impl Collisions {
         );
         bounds.clear();
         leaves.clear();
+        self.tree.planes.clear();
         for (index, (c, shape)) in self.colliders.iter().enumerate() {
             let s = world.body(c.body).map_err(|e| c.refused(index, e))?;
-            if let ColliderShape::Solid(_) = c.shape {
-                bounds.push(shape.compute_aabb(&Pose::from_parts(s.position, s.orientation)));
-                leaves.push(index);
+            match c.shape {
+                ColliderShape::Solid(_) => {
+                    let pose = Pose::from_parts(s.position, s.orientation);
+                    bounds.push(shape.compute_aabb(&pose).loosened(LEAF_MARGIN));
+                    leaves.push(index);
+                }
+                ColliderShape::Plane(_) => self.tree.planes.push(index),
             }
         }
         if self.tree.built_for == Some(self.version) {
@@ -258,13 +314,11 @@ impl Collisions {
         self.tree.stamp == Some((world.timeline(), world.pose_version(), self.version))
     }
 
-    /// Collider `index`'s pose now (its body's live: checked first).
+    /// Collider `index`'s pose now (its body's live: checked first, by
+    /// [`Collisions::check_queryable`]).
     fn pose_of(&self, world: &World, index: usize) -> Pose {
-        let body = self.colliders[index].0.body;
-        let s = world
-            .body(body)
-            .expect("the colliders' bodies were checked");
-        Pose::from_parts(s.position, s.orientation)
+        let (bodies, i) = (world.bodies(), self.colliders[index].0.body.index());
+        Pose::from_parts(bodies.position[i], bodies.orientation[i])
     }
 
     /// Refuses a world the set does not serve, or with a collider whose
@@ -287,11 +341,7 @@ impl Collisions {
     /// is fresh, else all of them.
     fn candidates(&self, world: &World, region: &Aabb, mut visit: impl FnMut(usize)) {
         if self.tree_fresh(world) {
-            for (k, (c, _)) in self.colliders.iter().enumerate() {
-                if matches!(c.shape, ColliderShape::Plane(_)) {
-                    visit(k);
-                }
-            }
+            self.tree.planes.iter().copied().for_each(&mut visit);
             for leaf in self.tree.bvh.intersect_aabb(region) {
                 visit(self.tree.leaves[leaf as usize]);
             }
@@ -322,18 +372,19 @@ impl Collisions {
         self.check_queryable(world)?;
         let reach = max_distance.min(MAX_QUERY_DISTANCE);
         let ray = Ray::new(origin, direction);
-        let mut best: Option<(f32, usize, Vec3)> = None;
-        let test = |k: usize, best: &mut Option<(f32, usize, Vec3)>| {
+        // The nearest hit so far: its distance, collider and normal.
+        let best: Cell<Option<(f32, usize, Vec3)>> = Cell::new(None);
+        let test = |k: usize| {
             if !filter.passes(self, world, k) {
                 return;
             }
-            let limit = best.map_or(reach, |b| b.0);
+            let limit = best.get().map_or(reach, |b| b.0);
             let pose = self.pose_of(world, k);
             if let Some(hit) = self.colliders[k]
                 .1
                 .cast_ray_and_get_normal(&pose, &ray, limit, true)
             {
-                let better = match *best {
+                let better = match best.get() {
                     None => true,
                     Some((t, j, _)) => hit.time_of_impact < t || (hit.time_of_impact == t && k < j),
                 };
@@ -343,33 +394,31 @@ impl Collisions {
                     } else {
                         hit.normal
                     };
-                    *best = Some((hit.time_of_impact, k, normal));
+                    best.set(Some((hit.time_of_impact, k, normal)));
                 }
             }
         };
         if self.tree_fresh(world) {
-            for k in 0..self.colliders.len() {
-                if matches!(self.colliders[k].0.shape, ColliderShape::Plane(_)) {
-                    test(k, &mut best);
-                }
-            }
-            // Nodes the ray enters no later than the best hit so far
-            // (ties kept: the lower index wins them).
-            self.tree.bvh.traverse(|node| {
-                let limit = best.map_or(reach, |b| b.0);
-                if node.cast_ray(&ray, limit) > limit {
-                    return TraversalAction::Prune;
-                }
-                if let Some(leaf) = node.leaf_data() {
-                    test(self.tree.leaves[leaf as usize], &mut best);
-                }
-                TraversalAction::Continue
-            });
+            self.tree.planes.iter().for_each(|&k| test(k));
+            // Nearest bounds first, each entered no later than the best
+            // hit so far (`next_down`: a tie is entered too, so that the
+            // lower index wins it, as over every collider).
+            let slabs = SlabRay::new(origin, direction);
+            self.tree.bvh.find_best(
+                best.get().map_or(reach, |b| b.0),
+                |node, _| {
+                    let t = slabs.entry(node);
+                    if t == f32::MAX { t } else { t.next_down() }
+                },
+                |leaf, _| {
+                    test(self.tree.leaves[leaf as usize]);
+                    best.get().map(|b| b.0)
+                },
+            );
         } else {
-            for k in 0..self.colliders.len() {
-                test(k, &mut best);
-            }
+            (0..self.colliders.len()).for_each(test);
         }
+        let best = best.get();
         Ok(best.map(|(distance, k, normal)| {
             let body = self.colliders[k].0.body;
             QueryHit {
