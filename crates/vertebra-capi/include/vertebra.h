@@ -383,6 +383,10 @@ typedef uint32_t VtColliderKind;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// A blend back under way (opaque; `vt_blend_back_create_ragdoll` or
+// `vt_blend_back_create_skeleton`; free it with `vt_blend_back_destroy`).
+typedef struct VtBlendBack VtBlendBack;
+
 // Bytes vertebra made and the caller owns (opaque; read them with
 // `vt_bytes_data`, free them with `vt_bytes_destroy`).
 typedef struct VtBytes VtBytes;
@@ -426,6 +430,26 @@ typedef struct VtVec3 {
   float z;
 } VtVec3;
 
+// A rotation as a unit quaternion `(x, y, z, w)`, `w` the scalar part.
+typedef struct VtQuat {
+  // x.
+  float x;
+  // y.
+  float y;
+  // z.
+  float z;
+  // w, the scalar part.
+  float w;
+} VtQuat;
+
+// A rigid transform: a position (m) and a rotation.
+typedef struct VtTransform {
+  // Position (m).
+  struct VtVec3 position;
+  // Rotation (unit quaternion).
+  struct VtQuat rotation;
+} VtTransform;
+
 // A solid shape in its body's frame, centred on the centre of mass (m).
 // Only the fields of its kind are read.
 typedef struct VtShape {
@@ -447,18 +471,6 @@ typedef struct VtMassProperties {
   // Inertia tensor, column by column.
   float inertia[9];
 } VtMassProperties;
-
-// A rotation as a unit quaternion `(x, y, z, w)`, `w` the scalar part.
-typedef struct VtQuat {
-  // x.
-  float x;
-  // y.
-  float y;
-  // z.
-  float z;
-  // w, the scalar part.
-  float w;
-} VtQuat;
 
 // A body to add.
 typedef struct VtBodyDesc {
@@ -557,6 +569,35 @@ typedef struct VtContact {
   // Restitution, in [0, 1].
   float restitution;
 } VtContact;
+
+// A drive's strength: `kind` is a `VtStrengthKind`.
+typedef struct VtStrength {
+  // A `VtStrengthKind`.
+  uint32_t kind;
+  // Compliance or frequency.
+  float a;
+  // Damping ratio.
+  float b;
+} VtStrength;
+
+// Drive settings for a whole ragdoll.
+typedef struct VtDriveSettings {
+  // Every joint's strength.
+  struct VtStrength strength;
+  // Damping (N m s / rad) of joints driven by compliance.
+  float damping;
+  // The largest torque (N m) each joint's drive exerts; infinity is
+  // unlimited.
+  float max_torque;
+} VtDriveSettings;
+
+// One joint's own strength, overriding the settings' for it.
+typedef struct VtJointStrength {
+  // The described joint (`vt_ragdoll_desc_joint_index`).
+  uint32_t joint;
+  // Its strength.
+  struct VtStrength strength;
+} VtJointStrength;
 
 // Which ragdoll and bone a body is.
 typedef struct VtRagdollPart {
@@ -790,14 +831,6 @@ typedef struct VtQueryShape {
   struct VtVec3 half_segment;
 } VtQueryShape;
 
-// A rigid transform: a position (m) and a rotation.
-typedef struct VtTransform {
-  // Position (m).
-  struct VtVec3 position;
-  // Rotation (unit quaternion).
-  struct VtQuat rotation;
-} VtTransform;
-
 // A collider a shape overlaps.
 typedef struct VtOverlap {
   // The collider's index in the layer.
@@ -822,27 +855,6 @@ typedef struct VtBuildOptions {
   // See `stabilise`.
   float stabilise_ratio;
 } VtBuildOptions;
-
-// A drive's strength: `kind` is a `VtStrengthKind`.
-typedef struct VtStrength {
-  // A `VtStrengthKind`.
-  uint32_t kind;
-  // Compliance or frequency.
-  float a;
-  // Damping ratio.
-  float b;
-} VtStrength;
-
-// Drive settings for a whole ragdoll.
-typedef struct VtDriveSettings {
-  // Every joint's strength.
-  struct VtStrength strength;
-  // Damping (N m s / rad) of joints driven by compliance.
-  float damping;
-  // The largest torque (N m) each joint's drive exerts; infinity is
-  // unlimited.
-  float max_torque;
-} VtDriveSettings;
 
 // A rod's stiffness: `kind` is a `VtStiffnessKind`; `a` and `b` as the
 // kind says.
@@ -976,6 +988,105 @@ typedef struct VtTaskSystem {
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+// Blends two ragdoll poses bone by bone: body `k` of the output (`out`)
+// is `a`'s at `weights[k] = 0`, `b`'s at 1 (exactly), positions
+// interpolated linearly and rotations along the shorter arc between
+// (each array `count` long, one per described body; `a` the animation's
+// and `b` the simulation's for Unreal's physics blend weight). Refused,
+// naming the body, for a pose that does not fit `desc` or a weight not
+// finite or outside [0, 1].
+//
+// # Safety
+// `desc` is live; `a`, `b` and `weights` point to `count` readable
+// items, `out` to `count` writable transforms (it may be `a` or `b`).
+enum VtResult vt_ragdoll_pose_blend(const struct VtRagdollDesc *desc,
+                                    const struct VtTransform *a,
+                                    const struct VtTransform *b,
+                                    const float *weights,
+                                    size_t count,
+                                    struct VtTransform *out);
+
+// Blends two skeleton poses bone by bone in local space (each array
+// `count` parent-local transforms, one per bone), as
+// `vt_ragdoll_pose_blend` blends a ragdoll's. Refused, naming the bone,
+// for a pose that does not fit `skeleton` or a weight not finite or
+// outside [0, 1].
+//
+// # Safety
+// `skeleton` is live; `a`, `b` and `weights` point to `count` readable
+// items, `out` to `count` writable transforms (it may be `a` or `b`).
+enum VtResult vt_skeleton_pose_blend(const struct VtSkeleton *skeleton,
+                                     const struct VtTransform *a,
+                                     const struct VtTransform *b,
+                                     const float *weights,
+                                     size_t count,
+                                     struct VtTransform *out);
+
+// Starts a blend back from a ragdoll's last simulated pose `simulated`
+// (`count` world transforms, one per described body; held from now on)
+// to the animation over `duration` seconds (finite, positive): each
+// frame `vt_blend_back_pose` with the frame's animation pose, then
+// `vt_blend_back_advance`. Writes it into `blend` (free it with
+// `vt_blend_back_destroy`). Refused for a pose that does not fit `desc`
+// (naming the body) or a duration out of range.
+//
+// # Safety
+// `desc` is live; `simulated` points to `count` readable transforms;
+// `blend` is writable.
+enum VtResult vt_blend_back_create_ragdoll(const struct VtRagdollDesc *desc,
+                                           const struct VtTransform *simulated,
+                                           size_t count,
+                                           float duration,
+                                           struct VtBlendBack **blend);
+
+// As `vt_blend_back_create_ragdoll`, on a skeleton's local poses:
+// `simulated` is `count` parent-local transforms, one per bone of
+// `skeleton` (the skeleton the simulated ragdoll was mapped onto).
+//
+// # Safety
+// `skeleton` is live; `simulated` points to `count` readable transforms;
+// `blend` is writable.
+enum VtResult vt_blend_back_create_skeleton(const struct VtSkeleton *skeleton,
+                                            const struct VtTransform *simulated,
+                                            size_t count,
+                                            float duration,
+                                            struct VtBlendBack **blend);
+
+// Frees a blend back (null does nothing).
+//
+// # Safety
+// `blend` is null or live, and not used afterwards.
+void vt_blend_back_destroy(struct VtBlendBack *blend);
+
+// This frame's output: `animation` (this frame's animation pose, `count`
+// transforms of the kind the blend was made for) blended toward the held
+// simulated pose at the blend's weight, into `pose` (`count` writable
+// transforms; it may be `animation`). The first frame's is the simulated
+// pose, every frame's from the duration on the animation's, exactly.
+// Refused for an animation that does not fit (naming the bone).
+//
+// # Safety
+// `blend` is live; `animation` points to `count` readable transforms,
+// `pose` to `count` writable ones.
+enum VtResult vt_blend_back_pose(struct VtBlendBack *blend,
+                                 const struct VtTransform *animation,
+                                 size_t count,
+                                 struct VtTransform *pose);
+
+// Moves the blend on by `dt` seconds (finite, not negative).
+//
+// # Safety
+// `blend` is live.
+enum VtResult vt_blend_back_advance(struct VtBlendBack *blend, float dt);
+
+// Writes the ragdoll's weight now into `weight` (1 as the blend starts,
+// 0 from its duration on, smoothstep between) and whether the blend has
+// reached the animation into `done` (1 or 0).
+//
+// # Safety
+// `blend` is live; `weight` and `done` are writable.
+enum VtResult vt_blend_back_weight(struct VtBlendBack *blend, float *weight, uint32_t *done);
 
 // The mass properties of `shape` with `mass` kg spread evenly through it.
 //
@@ -1256,6 +1367,41 @@ enum VtResult vt_world_contacts(struct VtWorld *world,
                                 struct VtContact *contacts,
                                 size_t capacity,
                                 size_t *count);
+
+// `vt_ragdoll_drive_to` with some joints at strengths of their own:
+// `overrides` (`override_count` of them; each described joint at most
+// once) replace the settings' strength for their joints; the settings'
+// damping and torque limit hold for every joint. A rod spine takes the
+// override of the spine's first joint. Refused, changing nothing, for a
+// joint index past the description's joints or named twice, or a
+// strength out of range (naming the override).
+//
+// # Safety
+// As `vt_ragdoll_drive_to`; `overrides` points to `override_count`
+// readable items (or the count is 0).
+enum VtResult vt_ragdoll_drive_to_with(struct VtRagdoll *ragdoll,
+                                       struct VtWorld *world,
+                                       const struct VtTransform *pose,
+                                       size_t count,
+                                       const struct VtDriveSettings *settings,
+                                       const struct VtJointStrength *overrides,
+                                       size_t override_count);
+
+// `vt_ragdoll_drive_following` with some joints at strengths of their
+// own, as `vt_ragdoll_drive_to_with` takes them.
+//
+// # Safety
+// As `vt_ragdoll_drive_following`; `overrides` points to
+// `override_count` readable items (or the count is 0).
+enum VtResult vt_ragdoll_drive_following_with(struct VtRagdoll *ragdoll,
+                                              struct VtWorld *world,
+                                              const struct VtTransform *previous,
+                                              const struct VtTransform *pose,
+                                              size_t count,
+                                              float dt,
+                                              const struct VtDriveSettings *settings,
+                                              const struct VtJointStrength *overrides,
+                                              size_t override_count);
 
 // The message of this thread's last refused call ("" if none): which
 // item, which field, and why.

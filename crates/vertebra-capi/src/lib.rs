@@ -2,7 +2,8 @@
 //! these sources): worlds, bodies, joints of every kind with their limits
 //! and drives, rods, impulses, contacts, snapshots, ragdolls (loaded from a
 //! file or a string, built at a pose, driven, mapped onto an animation
-//! skeleton, switched to from animation without a pop), the engine's job system and the collision layer.
+//! skeleton, switched to from animation without a pop and blended back to
+//! it), the engine's job system and the collision layer.
 //!
 //! # Conventions
 //! - Every function returns a `VtResult`: `VT_RESULT_OK` (0) or the reason
@@ -14,8 +15,8 @@
 //!   `VT_RESULT_PANIC` and poisons the object it was working on (every
 //!   later call on it but its destroy returns `VT_RESULT_POISONED`).
 //! - Objects (`VtWorld`, `VtCollisions`, `VtRagdollDesc`, `VtRagdoll`,
-//!   `VtSkeleton`, `VtSkeletonMapper`, `VtTransition`, `VtBytes`) are opaque. The caller
-//!   owns every object a function writes to a `T**` and frees it with that
+//!   `VtSkeleton`, `VtSkeletonMapper`, `VtTransition`, `VtBlendBack`,
+//!   `VtBytes`) are opaque. The caller owns every object a function writes to a `T**` and frees it with that
 //!   type's `_destroy` (null does nothing), exactly once. vertebra never
 //!   keeps a caller's pointer beyond the call (but the job system's
 //!   `context`, see `vt_world_set_tasks`), and copies every input array.
@@ -31,9 +32,11 @@
 //!   threads). Units are SI (m, kg, s, rad); vectors are in the world
 //!   frame unless a field says otherwise.
 
+mod blend;
 mod body;
 mod collide;
 mod contact;
+mod drives;
 mod error;
 mod events;
 mod ffi;
@@ -48,9 +51,11 @@ mod transition;
 mod types;
 mod world;
 
+pub use blend::*;
 pub use body::*;
 pub use collide::*;
 pub use contact::*;
+pub use drives::*;
 pub use error::{VtResult, vt_last_error_message, vt_result_name};
 pub use events::*;
 pub use joint::*;

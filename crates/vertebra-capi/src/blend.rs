@@ -1,0 +1,285 @@
+//! Blending between animation and simulation: two poses bone by bone at
+//! per-bone weights (Unreal's physics blend weight), and the blend back
+//! from the ragdoll's last pose to the animation (getting up;
+//! `BlendBack` in Rust, `docs/ragdolls.md`). Either on a ragdoll's body
+//! poses (world transforms, one per described body) or on a skeleton's
+//! local poses (parent-local transforms, one per bone).
+
+use vertebra_ragdoll::{BlendBack, LocalPose, Pose, RagdollDesc, Skeleton};
+
+use crate::error::{Failure, VtResult};
+use crate::ffi::{Object, boxed, call, enter, free, out, shared, slice, slice_mut};
+use crate::ragdoll::{VtRagdollDesc, pose_from, write_pose};
+use crate::skeleton::{VtSkeleton, write_bones};
+use crate::types::VtTransform;
+
+/// A blend back under way (opaque; `vt_blend_back_create_ragdoll` or
+/// `vt_blend_back_create_skeleton`; free it with `vt_blend_back_destroy`).
+pub struct VtBlendBack {
+    blend: Blending,
+    poisoned: bool,
+}
+
+impl Object for VtBlendBack {
+    const NAME: &'static str = "blend back";
+    fn poisoned(&mut self) -> &mut bool {
+        &mut self.poisoned
+    }
+}
+
+/// What a blend back blends, with the rig its poses are checked against
+/// (boxed: the two differ much in size).
+enum Blending {
+    Ragdoll(BlendBack<Pose>, Box<RagdollDesc>),
+    Skeleton(BlendBack<LocalPose>, Box<Skeleton>),
+}
+
+/// `count` parent-local transforms at `local` as a skeleton pose.
+///
+/// # Safety
+/// `local` points to `count` readable transforms.
+unsafe fn local_pose(
+    local: *const VtTransform,
+    count: usize,
+    what: &str,
+) -> Result<LocalPose, Failure> {
+    // SAFETY: the function's contract.
+    let bones = unsafe { slice(local, count, what) }?;
+    Ok(LocalPose {
+        bones: bones.iter().map(|&t| t.into()).collect(),
+    })
+}
+
+/// Blends two ragdoll poses bone by bone: body `k` of the output (`out`)
+/// is `a`'s at `weights[k] = 0`, `b`'s at 1 (exactly), positions
+/// interpolated linearly and rotations along the shorter arc between
+/// (each array `count` long, one per described body; `a` the animation's
+/// and `b` the simulation's for Unreal's physics blend weight). Refused,
+/// naming the body, for a pose that does not fit `desc` or a weight not
+/// finite or outside [0, 1].
+///
+/// # Safety
+/// `desc` is live; `a`, `b` and `weights` point to `count` readable
+/// items, `out` to `count` writable transforms (it may be `a` or `b`).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_ragdoll_pose_blend(
+    desc: *const VtRagdollDesc,
+    a: *const VtTransform,
+    b: *const VtTransform,
+    weights: *const f32,
+    count: usize,
+    out: *mut VtTransform,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (desc, a, b, weights) = unsafe {
+            (
+                shared(desc, "desc")?,
+                pose_from(a, count, "a")?,
+                pose_from(b, count, "b")?,
+                slice(weights, count, "weights")?,
+            )
+        };
+        let blended = a.blend(&desc.desc, &b, weights)?;
+        // SAFETY: the function's contract; the inputs were copied above.
+        let place = unsafe { slice_mut(out, count, "out") }?;
+        write_pose(&blended, place)
+    })
+}
+
+/// Blends two skeleton poses bone by bone in local space (each array
+/// `count` parent-local transforms, one per bone), as
+/// `vt_ragdoll_pose_blend` blends a ragdoll's. Refused, naming the bone,
+/// for a pose that does not fit `skeleton` or a weight not finite or
+/// outside [0, 1].
+///
+/// # Safety
+/// `skeleton` is live; `a`, `b` and `weights` point to `count` readable
+/// items, `out` to `count` writable transforms (it may be `a` or `b`).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_skeleton_pose_blend(
+    skeleton: *const VtSkeleton,
+    a: *const VtTransform,
+    b: *const VtTransform,
+    weights: *const f32,
+    count: usize,
+    out: *mut VtTransform,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (skeleton, a, b, weights) = unsafe {
+            (
+                shared(skeleton, "skeleton")?,
+                local_pose(a, count, "a")?,
+                local_pose(b, count, "b")?,
+                slice(weights, count, "weights")?,
+            )
+        };
+        let blended = a.blend(&skeleton.skeleton, &b, weights)?;
+        // SAFETY: the function's contract; the inputs were copied above.
+        let place = unsafe { slice_mut(out, count, "out") }?;
+        write_bones(&blended.bones, place)
+    })
+}
+
+/// Starts a blend back from a ragdoll's last simulated pose `simulated`
+/// (`count` world transforms, one per described body; held from now on)
+/// to the animation over `duration` seconds (finite, positive): each
+/// frame `vt_blend_back_pose` with the frame's animation pose, then
+/// `vt_blend_back_advance`. Writes it into `blend` (free it with
+/// `vt_blend_back_destroy`). Refused for a pose that does not fit `desc`
+/// (naming the body) or a duration out of range.
+///
+/// # Safety
+/// `desc` is live; `simulated` points to `count` readable transforms;
+/// `blend` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_blend_back_create_ragdoll(
+    desc: *const VtRagdollDesc,
+    simulated: *const VtTransform,
+    count: usize,
+    duration: f32,
+    blend: *mut *mut VtBlendBack,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (desc, simulated, place) = unsafe {
+            (
+                shared(desc, "desc")?,
+                pose_from(simulated, count, "simulated")?,
+                out(blend, "blend")?,
+            )
+        };
+        let made = BlendBack::new(&desc.desc, simulated, duration)?;
+        place.set(boxed(VtBlendBack {
+            blend: Blending::Ragdoll(made, Box::new(desc.desc.clone())),
+            poisoned: false,
+        }));
+        Ok(())
+    })
+}
+
+/// As `vt_blend_back_create_ragdoll`, on a skeleton's local poses:
+/// `simulated` is `count` parent-local transforms, one per bone of
+/// `skeleton` (the skeleton the simulated ragdoll was mapped onto).
+///
+/// # Safety
+/// `skeleton` is live; `simulated` points to `count` readable transforms;
+/// `blend` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_blend_back_create_skeleton(
+    skeleton: *const VtSkeleton,
+    simulated: *const VtTransform,
+    count: usize,
+    duration: f32,
+    blend: *mut *mut VtBlendBack,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (skeleton, simulated, place) = unsafe {
+            (
+                shared(skeleton, "skeleton")?,
+                local_pose(simulated, count, "simulated")?,
+                out(blend, "blend")?,
+            )
+        };
+        let made = BlendBack::new(&skeleton.skeleton, simulated, duration)?;
+        place.set(boxed(VtBlendBack {
+            blend: Blending::Skeleton(made, Box::new(skeleton.skeleton.clone())),
+            poisoned: false,
+        }));
+        Ok(())
+    })
+}
+
+/// Frees a blend back (null does nothing).
+///
+/// # Safety
+/// `blend` is null or live, and not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_blend_back_destroy(blend: *mut VtBlendBack) {
+    // SAFETY: the function's contract.
+    unsafe { free(blend) }
+}
+
+/// This frame's output: `animation` (this frame's animation pose, `count`
+/// transforms of the kind the blend was made for) blended toward the held
+/// simulated pose at the blend's weight, into `pose` (`count` writable
+/// transforms; it may be `animation`). The first frame's is the simulated
+/// pose, every frame's from the duration on the animation's, exactly.
+/// Refused for an animation that does not fit (naming the bone).
+///
+/// # Safety
+/// `blend` is live; `animation` points to `count` readable transforms,
+/// `pose` to `count` writable ones.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_blend_back_pose(
+    blend: *mut VtBlendBack,
+    animation: *const VtTransform,
+    count: usize,
+    pose: *mut VtTransform,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let blend = unsafe { enter(blend) }?;
+        match &blend.blend {
+            Blending::Ragdoll(back, desc) => {
+                // SAFETY: the function's contract.
+                let animation = unsafe { pose_from(animation, count, "animation") }?;
+                let output = back.pose(desc, &animation)?;
+                // SAFETY: the function's contract; the input was copied.
+                write_pose(&output, unsafe { slice_mut(pose, count, "pose") }?)
+            }
+            Blending::Skeleton(back, skeleton) => {
+                // SAFETY: the function's contract.
+                let animation = unsafe { local_pose(animation, count, "animation") }?;
+                let output = back.pose(skeleton, &animation)?;
+                // SAFETY: the function's contract; the input was copied.
+                write_bones(&output.bones, unsafe { slice_mut(pose, count, "pose") }?)
+            }
+        }
+    })
+}
+
+/// Moves the blend on by `dt` seconds (finite, not negative).
+///
+/// # Safety
+/// `blend` is live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_blend_back_advance(blend: *mut VtBlendBack, dt: f32) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let mut blend = unsafe { enter(blend) }?;
+        match &mut blend.blend {
+            Blending::Ragdoll(back, _) => back.advance(dt)?,
+            Blending::Skeleton(back, _) => back.advance(dt)?,
+        }
+        Ok(())
+    })
+}
+
+/// Writes the ragdoll's weight now into `weight` (1 as the blend starts,
+/// 0 from its duration on, smoothstep between) and whether the blend has
+/// reached the animation into `done` (1 or 0).
+///
+/// # Safety
+/// `blend` is live; `weight` and `done` are writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_blend_back_weight(
+    blend: *mut VtBlendBack,
+    weight: *mut f32,
+    done: *mut u32,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (blend, weight, done) =
+            unsafe { (enter(blend)?, out(weight, "weight")?, out(done, "done")?) };
+        let (w, d) = match &blend.blend {
+            Blending::Ragdoll(back, _) => (back.weight(), back.is_done()),
+            Blending::Skeleton(back, _) => (back.weight(), back.is_done()),
+        };
+        weight.set(w);
+        done.set(u32::from(d));
+        Ok(())
+    })
+}
