@@ -156,9 +156,10 @@ struct SlabRay {
 
 impl SlabRay {
     fn new(origin: Vec3, direction: Vec3) -> Self {
+        // 1 / d per axis, exact: the same bits everywhere.
         Self {
             origin,
-            inverse: direction.recip(),
+            inverse: Vec3::ONE / direction,
         }
     }
 
