@@ -528,12 +528,43 @@ pub const DT: f32 = 1.0 / 60.0;
 /// The ragdoll drop with `count` ragdolls (30 per pit) at 20 iterations on
 /// `threads` threads, one second (60 frames) in: piled up, many contacts.
 pub fn drop_scene(spine: SpineMode, count: usize, threads: usize) -> SceneWorld {
-    drop_scene_with(spine, count, threads, BackendChoice::Auto)
+    drop_scene_with(spine, count, threads, BackendChoice::Auto, 60)
 }
 
 /// [`drop_scene`] on one thread with a forced backend.
 pub fn drop_scene_on(spine: SpineMode, count: usize, backend: Backend) -> SceneWorld {
-    drop_scene_with(spine, count, 1, BackendChoice::Forced(backend))
+    drop_scene_with(spine, count, 1, BackendChoice::Forced(backend), 60)
+}
+
+/// Frames of the ragdoll drop after which its pile has formed: three
+/// seconds in, every ragdoll has landed and the pile's top has settled
+/// near 1 m, its fastest body under 1 m/s (one second in they are still
+/// landing, the fastest at 3.6 m/s; the highest layer starts 5.5 m up).
+pub const PILE_FRAMES: usize = 180;
+
+/// The 30-ragdoll drop on one thread with a forced backend, its pile
+/// formed ([`PILE_FRAMES`] in): what a game's rays and contact events
+/// meet once the ragdolls lie in a heap.
+pub fn drop_pile_on(spine: SpineMode, backend: Backend) -> SceneWorld {
+    drop_scene_with(spine, 30, 1, BackendChoice::Forced(backend), PILE_FRAMES)
+}
+
+/// Rays at the formed pile ([`drop_pile_on`]): from 3 m above every
+/// seventh body of its ragdolls, slanted a little, toward that body's
+/// centre (origin m, unit direction, world), so each meets the pile.
+pub fn rays_at_the_pile(scene: &SceneWorld) -> Vec<(GVec3, GVec3)> {
+    let bodies = scene
+        .ragdolls
+        .iter()
+        .flat_map(|r| r.bodies.iter().flatten());
+    bodies
+        .step_by(7)
+        .map(|&body| {
+            let centre = scene.world.body(body).expect("a live body").position;
+            let from = centre + GVec3::new(0.3, 3.0, 0.2);
+            (from, (centre - from).normalize())
+        })
+        .collect()
 }
 
 fn drop_scene_with(
@@ -541,11 +572,12 @@ fn drop_scene_with(
     count: usize,
     threads: usize,
     backend: BackendChoice,
+    frames: usize,
 ) -> SceneWorld {
     let mut config = SceneConfig::new(Scene::RagdollDrop, spine);
     (config.ragdolls, config.threads, config.backend) = (count, threads, backend);
     let mut scene = build(&config).expect("the drop scene");
-    for frame in 0..60 {
+    for frame in 0..frames {
         scene.advance(config.scene, frame, DT).expect("a frame");
     }
     scene
