@@ -71,7 +71,8 @@
 //! // with the animation's velocities, joints made at that pose (no pop).
 //! let skeleton = Skeleton::reference();
 //! let mut desc = RagdollDesc::reference_humanoid();
-//! // The left elbow tears past 2 kN (the file's `break_force` says so too).
+//! // The left elbow tears past 2 kN (a description file says it with
+//! // `break_force = 2000.0` on the joint).
 //! let elbow = desc.joint_index("elbow_l").expect("an elbow");
 //! desc.joints[elbow].breaking = Some(vertebra_world::JointBreaking {
 //!     force: 2000.0,
@@ -122,13 +123,15 @@
 //!         )?;
 //!         let part = hit.and_then(|h| h.part).expect("a bone was hit");
 //!         assert_eq!(Some(part.ragdoll), ragdoll.first_body());
-//!         // Then the left hand yanked hard: the elbow tears.
-//!         let hand = ragdoll.bodies[desc.body_index("forearm_l").expect("a forearm")]
+//!         // Then the left forearm yanked hard (120 N s): the elbow tears
+//!         // in the next frame's step.
+//!         let forearm = ragdoll.bodies[desc.body_index("forearm_l").expect("a forearm")]
 //!             .expect("a body");
-//!         world.apply_impulse(hand, Vec3::new(0.0, 120.0, 0.0))?;
+//!         world.apply_impulse(forearm, Vec3::new(0.0, 120.0, 0.0))?;
 //!     }
 //!     for broken in world.broken_joints() {
 //!         assert_eq!(Some(broken.joint), ragdoll.joints[elbow]);
+//!         assert!(frame > 30, "torn by the yank, not before");
 //!         torn = true;
 //!     }
 //!     // The engine's skeleton read back, every one of its bones.
