@@ -34,7 +34,10 @@ fn queries(c: &mut Criterion) {
         hit.and_then(|h| h.part).is_some()
     });
     // Most meet a bone first (a few graze a wall's top or a box).
-    assert!(bones.count() * 10 >= rays.len() * 9, "the rays miss the pile");
+    assert!(
+        bones.count() * 10 >= rays.len() * 9,
+        "the rays miss the pile"
+    );
     bench("ray_tree", set);
     group.finish();
 }
