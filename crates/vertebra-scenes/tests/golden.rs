@@ -117,7 +117,7 @@ fn anatomical_drop_direct() {
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
 const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x5fff_c5e6_5fb8_46f4;
-const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x8945_505a_0832_3883;
+const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0xb36d_d5f6_47c9_e263;
 
 // The direct solve's, set by the commit that introduced them;
 // all four moved when every limit row joined the solve with
@@ -148,11 +148,16 @@ const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x8945_505a_0832_3883;
 // ports: the same sums in another order. They were 0x54c3_20a6_97c2_c911
 // and 0x7ac9_2204_2740_dfc5 (bending), 0x3634_643b_ea27_12fe and
 // 0xbcd9_d34d_fee2_a132 (drop), and 0xc656_e349_9e78_23bd and
-// 0x6845_d290_5437_24b7 (anatomical).
+// 0x6845_d290_5437_24b7 (anatomical). Then the three rod ones by the
+// rod's length row taking the chord's turn with the bend (its angular
+// part, `length::chord_turn`), so a bent rod's length converges
+// quadratically: they were 0x3fe6_911f_8645_7cc7 (bending),
+// 0xaede_52fc_ecea_722f (drop) and 0x8945_505a_0832_3883 (anatomical);
+// the sockets' did not move.
 const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x2636_906e_671c_b1e1;
-const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x3fe6_911f_8645_7cc7;
+const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x7bb4_b6ec_3042_0e2d;
 const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3070_1f12_587a_75ea;
-const GOLDEN_DROP_ROD_DIRECT: u64 = 0xaede_52fc_ecea_722f;
+const GOLDEN_DROP_ROD_DIRECT: u64 = 0x8072_15bf_128f_98ab;
 
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision
