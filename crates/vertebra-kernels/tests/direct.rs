@@ -1631,13 +1631,7 @@ fn cut_scene(seed: u64, adversarial: bool) -> Cut {
     let cuts = topology.cuts(most);
     let trees: Vec<(&Topology, Vec<u32>)> = (0..count).map(|_| (&topology, cuts.clone())).collect();
     let mut topologies: Vec<Topology> = Vec::new();
-    let (mut blocks, placed) = split::lay_out(&trees, &mut |piece: &Topology| {
-        let known = topologies.iter().position(|t| t == piece);
-        known.unwrap_or_else(|| {
-            topologies.push(piece.clone());
-            topologies.len() - 1
-        }) as u32
-    });
+    let (mut blocks, placed) = split::lay_out(&trees, &mut topologies);
     for (data, pieces) in lanes.iter().zip(&placed) {
         for p in pieces {
             let b = &mut blocks[p.block];
