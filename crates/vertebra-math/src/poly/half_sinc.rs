@@ -31,7 +31,7 @@ pub fn half_sinc<L: Lane>(x: L) -> L {
 /// The slope's series: `d/dx sin(x/2)/x = x sum_n 2n c_n x^(2(n-1))` with
 /// `c_n` [`HALF_SINC`]'s terms, highest first.
 const HALF_SINC_SLOPE: [f32; 6] = [
-    2.352_398_9e-13,
+    2.352_399e-13,
     -1.223_247_5e-10,
     4.305_831e-8,
     -9.300_596e-6,
