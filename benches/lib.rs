@@ -577,15 +577,16 @@ pub fn single_ragdoll_solved(
 }
 
 /// The frames a lone ragdoll is dropped for before it is timed lying on
-/// the ground: three seconds, long after it has come to rest.
+/// the ground: three seconds, when every body is on it (the lowest centre
+/// 4.5 cm up) but not all are still (the fastest at 0.04 to 0.17 m/s).
 pub const LONE_SETTLE_FRAMES: usize = 180;
 
 /// The reference ragdoll alone, dropped onto the ground (the ragdoll-drop
 /// scene with one ragdoll) and lying there [`LONE_SETTLE_FRAMES`] frames
 /// in: its contacts with the ground found every frame, so a frame
 /// ([`SceneWorld::frame`]) is collision detection and the step, what a game
-/// pays for a ragdoll at rest that is still awake (sleeping off, as in the
-/// scenes). Solved by `solver`'s joint solve at its substeps x iterations,
+/// pays for a ragdoll on the ground that is still awake (sleeping off, as
+/// in the scenes). Solved by `solver`'s joint solve at its substeps x iterations,
 /// on one thread on `backend`, its residuals not measured.
 pub fn lone_ragdoll_on_ground(
     spine: SpineMode,
