@@ -40,6 +40,7 @@ mod rollback;
 mod sleep;
 mod snapshot;
 mod stages;
+mod start;
 mod step;
 mod tasks;
 mod trees;

@@ -25,10 +25,10 @@ use crate::bins::Bins;
 use crate::contact::{ContactBin, ContactLayout};
 use crate::islands::Islands;
 use crate::joint::JointKind;
-use crate::layout::start_blocks;
 use crate::layout::{Bin, Group, Layout};
 use crate::parallel::Shared;
 use crate::stages::{BlockChunks, Chunks, Cursor, Part, SharedBlocks, SliceChunks};
+use crate::start::start_blocks;
 
 /// Direct solves after a substep's last iteration, with nothing between
 /// (`SolverConfig::joints` = `Direct`): each is a Newton step on the

@@ -463,7 +463,7 @@ fn find(joints: &[Option<JointDesc>], rods: &[Option<RodDesc>], bodies: &BodySto
 
 /// Each lane's start of step: its joints' points (a rod's centres) as
 /// the step begins, and its bodies' mass properties as they are now.
-impl crate::layout::StartBlock for TreeBlock {
+impl crate::start::StartBlock for TreeBlock {
     fn start(&mut self, bodies: &BodyStore) {
         for lane in (0..BLOCK_LANES).filter(|l| self.padding & (1 << l) == 0) {
             for node in &mut self.bodies {
