@@ -1041,6 +1041,16 @@ fn named_tree(r: &mut StdRng, name: &str) -> Tree {
     }
 }
 
+/// Errors over three passes that fall quadratically: each of the first
+/// two passes leaves at most `k` times the square of the error before it,
+/// plus `floor` (the round-off it cannot go below), and the third is at
+/// its floor.
+fn assert_quadratic(e: &[f64], k: [f64; 2], floor: [f64; 3], context: &str) {
+    assert!(e[1] <= k[0] * e[0] * e[0] + floor[0], "{context}");
+    assert!(e[2] <= k[1] * e[1] * e[1] + floor[1], "{context}");
+    assert!(e[3] <= floor[2], "{context}");
+}
+
 fn show(errors: &[f64]) -> String {
     let shown: Vec<String> = errors.iter().map(|e| format!("{e:.2e}")).collect();
     shown.join(", ")
@@ -1086,9 +1096,7 @@ fn one_pass_is_exact_to_first_order_and_a_second_to_round_off() {
                 let offsets = offsets(&mut r, &tree, size);
                 let e = errors(&tree, &offsets, 3);
                 let context = format!("{name}, offsets {size}: errors {}", show(&e));
-                assert!(e[1] <= 4.0 * e[0] * e[0] + 1e-6, "{context}");
-                assert!(e[2] <= 20.0 * e[1] * e[1] + 2e-6, "{context}");
-                assert!(e[3] <= 2e-6, "{context}");
+                assert_quadratic(&e, [4.0, 20.0], [1e-6, 2e-6, 2e-6], &context);
                 if size <= 1e-3 {
                     assert!(e[1] <= 3e-2 * e[0], "{context}");
                 }
@@ -1273,9 +1281,7 @@ fn bent_rods_converge_quadratically() {
             let offsets = offsets(&mut r, &tree, size);
             let e = errors(&tree, &offsets, 3);
             let context = format!("offsets {size}: errors {}", show(&e));
-            assert!(e[1] <= 40.0 * e[0] * e[0] + 1e-6, "{context}");
-            assert!(e[2] <= 20.0 * e[1] * e[1] + 1e-6, "{context}");
-            assert!(e[3] <= 1e-6, "{context}");
+            assert_quadratic(&e, [40.0, 20.0], [1e-6; 3], &context);
         }
     }
 }
