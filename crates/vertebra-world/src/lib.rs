@@ -70,6 +70,7 @@ pub use snapshot::{Snapshot, Timeline};
 #[cfg(feature = "stage-timing")]
 pub use stages::timing as stage_timing;
 pub use tasks::{RayonTasks, SingleThreaded, TaskSystem};
+pub use vertebra_kernels::direct::MAX_LIMIT_RETURN_SPEED;
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
