@@ -786,6 +786,9 @@ typedef struct VtSolverConfig {
   float sleep_speed;
   // With `sleep`: how long (s) an island is still before it sleeps.
   float sleep_time;
+  // Non-zero: a touching contact takes back the separating speed its
+  // own push-out gave (`SolverConfig::relax_contacts`).
+  uint32_t relax_contacts;
 } VtSolverConfig;
 
 // A world's residual joint error: the paper's figure 8 measure.

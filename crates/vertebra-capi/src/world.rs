@@ -74,6 +74,9 @@ pub struct VtSolverConfig {
     pub sleep_speed: f32,
     /// With `sleep`: how long (s) an island is still before it sleeps.
     pub sleep_time: f32,
+    /// Non-zero: a touching contact takes back the separating speed its
+    /// own push-out gave (`SolverConfig::relax_contacts`).
+    pub relax_contacts: u32,
 }
 
 /// A world's residual joint error: the paper's figure 8 measure.
@@ -149,6 +152,7 @@ impl From<&SolverConfig> for VtSolverConfig {
             sleep: u32::from(c.sleep.is_some()),
             sleep_speed: sleep.speed,
             sleep_time: sleep.time,
+            relax_contacts: u32::from(c.relax_contacts),
         }
     }
 }
@@ -177,6 +181,7 @@ impl TryFrom<&VtSolverConfig> for SolverConfig {
             gravity: c.gravity.into(),
             parallel_min_blocks: c.parallel_min_blocks as usize,
             max_push_out_speed: c.max_push_out_speed,
+            relax_contacts: flag(c.relax_contacts),
             max_linear_speed: c.max_linear_speed,
             max_angular_speed: c.max_angular_speed,
             measure_residuals: flag(c.measure_residuals),

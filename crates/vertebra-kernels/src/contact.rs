@@ -37,6 +37,20 @@
 //!   pull), where `v_approach` is its value when the contact was made; below
 //!   `2 |g| h` of approach the target is 0, so resting contacts do not
 //!   jitter (Müller eq. 34).
+//! - **Relax** (a setting: [`RelaxPass`], run a few times after the
+//!   velocity pass): the normal relative velocity is brought to the same
+//!   target from either side, with an accumulated impulse
+//!   `lambda_v >= -lambda_n / h`: it may take back at most the impulse
+//!   the contact's own push-out gave this substep. The position level's
+//!   push-out, `depth / h` as speed, is then not kept: a body pressed into
+//!   the ground by a joint, a limit or a drive and pushed back out does not
+//!   fly up from it, and a pile comes to rest. It is Box2D v3's relax stage
+//!   (solve with the push-out, then relax without it), and Müller et al.'s
+//!   eq. 34 where it sets the normal velocity rather than raising it;
+//!   iterated with the accumulated bound (as an impulse solver clamps its
+//!   total impulse), the contacts of one body share the taking back, where
+//!   one pass of each in turn leaves a box pushed out on four corners
+//!   spinning.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3 as GVec3;
@@ -75,6 +89,9 @@ pub struct ContactBlock {
     /// Accumulated tangential multiplier (a world vector in the tangent
     /// plane), reset every substep.
     pub lambda_t: Vec3Block,
+    /// The relax passes' accumulated normal impulse (N s, at least
+    /// `-lambda_n / h`), reset every substep.
+    pub lambda_v: [f32; BLOCK_LANES],
 }
 
 /// One contact's solver data.
@@ -141,6 +158,7 @@ impl ContactBlock {
     pub fn start_substep(&mut self, remaining: f32) {
         self.lambda_n = [0.0; BLOCK_LANES];
         self.lambda_t = Vec3Block::default();
+        self.lambda_v = [0.0; BLOCK_LANES];
         for (allowed, overlap) in self.allowance.iter_mut().zip(self.overlap) {
             *allowed = overlap * remaining;
         }
@@ -306,6 +324,87 @@ impl LaneSlices for Velocities<'_> {
     }
 }
 
+/// A relax pass (module docs, "Relax"): each touching contact's normal
+/// velocity brought to its target, taking back at most its push-out.
+pub struct RelaxPass<'a> {
+    /// The blocks.
+    pub blocks: &'a mut [ContactBlock],
+    /// Body rows: poses and inertia read, velocities read and written.
+    pub rows: &'a BodyRows,
+    /// The substep `h` (s).
+    pub h: f32,
+    /// Approach speeds below this bounce not at all (m/s): `2 |g| h`.
+    pub resting_speed: f32,
+}
+
+impl LaneKernel for RelaxPass<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        for block in self.blocks.iter_mut() {
+            let padding = block.bodies.padding;
+            let mut relax = Relax {
+                block,
+                rows: self.rows,
+                h: self.h,
+                resting_speed: self.resting_speed,
+            };
+            for_live_slices::<L, _>(padding, &mut relax);
+        }
+    }
+}
+
+/// One block of a [`RelaxPass`].
+struct Relax<'a> {
+    block: &'a mut ContactBlock,
+    rows: &'a BodyRows,
+    h: f32,
+    resting_speed: f32,
+}
+
+impl LaneSlices for Relax<'_> {
+    #[inline(always)]
+    fn slice<L: Lane>(&mut self, start: usize) {
+        let (h, resting_speed) = (L::splat(self.h), L::splat(self.resting_speed));
+        relax::<L>(self.block, start, self.rows, h, resting_speed);
+    }
+}
+
+/// The normal relative velocity a contact aims for: `-e v_approach` when
+/// it came in faster than `resting_speed`, else 0 (m/s).
+#[inline(always)]
+fn normal_target<L: Lane>(block: &ContactBlock, start: usize, resting_speed: L) -> L {
+    let approach = L::load(&block.approach[start..]);
+    let bounces = (-approach).gt(resting_speed);
+    L::select(
+        bounces,
+        (-L::load(&block.restitution[start..]) * approach).max(L::splat(0.0)),
+        L::splat(0.0),
+    )
+}
+
+#[inline(always)]
+fn relax<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyRows, h: L, resting_speed: L) {
+    let pairs = &block.bodies;
+    let (a, b) = pairs.gather::<L>(rows, start);
+    let mut va = VelocityLanes::<L>::gather(rows, &pairs.body_a[start..]);
+    let mut vb = VelocityLanes::<L>::gather(rows, &pairs.body_b[start..]);
+    let n = block.normal.load::<L>(start);
+    let (ra, rb, _) = arms(block, start, &a, &b);
+    let lambda_n = L::load(&block.lambda_n[start..]);
+    let touching = lambda_n.gt(L::splat(0.0));
+    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
+    let target = normal_target(block, start, resting_speed);
+    let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
+    let before = L::load(&block.lambda_v[start..]);
+    let wanted = before + safe_ratio(target - relative.dot(n), wn);
+    let after = L::select(touching, wanted.max(-(lambda_n / h)), before);
+    kick(&a, &b, &mut va, &mut vb, ra, rb, n.scale(after - before));
+    after.store(&mut block.lambda_v[start..]);
+    va.scatter(rows, &pairs.write_a[start..]);
+    vb.scatter(rows, &pairs.write_b[start..]);
+}
+
 /// Adds the velocity impulse `impulse` at `rb` to b and its opposite at `ra`
 /// to a.
 #[inline(always)]
@@ -357,13 +456,7 @@ fn solve_velocities<L: Lane>(
     kick(&a, &b, &mut va, &mut vb, ra, rb, friction);
 
     let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
-    let approach = L::load(&block.approach[start..]);
-    let bounces = (-approach).gt(resting_speed);
-    let target = L::select(
-        bounces,
-        (-L::load(&block.restitution[start..]) * approach).max(zero),
-        zero,
-    );
+    let target = normal_target(block, start, resting_speed);
     let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
     let change = L::select(touching, (target - relative.dot(n)).max(zero), zero);
     kick(

@@ -9,7 +9,7 @@ use common::{
 use glam::Vec3;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::contact::{ContactBlock, ContactLane, PositionPass, VelocityPass};
+use vertebra_kernels::contact::{ContactBlock, ContactLane, PositionPass, RelaxPass, VelocityPass};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
@@ -75,9 +75,18 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[ContactBlock]) -> Vec<f32> {
         h: 1.0 / 60.0,
         resting_speed: 0.33,
     });
+    for _ in 0..2 {
+        backend.dispatch(RelaxPass {
+            blocks: &mut blocks,
+            rows: &rows,
+            h: 1.0 / 60.0,
+            resting_speed: 0.33,
+        });
+    }
     let mut out = flatten(&rows);
     for b in &blocks {
         out.extend(b.lambda_n);
+        out.extend(b.lambda_v);
         out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
             &b.lambda_t,
         )));

@@ -86,6 +86,16 @@ pub struct SolverConfig {
     /// conflict to the joints (the drop's joint error rose 7%-38% at
     /// 3 m/s). A game that teleports bodies sets it (Box2D uses 3 m/s).
     pub max_push_out_speed: f32,
+    /// After each substep's velocity pass, the touching contacts take back
+    /// the separating speed their own push-out gave (each at most its
+    /// substep's normal impulse, `lambda_n / h`; a few passes, so the
+    /// contacts of one body share it): a body pressed into another by a
+    /// joint, a limit or a drive and pushed back out does not fly off, and
+    /// piles come to rest. Box2D v3's relax stage, and Müller et al.'s
+    /// velocity update where it sets the normal velocity rather than
+    /// raising it (`crates/vertebra-kernels/src/contact.rs`, "Relax").
+    /// Off, push-out becomes speed (`depth / h`), as in the paper's scenes.
+    pub relax_contacts: bool,
     /// Bodies never move faster than this (m/s): velocities are clamped
     /// before each substep moves them (Jolt clamps at 500 m/s too). At most
     /// [`MAX_LINEAR_SPEED_LIMIT`].
@@ -124,6 +134,7 @@ impl Default for SolverConfig {
             gravity: Vec3::new(0.0, -9.81, 0.0),
             parallel_min_blocks: 4,
             max_push_out_speed: f32::INFINITY,
+            relax_contacts: false,
             max_linear_speed: 500.0,
             max_angular_speed: 100.0 * core::f32::consts::PI,
             measure_residuals: false,
