@@ -191,9 +191,9 @@ impl TryFrom<&VtSolverConfig> for SolverConfig {
     }
 }
 
-/// Writes the default settings (1 substep, 20 iterations, the best
-/// backend, one thread, gravity -9.81 m/s^2 along y, sleeping on) into
-/// `config`.
+/// Writes the default settings (the direct joint solve at 1 substep of 8
+/// iterations, contacts relaxed, the best backend, one thread, gravity
+/// -9.81 m/s^2 along y, sleeping on) into `config`.
 ///
 /// # Safety
 /// `config` is null or writable.
@@ -202,6 +202,21 @@ pub unsafe extern "C" fn vt_solver_config_default(config: *mut VtSolverConfig) -
     call(|| {
         // SAFETY: the function's contract.
         unsafe { out(config, "config") }?.set((&SolverConfig::default()).into());
+        Ok(())
+    })
+}
+
+/// Writes the paper's settings (every joint iterated, 1 substep of 20
+/// iterations, contacts not relaxed; the rest as the default) into
+/// `config`.
+///
+/// # Safety
+/// `config` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_solver_config_paper(config: *mut VtSolverConfig) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        unsafe { out(config, "config") }?.set((&SolverConfig::paper()).into());
         Ok(())
     })
 }

@@ -109,6 +109,11 @@ enum Command {
         /// paper's figures step every body every frame.
         #[arg(long)]
         sleep: bool,
+        /// Relax the contacts: they take back the speed their push-out
+        /// gives (the world's default, with --joints direct and
+        /// --iterations 8). Off by default: the paper's contacts.
+        #[arg(long)]
+        relax_contacts: bool,
         /// One JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -230,6 +235,7 @@ fn execute(command: Command) -> Result<(), String> {
             max_torque,
             seeds,
             sleep,
+            relax_contacts,
             json,
             skeleton_out,
             gltf,
@@ -271,6 +277,7 @@ fn execute(command: Command) -> Result<(), String> {
             config.drive_damping_ratio = damping_ratio;
             config.max_torque = max_torque;
             config.sleep = sleep.then(SleepSettings::default);
+            config.relax_contacts = relax_contacts;
             if let (Some(_), Some(_)) = (seeds, &skeleton_out) {
                 return Err("--skeleton-out writes one run; not with --seeds".to_owned());
             }
