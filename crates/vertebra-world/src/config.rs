@@ -129,8 +129,9 @@ pub struct SolverConfig {
 
 /// The default: the direct joint solve at 1 substep of 8 iterations, with
 /// the contacts relaxed. In the 30-ragdoll drop it holds joints about
-/// 17,000 times tighter than the paper's iterated 1 x 20 at 0.99x to 1.07x
-/// its time a step (`docs/direct.md`, "The default"); 8 iterations are
+/// 17,000 times tighter than the paper's iterated 1 x 20 at 0.95x (rod
+/// spines) to 1.02x (sockets) its frame (`docs/direct.md`, "The
+/// default"); 8 iterations are
 /// what the contacts need (fewer let fast bodies through the ground and
 /// leave resting ones deeper in it). [`SolverConfig::paper`] is the
 /// paper's solver.
