@@ -146,44 +146,77 @@ impl<L: Lane> Rows<L> {
     /// Measures the rows of a joint of kind `kind` between `a` and `b`.
     #[inline(always)]
     pub fn measure(kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) -> Self {
+        let mut rows = Self::zero();
+        rows.equalities(kind, a, b, g);
+        rows.limits(kind, a, b, g);
+        rows
+    }
+
+    /// Measures only the limit rows (from `kind.first_limit()`; the rest
+    /// zero), each as [`Rows::measure`] measures it, bit for bit.
+    #[inline(always)]
+    pub fn measure_limits(
+        kind: JointRows,
+        a: &BodyLanes<L>,
+        b: &BodyLanes<L>,
+        g: &Geometry<L>,
+    ) -> Self {
+        let mut rows = Self::zero();
+        rows.limits(kind, a, b, g);
+        rows
+    }
+
+    #[inline(always)]
+    fn zero() -> Self {
         let zero = L::splat(0.0);
-        let mut rows = Self {
+        Self {
             ja: [[zero; 6]; MAX],
             jb: [[zero; 6]; MAX],
             c: [zero; MAX],
-        };
+        }
+    }
+
+    /// The equality rows: the point (a rod's curve and length), a hinge's
+    /// axis, a fixed joint's lock.
+    #[inline(always)]
+    fn equalities(&mut self, kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         match kind {
-            JointRows::Socket(SwingRows::Cone) => {
-                rows.point(0, a, b, g);
-                rows.swing(3, a, b, g);
-                rows.twist(4, a, b, g);
-            }
-            JointRows::Socket(SwingRows::Ellipse) => {
-                rows.point(0, a, b, g);
-                rows.ellipse(3, a, b, g);
-                rows.twist(4, a, b, g);
-            }
-            JointRows::Socket(SwingRows::Pyramid) => {
-                rows.point(0, a, b, g);
-                rows.pyramid(3, a, b, g);
-                rows.twist(5, a, b, g);
-            }
+            JointRows::Socket(_) => self.point(0, a, b, g),
             JointRows::Hinge => {
-                rows.point(0, a, b, g);
-                rows.axis(3, a, b, g);
-                rows.twist(5, a, b, g);
+                self.point(0, a, b, g);
+                self.axis(3, a, b, g);
             }
             JointRows::Fixed => {
-                rows.point(0, a, b, g);
-                rows.lock(3, a, b, g);
+                self.point(0, a, b, g);
+                self.lock(3, a, b, g);
             }
             JointRows::Rod => {
-                rows.curve(0, a, b, g);
-                rows.length(2, a, b, g);
-                rows.rod_limits(3, a, b, g);
+                self.curve(0, a, b, g);
+                self.length(2, a, b, g);
             }
         }
-        rows
+    }
+
+    /// The limit rows, from `kind.first_limit()`.
+    #[inline(always)]
+    fn limits(&mut self, kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        match kind {
+            JointRows::Socket(SwingRows::Cone) => {
+                self.swing(3, a, b, g);
+                self.twist(4, a, b, g);
+            }
+            JointRows::Socket(SwingRows::Ellipse) => {
+                self.ellipse(3, a, b, g);
+                self.twist(4, a, b, g);
+            }
+            JointRows::Socket(SwingRows::Pyramid) => {
+                self.pyramid(3, a, b, g);
+                self.twist(5, a, b, g);
+            }
+            JointRows::Hinge => self.twist(5, a, b, g),
+            JointRows::Fixed => {}
+            JointRows::Rod => self.rod_limits(3, a, b, g),
+        }
     }
 
     /// Row `k`: error `c`, `J_b = [lb, ab]`, `J_a = [-lb, -aa]`.

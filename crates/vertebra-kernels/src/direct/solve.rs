@@ -915,7 +915,7 @@ pub(super) fn start_limits<L: Lane>(
         };
         let joint = &mut block.joints[index as usize];
         let (a, b) = joint.bodies.gather::<L>(rows, start);
-        let measured = Rows::measure(kind, &a, &b, &joint.geometry(start, scale));
+        let measured = Rows::measure_limits(kind, &a, &b, &joint.geometry(start, scale));
         for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
             let violation = measured.c[k].max(L::splat(0.0));
             violation.store(&mut joint.limit_start[l][start..]);
