@@ -133,8 +133,9 @@ pub struct SolverConfig {
 /// spines) to 1.02x (sockets) its frame (`docs/direct.md`, "The
 /// default"); 8 iterations are
 /// what the contacts need (fewer let fast bodies through the ground and
-/// leave resting ones deeper in it). [`SolverConfig::paper`] is the
-/// paper's solver.
+/// leave resting ones deeper in it; at 8 a pile of ragdolls rests 2 to
+/// 5 mm deep, at the paper's 20 about 1 mm). [`SolverConfig::paper`] is
+/// the paper's solver.
 impl Default for SolverConfig {
     fn default() -> Self {
         Self {
