@@ -4,7 +4,7 @@
 //! (`./benches/install-iai-runner.sh`).
 //! And a frame (collision detection and the step) of the reference ragdoll
 //! lying on the ground (`lone_ragdoll_on_ground`), per spine and backend,
-//! iterated at 1 x 20 (the world's default) and 1 x 4, and solved directly
+//! iterated at 1 x 20 (the paper's) and 1 x 4, and solved directly
 //! at 1 x 4 and 1 x 8 (`lone_solvers`, in that order).
 //! `cargo bench -p vertebra-benches --bench single_ragdoll_instructions`
 
