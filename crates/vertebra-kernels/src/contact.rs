@@ -37,7 +37,7 @@
 //!   pull), where `v_approach` is its value when the contact was made; below
 //!   `2 |g| h` of approach the target is 0, so resting contacts do not
 //!   jitter (Müller eq. 34).
-//! - **Relax** (a setting: [`RelaxPass`], run a few times after the
+//! - **Relax** (a setting: [`VelocityPass`] with `relax`, run a few times after the
 //!   velocity pass): the normal relative velocity is brought to the same
 //!   target from either side, with an accumulated impulse
 //!   `lambda_v >= -lambda_n / h`: it may take back at most the impulse
@@ -280,54 +280,12 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
     block.bodies.scatter(rows, start, &a, &b);
 }
 
-/// The velocity pass: dynamic friction and restitution.
+/// A velocity pass over the contacts: dynamic friction and restitution,
+/// or with `relax` a relax pass (module docs, "Relax"): each touching
+/// contact's normal velocity brought to its target, taking back at most
+/// its push-out.
 pub struct VelocityPass<'a> {
-    /// The blocks.
-    pub blocks: &'a [ContactBlock],
-    /// Body rows: poses and inertia read, velocities read and written.
-    pub rows: &'a BodyRows,
-    /// The substep `h` (s).
-    pub h: f32,
-    /// Approach speeds below this bounce not at all (m/s): `2 |g| h`.
-    pub resting_speed: f32,
-}
-
-impl LaneKernel for VelocityPass<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks {
-            let mut velocities = Velocities {
-                block,
-                rows: self.rows,
-                h: self.h,
-                resting_speed: self.resting_speed,
-            };
-            for_live_slices::<L, _>(block.bodies.padding, &mut velocities);
-        }
-    }
-}
-
-/// One block of a [`VelocityPass`].
-struct Velocities<'a> {
-    block: &'a ContactBlock,
-    rows: &'a BodyRows,
-    h: f32,
-    resting_speed: f32,
-}
-
-impl LaneSlices for Velocities<'_> {
-    #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let (h, resting_speed) = (L::splat(self.h), L::splat(self.resting_speed));
-        solve_velocities::<L>(self.block, start, self.rows, h, resting_speed);
-    }
-}
-
-/// A relax pass (module docs, "Relax"): each touching contact's normal
-/// velocity brought to its target, taking back at most its push-out.
-pub struct RelaxPass<'a> {
-    /// The blocks.
+    /// The blocks (a relax pass accumulates `lambda_v` in them).
     pub blocks: &'a mut [ContactBlock],
     /// Body rows: poses and inertia read, velocities read and written.
     pub rows: &'a BodyRows,
@@ -335,38 +293,46 @@ pub struct RelaxPass<'a> {
     pub h: f32,
     /// Approach speeds below this bounce not at all (m/s): `2 |g| h`.
     pub resting_speed: f32,
+    /// A relax pass, not the velocity pass.
+    pub relax: bool,
 }
 
-impl LaneKernel for RelaxPass<'_> {
+impl LaneKernel for VelocityPass<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
         for block in self.blocks.iter_mut() {
             let padding = block.bodies.padding;
-            let mut relax = Relax {
+            let mut velocities = Velocities {
                 block,
                 rows: self.rows,
                 h: self.h,
                 resting_speed: self.resting_speed,
+                relax: self.relax,
             };
-            for_live_slices::<L, _>(padding, &mut relax);
+            for_live_slices::<L, _>(padding, &mut velocities);
         }
     }
 }
 
-/// One block of a [`RelaxPass`].
-struct Relax<'a> {
+/// One block of a [`VelocityPass`].
+struct Velocities<'a> {
     block: &'a mut ContactBlock,
     rows: &'a BodyRows,
     h: f32,
     resting_speed: f32,
+    relax: bool,
 }
 
-impl LaneSlices for Relax<'_> {
+impl LaneSlices for Velocities<'_> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
         let (h, resting_speed) = (L::splat(self.h), L::splat(self.resting_speed));
-        relax::<L>(self.block, start, self.rows, h, resting_speed);
+        if self.relax {
+            relax::<L>(self.block, start, self.rows, h, resting_speed);
+        } else {
+            solve_velocities::<L>(self.block, start, self.rows, h, resting_speed);
+        }
     }
 }
 
@@ -383,45 +349,84 @@ fn normal_target<L: Lane>(block: &ContactBlock, start: usize, resting_speed: L) 
     )
 }
 
-#[inline(always)]
-fn relax<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyRows, h: L, resting_speed: L) {
-    let pairs = &block.bodies;
-    let (a, b) = pairs.gather::<L>(rows, start);
-    let mut va = VelocityLanes::<L>::gather(rows, &pairs.body_a[start..]);
-    let mut vb = VelocityLanes::<L>::gather(rows, &pairs.body_b[start..]);
-    let n = block.normal.load::<L>(start);
-    let (ra, rb, _) = arms(block, start, &a, &b);
-    let lambda_n = L::load(&block.lambda_n[start..]);
-    let touching = lambda_n.gt(L::splat(0.0));
-    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
-    let target = normal_target(block, start, resting_speed);
-    let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
-    let before = L::load(&block.lambda_v[start..]);
-    let wanted = before + safe_ratio(target - relative.dot(n), wn);
-    let after = L::select(touching, wanted.max(-(lambda_n / h)), before);
-    kick(&a, &b, &mut va, &mut vb, ra, rb, n.scale(after - before));
-    after.store(&mut block.lambda_v[start..]);
-    va.scatter(rows, &pairs.write_a[start..]);
-    vb.scatter(rows, &pairs.write_b[start..]);
-}
-
-/// Adds the velocity impulse `impulse` at `rb` to b and its opposite at `ra`
-/// to a.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn kick<L: Lane>(
-    a: &BodyLanes<L>,
-    b: &BodyLanes<L>,
-    va: &mut VelocityLanes<L>,
-    vb: &mut VelocityLanes<L>,
+/// A slice of contacts at the velocity level: both bodies' poses and
+/// velocities, the lever arms, the normal and the substep's normal
+/// multiplier, as both velocity passes read them.
+struct Touch<L: Lane> {
+    a: BodyLanes<L>,
+    b: BodyLanes<L>,
+    va: VelocityLanes<L>,
+    vb: VelocityLanes<L>,
     ra: Vec3<L>,
     rb: Vec3<L>,
-    impulse: Vec3<L>,
-) {
-    vb.v += impulse.scale(b.inv_mass);
-    vb.w += b.inv_inertia_mul(rb.cross(impulse));
-    va.v -= impulse.scale(a.inv_mass);
-    va.w -= a.inv_inertia_mul(ra.cross(impulse));
+    n: Vec3<L>,
+    lambda_n: L,
+}
+
+impl<L: Lane> Touch<L> {
+    #[inline(always)]
+    fn gather(block: &ContactBlock, start: usize, rows: &BodyRows) -> Self {
+        let pairs = &block.bodies;
+        let (a, b) = pairs.gather::<L>(rows, start);
+        let (ra, rb, _) = arms(block, start, &a, &b);
+        Self {
+            va: VelocityLanes::gather(rows, &pairs.body_a[start..]),
+            vb: VelocityLanes::gather(rows, &pairs.body_b[start..]),
+            n: block.normal.load(start),
+            lambda_n: L::load(&block.lambda_n[start..]),
+            a,
+            b,
+            ra,
+            rb,
+        }
+    }
+
+    /// Whether the contact pushed this substep (`lambda_n > 0`).
+    #[inline(always)]
+    fn touching(&self) -> L::Mask {
+        self.lambda_n.gt(L::splat(0.0))
+    }
+
+    /// b's contact point's velocity relative to a's (m/s).
+    #[inline(always)]
+    fn relative(&self) -> Vec3<L> {
+        (self.vb.v + self.vb.w.cross(self.rb)) - (self.va.v + self.va.w.cross(self.ra))
+    }
+
+    /// The generalised inverse mass along `d` at the contact point.
+    #[inline(always)]
+    fn weight(&self, d: Vec3<L>) -> L {
+        self.a.positional_weight(self.ra, d) + self.b.positional_weight(self.rb, d)
+    }
+
+    /// Adds the velocity impulse `impulse` at `rb` to b and its opposite
+    /// at `ra` to a.
+    #[inline(always)]
+    fn kick(&mut self, impulse: Vec3<L>) {
+        self.vb.v += impulse.scale(self.b.inv_mass);
+        self.vb.w += self.b.inv_inertia_mul(self.rb.cross(impulse));
+        self.va.v -= impulse.scale(self.a.inv_mass);
+        self.va.w -= self.a.inv_inertia_mul(self.ra.cross(impulse));
+    }
+
+    #[inline(always)]
+    fn scatter(&self, block: &ContactBlock, start: usize, rows: &BodyRows) {
+        self.va.scatter(rows, &block.bodies.write_a[start..]);
+        self.vb.scatter(rows, &block.bodies.write_b[start..]);
+    }
+}
+
+#[inline(always)]
+fn relax<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyRows, h: L, resting_speed: L) {
+    let mut touch = Touch::<L>::gather(block, start, rows);
+    let target = normal_target(block, start, resting_speed);
+    let (n, lambda_n) = (touch.n, touch.lambda_n);
+    let before = L::load(&block.lambda_v[start..]);
+    let wanted = before + safe_ratio(target - touch.relative().dot(n), touch.weight(n));
+    let after = L::select(touch.touching(), wanted.max(-(lambda_n / h)), before);
+    touch.kick(n.scale(after - before));
+    after.store(&mut block.lambda_v[start..]);
+    touch.scatter(block, start, rows);
 }
 
 #[inline(always)]
@@ -432,43 +437,22 @@ fn solve_velocities<L: Lane>(
     h: L,
     resting_speed: L,
 ) {
-    let pairs = &block.bodies;
-    let (a, b) = pairs.gather::<L>(rows, start);
-    let mut va = VelocityLanes::<L>::gather(rows, &pairs.body_a[start..]);
-    let mut vb = VelocityLanes::<L>::gather(rows, &pairs.body_b[start..]);
-    let n = block.normal.load::<L>(start);
-    let zero = L::splat(0.0);
-    let (ra, rb, _) = arms(block, start, &a, &b);
-    let lambda_n = L::load(&block.lambda_n[start..]);
-    let touching = lambda_n.gt(zero);
+    let mut touch = Touch::<L>::gather(block, start, rows);
+    let (n, zero, touching) = (touch.n, L::splat(0.0), touch.touching());
 
-    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
+    let relative = touch.relative();
     let vn = relative.dot(n);
     let (t, speed_t) = (relative - n.scale(vn)).normalize_or_zero();
     // The impulse that stops the sliding, capped by what the position
     // level left of Coulomb's budget: (mu lambda_n - |lambda_t|) / h.
-    let wt = a.positional_weight(ra, t) + b.positional_weight(rb, t);
-    let stop = safe_ratio(speed_t, wt);
+    let stop = safe_ratio(speed_t, touch.weight(t));
     let used = block.lambda_t.load::<L>(start).length();
-    let budget = ((L::load(&block.friction[start..]) * lambda_n - used) / h).max(zero);
+    let budget = ((L::load(&block.friction[start..]) * touch.lambda_n - used) / h).max(zero);
     let impulse = stop.min(budget);
-    let friction = t.scale(L::select(touching, -impulse, zero));
-    kick(&a, &b, &mut va, &mut vb, ra, rb, friction);
+    touch.kick(t.scale(L::select(touching, -impulse, zero)));
 
-    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
     let target = normal_target(block, start, resting_speed);
-    let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
-    let change = L::select(touching, (target - relative.dot(n)).max(zero), zero);
-    kick(
-        &a,
-        &b,
-        &mut va,
-        &mut vb,
-        ra,
-        rb,
-        n.scale(safe_ratio(change, wn)),
-    );
-
-    va.scatter(rows, &pairs.write_a[start..]);
-    vb.scatter(rows, &pairs.write_b[start..]);
+    let change = L::select(touching, (target - touch.relative().dot(n)).max(zero), zero);
+    touch.kick(n.scale(safe_ratio(change, touch.weight(n))));
+    touch.scatter(block, start, rows);
 }

@@ -9,7 +9,7 @@ use common::{
 use glam::Vec3;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::contact::{ContactBlock, ContactLane, PositionPass, RelaxPass, VelocityPass};
+use vertebra_kernels::contact::{ContactBlock, ContactLane, PositionPass, VelocityPass};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
@@ -69,18 +69,14 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[ContactBlock]) -> Vec<f32> {
             rows: &rows,
         });
     }
-    backend.dispatch(VelocityPass {
-        blocks: &blocks,
-        rows: &rows,
-        h: 1.0 / 60.0,
-        resting_speed: 0.33,
-    });
-    for _ in 0..2 {
-        backend.dispatch(RelaxPass {
+    // The velocity pass, then two relax passes.
+    for relax in [false, true, true] {
+        backend.dispatch(VelocityPass {
             blocks: &mut blocks,
             rows: &rows,
             h: 1.0 / 60.0,
             resting_speed: 0.33,
+            relax,
         });
     }
     let mut out = flatten(&rows);

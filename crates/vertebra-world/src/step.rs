@@ -589,10 +589,12 @@ fn backend_for_tree(backend: Backend, block: &TreeBlock) -> Backend {
 }
 
 /// The velocity pass (contact friction and restitution; joints have none:
-/// drives damp at the position level).
+/// drives damp at the position level), or with `relax` a relax pass
+/// (`contact::VelocityPass`: the contacts take back their push-out's speed).
 struct Velocities {
     h: f32,
     resting_speed: f32,
+    relax: bool,
 }
 
 impl Pass for Velocities {
@@ -604,12 +606,13 @@ impl Pass for Velocities {
     fn fixed(&self, _: &mut [FixedBlock], _: &BodyRows, _: Backend) {}
     fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
-        let (h, resting_speed) = (self.h, self.resting_speed);
+        let (h, resting_speed, relax) = (self.h, self.resting_speed, self.relax);
         backend.dispatch(contact::VelocityPass {
             blocks,
             rows,
             h,
             resting_speed,
+            relax,
         });
     }
 }
@@ -620,32 +623,6 @@ impl Pass for Velocities {
 /// corners leaves at under 1 cm/s and 0.01 rad/s, where one pass left it
 /// spinning at 1.2 rad/s).
 pub(crate) const RELAX_PASSES: u32 = 4;
-
-/// A relax pass (`contact::RelaxPass`): the contacts take back their
-/// push-out's speed.
-struct Relax {
-    h: f32,
-    resting_speed: f32,
-}
-
-impl Pass for Relax {
-    fn joints(&self) -> bool {
-        false
-    }
-    fn sockets(&self, _: &mut [SocketBlock], _: SocketBlocks, _: &BodyRows, _: Backend) {}
-    fn hinges(&self, _: &mut [HingeBlock], _: bool, _: &BodyRows, _: Backend) {}
-    fn fixed(&self, _: &mut [FixedBlock], _: &BodyRows, _: Backend) {}
-    fn rods(&self, _: &mut [RodBlock], _: &BodyRows, _: Backend) {}
-    fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
-        let (h, resting_speed) = (self.h, self.resting_speed);
-        backend.dispatch(contact::RelaxPass {
-            blocks,
-            rows,
-            h,
-            resting_speed,
-        });
-    }
-}
 
 /// The most chunks a body pass is split into.
 const MAX_BODY_CHUNKS: usize = 64;
@@ -849,13 +826,18 @@ impl Substep<'_> {
         });
         self.body_pass(cursor, |c, rows| derive_velocities(c, bodies, rows, h));
         let resting_speed = 2.0 * bodies.gravity.length() * h;
-        let velocities = Velocities { h, resting_speed };
-        self.for_each_colour(cursor, 0, &velocities);
-        self.bins_stage(cursor, |bin| self.solve_bin(bin, &velocities));
-        let relax = Relax { h, resting_speed };
-        for _ in 0..self.relax_passes {
-            self.for_each_colour(cursor, 0, &relax);
-            self.bins_stage(cursor, |bin| self.solve_bin(bin, &relax));
+        let velocities = Velocities {
+            h,
+            resting_speed,
+            relax: false,
+        };
+        let relax = Velocities {
+            relax: true,
+            ..velocities
+        };
+        for pass in core::iter::once(&velocities).chain((0..self.relax_passes).map(|_| &relax)) {
+            self.for_each_colour(cursor, 0, pass);
+            self.bins_stage(cursor, |bin| self.solve_bin(bin, pass));
         }
         self.body_pass(cursor, |c, rows| {
             read_velocities(c, bodies, rows);
