@@ -14,7 +14,7 @@ use vertebra_math::map::{LaneMap, map_arrays};
 use vertebra_math::{Backend, BackendChoice, Lane, Quat, Vec3, poly};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Scene, SceneConfig, SceneWorld, build};
-use vertebra_world::JointSolver;
+use vertebra_world::{JointSolver, SolverConfig};
 
 /// The backends the instruction-count benches measure, by argument index:
 /// 0 scalar, 1 portable, 2 sse4, 3 avx2 (8 lanes).
@@ -606,6 +606,58 @@ pub fn single_ragdoll_solved(
         scene.advance(config.scene, frame, DT).expect("a frame");
     }
     scene
+}
+
+/// The frames a lone ragdoll is dropped for before it is timed lying on
+/// the ground: three seconds, when every body is on it (the lowest centre
+/// 4.5 cm up) but not all are still (the fastest at 0.04 to 0.17 m/s).
+pub const LONE_SETTLE_FRAMES: usize = 180;
+
+/// The reference ragdoll alone, dropped onto the ground (the ragdoll-drop
+/// scene with one ragdoll) and lying there [`LONE_SETTLE_FRAMES`] frames
+/// in: its contacts with the ground found every frame, so a frame
+/// ([`SceneWorld::frame`]) is collision detection and the step, what a game
+/// pays for a ragdoll on the ground that is still awake (sleeping off, as
+/// in the scenes). Solved by `solver`'s joint solve at its substeps x iterations,
+/// on one thread on `backend`, its residuals not measured.
+pub fn lone_ragdoll_on_ground(
+    spine: SpineMode,
+    backend: BackendChoice,
+    solver: &SolverConfig,
+) -> SceneWorld {
+    let mut config = SceneConfig::new(Scene::RagdollDrop, spine);
+    config.ragdolls = 1;
+    (config.substeps, config.iterations, config.joints) =
+        (solver.substeps, solver.iterations, solver.joints);
+    config.relax_contacts = solver.relax_contacts;
+    config.backend = backend;
+    config.measure_residuals = false;
+    let mut scene = build(&config).expect("the drop scene with one ragdoll");
+    for frame in 0..LONE_SETTLE_FRAMES {
+        scene.frame(config.scene, frame, DT).expect("a frame");
+    }
+    scene
+}
+
+/// The solvers a lone ragdoll on the ground is timed with, by name: the
+/// paper's (iterated, 1 x 20, `SolverConfig::paper`), the iterated solve
+/// at 1 x 4, and the direct solve with relaxed contacts at 1 x 4 and at
+/// 1 x 8 (the world's default; `docs/direct.md`, "The default").
+pub fn lone_solvers() -> [(&'static str, SolverConfig); 4] {
+    let iterated = |iterations| SolverConfig {
+        iterations,
+        ..SolverConfig::paper()
+    };
+    let direct = |iterations| SolverConfig {
+        iterations,
+        ..SolverConfig::default()
+    };
+    [
+        ("iterated_1x20", iterated(20)),
+        ("iterated_1x4", iterated(4)),
+        ("direct_1x4", direct(4)),
+        ("direct_1x8", direct(8)),
+    ]
 }
 
 /// `scene` (the ragdoll drop, [`Scene::RagdollDrop`], or its anatomical

@@ -5,10 +5,11 @@
 //! starts): mean wall time per step and mean residual joint error per
 //! frame, each as its median and spread over the seeds, rapier's measured
 //! by our own metric on its body poses; vertebra with both joint solves
-//! (`--joints iterative` and `direct`). Then, per scene, the error against
+//! (`--joints iterative` and `direct`, and the world's default: direct at
+//! 1x8 with relaxed contacts). Then, per scene, the error against
 //! the cost at more settings (vertebra both ways at the substep x
-//! iteration splits of [`SWEEP`], from [`SWEEP_SEEDS`] starts; rapier's
-//! rows of the table), written as a plot and CSV to
+//! iteration splits of [`SWEEP`], from [`SWEEP_SEEDS`] starts; the
+//! default and rapier's rows of the table), written as a plot and CSV to
 //! `target/figures/peer/error_vs_cost_<scene>.{svg,csv}` ([`peer_plot`]).
 //! Then criterion's time per frame of the 30-ragdoll drop, one second in,
 //! for each engine and setting.
@@ -22,7 +23,7 @@ use criterion::Criterion;
 use vertebra_peer::{RapierScene, RapierSettings};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Frame, Scene, SceneConfig, Spread, build, run};
-use vertebra_world::JointSolver;
+use vertebra_world::{JointSolver, SolverConfig};
 
 use peer_plot::{Point, Series};
 
@@ -112,19 +113,31 @@ fn figures(ms: f64, frames: &[Frame]) -> (f64, f32, f32) {
 }
 
 /// Our whole runs of `scene` from seeds `0 .. seeds`, one at a time (so
-/// that the times are one run's).
+/// that the times are one run's), the contacts as the paper's.
 fn ours(
     scene: Scene,
     spine: SpineMode,
     joints: JointSolver,
-    (substeps, iterations): (u32, u32),
+    split: (u32, u32),
     seeds: u64,
 ) -> Figures {
+    let solver = SolverConfig {
+        joints,
+        substeps: split.0,
+        iterations: split.1,
+        ..SolverConfig::paper()
+    };
+    ours_with(scene, spine, &solver, seeds)
+}
+
+/// [`ours`] with `solver`'s joints, split and contacts.
+fn ours_with(scene: Scene, spine: SpineMode, solver: &SolverConfig, seeds: u64) -> Figures {
     (0..seeds)
         .map(|seed| {
             let mut config = SceneConfig::new(scene, spine);
-            (config.substeps, config.iterations) = (substeps, iterations);
-            config.joints = joints;
+            (config.substeps, config.iterations) = (solver.substeps, solver.iterations);
+            config.joints = solver.joints;
+            config.relax_contacts = solver.relax_contacts;
             config.seed = seed;
             let run = run(&config, |_, _| {}).expect("our scene");
             // The frame alone, as rapier's time is its step alone.
@@ -157,6 +170,16 @@ fn whole_runs() {
             }
         }
         let mut points = Vec::new();
+        let default = SolverConfig::default();
+        for (name, spine) in SPINES {
+            let runs = ours_with(scene, spine, &default, SEEDS);
+            let split = format!("{}x{}", default.substeps, default.iterations);
+            row(
+                &format!("vertebra {split} direct, relaxed contacts (the default), {name} spine"),
+                &runs,
+            );
+            points.push(point(Series::Default(spine), split, &runs));
+        }
         for settings in RapierSettings::COMPARED {
             let peer: Figures = (0..SEEDS)
                 .map(|seed| {

@@ -18,17 +18,22 @@ use vertebra_world::JointSolver;
 pub enum Series {
     /// vertebra, its joints solved by the [`JointSolver`], with the spine.
     Vertebra(JointSolver, SpineMode),
+    /// vertebra as a game gets it, `SolverConfig::default()` (the direct
+    /// solve at 1x8 with relaxed contacts), with this spine.
+    Default(SpineMode),
     /// rapier3d.
     Rapier,
 }
 
 impl Series {
     /// In drawing order.
-    const ALL: [Series; 5] = [
+    const ALL: [Series; 7] = [
         Series::Vertebra(JointSolver::Iterative, SpineMode::Rod),
         Series::Vertebra(JointSolver::Iterative, SpineMode::Sockets),
         Series::Vertebra(JointSolver::Direct, SpineMode::Rod),
         Series::Vertebra(JointSolver::Direct, SpineMode::Sockets),
+        Series::Default(SpineMode::Rod),
+        Series::Default(SpineMode::Sockets),
         Series::Rapier,
     ];
 
@@ -42,6 +47,7 @@ impl Series {
         match self {
             Series::Vertebra(JointSolver::Iterative, s) => ["vertebra", "iterative", spine(s)],
             Series::Vertebra(JointSolver::Direct, s) => ["vertebra", "direct", spine(s)],
+            Series::Default(s) => ["vertebra", "default", spine(s)],
             Series::Rapier => ["rapier", "rapier", "socket"],
         }
     }
@@ -51,15 +57,23 @@ impl Series {
     fn label(self) -> String {
         match self.columns() {
             ["rapier", _, spine] => format!("rapier, {spine} spine"),
+            [engine, "default", spine] => {
+                format!("{engine} default (direct, relaxed contacts), {spine} spine")
+            }
             [engine, joints, spine] => format!("{engine} {joints}, {spine} spine"),
         }
     }
 
     /// Rod red, sockets blue, rapier black; iterative hollow and larger,
     /// direct filled, so a direct point on top of its iterative one shows
-    /// both. The marker's radius in pixels.
+    /// both; the default a wide thick ring, marking it among the direct
+    /// points. The marker's radius in pixels.
     fn style(self) -> (ShapeStyle, u32) {
         match self {
+            Series::Default(spine) => {
+                let colour = if spine == SpineMode::Rod { RED } else { BLUE };
+                (colour.stroke_width(3), 11)
+            }
             Series::Vertebra(joints, spine) => {
                 let colour = if spine == SpineMode::Rod { RED } else { BLUE };
                 match joints {

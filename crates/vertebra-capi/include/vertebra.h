@@ -950,6 +950,9 @@ typedef struct VtSolverConfig {
   float sleep_speed;
   // With `sleep`: how long (s) an island is still before it sleeps.
   float sleep_time;
+  // Non-zero: a touching contact takes back the separating speed its
+  // own push-out gave (`SolverConfig::relax_contacts`).
+  uint32_t relax_contacts;
 } VtSolverConfig;
 
 // A world's residual joint error: the paper's figure 8 measure.
@@ -2158,13 +2161,21 @@ enum VtResult vt_transition_skeleton_pose(const struct VtTransition *transition,
                                           struct VtTransform *bones,
                                           size_t count);
 
-// Writes the default settings (1 substep, 20 iterations, the best
-// backend, one thread, gravity -9.81 m/s^2 along y, sleeping on) into
-// `config`.
+// Writes the default settings (the direct joint solve at 1 substep of 8
+// iterations, contacts relaxed, the best backend, one thread, gravity
+// -9.81 m/s^2 along y, sleeping on) into `config`.
 //
 // # Safety
 // `config` is null or writable.
 enum VtResult vt_solver_config_default(struct VtSolverConfig *config);
+
+// Writes the paper's settings (every joint iterated, 1 substep of 20
+// iterations, contacts not relaxed; the rest as the default) into
+// `config`.
+//
+// # Safety
+// `config` is null or writable.
+enum VtResult vt_solver_config_paper(struct VtSolverConfig *config);
 
 // Makes an empty world with `config` (null: the defaults) and writes it
 // to `world`. The caller owns it: free it with `vt_world_destroy`.

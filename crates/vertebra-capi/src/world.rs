@@ -74,6 +74,9 @@ pub struct VtSolverConfig {
     pub sleep_speed: f32,
     /// With `sleep`: how long (s) an island is still before it sleeps.
     pub sleep_time: f32,
+    /// Non-zero: a touching contact takes back the separating speed its
+    /// own push-out gave (`SolverConfig::relax_contacts`).
+    pub relax_contacts: u32,
 }
 
 /// A world's residual joint error: the paper's figure 8 measure.
@@ -149,6 +152,7 @@ impl From<&SolverConfig> for VtSolverConfig {
             sleep: u32::from(c.sleep.is_some()),
             sleep_speed: sleep.speed,
             sleep_time: sleep.time,
+            relax_contacts: u32::from(c.relax_contacts),
         }
     }
 }
@@ -177,6 +181,7 @@ impl TryFrom<&VtSolverConfig> for SolverConfig {
             gravity: c.gravity.into(),
             parallel_min_blocks: c.parallel_min_blocks as usize,
             max_push_out_speed: c.max_push_out_speed,
+            relax_contacts: flag(c.relax_contacts),
             max_linear_speed: c.max_linear_speed,
             max_angular_speed: c.max_angular_speed,
             measure_residuals: flag(c.measure_residuals),
@@ -186,9 +191,9 @@ impl TryFrom<&VtSolverConfig> for SolverConfig {
     }
 }
 
-/// Writes the default settings (1 substep, 20 iterations, the best
-/// backend, one thread, gravity -9.81 m/s^2 along y, sleeping on) into
-/// `config`.
+/// Writes the default settings (the direct joint solve at 1 substep of 8
+/// iterations, contacts relaxed, the best backend, one thread, gravity
+/// -9.81 m/s^2 along y, sleeping on) into `config`.
 ///
 /// # Safety
 /// `config` is null or writable.
@@ -197,6 +202,21 @@ pub unsafe extern "C" fn vt_solver_config_default(config: *mut VtSolverConfig) -
     call(|| {
         // SAFETY: the function's contract.
         unsafe { out(config, "config") }?.set((&SolverConfig::default()).into());
+        Ok(())
+    })
+}
+
+/// Writes the paper's settings (every joint iterated, 1 substep of 20
+/// iterations, contacts not relaxed; the rest as the default) into
+/// `config`.
+///
+/// # Safety
+/// `config` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_solver_config_paper(config: *mut VtSolverConfig) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        unsafe { out(config, "config") }?.set((&SolverConfig::paper()).into());
         Ok(())
     })
 }

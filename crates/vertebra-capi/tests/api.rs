@@ -15,8 +15,8 @@ use vertebra_ragdoll::{
     SpineMapping, SpineMode, Strength, Transform,
 };
 use vertebra_world::{
-    AngularDrive, BodyDesc, JointDesc, JointKind, LimitSoftness, RodDesc, RodStiffness, Shape,
-    SolverConfig, Swing, SwingTwist, World,
+    AngularDrive, BodyDesc, JointDesc, JointKind, JointSolver, LimitSoftness, RodDesc,
+    RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -499,6 +499,7 @@ fn a_null_argument_is_refused_naming_it_and_changes_nothing() {
     unsafe {
         refused(vt_world_create(null(), null_mut()), NULL, &["world"]);
         refused(vt_solver_config_default(null_mut()), NULL, &["config"]);
+        refused(vt_solver_config_paper(null_mut()), NULL, &["config"]);
         refused(vt_body_desc_default(0, null_mut()), NULL, &["desc"]);
         let mut mass = desc.mass;
         refused(
@@ -551,6 +552,49 @@ fn a_misaligned_pointer_is_refused_naming_it() {
         &["world", "aligned"],
     );
     assert_eq!(storage, [0; 4]);
+}
+
+/// The two presets are Rust's: the default (the direct solve, 1 x 8,
+/// contacts relaxed) and the paper's (iterated, 1 x 20, not relaxed).
+#[test]
+fn the_presets_are_the_default_and_the_papers_settings() {
+    for (preset, rust) in [
+        (
+            vt_solver_config_default as unsafe extern "C" fn(*mut VtSolverConfig) -> VtResult,
+            SolverConfig::default(),
+        ),
+        (vt_solver_config_paper, SolverConfig::paper()),
+    ] {
+        let mut config = std::mem::MaybeUninit::<VtSolverConfig>::uninit();
+        // SAFETY: writable.
+        ok(unsafe { preset(config.as_mut_ptr()) });
+        // SAFETY: written just above.
+        let config = unsafe { config.assume_init() };
+        assert_eq!(
+            (config.joints, config.iterations, config.substeps),
+            (
+                u32::from(rust.joints == JointSolver::Direct),
+                rust.iterations,
+                rust.substeps
+            )
+        );
+        assert_eq!(config.relax_contacts, u32::from(rust.relax_contacts));
+    }
+    assert_eq!(
+        (
+            SolverConfig::default().joints,
+            SolverConfig::default().iterations
+        ),
+        (JointSolver::Direct, 8)
+    );
+    assert_eq!(
+        (
+            SolverConfig::paper().joints,
+            SolverConfig::paper().iterations
+        ),
+        (JointSolver::Iterative, 20)
+    );
+    assert!(SolverConfig::default().relax_contacts && !SolverConfig::paper().relax_contacts);
 }
 
 const ENUM: VtResult = VtResult::InvalidEnum;

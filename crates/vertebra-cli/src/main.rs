@@ -19,7 +19,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, RagdollError, SpineMode};
 use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, SceneRun, Seeded};
-use vertebra_world::{JointSolver, SleepSettings};
+use vertebra_world::{JointSolver, SleepSettings, SolverConfig};
 
 use gltf_out::GltfOut;
 use skeleton_csv::{Failed, SkeletonCsv};
@@ -63,16 +63,21 @@ enum Command {
         #[arg(long)]
         spine: Spine,
         /// How the joints are solved: iterative (each joint on its own, as
-        /// the paper) or direct (every joint of a ragdoll at once).
-        #[arg(long, value_enum, default_value_t = Joints::Iterative)]
-        joints: Joints,
+        /// the paper) or direct (every joint of a ragdoll at once). The
+        /// paper's scenes, and any scene with --joints iterative, start
+        /// from the paper's settings (iterative, 1 substep x 20
+        /// iterations, contacts not relaxed); the others from the world's
+        /// default (direct, 1 x 8, relaxed). Each flag given replaces its
+        /// setting.
+        #[arg(long, value_enum)]
+        joints: Option<Joints>,
         /// Position iterations per substep (substeps x iterations at most
-        /// 10000).
-        #[arg(long, default_value_t = 20)]
-        iterations: u32,
-        /// Substeps per frame.
-        #[arg(long, default_value_t = 1)]
-        substeps: u32,
+        /// 10000; unless given, as --joints says).
+        #[arg(long)]
+        iterations: Option<u32>,
+        /// Substeps per frame (unless given, as --joints says).
+        #[arg(long)]
+        substeps: Option<u32>,
         /// Frames to run, 1 to 1000000 (the scene's own count by default).
         #[arg(long)]
         frames: Option<usize>,
@@ -109,6 +114,11 @@ enum Command {
         /// paper's figures step every body every frame.
         #[arg(long)]
         sleep: bool,
+        /// Relax the contacts (true or false; alone: true): they take
+        /// back the speed their push-out gives. Unless given, as --joints
+        /// says.
+        #[arg(long, num_args = 0..=1, default_missing_value = "true")]
+        relax_contacts: Option<bool>,
         /// One JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -230,6 +240,7 @@ fn execute(command: Command) -> Result<(), String> {
             max_torque,
             seeds,
             sleep,
+            relax_contacts,
             json,
             skeleton_out,
             gltf,
@@ -259,9 +270,18 @@ fn execute(command: Command) -> Result<(), String> {
                 .transpose()
                 .map_err(|e| e.to_string())?;
             let mut config = SceneConfig::new(scene, spine.into());
-            config.iterations = iterations;
-            config.substeps = substeps;
-            config.joints = joints.into();
+            // The paper's scenes, and any run told to iterate, start from
+            // the paper's solver; the others from the world's default.
+            let iterated = matches!(joints, Some(Joints::Iterative));
+            let solver = if scene.is_paper() || iterated {
+                SolverConfig::paper()
+            } else {
+                SolverConfig::default()
+            };
+            config.joints = joints.map_or(solver.joints, Into::into);
+            config.iterations = iterations.unwrap_or(solver.iterations);
+            config.substeps = substeps.unwrap_or(solver.substeps);
+            config.relax_contacts = relax_contacts.unwrap_or(solver.relax_contacts);
             config.frames = frames;
             config.backend = backend;
             config.threads = threads;

@@ -69,6 +69,7 @@ fn setting_json(config: &SceneConfig, run: &SceneRun) -> serde_json::Map<String,
         "backend": run.backend.name(),
         "threads": config.threads,
         "sleep": config.sleep.is_some(),
+        "relax_contacts": config.relax_contacts,
     }) else {
         unreachable!("a JSON object literal")
     };

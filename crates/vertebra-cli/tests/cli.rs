@@ -14,6 +14,48 @@ fn vertebra(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Unless told, the paper's scenes run the paper's solver and the others
+/// the world's default; `--joints iterative` starts from the paper's
+/// settings anywhere, and each flag given replaces its setting.
+#[test]
+fn a_scene_runs_the_papers_settings_or_the_worlds_default_unless_told() {
+    let settings = |args: &[&str]| {
+        let mut all = vec!["scene", "--frames", "2", "--json"];
+        all.extend_from_slice(args);
+        let (code, stdout, stderr) = vertebra(&all);
+        assert_eq!(code, 0, "{args:?}: {stderr}");
+        let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+        (
+            v["joints"].as_str().unwrap().to_owned(),
+            v["substeps"].as_u64().unwrap(),
+            v["iterations"].as_u64().unwrap(),
+            v["relax_contacts"].as_bool().unwrap(),
+        )
+    };
+    let paper = ("iterative".to_owned(), 1, 20, false);
+    let default = ("direct".to_owned(), 1, 8, true);
+    assert_eq!(settings(&["passive-bending", "--spine", "rod"]), paper);
+    assert_eq!(settings(&["heavy-chain", "--spine", "sockets"]), default);
+    let iterated = ["heavy-chain", "--spine", "sockets", "--joints", "iterative"];
+    assert_eq!(settings(&iterated), paper);
+    let direct = ["ragdoll-drop", "--spine", "rod", "--joints", "direct"];
+    assert_eq!(settings(&direct), ("direct".to_owned(), 1, 20, false));
+    let told = [
+        "heavy-chain",
+        "--spine",
+        "sockets",
+        "--iterations",
+        "3",
+        "--substeps",
+        "2",
+        "--relax-contacts",
+        "false",
+    ];
+    assert_eq!(settings(&told), ("direct".to_owned(), 2, 3, false));
+    let relaxed = ["passive-bending", "--spine", "rod", "--relax-contacts"];
+    assert_eq!(settings(&relaxed), ("iterative".to_owned(), 1, 20, true));
+}
+
 #[test]
 fn scene_json_has_every_field() {
     let (code, stdout, stderr) = vertebra(&[
@@ -35,6 +77,7 @@ fn scene_json_has_every_field() {
         "backend",
         "threads",
         "sleep",
+        "relax_contacts",
         "seed",
         "frames",
         "summary",
@@ -909,7 +952,8 @@ fn sleep_turns_sleeping_on() {
 }
 
 /// `--joints` reaches the scene and is reported: in the JSON, in the
-/// one-line summary and over seeds; iterative unless told.
+/// one-line summary and over seeds; for the heavy chain (not one of the
+/// paper's scenes), direct unless told.
 #[test]
 fn joints_choose_the_solver_and_are_reported() {
     let scene = |extra: &[&str]| {
@@ -930,7 +974,7 @@ fn joints_choose_the_solver_and_are_reported() {
         let stdout = scene(&[extra, &["--json"]].concat());
         serde_json::from_str::<serde_json::Value>(stdout.trim()).expect("one JSON object")
     };
-    assert_eq!(json(&[])["joints"], "iterative");
+    assert_eq!(json(&[])["joints"], "direct");
     assert_eq!(json(&["--joints", "iterative"])["joints"], "iterative");
     assert_eq!(json(&["--joints", "direct"])["joints"], "direct");
     assert_eq!(
@@ -942,7 +986,7 @@ fn joints_choose_the_solver_and_are_reported() {
         line.starts_with("heavy-chain (sockets, direct joints):"),
         "{line}"
     );
-    let seeded = scene(&["--seeds", "2"]);
+    let seeded = scene(&["--joints", "iterative", "--seeds", "2"]);
     assert!(
         seeded.starts_with("heavy-chain (sockets, iterative joints), seeds 0..1"),
         "{seeded}"

@@ -460,6 +460,8 @@ fn a_scene_that_maps_onto_no_skeleton_has_its_bodies_and_no_skin() {
         "heavy-chain",
         "--spine",
         "sockets",
+        "--joints",
+        "iterative",
         "--frames",
         "10",
         "--gltf",

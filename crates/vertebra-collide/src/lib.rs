@@ -43,20 +43,13 @@
 //!     BuildOptions, DriveSettings, RagdollDesc, Skeleton, SkeletonMapper, SpineMapping,
 //!     SpineMode, Strength, Transform, Transition,
 //! };
-//! use vertebra_world::{BodyDesc, JointSolver, Shape, SleepSettings, SolverConfig, World};
+//! use vertebra_world::{BodyDesc, Shape, SolverConfig, World};
 //!
 //! # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
-//! // The settings a game wants, said outright: every joint of a ragdoll
-//! // solved at once (exact through long chains and heavy hands), one
-//! // substep of four iterations, islands that fall asleep.
-//! let config = SolverConfig {
-//!     joints: JointSolver::Direct,
-//!     substeps: 1,
-//!     iterations: 4,
-//!     sleep: Some(SleepSettings::default()),
-//!     ..SolverConfig::default()
-//! };
-//! let mut world = World::new(config)?;
+//! // The world's default: every joint of a ragdoll solved at once (exact
+//! // through long chains and heavy hands), one substep of eight iterations,
+//! // contacts relaxed, islands that fall asleep.
+//! let mut world = World::new(SolverConfig::default())?;
 //! let mut collisions = Collisions::new();
 //!
 //! // The level: a ground plane and a wall 10 cm thick, static.

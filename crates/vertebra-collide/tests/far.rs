@@ -17,6 +17,11 @@ use vertebra_world::{BodyDesc, BodyHandle, Contact, SleepSettings, SolverConfig,
 
 const DT: f32 = 1.0 / 60.0;
 
+/// Summed joint error (cm) that is round-off, not a joint coming apart:
+/// 10 um over the pile's 30 joints and rods, a sixth of what an `f32`
+/// resolves of a coordinate at 1 km (0.06 mm).
+const ROUND_OFF_CM: f32 = 1e-3;
+
 /// What a pile of three ragdolls did in five seconds.
 #[derive(Debug)]
 struct Settled {
@@ -78,10 +83,12 @@ fn pile(offset: f32) -> Settled {
 }
 
 /// The precise range for collisions ends between 10 and 100 km
-/// (docs/robustness.md, "Where it ends for collisions"): out to 10 km the pile sleeps and
-/// its joints hold as at the origin (0.38 cm at the origin, 0.25 at 1 km,
-/// 0.42 at 10 km); at 100 km, where an `f32` resolves 7.8 mm, the contacts'
-/// rounding keeps every body awake.
+/// (docs/robustness.md, "Where it ends for collisions"): out to 10 km the
+/// pile sleeps and its joints hold as at the origin; at 100 km, where an
+/// `f32` resolves 7.8 mm, the contacts' rounding keeps every body awake.
+/// The default's direct solve holds the joints to round-off everywhere
+/// (4e-5 cm summed over the pile at the origin, 7e-5 at 1 km), so "as at
+/// the origin" is within a quarter more or under `ROUND_OFF_CM`.
 #[test]
 fn a_pile_settles_sleeps_and_holds_its_joints_out_to_ten_kilometres() {
     let origin = pile(0.0);
@@ -95,7 +102,7 @@ fn a_pile_settles_sleeps_and_holds_its_joints_out_to_ten_kilometres() {
         eprintln!("{offset} m: {far:?}");
         assert_eq!(far.asleep, far.bodies, "the pile sleeps at {offset} m");
         assert!(
-            far.eps_lin_cm < 1.25 * origin.eps_lin_cm,
+            far.eps_lin_cm < (1.25 * origin.eps_lin_cm).max(ROUND_OFF_CM),
             "at {offset} m: {} cm against {} at the origin",
             far.eps_lin_cm,
             origin.eps_lin_cm

@@ -191,12 +191,16 @@ fn drop_world(backend: Backend, threads: usize) -> (World, Collisions, Vec<Ragdo
     (w, c, ragdolls)
 }
 
+/// Three ragdolls dropped on each other come to rest: by 8 s every body is
+/// still (the top one rolls off the pile until 7 s; asleep by 2 to 7 s
+/// over six headings of the three, 2 to 4 s with the contacts not
+/// relaxed), none through the floor.
 #[test]
 fn dropped_ragdolls_come_to_rest_above_the_floor() {
     let (mut w, c, ragdolls) = drop_world(Backend::best(), 1);
     let (mut lowest, mut impact) = (f32::MAX, f32::MAX);
-    for frame in 0..300 {
-        if frame == 240 {
+    for frame in 0..480 {
+        if frame == 420 {
             // The last second is the resting one; before it, the impact.
             impact = lowest;
             lowest = f32::MAX;
@@ -223,7 +227,7 @@ fn dropped_ragdolls_come_to_rest_above_the_floor() {
         .map(|&b| w.body(b).unwrap().linear_velocity.length())
         .fold(0.0f32, f32::max);
     eprintln!(
-        "ragdolls: deepest at impact {:.2} mm, at rest {:.2} mm, fastest body after 5 s {fastest:.3} m/s",
+        "ragdolls: deepest at impact {:.2} mm, at rest {:.2} mm, fastest body after 8 s {fastest:.3} m/s",
         impact * 1e3,
         lowest * 1e3
     );

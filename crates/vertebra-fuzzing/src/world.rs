@@ -347,6 +347,7 @@ fn settings(input: &mut Input) -> SolverConfig {
         parallel_min_blocks: 1 + input.pick(8),
         measure_residuals: input.flag(),
         joints: joint_solver(input),
+        relax_contacts: input.flag(),
         ..SolverConfig::default()
     }
 }

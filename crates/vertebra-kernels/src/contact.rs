@@ -37,6 +37,20 @@
 //!   pull), where `v_approach` is its value when the contact was made; below
 //!   `2 |g| h` of approach the target is 0, so resting contacts do not
 //!   jitter (Müller eq. 34).
+//! - **Relax** (a setting: [`VelocityPass`] with `relax`, run a few times after the
+//!   velocity pass): the normal relative velocity is brought to the same
+//!   target from either side, with an accumulated impulse
+//!   `lambda_v >= -lambda_n / h`: it may take back at most the impulse
+//!   the contact's own push-out gave this substep. The position level's
+//!   push-out, `depth / h` as speed, is then not kept: a body pressed into
+//!   the ground by a joint, a limit or a drive and pushed back out does not
+//!   fly up from it, and a pile comes to rest. It is Box2D v3's relax stage
+//!   (solve with the push-out, then relax without it), and Müller et al.'s
+//!   eq. 34 where it sets the normal velocity rather than raising it;
+//!   iterated with the accumulated bound (as an impulse solver clamps its
+//!   total impulse), the contacts of one body share the taking back, where
+//!   one pass of each in turn leaves a box pushed out on four corners
+//!   spinning.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3 as GVec3;
@@ -75,6 +89,9 @@ pub struct ContactBlock {
     /// Accumulated tangential multiplier (a world vector in the tangent
     /// plane), reset every substep.
     pub lambda_t: Vec3Block,
+    /// The relax passes' accumulated normal impulse (N s, at least
+    /// `-lambda_n / h`), reset every substep.
+    pub lambda_v: [f32; BLOCK_LANES],
     /// `lambda_n` of the step's substeps before this one, summed (kg m):
     /// what the position level pushed (read by [`ContactBlock::impulse`];
     /// never read by the solve).
@@ -82,7 +99,8 @@ pub struct ContactBlock {
     /// `lambda_t` of the step's substeps before this one, summed (kg m,
     /// world).
     pub pushed_t: Vec3Block,
-    /// The velocity pass's normal impulses (restitution) of the step,
+    /// The velocity pass's normal impulses (restitution) and the relax
+    /// passes' (negative where they take back a push-out) of the step,
     /// summed (N s, along the normal; never read by the solve).
     pub kicked_n: [f32; BLOCK_LANES],
     /// The velocity pass's friction impulses on b of the step, summed (N s,
@@ -164,6 +182,7 @@ impl ContactBlock {
         }
         self.lambda_n = [0.0; BLOCK_LANES];
         self.lambda_t = Vec3Block::default();
+        self.lambda_v = [0.0; BLOCK_LANES];
         for (allowed, overlap) in self.allowance.iter_mut().zip(self.overlap) {
             *allowed = overlap * remaining;
         }
@@ -175,8 +194,9 @@ impl ContactBlock {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactImpulse {
     /// Along the normal (N s, at least 0: a contact pushes, never pulls):
-    /// the position level's push over every substep and the velocity
-    /// pass's restitution.
+    /// the position level's push over every substep, the velocity pass's
+    /// restitution, less what the relax passes took back (never more than
+    /// a substep's push).
     pub normal: f32,
     /// Friction, in the tangent plane (N s, world): the position level's
     /// static friction and the velocity pass's dynamic friction.
@@ -312,9 +332,13 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
     block.bodies.scatter(rows, start, &a, &b);
 }
 
-/// The velocity pass: dynamic friction and restitution.
+/// A velocity pass over the contacts: dynamic friction and restitution,
+/// or with `relax` a relax pass (module docs, "Relax"): each touching
+/// contact's normal velocity brought to its target, taking back at most
+/// its push-out.
 pub struct VelocityPass<'a> {
-    /// The blocks (their `kicked_n` and `kicked_t` written).
+    /// The blocks (a relax pass accumulates `lambda_v` in them; both
+    /// passes add their impulses to `kicked_n` and `kicked_t`).
     pub blocks: &'a mut [ContactBlock],
     /// Body rows: poses and inertia read, velocities read and written.
     pub rows: &'a BodyRows,
@@ -322,6 +346,8 @@ pub struct VelocityPass<'a> {
     pub h: f32,
     /// Approach speeds below this bounce not at all (m/s): `2 |g| h`.
     pub resting_speed: f32,
+    /// A relax pass, not the velocity pass.
+    pub relax: bool,
 }
 
 impl LaneKernel for VelocityPass<'_> {
@@ -335,6 +361,7 @@ impl LaneKernel for VelocityPass<'_> {
                 rows: self.rows,
                 h: self.h,
                 resting_speed: self.resting_speed,
+                relax: self.relax,
             };
             for_live_slices::<L, _>(padding, &mut velocities);
         }
@@ -347,33 +374,113 @@ struct Velocities<'a> {
     rows: &'a BodyRows,
     h: f32,
     resting_speed: f32,
+    relax: bool,
 }
 
 impl LaneSlices for Velocities<'_> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
         let (h, resting_speed) = (L::splat(self.h), L::splat(self.resting_speed));
-        solve_velocities::<L>(self.block, start, self.rows, h, resting_speed);
+        if self.relax {
+            relax::<L>(self.block, start, self.rows, h, resting_speed);
+        } else {
+            solve_velocities::<L>(self.block, start, self.rows, h, resting_speed);
+        }
     }
 }
 
-/// Adds the velocity impulse `impulse` at `rb` to b and its opposite at `ra`
-/// to a.
+/// The normal relative velocity a contact aims for: `-e v_approach` when
+/// it came in faster than `resting_speed`, else 0 (m/s).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn kick<L: Lane>(
-    a: &BodyLanes<L>,
-    b: &BodyLanes<L>,
-    va: &mut VelocityLanes<L>,
-    vb: &mut VelocityLanes<L>,
+fn normal_target<L: Lane>(block: &ContactBlock, start: usize, resting_speed: L) -> L {
+    let approach = L::load(&block.approach[start..]);
+    let bounces = (-approach).gt(resting_speed);
+    L::select(
+        bounces,
+        (-L::load(&block.restitution[start..]) * approach).max(L::splat(0.0)),
+        L::splat(0.0),
+    )
+}
+
+/// A slice of contacts at the velocity level: both bodies' poses and
+/// velocities, the lever arms, the normal and the substep's normal
+/// multiplier, as both velocity passes read them.
+struct Touch<L: Lane> {
+    a: BodyLanes<L>,
+    b: BodyLanes<L>,
+    va: VelocityLanes<L>,
+    vb: VelocityLanes<L>,
     ra: Vec3<L>,
     rb: Vec3<L>,
-    impulse: Vec3<L>,
-) {
-    vb.v += impulse.scale(b.inv_mass);
-    vb.w += b.inv_inertia_mul(rb.cross(impulse));
-    va.v -= impulse.scale(a.inv_mass);
-    va.w -= a.inv_inertia_mul(ra.cross(impulse));
+    n: Vec3<L>,
+    lambda_n: L,
+}
+
+impl<L: Lane> Touch<L> {
+    #[inline(always)]
+    fn gather(block: &ContactBlock, start: usize, rows: &BodyRows) -> Self {
+        let pairs = &block.bodies;
+        let (a, b) = pairs.gather::<L>(rows, start);
+        let (ra, rb, _) = arms(block, start, &a, &b);
+        Self {
+            va: VelocityLanes::gather(rows, &pairs.body_a[start..]),
+            vb: VelocityLanes::gather(rows, &pairs.body_b[start..]),
+            n: block.normal.load(start),
+            lambda_n: L::load(&block.lambda_n[start..]),
+            a,
+            b,
+            ra,
+            rb,
+        }
+    }
+
+    /// Whether the contact pushed this substep (`lambda_n > 0`).
+    #[inline(always)]
+    fn touching(&self) -> L::Mask {
+        self.lambda_n.gt(L::splat(0.0))
+    }
+
+    /// b's contact point's velocity relative to a's (m/s).
+    #[inline(always)]
+    fn relative(&self) -> Vec3<L> {
+        (self.vb.v + self.vb.w.cross(self.rb)) - (self.va.v + self.va.w.cross(self.ra))
+    }
+
+    /// The generalised inverse mass along `d` at the contact point.
+    #[inline(always)]
+    fn weight(&self, d: Vec3<L>) -> L {
+        self.a.positional_weight(self.ra, d) + self.b.positional_weight(self.rb, d)
+    }
+
+    /// Adds the velocity impulse `impulse` at `rb` to b and its opposite
+    /// at `ra` to a.
+    #[inline(always)]
+    fn kick(&mut self, impulse: Vec3<L>) {
+        self.vb.v += impulse.scale(self.b.inv_mass);
+        self.vb.w += self.b.inv_inertia_mul(self.rb.cross(impulse));
+        self.va.v -= impulse.scale(self.a.inv_mass);
+        self.va.w -= self.a.inv_inertia_mul(self.ra.cross(impulse));
+    }
+
+    #[inline(always)]
+    fn scatter(&self, block: &ContactBlock, start: usize, rows: &BodyRows) {
+        self.va.scatter(rows, &block.bodies.write_a[start..]);
+        self.vb.scatter(rows, &block.bodies.write_b[start..]);
+    }
+}
+
+#[inline(always)]
+fn relax<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyRows, h: L, resting_speed: L) {
+    let mut touch = Touch::<L>::gather(block, start, rows);
+    let target = normal_target(block, start, resting_speed);
+    let (n, lambda_n) = (touch.n, touch.lambda_n);
+    let before = L::load(&block.lambda_v[start..]);
+    let wanted = before + safe_ratio(target - touch.relative().dot(n), touch.weight(n));
+    let after = L::select(touch.touching(), wanted.max(-(lambda_n / h)), before);
+    touch.kick(n.scale(after - before));
+    after.store(&mut block.lambda_v[start..]);
+    (L::load(&block.kicked_n[start..]) + (after - before)).store(&mut block.kicked_n[start..]);
+    touch.scatter(block, start, rows);
 }
 
 #[inline(always)]
@@ -384,45 +491,27 @@ fn solve_velocities<L: Lane>(
     h: L,
     resting_speed: L,
 ) {
-    let pairs = &block.bodies;
-    let (a, b) = pairs.gather::<L>(rows, start);
-    let mut va = VelocityLanes::<L>::gather(rows, &pairs.body_a[start..]);
-    let mut vb = VelocityLanes::<L>::gather(rows, &pairs.body_b[start..]);
-    let n = block.normal.load::<L>(start);
-    let zero = L::splat(0.0);
-    let (ra, rb, _) = arms(block, start, &a, &b);
-    let lambda_n = L::load(&block.lambda_n[start..]);
-    let touching = lambda_n.gt(zero);
+    let mut touch = Touch::<L>::gather(block, start, rows);
+    let (n, zero, touching) = (touch.n, L::splat(0.0), touch.touching());
 
-    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
+    let relative = touch.relative();
     let vn = relative.dot(n);
     let (t, speed_t) = (relative - n.scale(vn)).normalize_or_zero();
     // The impulse that stops the sliding, capped by what the position
     // level left of Coulomb's budget: (mu lambda_n - |lambda_t|) / h.
-    let wt = a.positional_weight(ra, t) + b.positional_weight(rb, t);
-    let stop = safe_ratio(speed_t, wt);
+    let stop = safe_ratio(speed_t, touch.weight(t));
     let used = block.lambda_t.load::<L>(start).length();
-    let budget = ((L::load(&block.friction[start..]) * lambda_n - used) / h).max(zero);
+    let budget = ((L::load(&block.friction[start..]) * touch.lambda_n - used) / h).max(zero);
     let impulse = stop.min(budget);
     let friction = t.scale(L::select(touching, -impulse, zero));
-    kick(&a, &b, &mut va, &mut vb, ra, rb, friction);
+    touch.kick(friction);
     let kicked_t = block.kicked_t.load::<L>(start) + friction;
     block.kicked_t.store(start, kicked_t);
 
-    let relative = (vb.v + vb.w.cross(rb)) - (va.v + va.w.cross(ra));
-    let approach = L::load(&block.approach[start..]);
-    let bounces = (-approach).gt(resting_speed);
-    let target = L::select(
-        bounces,
-        (-L::load(&block.restitution[start..]) * approach).max(zero),
-        zero,
-    );
-    let wn = a.positional_weight(ra, n) + b.positional_weight(rb, n);
-    let change = L::select(touching, (target - relative.dot(n)).max(zero), zero);
-    let restitution = safe_ratio(change, wn);
-    kick(&a, &b, &mut va, &mut vb, ra, rb, n.scale(restitution));
+    let target = normal_target(block, start, resting_speed);
+    let change = L::select(touching, (target - touch.relative().dot(n)).max(zero), zero);
+    let restitution = safe_ratio(change, touch.weight(n));
+    touch.kick(n.scale(restitution));
     (L::load(&block.kicked_n[start..]) + restitution).store(&mut block.kicked_n[start..]);
-
-    va.scatter(rows, &pairs.write_a[start..]);
-    vb.scatter(rows, &pairs.write_b[start..]);
+    touch.scatter(block, start, rows);
 }

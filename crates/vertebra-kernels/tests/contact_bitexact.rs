@@ -69,15 +69,20 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[ContactBlock]) -> Vec<f32> {
             rows: &rows,
         });
     }
-    backend.dispatch(VelocityPass {
-        blocks: &mut blocks,
-        rows: &rows,
-        h: 1.0 / 60.0,
-        resting_speed: 0.33,
-    });
+    // The velocity pass, then two relax passes.
+    for relax in [false, true, true] {
+        backend.dispatch(VelocityPass {
+            blocks: &mut blocks,
+            rows: &rows,
+            h: 1.0 / 60.0,
+            resting_speed: 0.33,
+            relax,
+        });
+    }
     let mut out = flatten(&rows);
     for b in &blocks {
         out.extend(b.lambda_n);
+        out.extend(b.lambda_v);
         out.extend(b.kicked_n);
         for v in [&b.lambda_t, &b.kicked_t] {
             out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(v)));

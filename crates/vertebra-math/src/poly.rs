@@ -9,6 +9,7 @@
 //! | [`acos`] | [-1, 1] | 2.6e-7 | 2.5e-7 | clamped to [-1, 1]; NaN: NaN |
 //! | [`atan2`] | all (y, x), both infinite too | 2.7e-7 | 2.6e-7 | NaN in either: NaN |
 //! | [`half_sinc`] `sin(x/2)/x` | [-pi, pi] | 5.0e-8 | 4.3e-8 | clamped to [-pi, pi]; NaN: NaN |
+//! | [`half_sinc_slope`] its derivative | [-pi, pi] | 5.0e-8 | | clamped to [-pi, pi]; NaN: NaN |
 //! | [`wrap_angle`] to [-pi, pi] | \|x\| <= 4 pi | 3.5e-7 | 3.5e-7 | finite: a value near [-pi, pi], off by the rounding of `x / 2 pi`; inf, NaN: NaN |
 //!
 //! For scale: one ulp of pi in `f32` is 2.4e-7, so the inverse functions are
@@ -17,7 +18,8 @@
 //! rod's small bend angles live. The errors are measured against `f64` over
 //! dense grids by `tests/poly_accuracy.rs`, which asserts the bounds. The coefficients of `sin`, `cos`, `asin` and the
 //! arctangent are Cephes' single-precision minimax sets (S. L. Moshier);
-//! `half_sinc` is its Taylor series, which converges fast on [-pi, pi].
+//! `half_sinc` and its slope are Taylor series, which converge fast on
+//! [-pi, pi].
 
 mod asin;
 mod atan;
@@ -26,7 +28,7 @@ mod trig;
 
 pub use asin::{acos, asin};
 pub use atan::atan2;
-pub use half_sinc::half_sinc;
+pub use half_sinc::{half_sinc, half_sinc_slope};
 pub use trig::{cos, sin, sin_cos};
 
 use crate::lane::Lane;

@@ -6,7 +6,7 @@ mod common;
 use common::{arguments, assert_agree};
 use vertebra_math::poly;
 
-lane_map!(Eval, 2 -> 7, |i, o| {
+lane_map!(Eval, 2 -> 8, |i, o| {
     let (s, c) = poly::sin_cos(i[0]);
     o[0] = s;
     o[1] = c;
@@ -15,6 +15,7 @@ lane_map!(Eval, 2 -> 7, |i, o| {
     o[4] = poly::atan2(i[0], i[1]);
     o[5] = poly::half_sinc(i[0]);
     o[6] = poly::atan2(i[1], i[0]);
+    o[7] = poly::half_sinc_slope(i[0]);
 });
 
 /// Evaluates the polynomials at `x` (and `y` for atan2) on the scalar
@@ -100,6 +101,44 @@ fn half_sinc_within_bound_and_exact_at_zero() {
     report("half_sinc", 5.0e-8, max_error(&xs, &out[5], reference));
     let at_zero = eval(&[0.0, -0.0, 1.0e-30, 1.0e-20], &[0.0; 4]);
     assert!(at_zero[5].iter().all(|&v| v == 0.5), "{:?}", at_zero[5]);
+}
+
+/// The slope against the derivative's closed form,
+/// `(x/2 cos(x/2) - sin(x/2)) / x^2`, in `f64` (its own series near zero,
+/// where the closed form cancels): 0 at zero, odd.
+#[test]
+fn half_sinc_slope_within_bound_zero_at_zero_and_odd() {
+    let xs = grid(-std::f32::consts::PI, std::f32::consts::PI, 2_000_000);
+    let out = eval(&xs, &xs);
+    let reference = |x: f64| {
+        if x.abs() < 1e-3 {
+            -x / 24.0 + x.powi(3) / 960.0
+        } else {
+            ((x / 2.0) * (x / 2.0).cos() - (x / 2.0).sin()) / (x * x)
+        }
+    };
+    report(
+        "half_sinc_slope",
+        5.0e-8,
+        max_error(&xs, &out[7], reference),
+    );
+    let at_zero = eval(&[0.0, -0.0, 1.0e-30], &[0.0; 3]);
+    assert!(
+        at_zero[7][..2].iter().all(|&v| v == 0.0),
+        "{:?}",
+        at_zero[7]
+    );
+    assert_eq!(
+        at_zero[7][2],
+        -1.0e-30 / 24.0,
+        "the slope near zero is -x/24"
+    );
+    let negated: Vec<f32> = xs.iter().map(|x| -x).collect();
+    let mirrored = eval(&negated, &negated);
+    assert!(
+        (out[7].iter().zip(&mirrored[7])).all(|(a, b)| a.to_bits() == (-b).to_bits()),
+        "not odd"
+    );
 }
 
 #[test]

@@ -13,10 +13,11 @@ lane_map!(SinCos, 1 -> 4, |i, o| {
     o[2] = poly::sin(i[0]);
     o[3] = poly::cos(i[0]);
 });
-lane_map!(Inverse, 1 -> 3, |i, o| {
+lane_map!(Inverse, 1 -> 4, |i, o| {
     o[0] = poly::asin(i[0]);
     o[1] = poly::acos(i[0]);
     o[2] = poly::half_sinc(i[0]);
+    o[3] = poly::half_sinc_slope(i[0]);
 });
 lane_map!(Atan2, 2 -> 1, |i, o| { o[0] = poly::atan2(i[0], i[1]); });
 lane_map!(Wrap, 1 -> 1, |i, o| { o[0] = poly::wrap_angle(i[0]); });

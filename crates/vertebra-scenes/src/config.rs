@@ -58,6 +58,10 @@ pub struct SceneConfig {
     /// [`SceneConfig::new`]: the paper's figures, and the engines they are
     /// compared with, step every body at every frame.
     pub sleep: Option<SleepSettings>,
+    /// Whether the contacts take back their push-out's speed
+    /// (`SolverConfig::relax_contacts`): off in [`SceneConfig::new`], as
+    /// in the paper; on in the world's default.
+    pub relax_contacts: bool,
 }
 
 impl SceneConfig {
@@ -80,6 +84,7 @@ impl SceneConfig {
             max_torque: f32::INFINITY,
             measure_residuals: true,
             sleep: None,
+            relax_contacts: false,
         }
     }
 
@@ -124,7 +129,8 @@ impl SceneConfig {
             backend: self.backend,
             threads: self.threads,
             sleep: self.sleep,
-            ..SolverConfig::default()
+            relax_contacts: self.relax_contacts,
+            ..SolverConfig::paper()
         };
         Ok(World::new(config)?)
     }

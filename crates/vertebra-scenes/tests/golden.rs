@@ -117,42 +117,15 @@ fn anatomical_drop_direct() {
 const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
 const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
 const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x5fff_c5e6_5fb8_46f4;
-const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x8945_505a_0832_3883;
+const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0xb36d_d5f6_47c9_e263;
 
-// The direct solve's, set by the commit that introduced them;
-// all four moved when every limit row joined the solve with
-// its signed distance and an active set settled in the closing solves,
-// and the joint blocks the trees hold iterating only their drives (their
-// limits iterated as well before). They were 0x2d9f_e5a8_b349_f6a8
-// (bending, sockets), 0xcead_d528_664e_36fc (bending, rod),
-// 0x051a_b093_7a68_03cf (drop, sockets) and 0x8ca6_8dbe_7040_0965 (drop,
-// rod). The iterated solver's four did not move. Then the two drops' and
-// the anatomical drop's direct ones by the socket's twist row taking its
-// exact gradient (the rod's twist axes): they were 0x65de_b486_3a49_f307
-// (drop, sockets), 0x28a8_4720_0b0e_213e (drop, rod), 0x2a02_6cee_6d92_1348
-// (anatomical, sockets) and 0x34ba_9c8a_7994_6333 (anatomical, rod);
-// passive bending's, whose twists stay in range, did not move. Then all
-// six by the elimination's Schur complements formed from forward solves
-// (`W^T D^-1 W`, a different order of the same sums): they were
-// 0x1400_152b_eb04_3d1b and 0xdd60_df2e_065c_7745 (bending),
-// 0x9abf_0858_ac35_d97f and 0x4010_54ca_4ac9_5921 (drop), and
-// 0xec65_e3d1_f8d4_bd3f and 0x855d_a1c6_fc07_5c99 (anatomical), sockets
-// then rod. Then all six by the closing solves factoring again only for a
-// lane where a limit row crossed, not for a release alone: they were
-// 0xda85_7ec1_6e55_e66b and 0xbcb6_8235_7f1e_88a9 (bending),
-// 0x3160_b8fa_7c1a_7d0d and 0x32a4_83fc_f651_bae2 (drop), and
-// 0x50c8_df1a_1a03_746b and 0x979c_19ca_4c81_984d (anatomical). Then all
-// six by the up-looking elimination (each node pulls its children's
-// complements, only the rows its joint kind has) and a lone ragdoll's
-// subtrees laid out as pieces in lanes of their own, joined through
-// ports: the same sums in another order. They were 0x54c3_20a6_97c2_c911
-// and 0x7ac9_2204_2740_dfc5 (bending), 0x3634_643b_ea27_12fe and
-// 0xbcd9_d34d_fee2_a132 (drop), and 0xc656_e349_9e78_23bd and
-// 0x6845_d290_5437_24b7 (anatomical).
+// The direct solve's, as the current direct solve steps the paper's
+// scenes. Each time one moved, the commit that moved it, alone, says why
+// and what it was (`git log -G "GOLDEN_.*_DIRECT: u64"`).
 const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x2636_906e_671c_b1e1;
-const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x3fe6_911f_8645_7cc7;
+const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x7bb4_b6ec_3042_0e2d;
 const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3070_1f12_587a_75ea;
-const GOLDEN_DROP_ROD_DIRECT: u64 = 0xaede_52fc_ecea_722f;
+const GOLDEN_DROP_ROD_DIRECT: u64 = 0x8072_15bf_128f_98ab;
 
 // Set 2026-11-29 by the commit that introduced them (issue 13), on the
 // state the whole issue left: displacement rows, double-precision

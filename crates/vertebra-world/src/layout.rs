@@ -15,7 +15,7 @@ use core::f32::consts::PI;
 use core::ops::Range;
 use std::collections::BTreeSet;
 
-use vertebra_kernels::body::{BodyPairs, StartLane};
+use vertebra_kernels::body::BodyPairs;
 use vertebra_kernels::fixed::{FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{HingeBlock, HingeLane};
 use vertebra_kernels::rod::{RodBlock, RodLane};
@@ -28,6 +28,7 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 use crate::bins::Bins;
 use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
 use crate::rod::RodDesc;
+use crate::start::start_blocks;
 use crate::trees::Trees;
 
 /// Added to a rod's slot to make its colouring key.
@@ -345,7 +346,8 @@ impl Layout {
     /// Measures where every joint's bodies stand as the step begins (the
     /// rows then hold displacements from there): each socket's anchors,
     /// each rod's chord between centres of mass. Each block alone
-    /// ([`StartBlock`]): the step does it in chunks on its workers.
+    /// ([`crate::start::StartBlock`]): the step does it in chunks on its
+    /// workers.
     pub fn start_step(&mut self, bodies: &BodyStore) {
         start_blocks(&mut self.sockets.blocks, bodies);
         start_blocks(&mut self.hinges.blocks, bodies);
@@ -441,72 +443,6 @@ impl Layout {
             rods,
         }
     }
-}
-
-/// The lanes of a block that hold a joint: a padding lane's start of step
-/// stays as laid out (zero: the null row at the origin, no anchors), which
-/// is what measuring it would give, and no kernel reads it into a row.
-fn live_lanes(pairs: &BodyPairs) -> impl Iterator<Item = usize> + use<> {
-    let padding = pairs.padding;
-    (0..BLOCK_LANES).filter(move |lane| padding & (1 << lane) == 0)
-}
-
-/// A joint block whose lanes measure where their bodies stand as the step
-/// begins, each block reading only the bodies and writing only itself.
-pub(crate) trait StartBlock: Send {
-    /// Every live lane's start of step, from `bodies`.
-    fn start(&mut self, bodies: &BodyStore);
-}
-
-/// Sockets, hinges and fixed joints: their anchors (m, body frames).
-macro_rules! start_at_anchors {
-    ($($block:ty),*) => {$(
-        impl StartBlock for $block {
-            fn start(&mut self, bodies: &BodyStore) {
-                for lane in live_lanes(&self.bodies) {
-                    let anchors = (self.anchor_a.get(lane), self.anchor_b.get(lane));
-                    start_lane(&mut self.bodies, lane, anchors, bodies);
-                }
-                self.reaction.reset();
-            }
-        }
-    )*};
-}
-
-start_at_anchors!(SocketBlock, HingeBlock, FixedBlock);
-
-/// Rods: the chord between the centres of mass.
-impl StartBlock for RodBlock {
-    fn start(&mut self, bodies: &BodyStore) {
-        for lane in live_lanes(&self.bodies) {
-            let centres = (glam::Vec3::ZERO, glam::Vec3::ZERO);
-            start_lane(&mut self.bodies, lane, centres, bodies);
-        }
-    }
-}
-
-/// Each of `blocks`' start of step ([`StartBlock`]).
-pub(crate) fn start_blocks<B: StartBlock>(blocks: &mut [B], bodies: &BodyStore) {
-    blocks.iter_mut().for_each(|b| b.start(bodies));
-}
-
-/// Sets `lane`'s start of step for points `local` (m, body frames) on its
-/// bodies; padding lanes (the null row) start at the origin.
-fn start_lane(
-    pairs: &mut BodyPairs,
-    lane: usize,
-    (local_a, local_b): (glam::Vec3, glam::Vec3),
-    bodies: &BodyStore,
-) {
-    let pose = |row: u32| match row.checked_sub(1) {
-        Some(i) => (
-            bodies.precise_position(i as usize),
-            bodies.orientation[i as usize],
-        ),
-        None => (glam::DVec3::ZERO, glam::Quat::IDENTITY),
-    };
-    let ((pa, qa), (pb, qb)) = (pose(pairs.body_a[lane]), pose(pairs.body_b[lane]));
-    pairs.set_start(lane, &StartLane::new(pa, qa, local_a, pb, qb, local_b));
 }
 
 /// Body rows are slots + 1 (row 0 is the null row).

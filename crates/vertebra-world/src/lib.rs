@@ -42,6 +42,7 @@ mod rollback;
 mod sleep;
 mod snapshot;
 mod stages;
+mod start;
 mod step;
 mod tasks;
 mod trees;
@@ -76,6 +77,7 @@ pub use snapshot::{Snapshot, Timeline};
 pub use stages::timing as stage_timing;
 pub use tasks::{RayonTasks, SingleThreaded, TaskSystem};
 pub use vertebra_kernels::contact::ContactImpulse;
+pub use vertebra_kernels::direct::MAX_LIMIT_RETURN_SPEED;
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,

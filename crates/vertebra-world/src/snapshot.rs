@@ -17,7 +17,7 @@
 //! match for the snapshot to be accepted (the settings are the world's,
 //! not the snapshot's). To step on bit for bit as the original would have,
 //! the settings that change results must match: `substeps`, `iterations`,
-//! `gravity`, `max_push_out_speed`, `max_linear_speed`,
+//! `gravity`, `max_push_out_speed`, `relax_contacts`, `max_linear_speed`,
 //! `max_angular_speed`, `sleep`, `joints`; `backend`, `threads` and `parallel_min_blocks` may
 //! differ (stepping is bit-identical across them). "The same build" is the
 //! same vertebra version and snapshot format; identity across compilers and

@@ -130,14 +130,7 @@ impl Trees {
             .map(|&t| (self.topologies[t].clone(), self.topologies[t].cuts(most)))
             .collect();
         let trees: Vec<(&Topology, Vec<u32>)> = cut.iter().map(|(t, c)| (t, c.clone())).collect();
-        let topologies = &mut self.topologies;
-        let (mut blocks, placed) = split::lay_out(&trees, &mut |piece: &Topology| {
-            let known = topologies.iter().position(|t| t == piece);
-            known.unwrap_or_else(|| {
-                topologies.push(piece.clone());
-                topologies.len() - 1
-            }) as u32
-        });
+        let (mut blocks, placed) = split::lay_out(&trees, &mut self.topologies);
         for (tree, pieces) in found.iter().zip(&placed) {
             for p in pieces {
                 let lane = Lane {
@@ -470,7 +463,7 @@ fn find(joints: &[Option<JointDesc>], rods: &[Option<RodDesc>], bodies: &BodySto
 
 /// Each lane's start of step: its joints' points (a rod's centres) as
 /// the step begins, and its bodies' mass properties as they are now.
-impl crate::layout::StartBlock for TreeBlock {
+impl crate::start::StartBlock for TreeBlock {
     fn start(&mut self, bodies: &BodyStore) {
         for node in &mut self.bodies {
             node.reset_moved();

@@ -5,8 +5,10 @@
 mod common;
 
 use common::{capsule, hanging_chain};
-use glam::Vec3;
-use vertebra_world::{BodyDesc, JointDesc, JointSolver, SolverConfig, World};
+use glam::{Quat, Vec3};
+use vertebra_world::{
+    BodyDesc, JointDesc, JointSolver, MAX_LIMIT_RETURN_SPEED, SolverConfig, World,
+};
 
 fn world(iterations: u32, joints: JointSolver) -> World {
     World::new(SolverConfig {
@@ -139,4 +141,59 @@ fn a_restored_snapshot_steps_on_bit_for_bit() {
         restored.step(1.0 / 60.0).unwrap();
     }
     assert_eq!(w.state_hash(), restored.state_hash());
+}
+
+/// A hanging arm put a radian past its 0.3 rad swing cone (its pose set
+/// after the joint was made, as a ragdoll built from an animation that
+/// bends a joint past its limit): solved directly, the limit takes it
+/// back at `MAX_LIMIT_RETURN_SPEED`, the same angle every step while it is
+/// far, and holds it on the limit once there. The return is measured from
+/// the world's state alone: a snapshot taken halfway steps on bit for bit.
+#[test]
+fn a_limit_found_far_past_comes_back_at_a_bounded_speed() {
+    let dt = 1.0 / 60.0;
+    let config = SolverConfig {
+        iterations: 4,
+        gravity: Vec3::ZERO,
+        sleep: None,
+        joints: JointSolver::Direct,
+        ..SolverConfig::default()
+    };
+    let mut w = World::new(config).unwrap();
+    let anchor = w.add_body(BodyDesc::fixed()).unwrap();
+    let arm = capsule(&mut w, Vec3::ZERO, -Vec3::Y * 0.5, 2.0);
+    let joint = JointDesc::socket_at_world_anchor(w.bodies(), anchor, arm, Vec3::ZERO, -Vec3::Y)
+        .unwrap()
+        .with_swing_limit(0.3);
+    w.add_joint(joint).unwrap();
+    let turn = Quat::from_rotation_z(1.3);
+    w.set_body_pose(arm, turn * (-Vec3::Y * 0.25), turn)
+        .unwrap();
+    let swing = |w: &World| (w.body(arm).unwrap().orientation * -Vec3::Y).angle_between(-Vec3::Y);
+    let step = MAX_LIMIT_RETURN_SPEED * dt;
+    let mut before = swing(&w);
+    let mut steps = Vec::new();
+    let mut restored = World::new(config).unwrap();
+    for k in 0..30 {
+        if k == 7 {
+            restored.restore(&w.snapshot()).unwrap();
+        }
+        w.step(dt).unwrap();
+        if k >= 7 {
+            restored.step(dt).unwrap();
+        }
+        let now = swing(&w);
+        steps.push(before - now);
+        before = now;
+    }
+    assert_eq!(w.state_hash(), restored.state_hash(), "restored halfway");
+    eprintln!("swing {before:.5} rad after 0.5 s; taken back each step: {steps:?}");
+    // 1 rad at 0.067 rad a step: 15 steps, each a whole step's return.
+    for (k, &back) in steps.iter().enumerate() {
+        assert!(back <= step * 1.001, "step {k}: {back} rad, above {step}");
+        if k < 14 {
+            assert!(back >= step * 0.999, "step {k}: {back} rad, below {step}");
+        }
+    }
+    assert!((before - 0.3).abs() < 1e-4, "on the limit: {before} rad");
 }

@@ -403,8 +403,8 @@ pub struct JointNode {
     pub pyramid: [[[f32; BLOCK_LANES]; 2]; 2],
     /// The limits' softness (all zero: hard; `parts::limit`).
     pub softness: SoftnessBlock,
-    /// Each limit row's violation at the substep's start (the damping's
-    /// `C_0`; [`StartPass`]).
+    /// Each limit row's violation at the substep's start (`C_0`: a soft
+    /// limit's damping, a hard limit's return; [`StartPass`]).
     pub limit_start: [[f32; BLOCK_LANES]; MAX_LIMITS],
     /// Each limit row's multiplier accumulated over the substep (a soft
     /// limit's spring force; reset by [`StartPass`]).
@@ -782,6 +782,16 @@ impl PositionPass<'_> {
     }
 }
 
+/// The fastest a hard limit found past its bound is brought back (rad/s,
+/// or swing sines per second for an ellipse): a substep removes at most
+/// `MAX_LIMIT_RETURN_SPEED h` of what it finds at its first solve. A pose
+/// taken from an animation that bends a joint far past its ragdoll limit
+/// then comes back over a few frames instead of being thrown back in one
+/// substep (a rod spine created 0.8 rad past its bend limit came back at
+/// 3.3 m/s). At 60 Hz a substep takes back 0.067 rad (3.8 degrees): every
+/// violation a pile's impacts leave (under 2 degrees) is taken back whole.
+pub const MAX_LIMIT_RETURN_SPEED: f32 = 4.0;
+
 /// How many times a closing solve may factor its tree with a changed
 /// active set (`solve::settle`: a row crossed its limit): the first, then
 /// up to this many less one.
@@ -872,8 +882,9 @@ impl<const P: u8> LaneSlices for PhaseRun<'_, P> {
 
 /// The trees' substep start, before the bodies are predicted: every limit
 /// row's multiplier reset, the next solve's active set chosen afresh, and
-/// a soft block's violations measured (the
-/// damping's `C_0`, as `crate::limited::StartPass` measures the parts').
+/// every limit row's violation measured (a soft limit's damping `C_0`, as
+/// `crate::limited::StartPass` measures the parts'; a hard limit's
+/// return from far past, [`MAX_LIMIT_RETURN_SPEED`]).
 pub struct StartPass<'a> {
     /// The blocks.
     pub blocks: &'a mut [TreeBlock],
@@ -891,9 +902,6 @@ impl LaneKernel for StartPass<'_> {
             block.fresh = true;
             for joint in block.joints.iter_mut() {
                 joint.limit_lambda = [[0.0; BLOCK_LANES]; MAX_LIMITS];
-            }
-            if !block.soft {
-                continue;
             }
             let padding = block.padding;
             let mut starts = Starts {

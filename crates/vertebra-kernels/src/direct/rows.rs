@@ -9,7 +9,7 @@
 //! | hinge axis (2) | `C = theta n` (the turn from `t_a` to `t_b`) along two axes `u` spanning the plane normal to `t_a + t_b`; `J_b = [0, u]`, `J_a = [0, -u]` |
 //! | fixed lock (3) | `C = log((q_b F_b)(q_a F_a)*)`; `J_b = [0, 1]`, `J_a = [0, -1]` |
 //! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b` (from a's +Y reflected likewise); `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
-//! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, 0]`, `J_a = [-o, 0]` (the paper's "purely through linear motion") |
+//! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, -chord'(psi) n]`, `J_a = [-o, chord'(psi) n]` (`n` the bend axis: the paper's motion along the chord, and the chord's turn with the bend) |
 //! | limits (socket swing: a cone's or an ellipse's 1, a pyramid's 2; socket twist, hinge range, rod bend and twist: 1 each) | the signed distance past the limit (positive beyond it, negative inside: how far its boundary is), `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative parts turn about; which are held is the solve's active set (the solve's `settle`), and a row not held is zeroed (dropped) |
 //!
 //! The single angle the iterative parts correct (`hinge_axis`, `curve`)
@@ -146,44 +146,77 @@ impl<L: Lane> Rows<L> {
     /// Measures the rows of a joint of kind `kind` between `a` and `b`.
     #[inline(always)]
     pub fn measure(kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) -> Self {
+        let mut rows = Self::zero();
+        rows.equalities(kind, a, b, g);
+        rows.limits(kind, a, b, g);
+        rows
+    }
+
+    /// Measures only the limit rows (from `kind.first_limit()`; the rest
+    /// zero), each as [`Rows::measure`] measures it, bit for bit.
+    #[inline(always)]
+    pub fn measure_limits(
+        kind: JointRows,
+        a: &BodyLanes<L>,
+        b: &BodyLanes<L>,
+        g: &Geometry<L>,
+    ) -> Self {
+        let mut rows = Self::zero();
+        rows.limits(kind, a, b, g);
+        rows
+    }
+
+    #[inline(always)]
+    fn zero() -> Self {
         let zero = L::splat(0.0);
-        let mut rows = Self {
+        Self {
             ja: [[zero; 6]; MAX],
             jb: [[zero; 6]; MAX],
             c: [zero; MAX],
-        };
+        }
+    }
+
+    /// The equality rows: the point (a rod's curve and length), a hinge's
+    /// axis, a fixed joint's lock.
+    #[inline(always)]
+    fn equalities(&mut self, kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         match kind {
-            JointRows::Socket(SwingRows::Cone) => {
-                rows.point(0, a, b, g);
-                rows.swing(3, a, b, g);
-                rows.twist(4, a, b, g);
-            }
-            JointRows::Socket(SwingRows::Ellipse) => {
-                rows.point(0, a, b, g);
-                rows.ellipse(3, a, b, g);
-                rows.twist(4, a, b, g);
-            }
-            JointRows::Socket(SwingRows::Pyramid) => {
-                rows.point(0, a, b, g);
-                rows.pyramid(3, a, b, g);
-                rows.twist(5, a, b, g);
-            }
+            JointRows::Socket(_) => self.point(0, a, b, g),
             JointRows::Hinge => {
-                rows.point(0, a, b, g);
-                rows.axis(3, a, b, g);
-                rows.twist(5, a, b, g);
+                self.point(0, a, b, g);
+                self.axis(3, a, b, g);
             }
             JointRows::Fixed => {
-                rows.point(0, a, b, g);
-                rows.lock(3, a, b, g);
+                self.point(0, a, b, g);
+                self.lock(3, a, b, g);
             }
             JointRows::Rod => {
-                rows.curve(0, a, b, g);
-                rows.length(2, a, b, g);
-                rows.rod_limits(3, a, b, g);
+                self.curve(0, a, b, g);
+                self.length(2, a, b, g);
             }
         }
-        rows
+    }
+
+    /// The limit rows, from `kind.first_limit()`.
+    #[inline(always)]
+    fn limits(&mut self, kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
+        match kind {
+            JointRows::Socket(SwingRows::Cone) => {
+                self.swing(3, a, b, g);
+                self.twist(4, a, b, g);
+            }
+            JointRows::Socket(SwingRows::Ellipse) => {
+                self.ellipse(3, a, b, g);
+                self.twist(4, a, b, g);
+            }
+            JointRows::Socket(SwingRows::Pyramid) => {
+                self.pyramid(3, a, b, g);
+                self.twist(5, a, b, g);
+            }
+            JointRows::Hinge => self.twist(5, a, b, g),
+            JointRows::Fixed => {}
+            JointRows::Rod => self.rod_limits(3, a, b, g),
+        }
     }
 
     /// Row `k`: error `c`, `J_b = [lb, ab]`, `J_a = [-lb, -aa]`.
@@ -327,12 +360,14 @@ impl<L: Lane> Rows<L> {
         }
     }
 
-    /// The rod's length, along the chord.
+    /// The rod's length: along the chord as the bodies move, and against
+    /// the chord's turn as the rod bends (`length::chord_turn`).
     #[inline(always)]
     fn length(&mut self, at: usize, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         let f = frames(a, b, g.frame_a, g.frame_b);
         let (o, c) = length::measure(a, b, &f, g.rest_length, &g.start);
-        self.set(at, c, (o, Vec3::zero()), Vec3::zero());
+        let turn = -length::chord_turn(g.rest_length, &f);
+        self.set(at, c, (o, turn), turn);
     }
 }
 

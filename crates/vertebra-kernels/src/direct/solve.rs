@@ -30,6 +30,7 @@
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Lane, Mask, Sym3, Vec3};
 
+use super::MAX_LIMIT_RETURN_SPEED;
 use super::ldl::{self, Held, MAX, PACKED, at};
 use super::rows::{FREE, JointRows, LIMIT_RECORD as RECORD, MAX_LIMITS, Rows, SwingRows};
 use super::{Child, JointNode, MEASURED, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
@@ -146,9 +147,13 @@ pub(super) fn measure<L: Lane>(
                 let measured_rows = Rows::measure(kind, &body_a, &body_b, &geometry);
                 let first = kind.first_limit();
                 measured[..first].copy_from_slice(&measured_rows.c[..first]);
+                let back = Return {
+                    hard: !joint.soft_lanes::<L>(start),
+                    step: L::splat(MAX_LIMIT_RETURN_SPEED / scale.inv_h),
+                };
                 record_limits(
                     &mut block.scratch[n],
-                    kind,
+                    (kind, joint, back),
                     &measured_rows,
                     (&body_a, &body_b),
                     start,
@@ -180,13 +185,27 @@ pub(super) fn measure<L: Lane>(
     }
 }
 
+/// How a joint's hard limit rows come back from far past their bounds
+/// ([`MAX_LIMIT_RETURN_SPEED`]).
+struct Return<L: Lane> {
+    /// The lanes whose limits are hard (a soft limit's own spring and
+    /// damping bound its return).
+    hard: L::Mask,
+    /// What a substep takes back (`MAX_LIMIT_RETURN_SPEED h`).
+    step: L,
+}
+
 /// Records a joint's limit rows as measured (for the active set and
 /// [`settle`]: each row's signed distance, its angular Jacobians and its
 /// generalised inverse mass `w = j_a^T I_a^-1 j_a + j_b^T I_b^-1 j_b`).
+/// A hard row's distance is taken from where the substep lets it end:
+/// its violation at the substep's start (`JointNode::limit_start`) less
+/// a substep's return, none for a row that started less than that past
+/// its bound (whose distance is then its own, bit for bit).
 #[inline(always)]
 fn record_limits<L: Lane>(
     scratch: &mut super::NodeScratch,
-    kind: JointRows,
+    (kind, joint, back): (JointRows, &JointNode, Return<L>),
     measured: &Rows<L>,
     (a, b): (&BodyLanes<L>, &BodyLanes<L>),
     start: usize,
@@ -194,11 +213,12 @@ fn record_limits<L: Lane>(
     let zero = L::splat(0.0);
     for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
         let mut record = [zero; RECORD];
-        record[0] = measured.c[k];
         record[1..4].copy_from_slice(&measured.ja[k][3..6]);
         record[4..7].copy_from_slice(&measured.jb[k][3..6]);
         let ja = Vec3::new(record[1], record[2], record[3]);
         let jb = Vec3::new(record[4], record[5], record[6]);
+        let excess = (L::load(&joint.limit_start[l][start..]) - back.step).max(zero);
+        record[0] = measured.c[k] - L::select(back.hard, excess, zero);
         record[7] = inverse_mass(a, ja) + inverse_mass(b, jb);
         store(
             &record,
@@ -874,7 +894,7 @@ pub(super) fn accumulate<L: Lane>(block: &mut TreeBlock, topology: &Topology, st
 }
 
 /// Each limit row's violation as the substep starts (`C_0`, 0 within the
-/// limit), for a soft limit's damping.
+/// limit): a soft limit's damping, a hard limit's bounded return.
 #[inline(always)]
 pub(super) fn start_limits<L: Lane>(
     block: &mut TreeBlock,
@@ -895,7 +915,7 @@ pub(super) fn start_limits<L: Lane>(
         };
         let joint = &mut block.joints[index as usize];
         let (a, b) = joint.bodies.gather::<L>(rows, start);
-        let measured = Rows::measure(kind, &a, &b, &joint.geometry(start, scale));
+        let measured = Rows::measure_limits(kind, &a, &b, &joint.geometry(start, scale));
         for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
             let violation = measured.c[k].max(L::splat(0.0));
             violation.store(&mut joint.limit_start[l][start..]);

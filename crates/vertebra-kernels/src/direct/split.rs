@@ -217,13 +217,14 @@ pub struct Placed {
 /// limbs of every tree side by side, legs with arms where their shapes
 /// agree), eight to a block, the blocks without ports first and the
 /// trunks after; ports and parents name blocks by their place in the
-/// returned list. `shape` gives each piece's topology its index in the
-/// caller's list (adding it if new). Returns the blocks (padding in every
+/// returned list. Each piece's topology is found in `topologies` (the
+/// caller's list, which its blocks' `topology` index) or added to it.
+/// Returns the blocks (padding in every
 /// lane but the placed ones, whose bodies and joints the caller sets) and
 /// each tree's pieces.
 pub fn lay_out(
     trees: &[(&Topology, Vec<u32>)],
-    shape: &mut dyn FnMut(&Topology) -> u32,
+    topologies: &mut Vec<Topology>,
 ) -> (Vec<super::TreeBlock>, Vec<Vec<Placed>>) {
     use super::{Port, Source, TreeBlock};
     use std::collections::BTreeMap;
@@ -235,7 +236,10 @@ pub fn lay_out(
     let mut by_shape: BTreeMap<(bool, u32), Vec<(usize, usize)>> = BTreeMap::new();
     for (t, pieces) in split.iter().enumerate() {
         for (p, piece) in pieces.iter().enumerate() {
-            let key = (piece.topology.ports > 0, shape(&piece.topology));
+            let key = (
+                piece.topology.ports > 0,
+                intern(topologies, &piece.topology),
+            );
             if !by_shape.contains_key(&key) {
                 order.push(key);
             }
@@ -296,4 +300,13 @@ pub fn lay_out(
         }
     }
     (blocks, placed)
+}
+
+/// `piece`'s index in `topologies`, added at the end if it is not there.
+fn intern(topologies: &mut Vec<Topology>, piece: &Topology) -> u32 {
+    let known = topologies.iter().position(|t| t == piece);
+    known.unwrap_or_else(|| {
+        topologies.push(piece.clone());
+        topologies.len() - 1
+    }) as u32
 }

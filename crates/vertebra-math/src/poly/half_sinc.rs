@@ -1,6 +1,8 @@
 //! `sin(x/2) / x`, the factor in the rod's chord `2 l0 sin(psi/2) / psi`
-//! (paper eq. 9). Written as a series in `x^2` it has no division and no
-//! special case at `x = 0`, where it is exactly 1/2 and smooth.
+//! (paper eq. 9), and its slope (how the chord shortens as the rod bends:
+//! the direct solve's length row). Written as series in `x^2` they have no
+//! division and no special case at `x = 0`, where the factor is exactly
+//! 1/2 and its slope 0, both smooth.
 
 use crate::lane::Lane;
 
@@ -24,4 +26,25 @@ pub fn half_sinc<L: Lane>(x: L) -> L {
     // max(-pi, x) and min(pi, _) return the NaN operand, so NaN survives.
     let x = pi.min((-pi).max(x));
     super::horner(x * x, &HALF_SINC)
+}
+
+/// The slope's series: `d/dx sin(x/2)/x = x sum_n 2n c_n x^(2(n-1))` with
+/// `c_n` [`HALF_SINC`]'s terms, highest first.
+const HALF_SINC_SLOPE: [f32; 6] = [
+    2.352_399e-13,
+    -1.223_247_5e-10,
+    4.305_831e-8,
+    -9.300_596e-6,
+    1.041_666_7e-3,
+    -4.166_666_8e-2,
+];
+
+/// `d/dx (sin(x/2) / x)` for `x` in [-pi, pi] (0 at `x = 0`, `-x/24`
+/// near it); odd in `x`. Input beyond [-pi, pi] is clamped to it; NaN
+/// gives NaN. Accurate to 5e-8 (see [`crate::poly`]).
+#[inline(always)]
+pub fn half_sinc_slope<L: Lane>(x: L) -> L {
+    let pi = L::splat(super::PI);
+    let x = pi.min((-pi).max(x));
+    x * super::horner(x * x, &HALF_SINC_SLOPE)
 }

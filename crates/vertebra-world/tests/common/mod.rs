@@ -2,7 +2,9 @@
 #![allow(dead_code)]
 
 use glam::{Quat, Vec3};
-use vertebra_world::{BodyDesc, BodyHandle, JointDesc, JointHandle, Shape, SolverConfig, World};
+use vertebra_world::{
+    BodyDesc, BodyHandle, JointDesc, JointHandle, JointSolver, Shape, SolverConfig, World,
+};
 
 /// A capsule body of `mass` kg whose core segment runs from `top` to
 /// `bottom` (world, m), radius 0.05 m, at rest with identity orientation.
@@ -47,10 +49,17 @@ pub fn hanging_chain(
 /// never sleeps: these tests measure responses to their end, and a small
 /// slow oscillation or a slow return would fall asleep short of it.
 pub fn world(substeps: u32, iterations: u32) -> World {
+    world_with(substeps, iterations, JointSolver::default())
+}
+
+/// [`world`] with the joints solved by `joints`: the iterated solver for
+/// the promises of its parts one at a time (`SolverConfig::paper`'s).
+pub fn world_with(substeps: u32, iterations: u32, joints: JointSolver) -> World {
     World::new(SolverConfig {
         substeps,
         iterations,
         sleep: None,
+        joints,
         ..SolverConfig::default()
     })
     .expect("valid config")

@@ -8,6 +8,11 @@
 //! `sin(psi/2)/psi` is `poly::half_sinc`, exact and smooth at `psi = 0`
 //! (where the chord is `l0`) and up to `psi = pi` (where it is
 //! `2 l0 / pi`).
+//!
+//! The direct solve's row takes the whole gradient: the chord also turns
+//! with the bend, `dchord/dtheta_b = chord'(psi) n` ([`chord_turn`], `n`
+//! the bend axis; `-` for a), so a bent rod's length converges as fast as
+//! its other rows.
 
 use vertebra_math::{Lane, Vec3, poly};
 
@@ -18,6 +23,17 @@ use crate::body::{BodyLanes, PairStart, safe_ratio};
 #[inline(always)]
 pub fn chord<L: Lane>(rest_length: L, psi: L) -> L {
     L::splat(2.0) * rest_length * poly::half_sinc(psi)
+}
+
+/// How the chord's length turns with b (m/rad, world):
+/// `dchord/dtheta_b = 2 l0 (d/dpsi sin(psi/2)/psi) n`, with `n` the bend
+/// axis (`t_a x t_b` normalised; `dpsi/dtheta_b = n`, `dpsi/dtheta_a =
+/// -n`). Zero for a straight rod, where `n` has no direction and the
+/// chord's slope is zero too.
+#[inline(always)]
+pub fn chord_turn<L: Lane>(rest_length: L, f: &Frames<L>) -> Vec3<L> {
+    let (n, psi) = bend_angle(f.ta, f.tb);
+    n.scale(L::splat(2.0) * rest_length * poly::half_sinc_slope(psi))
 }
 
 /// The chord direction `o` and the length error `C` (m); the chord is
