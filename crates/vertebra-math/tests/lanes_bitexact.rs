@@ -157,4 +157,12 @@ fn this_machine_runs_the_simd_backends() {
         Backend::Sse41.is_available(),
         "x86_64 CI machines have SSE4.1; without it the SIMD paths went untested"
     );
+    #[cfg(target_arch = "aarch64")]
+    assert_eq!(Backend::best(), Backend::Neon, "every AArch64 CPU has NEON");
+    #[cfg(target_arch = "wasm32")]
+    assert_eq!(
+        Backend::Simd128.is_available(),
+        cfg!(target_feature = "simd128"),
+        "SIMD128 runs exactly in the builds made with it"
+    );
 }
