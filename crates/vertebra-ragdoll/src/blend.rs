@@ -7,6 +7,8 @@
 //! or 1 gives that pose's bone bit for bit.
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
+use vertebra_math::trig;
 
 use crate::description::RagdollDesc;
 use crate::error::RagdollError;
@@ -61,14 +63,18 @@ pub(crate) fn blend_bone((pa, qa): (Vec3, Quat), (pb, qb): (Vec3, Quat), w: f32)
 /// turn's, to rounding (the turn's angle from `atan2`, which resolves
 /// small turns; glam's `slerp` takes it from an approximate `acos`).
 fn slerp(a: Quat, b: Quat, w: f32) -> Quat {
-    let turn = a.conjugate() * b;
+    let turn = a.conjugate().mul_portable(b);
     let turn = if turn.w < 0.0 { -turn } else { turn };
     let sin_half = turn.xyz().length();
     if sin_half == 0.0 {
         return a;
     }
-    let angle = 2.0 * sin_half.atan2(turn.w);
-    (a * Quat::from_axis_angle(turn.xyz() / sin_half, angle * w)).normalize()
+    let angle = 2.0 * trig::atan2(sin_half, turn.w);
+    a.mul_portable(Quat::from_axis_angle_portable(
+        turn.xyz() / sin_half,
+        angle * w,
+    ))
+    .normalize_portable()
 }
 
 impl Pose {

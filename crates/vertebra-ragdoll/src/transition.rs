@@ -202,5 +202,5 @@ impl Transition {
 
 /// A rotation's angle (rad, in [0, pi]).
 fn angle(q: Quat) -> f32 {
-    2.0 * q.xyz().length().atan2(q.w.abs())
+    2.0 * vertebra_math::trig::atan2(q.xyz().length(), q.w.abs())
 }
