@@ -40,6 +40,7 @@ fn quats() -> Vec<Quat> {
     out
 }
 
+#[cfg(target_arch = "x86_64")]
 fn same_quat(a: Quat, b: Quat) -> bool {
     a.to_array()
         .into_iter()
