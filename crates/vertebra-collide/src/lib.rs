@@ -34,8 +34,8 @@ mod groups;
 mod pairing;
 mod snapshot;
 
-use vertebra_math::PortableQuat;
 use std::collections::{HashMap, HashSet};
+use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};

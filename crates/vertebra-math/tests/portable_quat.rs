@@ -108,14 +108,26 @@ fn trigonometry_is_the_platforms_double_precision_result_rounded_once() {
     // the two agree except where the value is within an `f64` ulp of an
     // `f32` rounding boundary, which none of these inputs is.
     let mut rng = rng(35);
-    let mut inputs: Vec<f32> = ADVERSARIAL.iter().copied().filter(|x| x.is_finite()).collect();
+    let mut inputs: Vec<f32> = ADVERSARIAL
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .collect();
     inputs.extend((0..50_000).map(|_| rng.random_range(-7.0f32..7.0)));
     inputs.extend((0..5_000).map(|_| rng.random_range(-1.0e4f32..1.0e4)));
     for &x in &inputs {
         let y = inputs[(x.to_bits() as usize) % inputs.len()];
         let d = f64::from(x);
-        assert_eq!(trig::sin(x).to_bits(), (d.sin() as f32).to_bits(), "sin {x:e}");
-        assert_eq!(trig::cos(x).to_bits(), (d.cos() as f32).to_bits(), "cos {x:e}");
+        assert_eq!(
+            trig::sin(x).to_bits(),
+            (d.sin() as f32).to_bits(),
+            "sin {x:e}"
+        );
+        assert_eq!(
+            trig::cos(x).to_bits(),
+            (d.cos() as f32).to_bits(),
+            "cos {x:e}"
+        );
         assert_eq!(trig::sin_cos(x), (trig::sin(x), trig::cos(x)));
         assert_eq!(
             trig::atan2(x, y).to_bits(),
