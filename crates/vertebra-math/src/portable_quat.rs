@@ -49,6 +49,20 @@ pub trait PortableQuat: Sized {
     fn from_rotation_x_portable(angle: f32) -> Self;
     /// `Quat::from_rotation_y(angle)`: `angle` radians about +y.
     fn from_rotation_y_portable(angle: f32) -> Self;
+    /// `self.slerp(end, w)` for unit quaternions: `self` turned toward
+    /// `end` by the fraction `w` of the shorter turn between them, about
+    /// that turn's fixed axis (the angle from `self` is `w` times the
+    /// whole turn's, to rounding). The turn's angle comes from
+    /// [`crate::trig::atan2`], which resolves small turns; glam's takes it
+    /// from an approximate `acos` and its sines from a per-target
+    /// polynomial or the C library, so its bits differ between targets
+    /// (and from these on x86-64).
+    fn slerp_portable(self, end: Self, w: f32) -> Self;
+    /// The angle (radians, in `[0, pi]`) of the turn from `self` to `rhs`:
+    /// glam's `angle_between`, from [`crate::trig::atan2`] of the turn's
+    /// half sine and cosine rather than glam's `acos` of a per-target dot
+    /// product (and exact for small turns, where `acos` is not).
+    fn angle_between_portable(self, rhs: Self) -> f32;
 }
 
 impl PortableQuat for Quat {
@@ -122,5 +136,27 @@ impl PortableQuat for Quat {
     fn from_rotation_y_portable(angle: f32) -> Quat {
         let (s, c) = crate::trig::sin_cos(angle * 0.5);
         Quat::from_xyzw(0.0, s, 0.0, c)
+    }
+
+    #[inline]
+    fn slerp_portable(self, end: Quat, w: f32) -> Quat {
+        let turn = self.conjugate().mul_portable(end);
+        let turn = if turn.w < 0.0 { -turn } else { turn };
+        let sin_half = turn.xyz().length();
+        if sin_half == 0.0 {
+            return self;
+        }
+        let angle = 2.0 * crate::trig::atan2(sin_half, turn.w);
+        self.mul_portable(Quat::from_axis_angle_portable(
+            turn.xyz() / sin_half,
+            angle * w,
+        ))
+        .normalize_portable()
+    }
+
+    #[inline]
+    fn angle_between_portable(self, rhs: Quat) -> f32 {
+        let turn = self.conjugate().mul_portable(rhs);
+        2.0 * crate::trig::atan2(turn.xyz().length(), turn.w.abs())
     }
 }

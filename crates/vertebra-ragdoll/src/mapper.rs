@@ -623,7 +623,7 @@ fn scaled(t: Transform, weight: f32) -> Transform {
     } else {
         Transform::new(
             t.translation * weight,
-            Quat::IDENTITY.slerp(t.rotation, weight),
+            Quat::IDENTITY.slerp_portable(t.rotation, weight),
         )
     }
 }

@@ -153,7 +153,7 @@ impl Chain {
                     p += q * (self.points[k] - self.points[k - 1]);
                     q = base
                         .1
-                        .mul_portable(Quat::IDENTITY.slerp(relative, self.fractions[k]));
+                        .mul_portable(Quat::IDENTITY.slerp_portable(relative, self.fractions[k]));
                     if k < last {
                         put(k, (p, q));
                     }
@@ -271,7 +271,7 @@ impl Arc {
             twist
                 .mul_portable(turn)
                 .mul_portable(self.f0)
-                .mul_portable(self.ga.slerp(self.gb, s))
+                .mul_portable(self.ga.slerp_portable(self.gb, s))
                 .normalize_portable(),
         )
     }
