@@ -137,3 +137,54 @@ fn trigonometry_is_the_platforms_double_precision_result_rounded_once() {
     }
     assert!(trig::sin(f32::NAN).is_nan() && trig::cos(f32::INFINITY).is_nan());
 }
+
+/// `a` and `b` in double precision: the turn `a* b`'s angle (rad, in
+/// `[0, pi]`), the reference the portable angle and slerp are held to.
+fn angle_f64(a: Quat, b: Quat) -> f64 {
+    let ([ax, ay, az, aw], [bx, by, bz, bw]) = (a.to_array(), b.to_array());
+    let [ax, ay, az, aw, bx, by, bz, bw] = [ax, ay, az, aw, bx, by, bz, bw].map(f64::from);
+    // (-a.xyz, a.w) * (b.xyz, b.w).
+    let x = aw * bx - ax * bw - (ay * bz - az * by);
+    let y = aw * by - ay * bw - (az * bx - ax * bz);
+    let z = aw * bz - az * bw - (ax * by - ay * bx);
+    let w = aw * bw + ax * bx + ay * by + az * bz;
+    2.0 * (x * x + y * y + z * z).sqrt().atan2(w.abs())
+}
+
+#[test]
+fn slerp_turns_the_fraction_of_the_turn_and_the_angle_is_the_turns() {
+    let mut rng = rng(36);
+    // `quats()`'s unit ones (every other).
+    let units: Vec<Quat> = quats().into_iter().step_by(2).take(20_000).collect();
+    let unit = |rng: &mut rand::rngs::StdRng| units[rng.random_range(0..units.len())];
+    for k in 0..20_000 {
+        let a = unit(&mut rng);
+        // Large turns, and small ones (down to 1e-6 rad) where an `acos`
+        // of the dot product loses them.
+        let b = if k % 2 == 0 {
+            unit(&mut rng)
+        } else {
+            let axis = unit(&mut rng).xyz().normalize();
+            let small = 10f32.powi(-rng.random_range(1..7));
+            a.mul_portable(Quat::from_axis_angle_portable(axis, small))
+        };
+        let whole = angle_f64(a, b);
+        let got = f64::from(a.angle_between_portable(b));
+        assert!(
+            (got - whole).abs() <= 1e-6 + 1e-6 * whole,
+            "{a:?} to {b:?}: {got} rad, not {whole}"
+        );
+        let w = rng.random_range(0.0f32..1.0);
+        let s = a.slerp_portable(b, w);
+        let (from_a, to_b) = (angle_f64(a, s), angle_f64(s, b));
+        let tol = 2e-6 + 2e-6 * whole;
+        assert!(
+            (from_a - f64::from(w) * whole).abs() <= tol
+                && (to_b - f64::from(1.0 - w) * whole).abs() <= tol,
+            "{a:?} to {b:?} at {w}: {from_a} and {to_b} of {whole} rad"
+        );
+    }
+    let a = unit(&mut rng);
+    assert_eq!(a.slerp_portable(a, 0.5), a, "no turn: a itself");
+    assert_eq!(a.angle_between_portable(a), 0.0);
+}
