@@ -176,9 +176,8 @@ impl SceneWorld {
                 for (i, body) in ragdoll.bodies.iter().enumerate() {
                     if let Some(state) = body.and_then(|b| world.body(b).ok()) {
                         deviation_cm += (state.position - target.bones[i].0).length() * 100.0;
-                        deviation_rad += state
-                            .orientation
-                            .angle_between_portable(target.bones[i].1);
+                        deviation_rad +=
+                            state.orientation.angle_between_portable(target.bones[i].1);
                     }
                 }
             }
