@@ -4,6 +4,8 @@
 
 mod common;
 
+use std::hint::black_box;
+
 use common::{arguments, assert_agree};
 use vertebra_math::check::same_bits;
 use vertebra_math::map::{LaneMap, map_arrays};
@@ -157,8 +159,16 @@ fn signed_zeros_and_nan_in_min_max_clamp_follow_the_rule_on_every_backend() {
     // checked against it rather than against the scalar reference: the
     // second operand on equality (so `min(-0.0, 0.0)` is `0.0` and
     // `min(0.0, -0.0)` is `-0.0`) and when either operand is NaN.
-    let min = |a: f32, b: f32| if a < b { a } else { b };
-    let max = |a: f32, b: f32| if a > b { a } else { b };
+    // Through `black_box`: with a constant operand the compiler may make
+    // these `FMINNM` on AArch64, the very fold the lanes must not make.
+    let min = |a: f32, b: f32| {
+        let (a, b) = black_box((a, b));
+        if a < b { a } else { b }
+    };
+    let max = |a: f32, b: f32| {
+        let (a, b) = black_box((a, b));
+        if a > b { a } else { b }
+    };
     let singles = every_tuple(&SIGNED_ZEROS_AND_NAN, 1);
     let pairs = every_tuple(&SIGNED_ZEROS_AND_NAN, 2);
     let triples = every_tuple(&SIGNED_ZEROS_AND_NAN, 3);

@@ -13,7 +13,11 @@
 //! - `FMIN`/`FMAX` return NaN when either operand is NaN and order
 //!   `-0.0` below `0.0`; [`Lane::min`]/[`Lane::max`] are a comparison and
 //!   a bitwise select instead (the second operand on NaN or equality, as
-//!   `minps`/`maxps`).
+//!   `minps`/`maxps`). The comparison's mask passes through an empty
+//!   `asm!` block ([`opaque_mask`]): LLVM otherwise turns the select of
+//!   `x < 0.0` between `x` and a constant `0.0` into `FMINNM`, which gives
+//!   `-0.0` for `x = -0.0` (measured with rustc 1.95, in this lane type
+//!   and in plain `f32` code alike).
 //! - [`Lane::round`] is `FRINTN`: to nearest, ties to even, as `roundps`
 //!   with `_MM_FROUND_TO_NEAREST_INT`.
 //! - `FABS`, `FNEG` and the sign select of [`Lane::copysign`] touch only
@@ -188,19 +192,13 @@ impl Lane for F32x4Neon {
     }
     #[inline(always)]
     fn min(self, other: Self) -> Self {
-        Self(neon!(vbslq_f32(
-            vcltq_f32(self.0, other.0),
-            self.0,
-            other.0
-        )))
+        let less = opaque_masks(neon!(vcltq_f32(self.0, other.0)));
+        Self(neon!(vbslq_f32(less, self.0, other.0)))
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
-        Self(neon!(vbslq_f32(
-            vcgtq_f32(self.0, other.0),
-            self.0,
-            other.0
-        )))
+        let greater = opaque_masks(neon!(vcgtq_f32(self.0, other.0)));
+        Self(neon!(vbslq_f32(greater, self.0, other.0)))
     }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
@@ -276,6 +274,33 @@ impl Lane for F32x4Neon {
         let a = self.to_array();
         ((a[0] + a[1]) + a[2]) + a[3]
     }
+}
+
+/// `masks` unchanged, through an empty `asm!` block the optimiser cannot
+/// see into, so that a select by them stays a select (module
+/// documentation: LLVM would make `min` with a constant `0.0` an
+/// `FMINNM`).
+#[inline(always)]
+fn opaque_masks(mut masks: uint32x4_t) -> uint32x4_t {
+    // SAFETY: the block holds only a comment: it reads and writes no
+    // register but `masks`'s own, and no memory.
+    unsafe {
+        core::arch::asm!("/* {0:v} */", inout(vreg) masks, options(pure, nomem, nostack, preserves_flags));
+    }
+    masks
+}
+
+/// `mask` unchanged, through an empty `asm!` block: the scalar reference's
+/// `min`/`max` select by it on AArch64, for the reason [`opaque_masks`]
+/// gives.
+#[inline(always)]
+pub(super) fn opaque_mask(mut mask: u32) -> u32 {
+    // SAFETY: the block holds only a comment: it reads and writes no
+    // register but `mask`'s own, and no memory.
+    unsafe {
+        core::arch::asm!("/* {0:w} */", inout(reg) mask, options(pure, nomem, nostack, preserves_flags));
+    }
+    mask
 }
 
 /// Transposes a 4x4 block: rows in, columns out (its own inverse). `TRN1`
