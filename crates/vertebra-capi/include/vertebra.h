@@ -99,6 +99,10 @@ enum VtBackend
   VT_BACKEND_AVX2X4 = 4,
   // Eight lanes of AVX2.
   VT_BACKEND_AVX2 = 5,
+  // Four lanes of AArch64 NEON.
+  VT_BACKEND_NEON = 6,
+  // Four lanes of WebAssembly SIMD128.
+  VT_BACKEND_SIMD128 = 7,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L

@@ -27,6 +27,10 @@ pub enum VtBackend {
     Avx2x4 = 4,
     /// Eight lanes of AVX2.
     Avx2 = 5,
+    /// Four lanes of AArch64 NEON.
+    Neon = 6,
+    /// Four lanes of WebAssembly SIMD128.
+    Simd128 = 7,
 }
 
 /// How the joints' equality parts are solved.
@@ -118,13 +122,15 @@ pub(crate) unsafe fn with_world(
     })
 }
 
-const BACKENDS: [Option<Backend>; 6] = [
+const BACKENDS: [Option<Backend>; 8] = [
     None,
     Some(Backend::Scalar),
     Some(Backend::Portable),
     Some(Backend::Sse41),
     Some(Backend::Avx2x4),
     Some(Backend::Avx2),
+    Some(Backend::Neon),
+    Some(Backend::Simd128),
 ];
 
 impl From<&SolverConfig> for VtSolverConfig {

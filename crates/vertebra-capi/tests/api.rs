@@ -679,7 +679,7 @@ fn an_enum_out_of_range_is_refused_naming_the_field() {
         (
             "config.backend",
             VtSolverConfig {
-                backend: 6,
+                backend: 8,
                 ..config
             },
         ),

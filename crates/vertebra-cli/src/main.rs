@@ -81,7 +81,7 @@ enum Command {
         /// Frames to run, 1 to 1000000 (the scene's own count by default).
         #[arg(long)]
         frames: Option<usize>,
-        /// auto, scalar, portable, sse4, avx2x4 or avx2.
+        /// auto, scalar, portable, sse4, avx2x4, avx2, neon or simd128.
         #[arg(long, default_value = "auto")]
         backend: String,
         /// Worker threads, 1 to 256.

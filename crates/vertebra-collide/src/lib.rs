@@ -146,6 +146,7 @@ mod query;
 mod snapshot;
 
 use std::collections::{HashMap, HashSet};
+use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
@@ -841,7 +842,7 @@ impl Collisions {
         for &(i, j) in &scratch.pairs {
             let ((ci, si), (cj, sj)) = (&self.colliders[i], &self.colliders[j]);
             fresh(&mut scratch.manifolds);
-            let relative = poses[i].inv_mul(&poses[j]);
+            let relative = relative_pose(&poses[i], &poses[j]);
             let prediction = self.prediction + reach[i] + reach[j];
             let on_plane = plane_manifold(
                 &relative,
@@ -983,6 +984,18 @@ fn wake_touched(scratch: &mut Detection, world: &World, found: &[Contact]) -> bo
         }
     }
     woke
+}
+
+/// `b` in `a`'s frame: parry's `a.inv_mul(b)`, with the rotations composed
+/// by [`PortableQuat::mul_portable`] (glam's product has other bits on
+/// other targets) and the translation turned as parry turns it (`Quat *
+/// Vec3`, the same bits everywhere).
+fn relative_pose(a: &Pose, b: &Pose) -> Pose {
+    let turn = a.rotation.inverse();
+    Pose::from_parts(
+        turn * (b.translation - a.translation),
+        turn.mul_portable(b.rotation),
+    )
 }
 
 /// A half space against a box or capsule (the ground under a body), into

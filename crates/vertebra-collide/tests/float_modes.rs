@@ -4,12 +4,12 @@
 //! with its contacts found each frame, pushed and driven, and mapped onto
 //! its skeleton through a transition, under each rounding mode and under
 //! flush-to-zero with denormals-are-zero, against the default mode.
-#![cfg(target_arch = "x86_64")]
+#![cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
 
-#[path = "../../vertebra-world/tests/mxcsr/mod.rs"]
-mod mxcsr;
+#[path = "../../vertebra-world/tests/host_mode/mod.rs"]
+mod host_mode;
 
-use mxcsr::{read_mxcsr, write_mxcsr};
+use host_mode::{DEFAULT, FLUSH, ROUNDING, STATUS, read_mode, write_mode};
 
 use glam::{Quat, Vec3};
 use vertebra_collide::{Collider, ColliderShape, Collisions};
@@ -22,25 +22,22 @@ use vertebra_world::{BodyDesc, SolverConfig, World};
 
 const DT: f32 = 1.0 / 60.0;
 
-/// MXCSR at reset: exceptions masked, round to nearest.
-const DEFAULT: u32 = 0x1F80;
-
-/// The modes a host may set: MXCSR's rounding field (bits 13-14) and
-/// flush-to-zero (bit 15) with denormals-are-zero (bit 6).
-const MODES: [(&str, u32); 4] = [
-    ("round down", DEFAULT | 0x2000),
-    ("round up", DEFAULT | 0x4000),
-    ("round toward zero", DEFAULT | 0x6000),
-    ("flush to zero, denormals are zero", DEFAULT | 0x8040),
+/// The modes a host may set: each rounding direction, and flush-to-zero
+/// (with denormals-are-zero on x86-64).
+const MODES: [(&str, u64); 4] = [
+    (ROUNDING[0].0, DEFAULT | ROUNDING[0].1),
+    (ROUNDING[1].0, DEFAULT | ROUNDING[1].1),
+    (ROUNDING[2].0, DEFAULT | ROUNDING[2].1),
+    ("flush to zero", DEFAULT | FLUSH),
 ];
 
 /// Runs `f` in `mode`, as a host would, and checks it got its mode back.
-fn in_mode<T>(mode: u32, f: impl FnOnce() -> T) -> T {
-    let before = read_mxcsr();
-    write_mxcsr(mode);
+fn in_mode<T>(mode: u64, f: impl FnOnce() -> T) -> T {
+    let before = read_mode();
+    write_mode(mode);
     let out = f();
-    let during = read_mxcsr() & !0x3F;
-    write_mxcsr(before);
+    let during = read_mode() & !STATUS;
+    write_mode(before);
     assert_eq!(during, mode, "a call did not give the host its mode back");
     out
 }

@@ -24,7 +24,7 @@ use vertebra_kernels::direct::{
 use vertebra_kernels::limited::LimitLane;
 use vertebra_kernels::parts::limit::Softness;
 use vertebra_math::block::BLOCK_LANES;
-use vertebra_math::{Backend, Sym3, Vec3};
+use vertebra_math::{Backend, PortableQuat, Sym3, Vec3, trig};
 
 // ---------------------------------------------------------------------------
 // The dense blocks: `direct::ldl`.
@@ -713,9 +713,21 @@ struct Tree {
     ground: (DVec3, GQuat),
 }
 
-/// `10^u`, `u` uniform in `[lo, hi)`.
+/// `10^u`, `u` uniform in `[lo, hi)` (`libm`'s power, not the
+/// platform's: the same cases on every target).
 fn log_uniform(r: &mut StdRng, lo: f32, hi: f32) -> f32 {
-    10f32.powf(r.random_range(lo..hi))
+    libm::powf(10.0, r.random_range(lo..hi))
+}
+
+/// glam's `Quat::from_scaled_axis` (a turn of `|v|` rad about `v`) with
+/// the same bits on every target.
+fn scaled_axis(v: GVec3) -> GQuat {
+    let angle = v.length();
+    if angle == 0.0 {
+        GQuat::IDENTITY
+    } else {
+        GQuat::from_axis_angle_portable(v / angle, angle)
+    }
 }
 
 fn body_at(r: &mut StdRng, x: DVec3, mass: f32) -> Body {
@@ -738,7 +750,10 @@ impl Tree {
         Self {
             bodies: Vec::new(),
             joints: Vec::new(),
-            ground: (DVec3::new(0.1, 0.2, -0.3), GQuat::from_rotation_y(0.4)),
+            ground: (
+                DVec3::new(0.1, 0.2, -0.3),
+                GQuat::from_rotation_y_portable(0.4),
+            ),
         }
     }
 
@@ -766,11 +781,11 @@ impl Tree {
             let reflected = 2.0 * ta.dot(o) * o - ta;
             let psi = ta.angle_between(reflected);
             let arc = if psi > 1e-6 {
-                psi / (2.0 * (psi / 2.0).sin())
+                psi / (2.0 * trig::sin(psi / 2.0))
             } else {
                 1.0
             };
-            let frame_b = GQuat::from_rotation_arc(ta, reflected) * frame;
+            let frame_b = GQuat::from_rotation_arc_portable(ta, reflected).mul_portable(frame);
             (GVec3::ZERO, GVec3::ZERO, frame_b, chord.length() * arc)
         } else {
             let local = |x: DVec3, q: GQuat| q.inverse() * (point - x).as_vec3();
@@ -782,8 +797,8 @@ impl Tree {
             b,
             anchor_a,
             anchor_b,
-            frame_a: qa.inverse() * frame,
-            frame_b: qb.inverse() * frame_b,
+            frame_a: qa.inverse().mul_portable(frame),
+            frame_b: qb.inverse().mul_portable(frame_b),
             rest_length,
             start: StartLane::new(xa, qa, anchor_a, xb, qb, anchor_b),
             limits: JointLane::FREE,
@@ -796,8 +811,8 @@ impl Tree {
         let ((xa, _), (xb, _)) = (self.pose(a), self.pose(b));
         let frame = if kind == JointRows::Rod {
             let o = (xb - xa).as_vec3().normalize();
-            GQuat::from_rotation_arc(GVec3::X, o)
-                * GQuat::from_rotation_x(r.random_range(-3.0..3.0))
+            GQuat::from_rotation_arc_portable(GVec3::X, o)
+                .mul_portable(GQuat::from_rotation_x_portable(r.random_range(-3.0..3.0)))
         } else {
             unit_quat(r)
         };
@@ -891,7 +906,7 @@ impl Scene {
     fn rows(&self, offsets: &Offsets) -> BodyRows {
         let mut raw = vec![BodyRows::null_raw(); self.tree.bodies.len() + 2];
         for (i, (body, &(dp, dtheta))) in self.tree.bodies.iter().zip(offsets).enumerate() {
-            let q = GQuat::from_scaled_axis(dtheta) * body.q;
+            let q = scaled_axis(dtheta).mul_portable(body.q);
             raw[1 + i] = [
                 BodyRows::pose_row(dp, 1.0 / body.mass, q),
                 BodyRows::inertia_row(body.inertia.inverse()),
@@ -1958,8 +1973,8 @@ fn posed(r: &mut StdRng, kind: JointRows, local: GQuat, limits: &JointLane) -> M
 
 /// A swing of `angle` (rad) about a random axis of the YZ plane.
 fn swing(r: &mut StdRng, angle: f32) -> GQuat {
-    let u = r.random_range(-PI..PI);
-    GQuat::from_axis_angle(GVec3::new(0.0, u.cos(), u.sin()), angle)
+    let (sin, cos) = trig::sin_cos(r.random_range(-PI..PI));
+    GQuat::from_axis_angle_portable(GVec3::new(0.0, cos, sin), angle)
 }
 
 /// The swing whose swing sines (`parts::ellipse`) are `(s_y, s_z)`.
@@ -1971,7 +1986,8 @@ fn swing_of_sines(p: [f32; 2]) -> GQuat {
 /// The swing whose pyramid angles (`parts::pyramid`) are `theta_y`,
 /// `theta_z` (rad): `2 atan2(s_y, s_w)` and `2 atan2(s_z, s_w)`.
 fn swing_of_angles(theta_y: f32, theta_z: f32) -> GQuat {
-    GQuat::from_xyzw(0.0, (theta_y / 2.0).tan(), (theta_z / 2.0).tan(), 1.0).normalize()
+    let tan = |x: f32| trig::sin(x) / trig::cos(x);
+    GQuat::from_xyzw(0.0, tan(theta_y / 2.0), tan(theta_z / 2.0), 1.0).normalize_portable()
 }
 
 /// A limit row's `c` against its closed form (and its sign), and its
@@ -2118,8 +2134,9 @@ const SEMI_AXES: [f32; 2] = [0.642_787_6, 0.300_705_8];
 /// unit normal there (swing-sine plane).
 fn ellipse_point(t: f64) -> ([f64; 2], [f64; 2]) {
     let [a, b] = SEMI_AXES.map(f64::from);
-    let q = [a * t.cos(), b * t.sin()];
-    let n = [t.cos() / a, t.sin() / b];
+    let (sin, cos) = (libm::sin(t), libm::cos(t));
+    let q = [a * cos, b * sin];
+    let n = [cos / a, sin / b];
     let length = (n[0] * n[0] + n[1] * n[1]).sqrt();
     (q, [n[0] / length, n[1] / length])
 }
@@ -2295,14 +2312,14 @@ fn limit_chain(r: &mut StdRng, kind: JointRows, bodies: usize, bend: f32) -> Tre
         tree.bodies.push(body_at(r, x, mass));
         if kind == Rod {
             let o = (x - above).as_vec3().normalize();
-            let ta = GQuat::from_axis_angle(o.any_orthonormal_vector(), bend) * o;
-            let roll = GQuat::from_rotation_x(r.random_range(-3.0..3.0));
+            let ta = GQuat::from_axis_angle_portable(o.any_orthonormal_vector(), bend) * o;
+            let roll = GQuat::from_rotation_x_portable(r.random_range(-3.0..3.0));
             tree.join(
                 Rod,
                 a,
                 Some(i),
                 above,
-                GQuat::from_rotation_arc(GVec3::X, ta) * roll,
+                GQuat::from_rotation_arc_portable(GVec3::X, ta).mul_portable(roll),
             );
         } else {
             tree.join(kind, a, Some(i), (above + x) * 0.5, unit_quat(r));
@@ -2378,7 +2395,7 @@ fn past_limit(
     let joint = &tree.joints[j];
     let (xa, qa) = tree.pose(joint.a);
     let point = xa + (qa * joint.anchor_a).as_dvec3();
-    let frame = qa * joint.frame_a;
+    let frame = qa.mul_portable(joint.frame_a);
     let mut limits = NO_LIMITS;
     let (local, row) = match case {
         "cone" => {
@@ -2402,11 +2419,11 @@ fn past_limit(
         }
         "twist" => {
             limits.twist = [-0.3, 0.4];
-            (GQuat::from_rotation_x(0.4 + e), 4)
+            (GQuat::from_rotation_x_portable(0.4 + e), 4)
         }
         "hinge range" => {
             limits.twist = [-0.5, 0.8];
-            (GQuat::from_rotation_x(-0.5 - e), 5)
+            (GQuat::from_rotation_x_portable(-0.5 - e), 5)
         }
         "rod bend" => {
             limits.swing_max = 2.0 * bend - e;
@@ -2423,9 +2440,14 @@ fn past_limit(
         "rod twist" => {
             let (xb, _) = tree.pose(tree.joints[j].b);
             let o = (xb - xa).as_vec3().normalize();
-            turn_below(&tree, j, xa, GQuat::from_axis_angle(o, 0.3 + e))
+            turn_below(&tree, j, xa, GQuat::from_axis_angle_portable(o, 0.3 + e))
         }
-        _ => turn_below(&tree, j, point, frame * local * frame.inverse()),
+        _ => turn_below(
+            &tree,
+            j,
+            point,
+            frame.mul_portable(local).mul_portable(frame.inverse()),
+        ),
     };
     (tree, offsets, row)
 }

@@ -29,6 +29,11 @@ pub enum Backend {
     Avx2x4,
     /// Eight lanes, explicit AVX2 intrinsics.
     Avx2,
+    /// Four lanes, explicit AArch64 NEON intrinsics.
+    Neon,
+    /// Four lanes, explicit WebAssembly SIMD128 intrinsics (builds with
+    /// the `simd128` target feature).
+    Simd128,
 }
 
 /// The work a backend runs: one body, generic over the lane type.
@@ -45,12 +50,14 @@ pub trait LaneKernel {
 
 impl Backend {
     /// Every backend, scalar first.
-    pub const ALL: [Backend; 5] = [
+    pub const ALL: [Backend; 7] = [
         Backend::Scalar,
         Backend::Portable,
         Backend::Sse41,
         Backend::Avx2x4,
         Backend::Avx2,
+        Backend::Neon,
+        Backend::Simd128,
     ];
 
     /// The name used on command lines and in reports.
@@ -61,6 +68,8 @@ impl Backend {
             Backend::Sse41 => "sse4",
             Backend::Avx2x4 => "avx2x4",
             Backend::Avx2 => "avx2",
+            Backend::Neon => "neon",
+            Backend::Simd128 => "simd128",
         }
     }
 
@@ -68,12 +77,20 @@ impl Backend {
     pub fn lanes(self) -> usize {
         match self {
             Backend::Scalar => 1,
-            Backend::Portable | Backend::Sse41 | Backend::Avx2x4 => 4,
+            Backend::Portable
+            | Backend::Sse41
+            | Backend::Avx2x4
+            | Backend::Neon
+            | Backend::Simd128 => 4,
             Backend::Avx2 => 8,
         }
     }
 
-    /// Whether this CPU can run the backend (detected once; cached by std).
+    /// Whether this CPU can run the backend: the x86 ones detected once
+    /// (cached by std); NEON wherever the target has it (every AArch64
+    /// CPU: it is the target's baseline); SIMD128 in a WebAssembly build
+    /// with the `simd128` target feature (WebAssembly cannot detect it at
+    /// run time: a module with SIMD does not load without it).
     pub fn is_available(self) -> bool {
         match self {
             Backend::Scalar | Backend::Portable => true,
@@ -84,8 +101,10 @@ impl Backend {
                 std::arch::is_x86_feature_detected!("avx2")
                     && std::arch::is_x86_feature_detected!("fma")
             }
+            Backend::Neon => cfg!(all(target_arch = "aarch64", target_feature = "neon")),
+            Backend::Simd128 => cfg!(all(target_arch = "wasm32", target_feature = "simd128")),
             #[cfg(not(target_arch = "x86_64"))]
-            _ => false,
+            Backend::Sse41 | Backend::Avx2x4 | Backend::Avx2 => false,
         }
     }
 
@@ -94,13 +113,19 @@ impl Backend {
         Self::ALL.into_iter().filter(|b| b.is_available())
     }
 
-    /// The fastest backend this CPU can run: 8-lane AVX2, else SSE4.1, else
+    /// The fastest backend this CPU can run: 8-lane AVX2, else SSE4.1 (on
+    /// x86-64), NEON (on AArch64), SIMD128 (on WebAssembly with SIMD), else
     /// the portable 4 lanes.
     pub fn best() -> Backend {
-        [Backend::Avx2, Backend::Sse41]
-            .into_iter()
-            .find(|b| b.is_available())
-            .unwrap_or(Backend::Portable)
+        [
+            Backend::Avx2,
+            Backend::Sse41,
+            Backend::Neon,
+            Backend::Simd128,
+        ]
+        .into_iter()
+        .find(|b| b.is_available())
+        .unwrap_or(Backend::Portable)
     }
 
     /// Runs `kernel` with this backend's lane type.
@@ -125,7 +150,14 @@ impl Backend {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: `is_available` confirmed AVX2 and FMA on this CPU.
             Backend::Avx2 => unsafe { x86::enter_avx2(kernel) },
-            #[cfg(not(target_arch = "x86_64"))]
+            // NEON and SIMD128 are the build's own instruction sets: no
+            // entry with other target features is needed.
+            #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+            Backend::Neon => kernel.run::<crate::lane::neon::F32x4Neon>(),
+            #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+            Backend::Simd128 => kernel.run::<crate::lane::simd128::F32x4Wasm>(),
+            // Unavailable here: handled above.
+            #[allow(unreachable_patterns)]
             _ => kernel.run::<f32>(),
         }
     }
@@ -185,7 +217,7 @@ impl BackendChoice {
 impl FromStr for BackendChoice {
     type Err = BackendError;
     /// `auto`, or a backend name: `scalar`, `portable`, `sse4`, `avx2x4`,
-    /// `avx2`.
+    /// `avx2`, `neon`, `simd128`.
     fn from_str(s: &str) -> Result<Self, BackendError> {
         if s == "auto" {
             return Ok(BackendChoice::Auto);
@@ -202,7 +234,7 @@ impl FromStr for BackendChoice {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum BackendError {
     /// The name is not one of `auto`, `scalar`, `portable`, `sse4`,
-    /// `avx2x4`, `avx2`.
+    /// `avx2x4`, `avx2`, `neon`, `simd128`.
     Unknown(String),
     /// This CPU lacks the instructions the forced backend needs.
     Unavailable(Backend),
@@ -213,7 +245,7 @@ impl fmt::Display for BackendError {
         match self {
             BackendError::Unknown(s) => write!(
                 f,
-                "unknown backend `{s}` (expected auto, scalar, portable, sse4, avx2x4 or avx2)"
+                "unknown backend `{s}` (expected auto, scalar, portable, sse4, avx2x4, avx2, neon or simd128)"
             ),
             BackendError::Unavailable(b) => {
                 write!(f, "backend `{b}` is not supported by this CPU")

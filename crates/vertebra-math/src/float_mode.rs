@@ -22,11 +22,14 @@
 //! | target | register | what is set |
 //! | --- | --- | --- |
 //! | x86-64 | MXCSR | `0x1F80`: all exceptions masked, round to nearest, FTZ and DAZ off (status flags cleared; the caller's come back) |
-//! | other (aarch64: FPCR) | | nothing: a host that sets FPCR's FZ, FZ16 or rounding bits changes results there |
+//! | AArch64 | FPCR | `0`: round to nearest, FZ and FZ16 (flush-to-zero) off, DN (default NaN) off, AH and FIZ (FEAT_AFP's alternate handling and input flushing) off, no trap enabled: the register's value at a Linux process's start |
+//! | WebAssembly | none | nothing to set: the standard fixes round to nearest and keeps subnormals |
+//! | other | | nothing: a host that sets another target's flush or rounding bits changes results there |
 //!
-//! Bits change only in `stmxcsr`/`ldmxcsr`, each its own `asm!` block, at
-//! the guard's creation and drop; the solver's arithmetic runs in the
-//! functions called in between.
+//! Bits change only in `stmxcsr`/`ldmxcsr` (`mrs`/`msr fpcr`), each its
+//! own `asm!` block, at the guard's creation and drop; the solver's
+//! arithmetic runs in the functions called in between. (FPSR, AArch64's
+//! status flags, is left alone: nothing reads it.)
 
 use core::marker::PhantomData;
 
@@ -34,6 +37,11 @@ use core::marker::PhantomData;
 /// nearest, FTZ and DAZ off.
 #[cfg(target_arch = "x86_64")]
 const DEFAULT_MXCSR: u32 = 0x1F80;
+
+/// FPCR as Linux starts a process (Arm ARM, D19.2.51 FPCR): every control
+/// bit clear.
+#[cfg(target_arch = "aarch64")]
+const DEFAULT_FPCR: u64 = 0;
 
 /// While alive, the current thread computes in the default floating-point
 /// mode; dropping it restores the mode it found. Not `Send`: it must be
@@ -43,6 +51,8 @@ const DEFAULT_MXCSR: u32 = 0x1F80;
 pub struct DefaultFloatMode {
     #[cfg(target_arch = "x86_64")]
     previous: u32,
+    #[cfg(target_arch = "aarch64")]
+    previous: u64,
     _this_thread: PhantomData<*const ()>,
 }
 
@@ -59,7 +69,16 @@ impl DefaultFloatMode {
                 _this_thread: PhantomData,
             }
         }
-        #[cfg(not(target_arch = "x86_64"))]
+        #[cfg(target_arch = "aarch64")]
+        {
+            let previous = read_fpcr();
+            write_fpcr(DEFAULT_FPCR);
+            Self {
+                previous,
+                _this_thread: PhantomData,
+            }
+        }
+        #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
         {
             Self {
                 _this_thread: PhantomData,
@@ -79,6 +98,8 @@ impl Drop for DefaultFloatMode {
     fn drop(&mut self) {
         #[cfg(target_arch = "x86_64")]
         write_mxcsr(self.previous);
+        #[cfg(target_arch = "aarch64")]
+        write_fpcr(self.previous);
     }
 }
 
@@ -102,6 +123,50 @@ fn write_mxcsr(value: u32) {
     // would fault).
     unsafe {
         core::arch::asm!("ldmxcsr [{}]", in(reg) &value, options(nostack, preserves_flags, readonly));
+    }
+}
+
+#[cfg(target_arch = "aarch64")]
+#[inline]
+fn read_fpcr() -> u64 {
+    let value: u64;
+    // SAFETY: `mrs` reads FPCR into a register; EL0 may read it.
+    unsafe {
+        core::arch::asm!("mrs {}, fpcr", out(reg) value, options(nomem, nostack, preserves_flags));
+    }
+    value
+}
+
+#[cfg(target_arch = "aarch64")]
+#[inline]
+fn write_fpcr(value: u64) {
+    // SAFETY: `msr` writes FPCR, which EL0 may write; `value` was read
+    // from FPCR or is its reset value, so every RES0 bit is zero.
+    unsafe {
+        core::arch::asm!("msr fpcr, {}", in(reg) value, options(nomem, nostack, preserves_flags));
+    }
+}
+
+#[cfg(all(test, target_arch = "aarch64"))]
+mod fpcr_tests {
+    use super::*;
+
+    #[test]
+    fn sets_the_default_mode_and_restores_the_callers() {
+        const FZ: u64 = 1 << 24;
+        let original = read_fpcr();
+        write_fpcr(DEFAULT_FPCR | FZ);
+        // Each product from its own opaque operand: the compiler assumes
+        // one floating-point mode and would compute the two as one.
+        let half_tiny = || core::hint::black_box(1.0e-38f32) * 0.5;
+        assert_eq!(half_tiny(), 0.0, "the host's FZ flushes a subnormal result");
+        {
+            let _mode = DefaultFloatMode::enter();
+            assert_eq!(read_fpcr(), DEFAULT_FPCR);
+            assert!(half_tiny() > 0.0, "a subnormal result is kept");
+        }
+        assert_eq!(read_fpcr(), DEFAULT_FPCR | FZ);
+        write_fpcr(original);
     }
 }
 

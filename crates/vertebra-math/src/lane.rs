@@ -9,10 +9,13 @@
 //! | `F32x4Portable` | 4 | `portable` | `wide::f32x4`, for targets without x86 intrinsics |
 //! | `F32x4` | 4 | `sse41` | explicit SSE4.1 intrinsics |
 //! | `F32x8` | 8 | `avx2` | explicit AVX intrinsics, entered with AVX2+FMA enabled |
+//! | `F32x4Neon` | 4 | `neon` | explicit AArch64 NEON intrinsics (NEON is every AArch64 target's baseline) |
+//! | `F32x4Wasm` | 4 | `simd128` | explicit WebAssembly SIMD128 intrinsics, in builds with the `simd128` target feature |
 //!
 //! The SIMD types are private to this crate: a value of one exists only
 //! inside [`crate::Backend::dispatch`] after the CPU was checked for its
-//! instructions, which is what makes their safe methods sound.
+//! instructions (or, for NEON and SIMD128, in a build whose target has
+//! them), which is what makes their safe methods sound.
 //!
 //! # Rules every implementation keeps (the bit-for-bit contract)
 //!
@@ -71,6 +74,12 @@ mod x86;
 pub(crate) mod avx2;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod sse41;
+
+#[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+pub(crate) mod neon;
+
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+pub(crate) mod simd128;
 
 /// A lane-wise boolean: all bits set for true, clear for false in the SIMD
 /// types, `bool` in the scalar reference.

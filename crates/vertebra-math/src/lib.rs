@@ -15,6 +15,9 @@
 //!   scalar reference, bit for bit.
 //! - [`float_mode`]: the default floating-point mode for a solver step,
 //!   whatever mode (FTZ, DAZ, rounding) the caller's thread runs in.
+//! - [`portable_quat`]: glam's quaternion operations whose bits differ
+//!   between targets, with the same bits on every one; [`trig`]: `sin`,
+//!   `cos` and `atan2` of an `f32` without the platform's C library.
 //!
 //! Public values outside kernels are `glam` types; `Vec3<f32>` and
 //! `Quat<f32>` convert to and from them.
@@ -28,14 +31,17 @@ pub mod lane;
 #[cfg(feature = "harness")]
 pub mod map;
 pub mod poly;
+pub mod portable_quat;
 pub mod quat;
 pub mod row;
 pub mod sym3;
+pub mod trig;
 pub mod vec3;
 
 pub use backend::{Backend, BackendChoice, BackendError, LaneKernel};
 pub use float_mode::DefaultFloatMode;
 pub use lane::{Lane, Mask};
+pub use portable_quat::PortableQuat;
 pub use quat::Quat;
 pub use sym3::Sym3;
 pub use vec3::Vec3;

@@ -63,7 +63,11 @@ impl Row {
     /// The first float, for the lane types' vector loads and stores (valid
     /// for reads and writes of the row's eight floats while `self` is
     /// borrowed, on this thread: the cell allows writes through `&self`).
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(any(
+        target_arch = "x86_64",
+        all(target_arch = "aarch64", target_feature = "neon"),
+        all(target_arch = "wasm32", target_feature = "simd128")
+    ))]
     #[inline(always)]
     pub(crate) fn as_ptr(&self) -> *mut f32 {
         self.0.as_ptr().cast::<f32>()

@@ -7,6 +7,7 @@
 //! or 1 gives that pose's bone bit for bit.
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
 
 use crate::description::RagdollDesc;
 use crate::error::RagdollError;
@@ -45,30 +46,16 @@ pub(crate) fn check_weights(
 }
 
 /// `a` and `b` blended at weight `w` (0: `a`, 1: `b`, exactly):
-/// translation `a (1 - w) + b w`, rotation [`slerp`]ed.
+/// translation `a (1 - w) + b w`, rotation along the shorter arc
+/// ([`PortableQuat::slerp_portable`]).
 pub(crate) fn blend_bone((pa, qa): (Vec3, Quat), (pb, qb): (Vec3, Quat), w: f32) -> (Vec3, Quat) {
     if w == 0.0 {
         (pa, qa)
     } else if w == 1.0 {
         (pb, qb)
     } else {
-        (pa * (1.0 - w) + pb * w, slerp(qa, qb, w))
+        (pa * (1.0 - w) + pb * w, qa.slerp_portable(qb, w))
     }
-}
-
-/// `a` turned toward `b` by the fraction `w` of the shorter turn between
-/// them, about its fixed axis: the angle from `a` is `w` times the whole
-/// turn's, to rounding (the turn's angle from `atan2`, which resolves
-/// small turns; glam's `slerp` takes it from an approximate `acos`).
-fn slerp(a: Quat, b: Quat, w: f32) -> Quat {
-    let turn = a.conjugate() * b;
-    let turn = if turn.w < 0.0 { -turn } else { turn };
-    let sin_half = turn.xyz().length();
-    if sin_half == 0.0 {
-        return a;
-    }
-    let angle = 2.0 * sin_half.atan2(turn.w);
-    (a * Quat::from_axis_angle(turn.xyz() / sin_half, angle * w)).normalize()
 }
 
 impl Pose {

@@ -9,6 +9,7 @@
 //! from the sockets it replaces: `rod_stiffness`).
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
 use vertebra_world::{AngularDrive, JointKind, RodDesc, RodStiffness, World};
 
 use crate::error::RagdollError;
@@ -220,8 +221,9 @@ impl Ragdoll {
         settings.validate(self.desc.joints.len())?;
         let relative = |pose: &Pose, j: &crate::JointDef| {
             let frame = j.frame;
-            ((pose.bones[j.parent].1 * frame).inverse() * (pose.bones[j.child].1 * frame))
-                .normalize()
+            (pose.bones[j.parent].1.mul_portable(frame).inverse())
+                .mul_portable(pose.bones[j.child].1.mul_portable(frame))
+                .normalize_portable()
         };
         for (k, (j, joint)) in self.desc.joints.iter().zip(&self.joints).enumerate() {
             // A fixed joint has no rotation to drive.
@@ -248,7 +250,10 @@ impl Ragdoll {
                     pose.bones[spine.bodies[0]].1,
                     pose.bones[*spine.bodies.last().expect("a chain")].1,
                 );
-                let (f0, f1) = (base * rest.frame_a, top * rest.frame_b);
+                let (f0, f1) = (
+                    base.mul_portable(rest.frame_a),
+                    top.mul_portable(rest.frame_b),
+                );
                 let tb = f1 * Vec3::X;
                 (
                     (f0.inverse() * tb).normalize(),

@@ -4,6 +4,7 @@
 //! field by field (`docs/ragdolls.md` gives the format).
 
 use std::collections::HashMap;
+use vertebra_math::PortableQuat;
 
 use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::Deserialize;
@@ -568,7 +569,7 @@ pub(crate) fn frame(
     }
     let x = x.normalize();
     let Some(normal) = normal else {
-        return Ok(Quat::from_rotation_arc(Vec3::X, x.as_vec3()));
+        return Ok(Quat::from_rotation_arc_portable(Vec3::X, x.as_vec3()));
     };
     finite(context, "normal", &normal)?;
     let n = DVec3::from(normal.map(f64::from));
@@ -581,7 +582,10 @@ pub(crate) fn frame(
     )?;
     let y = (n - x * n.dot(x)).normalize();
     let z = x.cross(y);
-    Ok(Quat::from_mat3(&Mat3::from_cols(x.as_vec3(), y.as_vec3(), z.as_vec3())).normalize())
+    Ok(
+        Quat::from_mat3(&Mat3::from_cols(x.as_vec3(), y.as_vec3(), z.as_vec3()))
+            .normalize_portable(),
+    )
 }
 
 /// Half a turn (rad), as the file's 180 degrees reads.

@@ -33,6 +33,7 @@
 //! chain's change of length.
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
 use vertebra_world::World;
 
 use crate::description::RagdollDesc;
@@ -510,12 +511,12 @@ impl SkeletonMapper {
             // The chains are laid out in the skeleton's bind pose: each
             // body's rotation from there, and the rod's frames in those.
             let (turn_a, turn_b) = (self.bind_turns[chain.base], self.bind_turns[chain.top]);
-            let from_bind = |(p, q): (Vec3, Quat), turn: Quat| (p, q * turn.inverse());
+            let from_bind = |(p, q): (Vec3, Quat), turn: Quat| (p, q.mul_portable(turn.inverse()));
             chain.place(
                 mapping,
                 from_bind(bodies[chain.base], turn_a),
                 from_bind(bodies[chain.top], turn_b),
-                rod_frames.map(|(a, b)| (turn_a * a, turn_b * b)),
+                rod_frames.map(|(a, b)| (turn_a.mul_portable(a), turn_b.mul_portable(b))),
                 out,
             );
         }
@@ -598,7 +599,12 @@ fn same_bind(own: &Skeleton, given: &Skeleton) -> Result<(), RagdollError> {
         let there = given_bind.bones[j];
         let (moved, turned) = (
             there.translation.distance(at.translation),
-            2.0 * (at.rotation.inverse() * there.rotation).xyz().length(),
+            2.0 * at
+                .rotation
+                .inverse()
+                .mul_portable(there.rotation)
+                .xyz()
+                .length(),
         );
         if !(moved <= 1e-4 && turned <= 1e-4) {
             return Err(refuse(format!(
@@ -617,7 +623,7 @@ fn scaled(t: Transform, weight: f32) -> Transform {
     } else {
         Transform::new(
             t.translation * weight,
-            Quat::IDENTITY.slerp(t.rotation, weight),
+            Quat::IDENTITY.slerp_portable(t.rotation, weight),
         )
     }
 }

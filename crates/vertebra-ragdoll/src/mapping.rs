@@ -17,6 +17,8 @@
 //! body.
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
+use vertebra_math::trig;
 use vertebra_world::{World, arc_tangent, rod_twist};
 
 use crate::error::RagdollError;
@@ -132,12 +134,15 @@ impl Chain {
         let _mode = DefaultFloatMode::enter();
         let last = self.points.len() - 1;
         let mut put = |k: usize, (p, q): (Vec3, Quat)| {
-            out[self.bones[k - 1]] =
-                Transform::new(p, (q * self.bind_rotations[k - 1]).normalize());
+            out[self.bones[k - 1]] = Transform::new(
+                p,
+                q.mul_portable(self.bind_rotations[k - 1])
+                    .normalize_portable(),
+            );
         };
         match mode {
             SpineMapping::Orientation | SpineMapping::PositionOrientation => {
-                let relative = base.1.inverse() * top.1;
+                let relative = base.1.inverse().mul_portable(top.1);
                 let relative = if relative.w < 0.0 {
                     -relative
                 } else {
@@ -146,7 +151,9 @@ impl Chain {
                 let (mut p, mut q) = base;
                 for k in 1..=last {
                     p += q * (self.points[k] - self.points[k - 1]);
-                    q = base.1 * Quat::IDENTITY.slerp(relative, self.fractions[k]);
+                    q = base
+                        .1
+                        .mul_portable(Quat::IDENTITY.slerp_portable(relative, self.fractions[k]));
                     if k < last {
                         put(k, (p, q));
                     }
@@ -199,10 +206,12 @@ fn bind_frames(points: &[Vec3]) -> (Quat, Quat) {
         .and_then(|&m| arc_tangent(a, m, b))
         .unwrap_or(o);
     let tb = 2.0 * ta.dot(o) * o - ta;
-    let frame_a = Quat::from_rotation_arc(Vec3::X, ta);
+    let frame_a = Quat::from_rotation_arc_portable(Vec3::X, ta);
     (
         frame_a,
-        (Quat::from_rotation_arc(ta, tb) * frame_a).normalize(),
+        Quat::from_rotation_arc_portable(ta, tb)
+            .mul_portable(frame_a)
+            .normalize_portable(),
     )
 }
 
@@ -228,10 +237,10 @@ struct Arc {
 
 impl Arc {
     fn new(a: (Vec3, Quat), b: (Vec3, Quat), frame_a: Quat, frame_b: Quat) -> Self {
-        let (f0, f1) = (a.1 * frame_a, b.1 * frame_b);
+        let (f0, f1) = (a.1.mul_portable(frame_a), b.1.mul_portable(frame_b));
         let (ta, tb) = (f0 * Vec3::X, f1 * Vec3::X);
         let cross = ta.cross(tb);
-        let psi = cross.length().atan2(ta.dot(tb));
+        let psi = trig::atan2(cross.length(), ta.dot(tb));
         Self {
             start: a.0,
             ta,
@@ -249,17 +258,21 @@ impl Arc {
     fn at(&self, s: f32) -> (Vec3, Quat) {
         let h = half_sinc;
         let x = self.psi * s;
-        let along = self.ta * (2.0 * h(x) * (x / 2.0).cos())
+        let along = self.ta * (2.0 * h(x) * trig::cos(x / 2.0))
             + self.n.cross(self.ta) * (2.0 * x * h(x) * h(x));
         let turn = if self.n == Vec3::ZERO {
             Quat::IDENTITY
         } else {
-            Quat::from_axis_angle(self.n, x)
+            Quat::from_axis_angle_portable(self.n, x)
         };
-        let twist = Quat::from_axis_angle(turn * self.ta, self.tau * s);
+        let twist = Quat::from_axis_angle_portable(turn * self.ta, self.tau * s);
         (
             self.start + along * (self.length * s),
-            (twist * turn * self.f0 * self.ga.slerp(self.gb, s)).normalize(),
+            twist
+                .mul_portable(turn)
+                .mul_portable(self.f0)
+                .mul_portable(self.ga.slerp_portable(self.gb, s))
+                .normalize_portable(),
         )
     }
 }

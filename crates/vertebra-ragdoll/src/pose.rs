@@ -4,6 +4,7 @@
 //! bind, where body axes are world axes).
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
 use vertebra_world::{check_coordinate, check_unit_quat};
 
 use crate::description::RagdollDesc;
@@ -37,7 +38,12 @@ impl Pose {
         let bones = self
             .bones
             .iter()
-            .map(|&(p, q)| (pivot + rotation * (p - pivot) + translation, rotation * q))
+            .map(|&(p, q)| {
+                (
+                    pivot + rotation * (p - pivot) + translation,
+                    rotation.mul_portable(q),
+                )
+            })
             .collect();
         Self { bones }
     }
@@ -73,7 +79,7 @@ impl Pose {
             for (k, j) in desc.joints.iter().enumerate() {
                 if let (Some((pp, pq)), None) = (bones[j.parent], bones[j.child]) {
                     let anchor = pp + pq * (j.anchor - desc.bodies[j.parent].centre());
-                    let q = (pq * rotations[k]).normalize();
+                    let q = pq.mul_portable(rotations[k]).normalize_portable();
                     bones[j.child] =
                         Some((anchor + q * (desc.bodies[j.child].centre() - j.anchor), q));
                 }

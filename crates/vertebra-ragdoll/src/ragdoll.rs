@@ -3,6 +3,7 @@
 
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
+use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
@@ -606,7 +607,7 @@ pub(crate) fn rod_name(desc: &RagdollDesc) -> String {
 fn measured_from_bind(mut rod: RodDesc) -> RodDesc {
     use core::f32::consts::PI;
     let (ta, tb) = (rod.frame_a * Vec3::X, rod.frame_b * Vec3::X);
-    let bend = ta.cross(tb).length().atan2(ta.dot(tb));
+    let bend = vertebra_math::trig::atan2(ta.cross(tb).length(), ta.dot(tb));
     let twist = vertebra_world::rod_twist(rod.frame_a, rod.frame_b);
     rod.bend_rest = (rod.frame_a.inverse() * tb).normalize();
     rod.twist_rest = twist;
@@ -619,7 +620,7 @@ fn measured_from_bind(mut rod: RodDesc) -> RodDesc {
 
 /// Velocities that carry `from` to `to` in `dt` seconds.
 fn velocities(from: (Vec3, Quat), to: (Vec3, Quat), dt: f32) -> (Vec3, Vec3) {
-    let turn = vertebra_math::Quat::<f32>::from(to.1 * from.1.conjugate());
+    let turn = vertebra_math::Quat::<f32>::from(to.1.mul_portable(from.1.conjugate()));
     (
         (to.0 - from.0) / dt,
         Vec3::from(turn.to_rotation_vector()) / dt,

@@ -11,6 +11,7 @@
 //! first bone converts a local pose to model space.
 
 use core::ops::Mul;
+use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
 use vertebra_world::{MAX_COORDINATE, check_unit_quat};
@@ -99,7 +100,7 @@ impl Transform {
                 field: "rotation",
                 reason: format!(
                     "has length {}; must be a unit quaternion (within 1e-3)",
-                    self.rotation.length()
+                    self.rotation.length_portable()
                 ),
             },
         })
@@ -113,7 +114,7 @@ impl Mul for Transform {
     fn mul(self, b: Transform) -> Transform {
         Transform {
             translation: self.transform_point(b.translation),
-            rotation: (self.rotation * b.rotation).normalize(),
+            rotation: self.rotation.mul_portable(b.rotation).normalize_portable(),
         }
     }
 }
@@ -268,7 +269,7 @@ impl LocalPose {
 /// the checks' tolerance would otherwise scale the translations it turns
 /// by its squared length.
 fn unit(t: Transform) -> Transform {
-    Transform::new(t.translation, t.rotation.normalize())
+    Transform::new(t.translation, t.rotation.normalize_portable())
 }
 
 impl ModelPose {

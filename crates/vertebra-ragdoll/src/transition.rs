@@ -23,7 +23,7 @@ use crate::mapper::{BoneRole, SkeletonMapper};
 use crate::mapping::SpineMapping;
 use crate::ragdoll::Ragdoll;
 use crate::skeleton::{LocalPose, ModelPose, Transform};
-use vertebra_math::DefaultFloatMode;
+use vertebra_math::{DefaultFloatMode, PortableQuat};
 
 /// The chain bones' offsets from the mapping at the switch to ragdoll.
 ///
@@ -202,5 +202,5 @@ impl Transition {
 
 /// A rotation's angle (rad, in [0, pi]).
 fn angle(q: Quat) -> f32 {
-    2.0 * q.xyz().length().atan2(q.w.abs())
+    Quat::IDENTITY.angle_between_portable(q)
 }

@@ -1,6 +1,8 @@
 //! Figure 6: where the end of the spine can go, a rod against chains of
 //! sockets, in the plane of bending (kinematics only).
 
+use vertebra_math::trig;
+
 /// End-point loci in the bending plane (m): x forward, y up from the base.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Locus {
@@ -20,8 +22,8 @@ fn chain_end(length: f32, angles: &[f32]) -> [f32; 2] {
     let (mut heading, mut x, mut y) = (0.0f32, 0.0f32, 0.0f32);
     for &a in angles {
         heading += a / 2.0;
-        x += heading.sin() * length / n;
-        y += heading.cos() * length / n;
+        x += trig::sin(heading) * length / n;
+        y += trig::cos(heading) * length / n;
         heading += a / 2.0;
     }
     [x, y]
@@ -37,7 +39,7 @@ pub fn kinematics(length: f32, limit: f32, samples: usize) -> Locus {
         .iter()
         .map(|&psi| {
             let chord = 2.0 * length * vertebra_math::poly::half_sinc(psi);
-            [chord * (psi / 2.0).sin(), chord * (psi / 2.0).cos()]
+            [chord * trig::sin(psi / 2.0), chord * trig::cos(psi / 2.0)]
         })
         .collect();
     let mut chains = Vec::new();

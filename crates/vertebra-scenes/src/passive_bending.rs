@@ -2,6 +2,7 @@
 //! degrees and left to slump.
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
 use vertebra_ragdoll::{Pose, RagdollDesc, RagdollError};
 use vertebra_world::World;
 
@@ -17,7 +18,7 @@ pub(crate) fn build(
 ) -> Result<SceneWorld, RagdollError> {
     let pose = Pose::bind(desc).moved(
         Vec3::new(0.0, 1.0, 0.0),
-        Quat::from_rotation_x(30f32.to_radians()),
+        Quat::from_rotation_x_portable(30f32.to_radians()),
         Vec3::ZERO,
     );
     let pose = seeded(pose, desc, config.seed, 0);

@@ -2,6 +2,7 @@
 
 use glam::{Quat, Vec3};
 use vertebra_collide::{Collider, ColliderShape, Collisions};
+use vertebra_math::{PortableQuat, trig};
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
 use vertebra_world::{BodyDesc, Shape, World};
 
@@ -83,7 +84,7 @@ pub fn ragdoll_drop(
             fixed(
                 &mut world,
                 centre(pit) + at,
-                Quat::from_rotation_y(turn),
+                Quat::from_rotation_y_portable(turn),
                 ColliderShape::Solid(Shape::Box { half_extents: half }),
             )?;
         }
@@ -94,8 +95,9 @@ pub fn ragdoll_drop(
         let (pit, k) = (index / RAGDOLLS_PER_PIT, index % RAGDOLLS_PER_PIT);
         let (layer, slot) = (k / 3, k % 3);
         let yaw = (37.0 * layer as f32).to_radians();
-        let turn = Quat::from_rotation_y(yaw) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
-        let u = Vec3::new(yaw.cos(), 0.0, -yaw.sin());
+        let turn = Quat::from_rotation_y_portable(yaw)
+            .mul_portable(Quat::from_rotation_x_portable(std::f32::consts::FRAC_PI_2));
+        let u = Vec3::new(trig::cos(yaw), 0.0, -trig::sin(yaw));
         let at = centre(pit)
             + Vec3::new(0.0, 1.0 + 0.5 * layer as f32, 0.0)
             + u * (0.6 * (slot as f32 - 1.0));

@@ -9,7 +9,7 @@ use vertebra_ragdoll::{Pose, Ragdoll, RagdollError};
 use vertebra_world::{BodyHandle, Contact, JointHandle, RodHandle, World};
 
 use crate::{Frame, Scene};
-use vertebra_math::DefaultFloatMode;
+use vertebra_math::{DefaultFloatMode, PortableQuat};
 
 /// A built scene: its world, collisions and ragdolls, and what is
 /// measured. [`SceneWorld::advance`] runs one frame as [`run`](crate::run)
@@ -176,7 +176,8 @@ impl SceneWorld {
                 for (i, body) in ragdoll.bodies.iter().enumerate() {
                     if let Some(state) = body.and_then(|b| world.body(b).ok()) {
                         deviation_cm += (state.position - target.bones[i].0).length() * 100.0;
-                        deviation_rad += state.orientation.angle_between(target.bones[i].1);
+                        deviation_rad +=
+                            state.orientation.angle_between_portable(target.bones[i].1);
                     }
                 }
             }

@@ -9,6 +9,7 @@
 //! seeded scene is the same on every backend, thread count and machine.
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
 
 /// The largest horizontal offset of a seeded start (m).
 pub const MAX_OFFSET: f32 = 1.0e-3;
@@ -33,5 +34,5 @@ pub fn perturbation(seed: u64, index: usize) -> (Vec3, Quat) {
         (z >> 40) as f32 / (1u64 << 23) as f32 - 1.0
     };
     let offset = Vec3::new(unit() * MAX_OFFSET, 0.0, unit() * MAX_OFFSET);
-    (offset, Quat::from_rotation_y(unit() * MAX_TURN))
+    (offset, Quat::from_rotation_y_portable(unit() * MAX_TURN))
 }

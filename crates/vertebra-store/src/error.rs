@@ -2,6 +2,7 @@
 //! wrong with which input, and leaves the world as it was.
 
 use core::fmt;
+use vertebra_math::PortableQuat;
 
 use crate::BodyHandle;
 
@@ -143,7 +144,7 @@ pub(crate) fn finite(what: &'static str, values: &[f32]) -> Result<(), Error> {
 /// Checks a finite quaternion of unit length (within 1e-3).
 pub fn check_unit_quat(what: &'static str, q: glam::Quat) -> Result<(), Error> {
     finite(what, &q.to_array())?;
-    if (q.length() - 1.0).abs() > 1e-3 {
+    if (q.length_portable() - 1.0).abs() > 1e-3 {
         return Err(Error::NotNormalized(what));
     }
     Ok(())

@@ -2,6 +2,7 @@
 //! the body handle's slot.
 
 use glam::{DVec3, Mat3, Quat, Vec3};
+use vertebra_math::PortableQuat;
 
 use crate::error::{
     Error, MAX_COORDINATE, check_coordinate, check_finite, check_point, check_unit_quat,
@@ -356,7 +357,7 @@ impl BodyStore {
         self.kind[i] = desc.kind;
         self.position[i] = desc.position;
         self.position_low[i] = Vec3::ZERO;
-        self.orientation[i] = desc.orientation.normalize();
+        self.orientation[i] = desc.orientation.normalize_portable();
         self.linear_velocity[i] = velocity;
         self.angular_velocity[i] = spin;
         self.mass[i] = derived.mass;
@@ -454,7 +455,7 @@ impl BodyStore {
         check_unit_quat("orientation", orientation)?;
         self.position[i] = position;
         self.position_low[i] = Vec3::ZERO;
-        self.orientation[i] = orientation.normalize();
+        self.orientation[i] = orientation.normalize_portable();
         Ok(())
     }
 

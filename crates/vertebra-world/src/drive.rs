@@ -4,6 +4,7 @@
 //! is in `vertebra_kernels::parts::drive`; the guide in `docs/ragdolls.md`.
 
 use core::f32::consts::TAU;
+use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
 use vertebra_kernels::driven::DriveLane;
@@ -125,7 +126,7 @@ impl AngularDrive {
     /// refused when the drive is added or set, as any drive's velocity.
     pub fn following(mut self, prev: Quat, pose: Quat, dt: f32) -> Result<Self, Error> {
         crate::checks::following_time_step(dt)?;
-        let turn = vertebra_math::Quat::<f32>::from(pose * prev.conjugate());
+        let turn = vertebra_math::Quat::<f32>::from(pose.mul_portable(prev.conjugate()));
         self.target = prev;
         self.target_velocity = Vec3::from(turn.to_rotation_vector()) / dt;
         Ok(self)
@@ -154,7 +155,7 @@ impl AngularDrive {
             }
         };
         DriveLane {
-            target: self.target.normalize(),
+            target: self.target.normalize_portable(),
             velocity: self.target_velocity,
             compliance,
             period2,

@@ -50,6 +50,7 @@
 
 use glam::{DVec3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
+use vertebra_math::PortableQuat;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error};
 
 use crate::{Contact, JointDesc, RodDesc};
@@ -61,7 +62,7 @@ use crate::{Contact, JointDesc, RodDesc};
 /// `v = 2 sin(a / 2) axis`, twice the turn's vector part (in the body
 /// frame, where `I` is given).
 fn mass_moved_squared(bodies: &BodyStore, i: usize, from: (DVec3, Quat), to: (DVec3, Quat)) -> f64 {
-    let turn = from.1.inverse() * to.1;
+    let turn = from.1.inverse().mul_portable(to.1);
     let v = (2.0 * Vec3::new(turn.x, turn.y, turn.z)).as_dvec3();
     let inertia = bodies.inertia[i].as_dmat3();
     let spread = v.dot(inertia * v) / f64::from(bodies.mass[i]);

@@ -2,6 +2,7 @@
 //! validation. See `docs/joints.md` for each kind's parts and units.
 
 use glam::{Quat, Vec3};
+use vertebra_math::PortableQuat;
 
 use crate::drive::{AngularDrive, validate_drive};
 use serde::{Deserialize, Serialize};
@@ -278,8 +279,8 @@ fn frames_at(
         body_b,
         anchor_a: a.orientation.inverse() * (anchor - a.position),
         anchor_b: b.orientation.inverse() * (anchor - b.position),
-        frame_a: a.orientation.inverse() * joint,
-        frame_b: b.orientation.inverse() * joint,
+        frame_a: a.orientation.inverse().mul_portable(joint),
+        frame_b: b.orientation.inverse().mul_portable(joint),
         kind,
         drive: None,
         breaking: None,
@@ -301,7 +302,7 @@ impl JointDesc {
     ) -> Result<Self, Error> {
         let _mode = DefaultFloatMode::enter();
         check_unit_vec("twist axis", twist_axis)?;
-        let joint = Quat::from_rotation_arc(Vec3::X, twist_axis.normalize());
+        let joint = Quat::from_rotation_arc_portable(Vec3::X, twist_axis.normalize());
         let kind = JointKind::Socket(SwingTwist::FREE);
         frames_at(bodies, body_a, body_b, anchor, joint, kind)
     }
@@ -319,7 +320,7 @@ impl JointDesc {
     ) -> Result<Self, Error> {
         let _mode = DefaultFloatMode::enter();
         check_unit_vec("hinge axis", axis)?;
-        let joint = Quat::from_rotation_arc(Vec3::X, axis.normalize());
+        let joint = Quat::from_rotation_arc_portable(Vec3::X, axis.normalize());
         let kind = JointKind::Hinge {
             range: None,
             softness: LimitSoftness::Hard,

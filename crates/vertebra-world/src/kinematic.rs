@@ -13,6 +13,7 @@
 
 use glam::{Quat, Vec3};
 use vertebra_math::DefaultFloatMode;
+use vertebra_math::PortableQuat;
 use vertebra_store::{
     BodyHandle, BodyKind, Error, MAX_TIME_STEP, MIN_TIME_STEP, check_coordinate, check_positive,
     check_unit_quat,
@@ -133,8 +134,11 @@ impl World {
         }
         let travel = position.as_dvec3() - self.bodies.precise_position(i);
         let linear = (travel / f64::from(dt)).as_vec3();
-        let angular =
-            step::angular_velocity(orientation.normalize(), self.bodies.orientation[i], dt);
+        let angular = step::angular_velocity(
+            orientation.normalize_portable(),
+            self.bodies.orientation[i],
+            dt,
+        );
         let (max_linear, max_angular) =
             (self.config.max_linear_speed, self.config.max_angular_speed);
         if linear.length_squared() > max_linear * max_linear {

@@ -14,6 +14,7 @@
 use core::f32::consts::PI;
 use core::ops::Range;
 use std::collections::BTreeSet;
+use vertebra_math::PortableQuat;
 
 use vertebra_kernels::body::BodyPairs;
 use vertebra_kernels::fixed::{FixedBlock, FixedLane};
@@ -469,8 +470,8 @@ pub(crate) fn socket_lane(desc: &JointDesc, limits: &SwingTwist, bodies: &BodySt
         dynamic_b,
         anchor_a: desc.anchor_a,
         anchor_b: desc.anchor_b,
-        frame_a: desc.frame_a.normalize(),
-        frame_b: desc.frame_b.normalize(),
+        frame_a: desc.frame_a.normalize_portable(),
+        frame_b: desc.frame_b.normalize_portable(),
         swing_max: plain_cone,
         twist: limits.twist.unwrap_or([-PI, PI]),
         drive: desc.drive.map(|d| d.lane()),
@@ -511,8 +512,8 @@ pub(crate) fn hinge_lane(
         dynamic_b,
         anchor_a: desc.anchor_a,
         anchor_b: desc.anchor_b,
-        frame_a: desc.frame_a.normalize(),
-        frame_b: desc.frame_b.normalize(),
+        frame_a: desc.frame_a.normalize_portable(),
+        frame_b: desc.frame_b.normalize_portable(),
         range: range.unwrap_or([-PI, PI]),
         softness: softness.lane(),
         drive: desc.drive.map(|d| d.lane()),
@@ -529,8 +530,8 @@ pub(crate) fn fixed_lane(desc: &JointDesc, bodies: &BodyStore) -> FixedLane {
         dynamic_b,
         anchor_a: desc.anchor_a,
         anchor_b: desc.anchor_b,
-        frame_a: desc.frame_a.normalize(),
-        frame_b: desc.frame_b.normalize(),
+        frame_a: desc.frame_a.normalize_portable(),
+        frame_b: desc.frame_b.normalize_portable(),
     }
 }
 
@@ -542,8 +543,8 @@ pub(crate) fn rod_lane(desc: &RodDesc, bodies: &BodyStore) -> RodLane {
         body_b,
         dynamic_a,
         dynamic_b,
-        frame_a: desc.frame_a.normalize(),
-        frame_b: desc.frame_b.normalize(),
+        frame_a: desc.frame_a.normalize_portable(),
+        frame_b: desc.frame_b.normalize_portable(),
         rest_length: desc.rest_length,
         bend_rest: desc.bend_rest.normalize(),
         twist_rest: desc.twist_rest,

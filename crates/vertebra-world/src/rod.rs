@@ -2,6 +2,7 @@
 //! pose of its two bodies (paper section 6).
 
 use core::f32::consts::{PI, TAU};
+use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
@@ -176,13 +177,22 @@ impl RodDesc {
         }
         let tb = 2.0 * ta.dot(o) * o - ta;
         let rest_length = chord.length() / (2.0 * half_sinc(psi));
-        let material_a = Quat::from_rotation_arc(a.orientation * Vec3::X, ta) * a.orientation;
-        let material_b = Quat::from_rotation_arc(ta, tb) * material_a;
+        let material_a = Quat::from_rotation_arc_portable(a.orientation * Vec3::X, ta)
+            .mul_portable(a.orientation);
+        let material_b = Quat::from_rotation_arc_portable(ta, tb).mul_portable(material_a);
         Ok(Self {
             body_a,
             body_b,
-            frame_a: (a.orientation.inverse() * material_a).normalize(),
-            frame_b: (b.orientation.inverse() * material_b).normalize(),
+            frame_a: a
+                .orientation
+                .inverse()
+                .mul_portable(material_a)
+                .normalize_portable(),
+            frame_b: b
+                .orientation
+                .inverse()
+                .mul_portable(material_b)
+                .normalize_portable(),
             rest_length,
             bend_rest: (material_a.inverse() * tb).normalize(),
             twist_rest: 0.0,
@@ -233,7 +243,7 @@ impl RodDesc {
     ) -> Result<Self, Error> {
         crate::checks::following_time_step(dt)?;
         let (bend, twist) = prev;
-        let turn = vertebra_math::Quat::<f32>::from(Quat::from_rotation_arc(bend, pose.0));
+        let turn = vertebra_math::Quat::<f32>::from(Quat::from_rotation_arc_portable(bend, pose.0));
         self.bend_rest = bend;
         self.twist_rest = twist;
         self.bend_rest_velocity = Vec3::from(turn.to_rotation_vector()) / dt;

@@ -418,13 +418,16 @@ fn gyroscopic(w: Vec3, inertia: glam::Mat3, h: f32) -> Vec3 {
 fn integrate(q: Quat, w: Vec3, h: f32) -> Quat {
     let (axis, speed) = vertebra_math::Vec3::<f32>::from(w).normalize_or_zero();
     let turn = vertebra_math::Quat::<f32>::from_axis_angle(axis, speed * h);
-    glam::Quat::from(turn * q.into()).normalize()
+    vertebra_math::PortableQuat::normalize_portable(glam::Quat::from(turn * q.into()))
 }
 
 /// The angular velocity that turns `q0` into `q` in `h` seconds, exactly
 /// (the inverse of [`integrate`]): `log(q q0*) / h`, shortest arc.
 pub(crate) fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
-    let turn = vertebra_math::Quat::<f32>::from(q * q0.conjugate());
+    let turn = vertebra_math::Quat::<f32>::from(vertebra_math::PortableQuat::mul_portable(
+        q,
+        q0.conjugate(),
+    ));
     Vec3::from(turn.to_rotation_vector()) / h
 }
 

@@ -332,8 +332,8 @@ fn joint_lane(d: &JointDesc) -> JointLane {
         body_b: d.body_b.index() as u32 + 1,
         anchor_a: d.anchor_a,
         anchor_b: d.anchor_b,
-        frame_a: d.frame_a.normalize(),
-        frame_b: d.frame_b.normalize(),
+        frame_a: vertebra_math::PortableQuat::normalize_portable(d.frame_a),
+        frame_b: vertebra_math::PortableQuat::normalize_portable(d.frame_b),
         ..JointLane::FREE
     };
     match d.kind {
@@ -365,8 +365,8 @@ fn rod_lane(d: &RodDesc) -> JointLane {
         body_b: d.body_b.index() as u32 + 1,
         anchor_a: glam::Vec3::ZERO,
         anchor_b: glam::Vec3::ZERO,
-        frame_a: d.frame_a.normalize(),
-        frame_b: d.frame_b.normalize(),
+        frame_a: vertebra_math::PortableQuat::normalize_portable(d.frame_a),
+        frame_b: vertebra_math::PortableQuat::normalize_portable(d.frame_b),
         rest_length: d.rest_length,
         swing_max: d.bend_limit.unwrap_or(PI),
         twist: d.twist_limit.unwrap_or([-PI, PI]),

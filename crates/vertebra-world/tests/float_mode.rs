@@ -1,11 +1,12 @@
 //! A step gives the same bits whatever floating-point mode its caller runs
-//! in: here a host that set flush-to-zero and denormals-are-zero (as game
-//! engines do), on its own thread and on the threads it creates.
-#![cfg(target_arch = "x86_64")]
+//! in: here a host that set flush-to-zero (with denormals-are-zero on
+//! x86-64, as game engines do; FPCR.FZ on AArch64), on its own thread and
+//! on the threads it creates.
+#![cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
 
-mod mxcsr;
+mod host_mode;
 
-use mxcsr::{read_mxcsr, write_mxcsr};
+use host_mode::{FLUSH, ROUNDING, read_mode, write_mode};
 
 use glam::Vec3;
 use vertebra_world::{
@@ -13,19 +14,16 @@ use vertebra_world::{
     World,
 };
 
-/// MXCSR's flush-to-zero (bit 15) and denormals-are-zero (bit 6).
-const FTZ_DAZ: u32 = 0x8040;
-
-/// Runs `f` with FTZ and DAZ set on this thread, as a host would.
+/// Runs `f` with flush-to-zero set on this thread, as a host would.
 fn as_a_host_with_ftz_daz<T>(f: impl FnOnce() -> T) -> T {
-    let before = read_mxcsr();
-    write_mxcsr(before | FTZ_DAZ);
+    let before = read_mode();
+    write_mode(before | FLUSH);
     let out = f();
-    let during = read_mxcsr();
-    write_mxcsr(before);
+    let during = read_mode();
+    write_mode(before);
     assert_eq!(
-        during & FTZ_DAZ,
-        FTZ_DAZ,
+        during & FLUSH,
+        FLUSH,
         "the step gave the host its mode back"
     );
     out
@@ -122,13 +120,14 @@ fn ftz_and_daz_on_the_callers_threads_change_no_bit() {
     }
 }
 
-/// Runs `f` with `bits` set in MXCSR on this thread (FTZ and DAZ, or
-/// 0x6000: round toward zero), then gives the thread its mode back.
-fn in_mode<T>(bits: u32, f: impl FnOnce() -> T) -> T {
-    let before = read_mxcsr();
-    write_mxcsr(before | bits);
+/// Runs `f` with `bits` set in the control register on this thread
+/// (flush-to-zero, or round toward zero), then gives the thread its mode
+/// back.
+fn in_mode<T>(bits: u64, f: impl FnOnce() -> T) -> T {
+    let before = read_mode();
+    write_mode(before | bits);
     let out = f();
-    write_mxcsr(before);
+    write_mode(before);
     out
 }
 
@@ -158,7 +157,7 @@ fn adding_a_body_does_not_depend_on_the_callers_mode() {
         w
     };
     let reference = world();
-    for bits in [FTZ_DAZ, 0x6000] {
+    for bits in [FLUSH, ROUNDING[2].1] {
         let host = in_mode(bits, world);
         assert_eq!(host.state_hash(), reference.state_hash(), "mode {bits:#x}");
         let mut fresh = World::new(SolverConfig::default()).unwrap();
@@ -199,7 +198,7 @@ fn setting_a_rod_does_not_depend_on_the_callers_mode() {
     let ((mut w1, r1), (mut w2, r2)) = (build(), build());
     w1.set_rod(r1, tiny(&w1, r1)).unwrap();
     let d2 = tiny(&w2, r2);
-    in_mode(FTZ_DAZ, || w2.set_rod(r2, d2)).expect("accepted as in the default mode");
+    in_mode(FLUSH, || w2.set_rod(r2, d2)).expect("accepted as in the default mode");
     for _ in 0..60 {
         w1.step(1.0 / 60.0).unwrap();
         w2.step(1.0 / 60.0).unwrap();

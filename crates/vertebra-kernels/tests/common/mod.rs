@@ -6,9 +6,9 @@ use rand::RngExt;
 use rand::rngs::StdRng;
 use vertebra_kernels::body::{BodyRows, StartLane};
 use vertebra_kernels::limited::LimitLane;
-use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::check::same_bits;
+use vertebra_math::{Backend, PortableQuat};
 
 /// Body rows as plain floats: pose, inverse inertia, velocity.
 pub type RawRows = Vec<[[f32; 8]; 3]>;
@@ -20,7 +20,7 @@ pub fn unit_quat(r: &mut StdRng) -> Quat {
         r.random_range(-1.0..1.0),
         r.random_range(-1.0..1.0),
     )
-    .normalize()
+    .normalize_portable()
 }
 
 pub fn vec(r: &mut StdRng, scale: f32) -> Vec3 {

@@ -6,6 +6,17 @@ use crate::row::{ROW_LEN, Row};
 
 impl Mask for bool {}
 
+/// The comparison `min`/`max` select by. On AArch64 it passes through
+/// [`super::neon::opaque_mask`]: LLVM there turns `if x < 0.0 { x } else
+/// { 0.0 }` into `FMINNM`, which gives `-0.0` for `x = -0.0` where the
+/// contract (and x86-64's `minss`) gives `0.0`.
+#[inline(always)]
+fn opaque_test(test: bool) -> bool {
+    #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+    let test = super::neon::opaque_mask(test as u32) != 0;
+    test
+}
+
 /// 2^23: from here on every `f32` is an integer.
 const ROUND_LIMIT: f32 = 8_388_608.0;
 
@@ -50,11 +61,19 @@ impl Lane for f32 {
     }
     #[inline(always)]
     fn min(self, other: Self) -> Self {
-        if self < other { self } else { other }
+        if opaque_test(self < other) {
+            self
+        } else {
+            other
+        }
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
-        if self > other { self } else { other }
+        if opaque_test(self > other) {
+            self
+        } else {
+            other
+        }
     }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
