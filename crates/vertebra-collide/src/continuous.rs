@@ -10,11 +10,24 @@
 //! after the step, each **fast** body (an awake dynamic body whose motion
 //! in the step, `|dx| + |dtheta| r_max` with `r_max` its collider's
 //! reach from its centre of mass, exceeds its **thickness**: a sphere's or
-//! capsule's radius, a box's smallest half extent) is swept from its pose before the step to its pose after it
-//! (translation and rotation together: parry's nonlinear shape cast)
-//! against every static solid collider, and if it would have passed into
-//! one it is put back where it first touched, its velocity kept, for the
-//! next step's contacts to stop.
+//! capsule's radius, a box's smallest half extent) is swept from its pose
+//! before the step to its pose after it against every static solid
+//! collider, and if it would have passed into one it is put back where it
+//! first touched, its velocity kept, for the next step's contacts to stop.
+//!
+//! **The sweep** moves the translation linearly and the rotation by the
+//! normalised linear blend of the two orientations (Box2D's sweep), and
+//! finds the first touch by conservative advancement (Mirtich): from the
+//! core's distance `d` to the static solid at time `t`, no point of it can
+//! close that gap before `t + d / s`, where `s` bounds the speed of every
+//! point of the core over the blend, `|dx| + 4 tan(theta / 4) r_max` (the
+//! blend turns fastest at its middle, `4 tan(theta / 4)` for a whole turn
+//! of `theta`, at most 1.28 `theta`). Every operation in it has the same
+//! bits on every target (the portable quaternion operations; parry's
+//! distance between poses made relative first, as the contacts are), so
+//! a world with fast bodies steps the same everywhere; parry's nonlinear
+//! cast takes its rotations from the platform's sine and cosine and
+//! glam's per-target quaternion product.
 //!
 //! **What is swept is the body's core**: its collider shrunk by half its
 //! thickness (a capsule or sphere of half the radius, a box inset by half
@@ -29,11 +42,64 @@
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::query::NonlinearRigidMotion;
 use parry3d::shape::{Ball, Capsule, Cuboid, Shape as ParryShape};
+use vertebra_math::PortableQuat;
 use vertebra_world::{BodyHandle, BodyKind, Error, Shape, World};
 
-use crate::{ColliderShape, Collisions};
+use crate::{ColliderShape, Collisions, relative_pose};
+
+/// A core this close to a static solid (m) has touched it: where the
+/// advancement stops. The body is put back this far short of the core's
+/// touch, so still half its thickness less this inside the solid's
+/// surface, for the next step's contacts.
+const TOUCH: f32 = 1e-3;
+
+/// Advancements before a sweep settles for the time it reached: still
+/// short of the touch (the core is still apart there), so a body is never
+/// put back past it.
+const MAX_ADVANCES: usize = 32;
+
+/// A body's motion over the step, from its pose before (`t` = 0) to its
+/// pose after (`t` = 1).
+struct Sweep {
+    from: Vec3,
+    by: Vec3,
+    start: Quat,
+    /// The orientation after, on the same side as `start` (`start . end`
+    /// >= 0), so the blend takes the shorter way.
+    end: Quat,
+    /// A bound on the speed of every point within `reach` of the body's
+    /// centre (m per unit of `t`).
+    speed: f32,
+}
+
+impl Sweep {
+    fn new(before: &Pose, position: Vec3, orientation: Quat, reach: f32) -> Self {
+        let cos_half = before.rotation.dot_portable(orientation);
+        let end = if cos_half < 0.0 {
+            -orientation
+        } else {
+            orientation
+        };
+        // 4 tan(theta / 4) = 4 sin(theta / 2) / (1 + cos(theta / 2)).
+        let c = cos_half.abs().min(1.0);
+        let turn_rate = 4.0 * (1.0 - c * c).sqrt() / (1.0 + c);
+        let by = position - before.translation;
+        Self {
+            from: before.translation,
+            by,
+            start: before.rotation,
+            end,
+            speed: by.length() + turn_rate * reach,
+        }
+    }
+
+    /// The pose at `t` in `[0, 1]`.
+    fn at(&self, t: f32) -> Pose {
+        let blend = self.start * (1.0 - t) + self.end * t;
+        Pose::from_parts(self.from + self.by * t, blend.normalize_portable())
+    }
+}
 
 /// A body's motion is fast when it exceeds this fraction of its thickness
 /// in a step. Box2D v3 sweeps from half; at half, a limb of the 30-ragdoll
@@ -120,7 +186,7 @@ impl Collisions {
         if statics.is_empty() {
             return;
         }
-        let mut first: Vec<(BodyHandle, f32, NonlinearRigidMotion)> = Vec::new();
+        let mut first: Vec<(BodyHandle, f32, Sweep)> = Vec::new();
         for (k, (collider, shape)) in self.colliders.iter().enumerate() {
             let (Some(start), ColliderShape::Solid(solid)) = (self.found.before[k], collider.shape)
             else {
@@ -132,44 +198,36 @@ impl Collisions {
             if world.bodies().kind[collider.body.index()] != BodyKind::Dynamic {
                 continue;
             }
-            // The shortest arc from the pose before to the pose after.
-            let turn = now.orientation * start.rotation.inverse();
-            let turn = if turn.w < 0.0 { -turn } else { turn };
             let reach = shape.compute_local_bounding_sphere().radius;
-            let moved =
-                (now.position - start.translation).length() + turn.to_axis_angle().1.abs() * reach;
+            let turn = start.rotation.angle_between_portable(now.orientation);
+            let moved = (now.position - start.translation).length() + turn * reach;
             if moved.is_nan() || moved <= FAST * thickness(&solid) {
                 continue;
             }
-            let motion = NonlinearRigidMotion::new(
-                start,
-                Vec3::ZERO,
-                now.position - start.translation,
-                turn.to_scaled_axis(),
-            );
+            let sweep = Sweep::new(&start, now.position, now.orientation, reach);
             let end = Pose::from_parts(now.position, now.orientation);
             let swept = shape.compute_aabb(&start).merged(&shape.compute_aabb(&end));
-            if let Some(t) = self.first_touch(statics, &solid, &motion, &swept) {
-                first.push((collider.body, t, motion));
+            if let Some(t) = self.first_touch(statics, &solid, &sweep, &swept) {
+                first.push((collider.body, t, sweep));
             }
         }
         // A body's earliest touch over its colliders, bodies in slot order.
         first.sort_by(|x, y| (x.0.index().cmp(&y.0.index())).then(x.1.total_cmp(&y.1)));
         first.dedup_by_key(|x| x.0);
-        out.extend(first.into_iter().map(|(body, t, motion)| {
-            let pose = motion.position_at_time(t);
-            (body, pose.translation, pose.rotation.normalize())
+        out.extend(first.into_iter().map(|(body, t, sweep)| {
+            let pose = sweep.at(t);
+            (body, pose.translation, pose.rotation)
         }));
     }
 
     /// The earliest time in `(0, 1)` at which `solid`'s core, moving by
-    /// `motion` over the step (time 1), touches a static solid collider
+    /// `sweep` over the step (time 1), touches a static solid collider
     /// whose bounds meet `swept`.
     fn first_touch(
         &self,
         statics: &[(usize, Aabb, Pose)],
         solid: &Shape,
-        motion: &NonlinearRigidMotion,
+        sweep: &Sweep,
         swept: &Aabb,
     ) -> Option<f32> {
         let mut first: Option<f32> = None;
@@ -177,26 +235,47 @@ impl Collisions {
             if !bounds.intersects(swept) {
                 continue;
             }
-            let shape = &self.colliders[k].1;
-            let fixed = NonlinearRigidMotion::constant_position(pose);
-            let hit = with_core(solid, |core| {
-                parry3d::query::cast_shapes_nonlinear(
-                    motion,
-                    core,
-                    &fixed,
-                    shape.as_ref(),
-                    0.0,
-                    1.0,
-                    true,
-                )
-            });
-            if let Ok(Some(hit)) = hit
-                && hit.time_of_impact > 0.0
-                && hit.time_of_impact < 1.0
-            {
-                first = Some(first.map_or(hit.time_of_impact, |t| t.min(hit.time_of_impact)));
+            let shape = self.colliders[k].1.as_ref();
+            if let Some(t) = with_core(solid, |core| advance(core, shape, &pose, sweep)) {
+                first = Some(first.map_or(t, |f| f.min(t)));
             }
         }
         first
     }
+}
+
+/// Conservative advancement of `core` along `sweep` toward `shape` at
+/// `pose` (module docs): the time in `(0, 1)` it comes within [`TOUCH`]
+/// (or the time [`MAX_ADVANCES`] reached), or `None` when it never does
+/// or overlaps already at the start. A core that starts nearer than
+/// `2 TOUCH` (one put back the step before) stops at half its starting
+/// gap instead, so it is stopped again rather than left alone, while one
+/// moving away is let go.
+fn advance(
+    core: &dyn ParryShape,
+    shape: &dyn ParryShape,
+    pose: &Pose,
+    sweep: &Sweep,
+) -> Option<f32> {
+    let gap_at = |t: f32| {
+        let relative = relative_pose(&sweep.at(t), pose);
+        parry3d::query::distance(&Pose::IDENTITY, core, &relative, shape).map(|d| d.distance)
+    };
+    let mut gap = gap_at(0.0).ok()?;
+    if gap <= 0.0 {
+        return None;
+    }
+    let touch = TOUCH.min(0.5 * gap);
+    let mut t = 0.0f32;
+    for _ in 0..MAX_ADVANCES {
+        t += gap / sweep.speed;
+        if t >= 1.0 {
+            return None;
+        }
+        gap = gap_at(t).ok()?;
+        if gap <= touch {
+            return Some(t);
+        }
+    }
+    Some(t)
 }

@@ -990,7 +990,7 @@ fn wake_touched(scratch: &mut Detection, world: &World, found: &[Contact]) -> bo
 /// by [`PortableQuat::mul_portable`] (glam's product has other bits on
 /// other targets) and the translation turned as parry turns it (`Quat *
 /// Vec3`, the same bits everywhere).
-fn relative_pose(a: &Pose, b: &Pose) -> Pose {
+pub(crate) fn relative_pose(a: &Pose, b: &Pose) -> Pose {
     let turn = a.rotation.inverse();
     Pose::from_parts(
         turn * (b.translation - a.translation),

@@ -26,13 +26,15 @@ use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNode, BvhWorkspace};
 use parry3d::query::{Ray, ShapeCastOptions};
 use parry3d::shape::{Ball, Capsule, Shape as ParryShape};
-use vertebra_math::DefaultFloatMode;
+use vertebra_math::{DefaultFloatMode, PortableQuat};
 use vertebra_world::{
     BodyHandle, BodyKind, Error, MAX_COORDINATE, Timeline, World, check_point, check_unit_quat,
     check_unit_vec,
 };
 
-use crate::{ColliderShape, CollisionGroups, Collisions, MAX_COLLIDER_EXTENT, RagdollPart};
+use crate::{
+    ColliderShape, CollisionGroups, Collisions, MAX_COLLIDER_EXTENT, RagdollPart, relative_pose,
+};
 
 /// Which colliders a query sees (Rapier's `QueryFilter`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -457,7 +459,7 @@ impl Collisions {
         let direction = check_travel(position, direction, max_distance)?;
         self.check_queryable(world)?;
         let reach = max_distance.min(MAX_QUERY_DISTANCE);
-        let start = Pose::from_parts(position, orientation.normalize());
+        let start = Pose::from_parts(position, orientation.normalize_portable());
         shape.with(|query| {
             let at_start = query.compute_aabb(&start);
             let end = Pose::from_parts(position + direction * reach, start.rotation);
@@ -475,11 +477,13 @@ impl Collisions {
                 }
                 let (_, other) = &self.colliders[k];
                 let pose = self.pose_of(world, k);
+                // In the query's frame, composed as the contacts are: the
+                // same bits on every target.
                 let Ok(Some(hit)) = parry3d::query::cast_shapes(
-                    &start,
-                    direction,
+                    &Pose::IDENTITY,
+                    start.rotation.inverse() * direction,
                     query,
-                    &pose,
+                    &relative_pose(&start, &pose),
                     Vec3::ZERO,
                     other.as_ref(),
                     options,
@@ -531,7 +535,7 @@ impl Collisions {
         check_point("query position", position)?;
         check_unit_quat("query orientation", orientation)?;
         self.check_queryable(world)?;
-        let pose = Pose::from_parts(position, orientation.normalize());
+        let pose = Pose::from_parts(position, orientation.normalize_portable());
         shape.with(|query| {
             let region = query.compute_aabb(&pose);
             self.candidates(world, &region, |k| {
@@ -540,9 +544,9 @@ impl Collisions {
                 }
                 let other = self.pose_of(world, k);
                 let touching = parry3d::query::intersection_test(
-                    &pose,
+                    &Pose::IDENTITY,
                     query,
-                    &other,
+                    &relative_pose(&pose, &other),
                     self.colliders[k].1.as_ref(),
                 )
                 .is_ok_and(|i| i.intersecting);
