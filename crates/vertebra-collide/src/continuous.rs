@@ -34,9 +34,13 @@
 //! its smallest half extent). A body that only sinks into a wall or floor
 //! by less than that (a ragdoll landing 1 cm deep) is left to the contacts
 //! exactly as before: no pose is changed, so worlds whose bodies never
-//! pass that deep (every paper scene) keep every bit. A core already
-//! inside static geometry at the step's start is left alone (putting it
-//! back to its start would not get it out). Ground planes (half spaces)
+//! pass that deep (every paper scene) keep every bit. A core that starts
+//! the step touching static geometry (a limb pressed against a wall, or
+//! put back against it the step before) is swept instead as a ball of a
+//! quarter of its thickness at its centre (Box2D v3's fallback): it may
+//! slide along the wall, not cross it. One whose ball starts inside too is
+//! left alone (putting it back to its start would not get it out).
+//! Ground planes (half spaces)
 //! cannot be passed through: their contacts push out of any depth.
 
 use glam::{Quat, Vec3};
@@ -48,15 +52,14 @@ use vertebra_world::{BodyHandle, BodyKind, Error, Shape, World};
 
 use crate::{ColliderShape, Collisions, relative_pose};
 
-/// A core this close to a static solid (m) has touched it: where the
-/// advancement stops. The body is put back this far short of the core's
-/// touch, so still half its thickness less this inside the solid's
-/// surface, for the next step's contacts.
-const TOUCH: f32 = 1e-3;
+/// How far short of a static solid (m) a swept core (or centre ball) is
+/// put back: the advancement aims for this gap and stops within
+/// `SKIN / 2` above it, never below. A probe that starts the step nearer
+/// than `SKIN` touches already.
+const SKIN: f32 = 2e-3;
 
 /// Advancements before a sweep settles for the time it reached: still
-/// short of the touch (the core is still apart there), so a body is never
-/// put back past it.
+/// `SKIN` short of the touch, so a body is never put back past it.
 const MAX_ADVANCES: usize = 32;
 
 /// A body's motion over the step, from its pose before (`t` = 0) to its
@@ -236,7 +239,11 @@ impl Collisions {
                 continue;
             }
             let shape = self.colliders[k].1.as_ref();
-            if let Some(t) = with_core(solid, |core| advance(core, shape, &pose, sweep)) {
+            let touch = match with_core(solid, |core| advance(core, shape, &pose, sweep)) {
+                Ok(touch) => touch,
+                Err(_) => hold_centre(&centre(solid), shape, &pose, sweep),
+            };
+            if let Some(t) = touch {
                 first = Some(first.map_or(t, |f| f.min(t)));
             }
         }
@@ -244,38 +251,72 @@ impl Collisions {
     }
 }
 
-/// Conservative advancement of `core` along `sweep` toward `shape` at
-/// `pose` (module docs): the time in `(0, 1)` it comes within [`TOUCH`]
-/// (or the time [`MAX_ADVANCES`] reached), or `None` when it never does
-/// or overlaps already at the start. A core that starts nearer than
-/// `2 TOUCH` (one put back the step before) stops at half its starting
-/// gap instead, so it is stopped again rather than left alone, while one
-/// moving away is let go.
-fn advance(
-    core: &dyn ParryShape,
+/// A ball of a quarter of the solid's thickness at its centre: what is
+/// swept when the core starts touching (Box2D v3's fallback), so a limb
+/// pressed against a wall, or put back against it the step before, is
+/// still kept from crossing it while it may slide along it.
+fn centre(shape: &Shape) -> Ball {
+    Ball::new(0.25 * thickness(shape))
+}
+
+/// The centre ball's sweep (`centre`): advanced as a core is; one that
+/// starts within [`SKIN`] of `shape` (pressed in by its joints step after
+/// step) stays where it started (time 0) if its step ends nearer, and is
+/// let go if it slides along or away; one that starts inside is left
+/// alone.
+fn hold_centre(ball: &Ball, shape: &dyn ParryShape, pose: &Pose, sweep: &Sweep) -> Option<f32> {
+    match advance(ball, shape, pose, sweep) {
+        Ok(touch) => touch,
+        Err(start) if start > 0.0 => {
+            let end = gap(ball, shape, pose, sweep, 1.0).ok()?;
+            (end < start).then_some(0.0)
+        }
+        Err(_) => None,
+    }
+}
+
+/// `probe`'s distance (m) to `shape` at `pose` at time `t` of `sweep`,
+/// the poses made relative first (module docs).
+fn gap(
+    probe: &dyn ParryShape,
     shape: &dyn ParryShape,
     pose: &Pose,
     sweep: &Sweep,
-) -> Option<f32> {
-    let gap_at = |t: f32| {
-        let relative = relative_pose(&sweep.at(t), pose);
-        parry3d::query::distance(&Pose::IDENTITY, core, &relative, shape).map(|d| d.distance)
-    };
-    let mut gap = gap_at(0.0).ok()?;
-    if gap <= 0.0 {
-        return None;
+    t: f32,
+) -> Result<f32, ()> {
+    let relative = relative_pose(&sweep.at(t), pose);
+    parry3d::query::distance(&Pose::IDENTITY, probe, &relative, shape)
+        .map(|d| d.distance)
+        .map_err(|_| ())
+}
+
+/// Conservative advancement of `probe` along `sweep` toward `shape` at
+/// `pose` (module docs), aiming [`SKIN`] short of it: `Ok(Some(t))` with
+/// the time in `(0, 1)` it comes within `1.5 SKIN` (never nearer than
+/// `SKIN`; or the time [`MAX_ADVANCES`] reached), `Ok(None)` when it never
+/// does, `Err(gap)` with its gap at the start when that is `SKIN` or less
+/// (`-1` when parry has no distance for the pair).
+fn advance(
+    probe: &dyn ParryShape,
+    shape: &dyn ParryShape,
+    pose: &Pose,
+    sweep: &Sweep,
+) -> Result<Option<f32>, f32> {
+    let gap_at = |t| gap(probe, shape, pose, sweep, t).map_err(|()| -1.0);
+    let mut now = gap_at(0.0)?;
+    if now <= SKIN {
+        return Err(now);
     }
-    let touch = TOUCH.min(0.5 * gap);
     let mut t = 0.0f32;
     for _ in 0..MAX_ADVANCES {
-        t += gap / sweep.speed;
+        t += (now - SKIN) / sweep.speed;
         if t >= 1.0 {
-            return None;
+            return Ok(None);
         }
-        gap = gap_at(t).ok()?;
-        if gap <= touch {
-            return Some(t);
+        now = gap_at(t)?;
+        if now <= 1.5 * SKIN {
+            return Ok(Some(t));
         }
     }
-    Some(t)
+    Ok(Some(t))
 }
