@@ -13,11 +13,13 @@
 //! capsule's radius, a box's smallest half extent) is swept from its pose
 //! before the step to its pose after it against every static solid
 //! collider, and if it would have passed into one it is put back where it
-//! first touched, its velocity kept, for the next step's contacts to stop.
+//! was 2 to 3 mm short of its first touch (`SKIN`), its velocity kept,
+//! for the next step's contacts to stop.
 //!
 //! **The sweep** moves the translation linearly and the rotation by the
 //! normalised linear blend of the two orientations (Box2D's sweep), and
-//! finds the first touch by conservative advancement (Mirtich): from the
+//! finds the first touch (a gap under 10 um, `CONTACT`) by conservative
+//! advancement (Mirtich): from the
 //! core's distance `d` to the static solid at time `t`, no point of it can
 //! close that gap before `t + d / s`, where `s` bounds the speed of every
 //! point of the core over the blend, `|dx| + 4 tan(theta / 4) r_max` (the
@@ -35,13 +37,14 @@
 //! by less than that (a ragdoll landing 1 cm deep) is left to the contacts
 //! exactly as before: no pose is changed, so worlds whose bodies never
 //! pass that deep (every paper scene) keep every bit. A core that starts
-//! the step touching static geometry (a limb pressed against a wall, or
-//! put back against it the step before) is swept instead as a ball of a
-//! quarter of its thickness at its centre (Box2D v3's fallback): it may
-//! slide along the wall, not cross it. One whose ball starts inside too is
-//! left alone (putting it back to its start would not get it out).
-//! Ground planes (half spaces)
-//! cannot be passed through: their contacts push out of any depth.
+//! the step within `SKIN` of static geometry (a limb pressed against a
+//! wall, or put back against it the step before) is swept instead as a
+//! ball of a quarter of its thickness at its centre (Box2D v3's fallback):
+//! it may slide along the wall or leave it, not cross it; a ball that
+//! starts within `SKIN` too stays where it started if its step would end
+//! nearer. One whose ball starts inside is left alone (putting it back to
+//! its start would not get it out). Ground planes (half spaces) cannot be
+//! passed through: their contacts push out of any depth.
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
@@ -55,8 +58,12 @@ use crate::{ColliderShape, Collisions, relative_pose};
 /// How far short of a static solid (m) a swept core (or centre ball) is
 /// put back: the advancement aims for this gap and stops within
 /// `SKIN / 2` above it, never below. A probe that starts the step nearer
-/// than `SKIN` touches already.
+/// than `SKIN` is treated as touching already.
 const SKIN: f32 = 2e-3;
+
+/// A probe this near a solid (m) touches it: parry's distances between
+/// our shapes are good to about this.
+const CONTACT: f32 = 1e-5;
 
 /// Advancements before a sweep settles for the time it reached: still
 /// `SKIN` short of the touch, so a body is never put back past it.
@@ -291,11 +298,12 @@ fn gap(
 }
 
 /// Conservative advancement of `probe` along `sweep` toward `shape` at
-/// `pose` (module docs), aiming [`SKIN`] short of it: `Ok(Some(t))` with
-/// the time in `(0, 1)` it comes within `1.5 SKIN` (never nearer than
-/// `SKIN`; or the time [`MAX_ADVANCES`] reached), `Ok(None)` when it never
-/// does, `Err(gap)` with its gap at the start when that is `SKIN` or less
-/// (`-1` when parry has no distance for the pair).
+/// `pose` (module docs): `Ok(Some(t))` when the probe touches `shape` in
+/// the step (comes within [`CONTACT`]), with the time `t` in `(0, 1)` it
+/// was still [`SKIN`] to `1.5 SKIN` short of it (or the time
+/// [`MAX_ADVANCES`] reached, still short); `Ok(None)` when it never
+/// touches; `Err(gap)` with its gap at the start when that is `SKIN` or
+/// less (`-1` when parry has no distance for the pair).
 fn advance(
     probe: &dyn ParryShape,
     shape: &dyn ParryShape,
@@ -303,20 +311,39 @@ fn advance(
     sweep: &Sweep,
 ) -> Result<Option<f32>, f32> {
     let gap_at = |t| gap(probe, shape, pose, sweep, t).map_err(|()| -1.0);
-    let mut now = gap_at(0.0)?;
-    if now <= SKIN {
-        return Err(now);
+    let start = gap_at(0.0)?;
+    if start <= SKIN {
+        return Err(start);
     }
-    let mut t = 0.0f32;
+    // To SKIN short of the solid, where the probe would be put back ...
+    let Some((short, gap)) = approach(&gap_at, sweep.speed, 0.0, start, (SKIN, 1.5 * SKIN))? else {
+        return Ok(None);
+    };
+    // ... if it goes on to touch it in the step.
+    let touches = approach(&gap_at, sweep.speed, short, gap, (0.0, CONTACT))?.is_some();
+    Ok(touches.then_some(short))
+}
+
+/// Advances from time `t` (gap `gap`) toward `target` (m): the first
+/// time at or after `t` with a gap of `within` or less (never below
+/// `target`), with that gap, or `None` when the step ends first; after
+/// [`MAX_ADVANCES`] the time reached.
+fn approach(
+    gap_at: &impl Fn(f32) -> Result<f32, f32>,
+    speed: f32,
+    mut t: f32,
+    mut gap: f32,
+    (target, within): (f32, f32),
+) -> Result<Option<(f32, f32)>, f32> {
     for _ in 0..MAX_ADVANCES {
-        t += (now - SKIN) / sweep.speed;
+        if gap <= within {
+            return Ok(Some((t, gap)));
+        }
+        t += (gap - target) / speed;
         if t >= 1.0 {
             return Ok(None);
         }
-        now = gap_at(t)?;
-        if now <= 1.5 * SKIN {
-            return Ok(Some(t));
-        }
+        gap = gap_at(t)?;
     }
-    Ok(Some(t))
+    Ok(Some((t, gap)))
 }
