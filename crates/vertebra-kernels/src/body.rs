@@ -312,7 +312,7 @@ pub struct BodyPairs {
     /// padding (`vertebra_math::block::for_live_slices`). Zero (a zeroed
     /// header) runs every lane.
     pub padding: u32,
-    /// Nonzero: the direct solve (`crate::direct`) solves the equality
+    /// Nonzero: the direct solve (the `direct` module) solves the equality
     /// parts of every live lane (points, hinge axes, locks, the rod's curve
     /// and length), so the block's position pass leaves them out and
     /// solves only its limits, drives and soft parts. Zero (a zeroed
