@@ -63,6 +63,7 @@ use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Su
 
 use crate::row::{ROW_LEN, Row};
 
+mod by_lane;
 pub mod scalar;
 
 pub(crate) mod portable;
@@ -115,7 +116,7 @@ pub trait Lane:
     /// instruction set: `F32x4` for `F32x8` (entered with AVX2 and FMA, it
     /// is the VEX-encoded code of [`crate::Backend::Avx2x4`]), the type
     /// itself for every other. A block whose other half is padding runs on
-    /// it ([`crate::block::for_live_slices`]); every lane type gives the
+    /// it (`block::for_live_slices`); every lane type gives the
     /// same bits per lane, so the narrower one changes no result.
     type Narrow: Lane;
 

@@ -196,11 +196,11 @@ impl Lane for F32x4Portable {
     }
     #[inline(always)]
     fn gather_rows(rows: &[Row], indices: &[u32]) -> [Self; ROW_LEN] {
-        crate::row::gather_by_lane(rows, indices)
+        super::by_lane::gather_by_lane(rows, indices)
     }
     #[inline(always)]
     fn scatter_rows(values: &[Self; ROW_LEN], rows: &[Row], indices: &[u32]) {
-        crate::row::scatter_by_lane(values, rows, indices)
+        super::by_lane::scatter_by_lane(values, rows, indices)
     }
     #[inline(always)]
     fn reduce_add(self) -> f32 {
