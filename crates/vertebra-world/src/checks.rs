@@ -7,9 +7,6 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error};
 
 use crate::MAX_ANGULAR_SPEED_LIMIT;
 
-use crate::drive::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
-use crate::joint::LimitSoftness;
-
 /// The time step a drive or a rod follows an animation over: finite and at
 /// least [`MIN_TIME_STEP`](vertebra_store::MIN_TIME_STEP). A negative one
 /// would turn the target away from the animation, a zero one divide by
@@ -64,52 +61,6 @@ pub(crate) fn angle_range(limit: Option<[f32; 2]>, what: &'static str) -> Result
         Some([lo, hi]) if !lo.is_finite() || !hi.is_finite() => Err(Error::NonFinite(what)),
         Some([lo, hi]) if !(-PI <= lo && lo <= hi && hi <= PI) => Err(Error::InvalidLimit(what)),
         _ => Ok(()),
-    }
-}
-
-/// A limit's softness: the drive's ranges, each error naming the limit's
-/// field.
-pub(crate) fn softness(softness: LimitSoftness) -> Result<(), Error> {
-    let not_negative = |what, x: f32| {
-        if !x.is_finite() {
-            Err(Error::NonFinite(what))
-        } else if x < 0.0 {
-            Err(Error::NonPositive(what))
-        } else {
-            Ok(())
-        }
-    };
-    match softness {
-        LimitSoftness::Hard => Ok(()),
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => {
-            not_negative("limit compliance", compliance)?;
-            not_negative("limit damping", damping)?;
-            if compliance * damping > MAX_DRIVE_DAMPING_TIME {
-                return Err(Error::OutOfRange(
-                    "limit damping (compliance times damping at most 1e6 s)",
-                ));
-            }
-            Ok(())
-        }
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => {
-            if frequency.is_nan() {
-                return Err(Error::NonFinite("limit frequency"));
-            }
-            if frequency < MIN_DRIVE_FREQUENCY {
-                return Err(Error::OutOfRange("limit frequency (at least 1e-3 Hz)"));
-            }
-            not_negative("limit damping ratio", damping_ratio)?;
-            if damping_ratio > MAX_DRIVE_DAMPING_RATIO {
-                return Err(Error::OutOfRange("limit damping ratio (at most 1e3)"));
-            }
-            Ok(())
-        }
     }
 }
 

@@ -4,7 +4,10 @@
 use glam::{Quat, Vec3};
 use vertebra_math::PortableQuat;
 
-use crate::drive::{AngularDrive, validate_drive};
+use crate::drive::{
+    AngularDrive, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY,
+    validate_drive,
+};
 use serde::{Deserialize, Serialize};
 use vertebra_kernels::limited::LimitLane;
 use vertebra_math::DefaultFloatMode;
@@ -202,11 +205,9 @@ pub enum JointKind {
 /// Each body carries a joint frame (an anchor point and a rotation, in its
 /// body frame); every kind holds the anchors together, and the frames'
 /// relative rotation is what the kind limits (see [`JointKind`]).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(
-    from = "crate::joint_wire::JointWire",
-    into = "crate::joint_wire::JointWire"
-)]
+/// Serialised through its wire form (`joint_wire.rs`), which implements
+/// serde's traits for it.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointDesc {
     /// The parent body.
     pub body_a: BodyHandle,
@@ -410,9 +411,55 @@ impl JointDesc {
     }
 }
 
+/// A limit's softness: the drive's ranges, each error naming the limit's
+/// field.
+fn softness(softness: LimitSoftness) -> Result<(), Error> {
+    let not_negative = |what, x: f32| {
+        if !x.is_finite() {
+            Err(Error::NonFinite(what))
+        } else if x < 0.0 {
+            Err(Error::NonPositive(what))
+        } else {
+            Ok(())
+        }
+    };
+    match softness {
+        LimitSoftness::Hard => Ok(()),
+        LimitSoftness::Compliance {
+            compliance,
+            damping,
+        } => {
+            not_negative("limit compliance", compliance)?;
+            not_negative("limit damping", damping)?;
+            if compliance * damping > MAX_DRIVE_DAMPING_TIME {
+                return Err(Error::OutOfRange(
+                    "limit damping (compliance times damping at most 1e6 s)",
+                ));
+            }
+            Ok(())
+        }
+        LimitSoftness::Spring {
+            frequency,
+            damping_ratio,
+        } => {
+            if frequency.is_nan() {
+                return Err(Error::NonFinite("limit frequency"));
+            }
+            if frequency < MIN_DRIVE_FREQUENCY {
+                return Err(Error::OutOfRange("limit frequency (at least 1e-3 Hz)"));
+            }
+            not_negative("limit damping ratio", damping_ratio)?;
+            if damping_ratio > MAX_DRIVE_DAMPING_RATIO {
+                return Err(Error::OutOfRange("limit damping ratio (at most 1e3)"));
+            }
+            Ok(())
+        }
+    }
+}
+
 /// Checks a kind's limits and softness.
 fn validate_kind(kind: &JointKind) -> Result<(), Error> {
-    use crate::checks::{angle_range, max_angle, softness, twist_range};
+    use crate::checks::{angle_range, max_angle, twist_range};
     match *kind {
         JointKind::Socket(SwingTwist {
             swing,

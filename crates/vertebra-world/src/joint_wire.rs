@@ -14,7 +14,7 @@
 //! (variants 0 and 1), one with them after a third tag.
 
 use glam::{Quat, Vec3};
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use vertebra_store::BodyHandle;
 
 use crate::drive::AngularDrive;
@@ -124,5 +124,17 @@ impl From<JointWire> for JointDesc {
             drive,
             breaking,
         }
+    }
+}
+
+impl Serialize for JointDesc {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        JointWire::from(*self).serialize(serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for JointDesc {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        JointWire::deserialize(deserializer).map(Self::from)
     }
 }
