@@ -1265,24 +1265,6 @@ enum VtResult vt_collisions_set_body_groups(struct VtCollisions *collisions,
                                             uint32_t membership,
                                             uint32_t filter);
 
-// Sets the groups of every collider of a ragdoll.
-//
-// # Safety
-// `collisions` and `ragdoll` are live.
-enum VtResult vt_collisions_set_ragdoll_groups(struct VtCollisions *collisions,
-                                               struct VtRagdoll *ragdoll,
-                                               uint32_t membership,
-                                               uint32_t filter);
-
-// Lets a ragdoll's bodies collide with each other (non-zero; its jointed
-// pairs never do) or not (0).
-//
-// # Safety
-// `collisions` and `ragdoll` are live.
-enum VtResult vt_collisions_set_ragdoll_self_collision(struct VtCollisions *collisions,
-                                                       struct VtRagdoll *ragdoll,
-                                                       uint32_t collide);
-
 // Removes every collider on `body` (and its exclusions).
 //
 // # Safety
@@ -1914,6 +1896,24 @@ enum VtResult vt_ragdoll_joint(struct VtRagdoll *ragdoll,
 // # Safety
 // `ragdoll` is live; `body` is writable.
 enum VtResult vt_ragdoll_first_body(struct VtRagdoll *ragdoll, struct VtBody *body);
+
+// Sets the groups of every collider of a ragdoll.
+//
+// # Safety
+// `collisions` and `ragdoll` are live.
+enum VtResult vt_collisions_set_ragdoll_groups(struct VtCollisions *collisions,
+                                               struct VtRagdoll *ragdoll,
+                                               uint32_t membership,
+                                               uint32_t filter);
+
+// Lets a ragdoll's bodies collide with each other (non-zero; its jointed
+// pairs never do) or not (0).
+//
+// # Safety
+// `collisions` and `ragdoll` are live.
+enum VtResult vt_collisions_set_ragdoll_self_collision(struct VtCollisions *collisions,
+                                                       struct VtRagdoll *ragdoll,
+                                                       uint32_t collide);
 
 // Writes into `desc` a rod between two bodies that holds exactly at their
 // current poses: its arc through the middle of `through` (`count` world

@@ -8,9 +8,8 @@ use vertebra_world::Contact;
 use crate::body::{VtShape, VtShapeKind};
 use crate::error::{Failure, VtResult};
 use crate::ffi::{Object, boxed, call, enter, free, optional, out, read, slice};
-use crate::ragdoll::VtRagdoll;
 use crate::snapshot::VtBytes;
-use crate::types::{VtBody, VtVec3, flag, pick};
+use crate::types::{VtBody, VtVec3, pick};
 use crate::world::VtWorld;
 
 /// Colliders and the contacts they make (opaque; `vt_collisions_create`,
@@ -245,50 +244,6 @@ pub unsafe extern "C" fn vt_collisions_set_body_groups(
     unsafe {
         with_layer(collisions, |layer| {
             Ok(layer.collisions.set_body_groups(body.into(), groups)?)
-        })
-    }
-}
-
-/// Sets the groups of every collider of a ragdoll.
-///
-/// # Safety
-/// `collisions` and `ragdoll` are live.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn vt_collisions_set_ragdoll_groups(
-    collisions: *mut VtCollisions,
-    ragdoll: *mut VtRagdoll,
-    membership: u32,
-    filter: u32,
-) -> VtResult {
-    let groups = CollisionGroups { membership, filter };
-    // SAFETY: the function's contract.
-    unsafe {
-        with_layer(collisions, |layer| {
-            let ragdoll = enter(ragdoll)?;
-            Ok(layer
-                .collisions
-                .set_ragdoll_groups(&ragdoll.ragdoll, groups)?)
-        })
-    }
-}
-
-/// Lets a ragdoll's bodies collide with each other (non-zero; its jointed
-/// pairs never do) or not (0).
-///
-/// # Safety
-/// `collisions` and `ragdoll` are live.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn vt_collisions_set_ragdoll_self_collision(
-    collisions: *mut VtCollisions,
-    ragdoll: *mut VtRagdoll,
-    collide: u32,
-) -> VtResult {
-    // SAFETY: the function's contract.
-    unsafe {
-        with_layer(collisions, |layer| {
-            let ragdoll = enter(ragdoll)?;
-            let layer = &mut layer.collisions;
-            Ok(layer.set_ragdoll_self_collision(&ragdoll.ragdoll, flag(collide))?)
         })
     }
 }

@@ -4,13 +4,13 @@
 
 use std::path::Path;
 
-use vertebra_collide::Collisions;
+use vertebra_collide::{CollisionGroups, Collisions};
 use vertebra_ragdoll::{
     BuildOptions, DriveSettings, MAX_FILE_BYTES, Pose, Ragdoll, RagdollDesc, RagdollError,
     SpineMode, Strength,
 };
 
-use crate::collide::VtCollisions;
+use crate::collide::{VtCollisions, with_layer};
 use crate::error::{Failure, VtResult};
 use crate::ffi::{
     Object, bounded_text, boxed, call, copy_text, enter, free, index_of, optional, out, read,
@@ -857,4 +857,48 @@ pub unsafe extern "C" fn vt_ragdoll_first_body(
         })?;
         body.done(first.into())
     })
+}
+
+/// Sets the groups of every collider of a ragdoll.
+///
+/// # Safety
+/// `collisions` and `ragdoll` are live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_set_ragdoll_groups(
+    collisions: *mut VtCollisions,
+    ragdoll: *mut VtRagdoll,
+    membership: u32,
+    filter: u32,
+) -> VtResult {
+    let groups = CollisionGroups { membership, filter };
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let ragdoll = enter(ragdoll)?;
+            Ok(layer
+                .collisions
+                .set_ragdoll_groups(&ragdoll.ragdoll, groups)?)
+        })
+    }
+}
+
+/// Lets a ragdoll's bodies collide with each other (non-zero; its jointed
+/// pairs never do) or not (0).
+///
+/// # Safety
+/// `collisions` and `ragdoll` are live.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_collisions_set_ragdoll_self_collision(
+    collisions: *mut VtCollisions,
+    ragdoll: *mut VtRagdoll,
+    collide: u32,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let ragdoll = enter(ragdoll)?;
+            let layer = &mut layer.collisions;
+            Ok(layer.set_ragdoll_self_collision(&ragdoll.ragdoll, flag(collide))?)
+        })
+    }
 }
