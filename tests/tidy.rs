@@ -335,3 +335,133 @@ fn the_readme_quick_start_is_the_doctest() {
         "README.md's quick start differs from the doctest"
     );
 }
+
+/// Import circles between a crate's files still being taken apart: the
+/// crate and how many files its circle holds, a count that may only
+/// fall. Every other crate has none.
+const CIRCLES_LEFT: &[(&str, usize)] = &[("vertebra-ragdoll", 13)];
+
+/// A crate's files by module path (`a/b` for `src/a/b.rs` or
+/// `src/a/b/mod.rs`; `lib.rs` is the empty path), each with its text
+/// before its unit tests (which may reach anywhere).
+fn modules(src: &Path) -> Vec<(Vec<String>, String)> {
+    let root = root();
+    let prefix = src
+        .strip_prefix(&root)
+        .expect("under root")
+        .to_string_lossy()
+        .into_owned();
+    let mut out = Vec::new();
+    for (path, text) in sources() {
+        let Some(rel) = path.strip_prefix(&format!("{prefix}/")) else {
+            continue;
+        };
+        let mut module: Vec<String> = rel
+            .trim_end_matches(".rs")
+            .split('/')
+            .map(String::from)
+            .collect();
+        if matches!(
+            module.last().map(String::as_str),
+            Some("mod" | "lib" | "main")
+        ) {
+            module.pop();
+        }
+        let code = text.split("#[cfg(test)]").next().unwrap_or("").to_string();
+        out.push((module, code));
+    }
+    out
+}
+
+/// The modules `code` (in `module`) names by `crate::` or `super::` paths,
+/// each the longest prefix of the path that is a module of the crate
+/// other than its root.
+fn imports(module: &[String], code: &str, known: &[Vec<String>]) -> Vec<usize> {
+    let mut out = Vec::new();
+    for (kind, base) in [
+        ("crate", Vec::new()),
+        ("super", module[..module.len().saturating_sub(1)].to_vec()),
+    ] {
+        let pattern = format!("{kind}::");
+        for (at, _) in code.match_indices(&pattern) {
+            let before = code[..at].chars().next_back();
+            if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
+                continue;
+            }
+            let rest = &code[at + pattern.len()..];
+            let parts: Vec<String> = rest
+                .split("::")
+                .map(|p| {
+                    p.chars()
+                        .take_while(|c| c.is_alphanumeric() || *c == '_')
+                        .collect::<String>()
+                })
+                .take_while(|p| !p.is_empty())
+                .collect();
+            let target = (1..=parts.len()).rev().find_map(|k| {
+                let path: Vec<String> = base.iter().chain(&parts[..k]).cloned().collect();
+                known.iter().position(|m| *m == path)
+            });
+            if let Some(t) = target
+                && known[t] != module
+                && !known[t].is_empty()
+            {
+                out.push(t);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn no_import_circles_between_a_crates_files() {
+    let crates = root().join("crates");
+    let mut names: Vec<_> = fs::read_dir(&crates)
+        .expect("crates")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    for name in names {
+        let src = crates.join(&name).join("src");
+        if !src.is_dir() {
+            continue;
+        }
+        let modules = modules(&src);
+        let known: Vec<Vec<String>> = modules.iter().map(|(m, _)| m.clone()).collect();
+        let edges: Vec<Vec<usize>> = modules
+            .iter()
+            .map(|(m, code)| imports(m, code, &known))
+            .collect();
+        // Which modules each reaches (depth-first), then the largest set
+        // of modules that reach each other.
+        let reach = |from: usize| {
+            let mut seen = vec![false; known.len()];
+            let mut stack = edges[from].clone();
+            while let Some(n) = stack.pop() {
+                if !std::mem::replace(&mut seen[n], true) {
+                    stack.extend(&edges[n]);
+                }
+            }
+            seen
+        };
+        let reaches: Vec<Vec<bool>> = (0..known.len()).map(reach).collect();
+        let circle = |a: usize| -> Vec<String> {
+            (0..known.len())
+                .filter(|&b| reaches[a][b] && reaches[b][a])
+                .map(|b| known[b].join("/"))
+                .collect()
+        };
+        let largest = (0..known.len())
+            .map(circle)
+            .max_by_key(Vec::len)
+            .unwrap_or_default();
+        let allowed = CIRCLES_LEFT
+            .iter()
+            .find(|(c, _)| *c == name)
+            .map_or(0, |&(_, n)| n);
+        assert!(
+            largest.len() <= allowed,
+            "{name}: these files import each other in a circle (at most {allowed} may): {largest:?}"
+        );
+    }
+}
