@@ -8,13 +8,11 @@ use std::collections::{HashMap, HashSet};
 
 use vertebra_world::check_coordinate;
 
-use crate::description::{
-    BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef, finite, range,
-};
-use crate::drive::DriveSettings;
-use crate::drive_def::{check_drive, own_strengths};
-use crate::error::{Problems, RagdollError, first};
+use crate::drive::{DriveSettings, Strength};
+use crate::drive_def::damping_for_compliance;
+use crate::error::{Problems, RagdollError, finite, first, range};
 use crate::joint_def::{JointDef, JointSpec, check_joint, half_turn, resolve};
+use crate::model::{BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef};
 use crate::skeleton::{Skeleton, Transform};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
 use crate::text::item;
@@ -707,4 +705,58 @@ fn rod_limits(
         twist_stiffness >= 0.0,
         "must not be negative",
     )
+}
+
+/// The joints' own strengths as the settings' per-joint list: each
+/// joint's, or none when no joint has its own.
+pub(crate) fn own_strengths(joints: &[JointDef]) -> Vec<Option<Strength>> {
+    if joints.iter().any(|j| j.drive.is_some()) {
+        joints.iter().map(|j| j.drive).collect()
+    } else {
+        Vec::new()
+    }
+}
+
+/// Checks a description's drive settings as the loader does: a joint's own
+/// strength needs settings to fall back on, the settings' per-joint list
+/// is the joints' own strengths, and every value is one the world takes.
+/// `context` names the `[drive]` table, `joint` a joint.
+pub(crate) fn check_drive(
+    drive: Option<&DriveSettings>,
+    joints: &[JointDef],
+    context: &str,
+    joint: impl Fn(usize) -> String,
+) -> Result<(), RagdollError> {
+    let Some(settings) = drive else {
+        return match joints.iter().position(|j| j.drive.is_some()) {
+            Some(k) => Err(RagdollError::OutOfRange {
+                context: joint(k),
+                field: "drive",
+                reason: "needs a [drive] table for the ragdoll's other joints".to_owned(),
+            }),
+            None => Ok(()),
+        };
+    };
+    damping_for_compliance(context, settings.strength, settings.damping != 0.0)?;
+    settings
+        .validate(joints.len())
+        .map_err(|e| in_context(context, e))?;
+    range(
+        context,
+        "joints",
+        settings.joints == own_strengths(joints),
+        "must be each joint's own strength (`JointDef::drive`), or empty when no joint has one",
+    )
+}
+
+/// `e`, said of the `[drive]` table at its line.
+fn in_context(context: &str, e: RagdollError) -> RagdollError {
+    match e {
+        RagdollError::OutOfRange { field, reason, .. } => RagdollError::OutOfRange {
+            context: context.to_owned(),
+            field,
+            reason,
+        },
+        other => other,
+    }
 }

@@ -12,8 +12,8 @@
 //! pose (metres for positions, radians for rotations), and `|w' - w|` is
 //! at most `1.5 dt / duration`.
 
-use crate::description::RagdollDesc;
 use crate::error::RagdollError;
+use crate::model::RagdollDesc;
 use crate::pose::Pose;
 use crate::skeleton::{LocalPose, Skeleton};
 use vertebra_math::DefaultFloatMode;

@@ -4,10 +4,8 @@
 
 use serde::Deserialize;
 
-use crate::description::{finite, range};
 use crate::drive::{DriveSettings, Strength};
-use crate::error::RagdollError;
-use crate::joint_def::JointDef;
+use crate::error::{RagdollError, finite, range};
 
 /// A strength as written: `strength = "infinite"`, `frequency` (Hz) with
 /// `damping_ratio`, or `compliance` (rad / (N m)).
@@ -98,7 +96,7 @@ pub(crate) fn drive_settings(raw: &RawDrive, context: &str) -> Result<DriveSetti
 }
 
 /// A damping (`given`) is for a compliance strength only.
-fn damping_for_compliance(
+pub(crate) fn damping_for_compliance(
     context: &str,
     strength: Strength,
     given: bool,
@@ -109,58 +107,4 @@ fn damping_for_compliance(
         !given || matches!(strength, Strength::Compliance(_)),
         "is for a compliance strength only (a spring's damping is its ratio)",
     )
-}
-
-/// The joints' own strengths as the settings' per-joint list: each
-/// joint's, or none when no joint has its own.
-pub(crate) fn own_strengths(joints: &[JointDef]) -> Vec<Option<Strength>> {
-    if joints.iter().any(|j| j.drive.is_some()) {
-        joints.iter().map(|j| j.drive).collect()
-    } else {
-        Vec::new()
-    }
-}
-
-/// Checks a description's drive settings as the loader does: a joint's own
-/// strength needs settings to fall back on, the settings' per-joint list
-/// is the joints' own strengths, and every value is one the world takes.
-/// `context` names the `[drive]` table, `joint` a joint.
-pub(crate) fn check_drive(
-    drive: Option<&DriveSettings>,
-    joints: &[JointDef],
-    context: &str,
-    joint: impl Fn(usize) -> String,
-) -> Result<(), RagdollError> {
-    let Some(settings) = drive else {
-        return match joints.iter().position(|j| j.drive.is_some()) {
-            Some(k) => Err(RagdollError::OutOfRange {
-                context: joint(k),
-                field: "drive",
-                reason: "needs a [drive] table for the ragdoll's other joints".to_owned(),
-            }),
-            None => Ok(()),
-        };
-    };
-    damping_for_compliance(context, settings.strength, settings.damping != 0.0)?;
-    settings
-        .validate(joints.len())
-        .map_err(|e| in_context(context, e))?;
-    range(
-        context,
-        "joints",
-        settings.joints == own_strengths(joints),
-        "must be each joint's own strength (`JointDef::drive`), or empty when no joint has one",
-    )
-}
-
-/// `e`, said of the `[drive]` table at its line.
-fn in_context(context: &str, e: RagdollError) -> RagdollError {
-    match e {
-        RagdollError::OutOfRange { field, reason, .. } => RagdollError::OutOfRange {
-            context: context.to_owned(),
-            field,
-            reason,
-        },
-        other => other,
-    }
 }

@@ -245,3 +245,39 @@ pub(crate) fn first(problems: Vec<RagdollError>) -> RagdollError {
         .next()
         .expect("a refusal has at least one problem")
 }
+
+/// `Ok` when every one of `values` is finite, else the error naming
+/// `context` and `field`.
+pub(crate) fn finite(
+    context: &str,
+    field: &'static str,
+    values: &[f32],
+) -> Result<(), RagdollError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(RagdollError::NonFinite {
+            context: context.to_owned(),
+            field,
+        })
+    }
+}
+
+/// `Ok` when `ok`, else the error naming `context` and `field`, with
+/// `reason`.
+pub(crate) fn range(
+    context: &str,
+    field: &'static str,
+    ok: bool,
+    reason: &str,
+) -> Result<(), RagdollError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(RagdollError::OutOfRange {
+            context: context.to_owned(),
+            field,
+            reason: reason.to_owned(),
+        })
+    }
+}

@@ -13,9 +13,9 @@ use core::f32::consts::PI;
 use glam::{Quat, Vec3};
 use vertebra_world::{JointKind, LimitSoftness, SwingTwist};
 
-use crate::description::RagdollDesc;
 use crate::error::RagdollError;
 use crate::joint_def::{JointFrame, JointSpec};
+use crate::model::RagdollDesc;
 use crate::skeleton::{Skeleton, Transform};
 use crate::spec::{BodySpec, SpineSpec};
 use vertebra_math::DefaultFloatMode;

@@ -14,10 +14,10 @@ use glam::Vec3;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::description::RagdollDesc;
 use crate::error::{Problems, RagdollError, first};
 use crate::generate::{BodyMass, BoneBody, RagdollGenerator, RodSpine, SegmentEnd};
 use crate::joint_def::RawBoneJoint;
+use crate::model::RagdollDesc;
 use crate::skeleton::Skeleton;
 use crate::text::{Lines, in_file, item, read_text, syntax, within_cap};
 use vertebra_math::DefaultFloatMode;

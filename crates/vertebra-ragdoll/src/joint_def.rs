@@ -13,10 +13,9 @@ use vertebra_world::{
     MIN_DRIVE_FREQUENCY, Swing, SwingTwist, check_coordinate, check_unit_quat,
 };
 
-use crate::description::{finite, range};
 use crate::drive::Strength;
 use crate::drive_def::RawStrength;
-use crate::error::RagdollError;
+use crate::error::{RagdollError, finite, range};
 
 /// A joint between a parent and a child body.
 #[derive(Clone, Debug, PartialEq)]

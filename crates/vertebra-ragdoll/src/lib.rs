@@ -125,6 +125,7 @@
 mod assemble;
 mod blend;
 mod blend_back;
+mod builder;
 mod description;
 mod drive;
 mod drive_def;
@@ -134,10 +135,13 @@ mod generate_file;
 mod joint_def;
 mod mapper;
 mod mapping;
+mod model;
 mod motion;
 mod partial;
 mod pose;
+mod pose_drive;
 mod ragdoll;
+mod read_back;
 mod skeleton;
 mod skeleton_file;
 mod spec;
@@ -146,20 +150,19 @@ mod transition;
 mod write;
 
 pub use blend_back::{Blend, BlendBack};
-pub use description::{
-    ANATOMICAL_HUMANOID, BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, REFERENCE_HUMANOID,
-    RagdollDesc, SpineDef,
-};
+pub use builder::RagdollBuilder;
+pub use description::{ANATOMICAL_HUMANOID, REFERENCE_HUMANOID};
 pub use drive::{DriveSettings, Strength};
 pub use error::RagdollError;
 pub use generate::{BodyMass, BoneBody, MIN_SEGMENT, RagdollGenerator, RodSpine, SegmentEnd};
 pub use joint_def::{JointDef, JointFrame, JointSpec};
 pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
+pub use model::{BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef, SpineMode};
 pub use pose::Pose;
-pub use ragdoll::{BuildOptions, JointAnchors, Ragdoll, RodRest, SpineMode, body_masses};
+pub use ragdoll::{BuildOptions, JointAnchors, Ragdoll, RodRest, body_masses};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
 pub use skeleton_file::REFERENCE_SKELETON;
-pub use spec::{BodyShape, BodySpec, RagdollBuilder, SpineSpec};
+pub use spec::{BodyShape, BodySpec, SpineSpec};
 pub use text::{MAX_FILE_BYTES, read_text};
 pub use transition::Transition;

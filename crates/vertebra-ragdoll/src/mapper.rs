@@ -34,13 +34,12 @@
 
 use glam::{Quat, Vec3};
 use vertebra_math::PortableQuat;
-use vertebra_world::World;
 
-use crate::description::RagdollDesc;
 use crate::error::RagdollError;
 use crate::mapping::{Chain, SpineMapping};
+use crate::model::RagdollDesc;
+use crate::model::{SpineMode, rod_name};
 use crate::pose::Pose;
-use crate::ragdoll::{Ragdoll, SpineMode, rod_name};
 use crate::skeleton::{Bone, LocalPose, ModelPose, Skeleton, Transform};
 use vertebra_math::DefaultFloatMode;
 
@@ -72,8 +71,8 @@ pub enum BoneRole {
 /// per skeleton, description and spine mode.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SkeletonMapper {
-    desc: RagdollDesc,
-    spine: SpineMode,
+    pub(crate) desc: RagdollDesc,
+    pub(crate) spine: SpineMode,
     skeleton: Skeleton,
     /// Per body, its bone.
     binding: Vec<usize>,
@@ -365,9 +364,10 @@ impl SkeletonMapper {
 
     /// Every body's world pose (centre of mass, rotation relative to bind)
     /// from an animation pose in model space and the model frame's place
-    /// in the world: for [`Ragdoll::build`] (two of them, a frame apart,
+    /// in the world: for [`Ragdoll::build`](crate::Ragdoll::build) (two of them, a frame apart,
     /// give the bodies the animation's velocities) and for
-    /// [`Ragdoll::drive_to`] / [`Ragdoll::drive_following`]. Refused,
+    /// [`Ragdoll::drive_to`](crate::Ragdoll::drive_to) /
+    /// [`Ragdoll::drive_following`](crate::Ragdoll::drive_following). Refused,
     /// naming the bone and field, for a pose that does not fit the
     /// skeleton.
     pub fn map_to_ragdoll(
@@ -388,33 +388,6 @@ impl SkeletonMapper {
             })
             .collect();
         Ok(Pose { bones })
-    }
-
-    /// Every bone's world transform from the ragdoll's bodies in `world`
-    /// and the animation's current local pose (for the bones without a
-    /// body that follow their parents or the model frame). `ragdoll` must
-    /// be built from the mapper's description and spine mode, and still be
-    /// in `world`: a removed ragdoll is refused
-    /// ([`RagdollError::Removed`], naming it), and so is one whose body or
-    /// rod is no longer in `world` (naming the body or rod).
-    pub fn map_to_skeleton(
-        &self,
-        ragdoll: &Ragdoll,
-        world: &World,
-        animation: &LocalPose,
-        model_to_world: Transform,
-        mapping: SpineMapping,
-    ) -> Result<ModelPose, RagdollError> {
-        let _mode = DefaultFloatMode::enter();
-        let (bodies, rod_frames) = self.read(ragdoll, world)?;
-        self.map(
-            &bodies,
-            rod_frames,
-            animation,
-            model_to_world,
-            mapping,
-            None,
-        )
     }
 
     /// As [`SkeletonMapper::map_to_skeleton`], from bodies given as a pose
@@ -448,54 +421,6 @@ impl SkeletonMapper {
             mapping,
             None,
         )
-    }
-
-    /// The bodies' world poses and the rod's frames, read from `world`.
-    pub(crate) fn read(&self, ragdoll: &Ragdoll, world: &World) -> Result<Bodies, RagdollError> {
-        // A removed ragdoll has no bodies to read: refused by name, where
-        // it used to map with every body at the world origin.
-        ragdoll.check_not_removed()?;
-        if ragdoll.options.spine != self.spine
-            || ragdoll.desc.name != self.desc.name
-            || ragdoll.desc.bodies.len() != self.desc.bodies.len()
-        {
-            return Err(RagdollError::OutOfRange {
-                context: "skeleton mapper".to_owned(),
-                field: "ragdoll",
-                reason: format!(
-                    "is `{}` ({} bodies, {:?} spine); the mapper was made for `{}` ({} bodies, {:?} spine)",
-                    ragdoll.desc.name,
-                    ragdoll.desc.bodies.len(),
-                    ragdoll.options.spine,
-                    self.desc.name,
-                    self.desc.bodies.len(),
-                    self.spine
-                ),
-            });
-        }
-        let mut bodies = vec![(Vec3::ZERO, Quat::IDENTITY); ragdoll.bodies.len()];
-        for ((out, handle), def) in bodies
-            .iter_mut()
-            .zip(&ragdoll.bodies)
-            .zip(&ragdoll.desc.bodies)
-        {
-            if let Some(h) = handle {
-                let s = world
-                    .body(*h)
-                    .map_err(|e| RagdollError::world(&format!("body `{}`", def.name), e))?;
-                *out = (s.position, s.orientation);
-            }
-        }
-        let rod_frames = match ragdoll.rod {
-            Some(rod) => {
-                let rod = world
-                    .rod(rod)
-                    .map_err(|e| RagdollError::world(&rod_name(&ragdoll.desc), e))?;
-                Some((rod.frame_a, rod.frame_b))
-            }
-            None => None,
-        };
-        Ok((bodies, rod_frames))
     }
 
     /// Writes each chain bone's world transform as its chain places it

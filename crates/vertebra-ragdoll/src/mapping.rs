@@ -19,11 +19,8 @@
 use glam::{Quat, Vec3};
 use vertebra_math::PortableQuat;
 use vertebra_math::trig;
-use vertebra_world::{World, arc_tangent, rod_twist};
+use vertebra_world::{arc_tangent, rod_twist};
 
-use crate::error::RagdollError;
-use crate::pose::Pose;
-use crate::ragdoll::Ragdoll;
 use crate::skeleton::Transform;
 use vertebra_math::DefaultFloatMode;
 
@@ -280,37 +277,4 @@ impl Arc {
 /// `sin(x/2) / x`, through the math layer (the kernels' own definition).
 fn half_sinc(x: f32) -> f32 {
     vertebra_math::poly::half_sinc(x)
-}
-
-impl Ragdoll {
-    /// The pose of every body as an animation bone (one bone per described
-    /// body, at its centre of mass, rotation relative to bind), from the
-    /// bodies in `world`; a simplified ragdoll's interior spine bodies are
-    /// placed by `mapping`. It is [`SkeletonMapper`](crate::SkeletonMapper) on a skeleton of one
-    /// bone per body (each at its centre of mass, unrotated at bind); for
-    /// an engine's own skeleton use the mapper.
-    pub fn skeleton_pose(
-        &self,
-        world: &World,
-        mapping: SpineMapping,
-    ) -> Result<Pose, RagdollError> {
-        let _mode = DefaultFloatMode::enter();
-        let mapper = &self.as_bones;
-        let model = mapper.map_to_skeleton(
-            self,
-            world,
-            &mapper.skeleton().bind_pose(),
-            Transform::IDENTITY,
-            mapping,
-        )?;
-        let bones = mapper
-            .binding()
-            .iter()
-            .map(|&bone| {
-                let t = model.bones[bone];
-                (t.translation, t.rotation)
-            })
-            .collect();
-        Ok(Pose { bones })
-    }
 }

@@ -5,8 +5,8 @@
 use glam::{Quat, Vec3};
 use vertebra_world::{BodyHandle, World};
 
-use crate::description::BodyDef;
 use crate::error::RagdollError;
+use crate::model::BodyDef;
 use crate::ragdoll::Ragdoll;
 use vertebra_math::DefaultFloatMode;
 

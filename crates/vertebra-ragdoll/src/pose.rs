@@ -7,8 +7,8 @@ use glam::{Quat, Vec3};
 use vertebra_math::PortableQuat;
 use vertebra_world::{check_coordinate, check_unit_quat};
 
-use crate::description::RagdollDesc;
 use crate::error::RagdollError;
+use crate::model::RagdollDesc;
 use vertebra_math::DefaultFloatMode;
 
 /// A world transform per bone.

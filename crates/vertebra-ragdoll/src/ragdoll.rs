@@ -11,21 +11,11 @@ use vertebra_world::{
     RodHandle, RodStiffness, Shape, World,
 };
 
-use crate::description::RagdollDesc;
 use crate::error::RagdollError;
 use crate::mapper::SkeletonMapper;
+use crate::model::{RagdollDesc, SpineMode, rod_name};
 use crate::pose::Pose;
 use vertebra_math::DefaultFloatMode;
-
-/// How the spine is simulated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum SpineMode {
-    /// The standard ragdoll: every spine body and its socket joints.
-    Sockets,
-    /// The simplified ragdoll: the spine's interior bodies removed (their
-    /// mass split equally onto the two ends) and one rod between the ends.
-    Rod,
-}
 
 /// What a simplified ragdoll's rod takes its rest shape and limits from.
 /// Either way the rod is made at the pose it is built at (its material
@@ -584,18 +574,6 @@ impl RagdollDesc {
             }),
             _ => Ok(()),
         }
-    }
-}
-
-/// How errors name a simplified ragdoll's spine rod: by its end bodies.
-pub(crate) fn rod_name(desc: &RagdollDesc) -> String {
-    match &desc.spine {
-        Some(spine) => format!(
-            "spine rod `{}`-`{}`",
-            desc.bodies[spine.bodies[0]].name,
-            desc.bodies[*spine.bodies.last().expect("a chain")].name
-        ),
-        None => "spine rod".to_owned(),
     }
 }
 

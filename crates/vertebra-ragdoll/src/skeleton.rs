@@ -320,7 +320,7 @@ impl LocalPose {
         let _mode = DefaultFloatMode::enter();
         skeleton.check("", &self.bones)?;
         skeleton.check("", &other.bones)?;
-        crate::blend::check_weights(weights, skeleton.len(), |k| {
+        check_weights(weights, skeleton.len(), |k| {
             bone_context(k, &skeleton.bones[k].name)
         })?;
         let bones = self
@@ -329,14 +329,56 @@ impl LocalPose {
             .zip(&other.bones)
             .zip(weights)
             .map(|((a, b), &w)| {
-                let (translation, rotation) = crate::blend::blend_bone(
-                    (a.translation, a.rotation),
-                    (b.translation, b.rotation),
-                    w,
-                );
+                let (translation, rotation) =
+                    blend_bone((a.translation, a.rotation), (b.translation, b.rotation), w);
                 Transform::new(translation, rotation)
             })
             .collect();
         Ok(LocalPose { bones })
+    }
+}
+
+/// Checks one weight per bone, each finite and in [0, 1]; `context(k)`
+/// names bone `k` in the error.
+pub(crate) fn check_weights(
+    weights: &[f32],
+    bones: usize,
+    context: impl Fn(usize) -> String,
+) -> Result<(), RagdollError> {
+    if weights.len() != bones {
+        return Err(RagdollError::OutOfRange {
+            context: "blend".to_owned(),
+            field: "weights",
+            reason: format!("has {} entries for {bones} bones", weights.len()),
+        });
+    }
+    for (k, &w) in weights.iter().enumerate() {
+        if !w.is_finite() {
+            return Err(RagdollError::NonFinite {
+                context: context(k),
+                field: "weight",
+            });
+        }
+        if !(0.0..=1.0).contains(&w) {
+            return Err(RagdollError::OutOfRange {
+                context: context(k),
+                field: "weight",
+                reason: format!("is {w}; must be within [0, 1]"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `a` and `b` blended at weight `w` (0: `a`, 1: `b`, exactly):
+/// translation `a (1 - w) + b w`, rotation along the shorter arc
+/// ([`PortableQuat::slerp_portable`]).
+pub(crate) fn blend_bone((pa, qa): (Vec3, Quat), (pb, qb): (Vec3, Quat), w: f32) -> (Vec3, Quat) {
+    if w == 0.0 {
+        (pa, qa)
+    } else if w == 1.0 {
+        (pb, qb)
+    } else {
+        (pa * (1.0 - w) + pb * w, qa.slerp_portable(qb, w))
     }
 }

@@ -7,9 +7,9 @@
 use glam::{Quat, Vec3};
 use vertebra_world::{JointKind, LimitSoftness, Swing};
 
-use crate::description::{BodyDef, RagdollDesc};
 use crate::drive::{DriveSettings, Strength};
 use crate::joint_def::{JointDef, frame, kind_name};
+use crate::model::{BodyDef, RagdollDesc};
 use crate::skeleton::{Skeleton, Transform};
 use crate::skeleton_file::write_bones;
 use crate::text::{float, floats, same_bits, string};
