@@ -299,17 +299,8 @@ pub unsafe extern "C" fn vt_ragdoll_desc_body_index(
     name: *const core::ffi::c_char,
     index: *mut usize,
 ) -> VtResult {
-    call(|| {
-        // SAFETY: the function's contract.
-        let desc = unsafe { shared(desc, "desc") }?;
-        let find = |name: &str| {
-            let found = desc.desc.body_index(name);
-            let why = || format!("the ragdoll has no body `{name}`");
-            found.ok_or_else(|| Failure::new(VtResult::Ragdoll, why()))
-        };
-        // SAFETY: the function's contract.
-        unsafe { index_of(name, index, find) }
-    })
+    // SAFETY: the function's contract.
+    unsafe { desc_index_by_name(desc, name, index, "body", RagdollDesc::body_index) }
 }
 
 /// Copies the name of body `index` with its NUL into `buffer` (`capacity`
@@ -328,19 +319,8 @@ pub unsafe extern "C" fn vt_ragdoll_desc_body_name(
     capacity: usize,
     length: *mut usize,
 ) -> VtResult {
-    call(|| {
-        // SAFETY: the function's contract.
-        let desc = unsafe { shared(desc, "desc") }?;
-        let body = desc.desc.bodies.get(index).ok_or_else(|| {
-            let n = desc.desc.bodies.len();
-            Failure::new(
-                VtResult::OutOfRange,
-                format!("body {index} of a ragdoll of {n}"),
-            )
-        })?;
-        // SAFETY: the function's contract.
-        unsafe { copy_text(&body.name, buffer, capacity, length) }
-    })
+    // SAFETY: the function's contract.
+    unsafe { desc_name(desc, index, BODIES, buffer, capacity, length) }
 }
 
 /// Writes the bind pose (every body at its description's place, unrotated;
@@ -753,17 +733,8 @@ pub unsafe extern "C" fn vt_ragdoll_desc_joint_index(
     name: *const core::ffi::c_char,
     index: *mut usize,
 ) -> VtResult {
-    call(|| {
-        // SAFETY: the function's contract.
-        let desc = unsafe { shared(desc, "desc") }?;
-        let find = |name: &str| {
-            let found = desc.desc.joint_index(name);
-            let why = || format!("the ragdoll has no joint `{name}`");
-            found.ok_or_else(|| Failure::new(VtResult::Ragdoll, why()))
-        };
-        // SAFETY: the function's contract.
-        unsafe { index_of(name, index, find) }
-    })
+    // SAFETY: the function's contract.
+    unsafe { desc_index_by_name(desc, name, index, "joint", RagdollDesc::joint_index) }
 }
 
 /// Copies the name of joint `index` with its NUL into `buffer` (`capacity`
@@ -781,19 +752,8 @@ pub unsafe extern "C" fn vt_ragdoll_desc_joint_name(
     capacity: usize,
     length: *mut usize,
 ) -> VtResult {
-    call(|| {
-        // SAFETY: the function's contract.
-        let desc = unsafe { shared(desc, "desc") }?;
-        let joint = desc.desc.joints.get(index).ok_or_else(|| {
-            let n = desc.desc.joints.len();
-            Failure::new(
-                VtResult::OutOfRange,
-                format!("joint {index} of a ragdoll of {n}"),
-            )
-        })?;
-        // SAFETY: the function's contract.
-        unsafe { copy_text(&joint.name, buffer, capacity, length) }
-    })
+    // SAFETY: the function's contract.
+    unsafe { desc_name(desc, index, JOINTS, buffer, capacity, length) }
 }
 
 /// Writes the handle of described joint `index` into `joint` and 1 into
@@ -901,4 +861,70 @@ pub unsafe extern "C" fn vt_collisions_set_ragdoll_self_collision(
             Ok(layer.set_ragdoll_self_collision(&ragdoll.ragdoll, flag(collide))?)
         })
     }
+}
+
+/// Writes the index of `desc`'s `what` (a body or joint) named `name`,
+/// found by `find`, into `index`.
+///
+/// # Safety
+/// `desc` is live; `name` is a NUL-terminated string; `index` is writable.
+unsafe fn desc_index_by_name(
+    desc: *const VtRagdollDesc,
+    name: *const core::ffi::c_char,
+    index: *mut usize,
+    what: &str,
+    find: fn(&RagdollDesc, &str) -> Option<usize>,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let desc = unsafe { shared(desc, "desc") }?;
+        let find = |name: &str| {
+            let why = || format!("the ragdoll has no {what} `{name}`");
+            find(&desc.desc, name).ok_or_else(|| Failure::new(VtResult::Ragdoll, why()))
+        };
+        // SAFETY: the function's contract.
+        unsafe { index_of(name, index, find) }
+    })
+}
+
+/// A kind of item a description lists (`"body"` or `"joint"`), how
+/// many it has and the name of one.
+type DescItem = (
+    &'static str,
+    fn(&RagdollDesc) -> usize,
+    fn(&RagdollDesc, usize) -> &str,
+);
+
+/// A description's bodies.
+const BODIES: DescItem = ("body", |d| d.bodies.len(), |d, k| &d.bodies[k].name);
+
+/// A description's joints.
+const JOINTS: DescItem = ("joint", |d| d.joints.len(), |d, k| &d.joints[k].name);
+
+/// Copies the name of `desc`'s item `index` of a kind (`BODIES`,
+/// `JOINTS`) with its NUL into `buffer` (`capacity` bytes) and its length
+/// with the NUL into `length`.
+///
+/// # Safety
+/// `desc` is live; `buffer` points to `capacity` writable bytes; `length`
+/// is writable.
+unsafe fn desc_name(
+    desc: *const VtRagdollDesc,
+    index: usize,
+    (what, count, name): DescItem,
+    buffer: *mut core::ffi::c_char,
+    capacity: usize,
+    length: *mut usize,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let desc = unsafe { shared(desc, "desc") }?;
+        let n = count(&desc.desc);
+        if index >= n {
+            let why = format!("{what} {index} of a ragdoll of {n}");
+            return Err(Failure::new(VtResult::OutOfRange, why));
+        }
+        // SAFETY: the function's contract.
+        unsafe { copy_text(name(&desc.desc, index), buffer, capacity, length) }
+    })
 }
