@@ -2,7 +2,7 @@
 //! count) benchmarks, so both measure exactly the same work.
 
 use glam::{Mat3, Quat as GQuat, Vec3 as GVec3};
-use vertebra_kernels::body::{BodyRows, StartLane};
+use vertebra_kernels::body::{BodyRows, JointFrames, LaneBlock, PairLane, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::driven::DriveLane;
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
@@ -204,14 +204,18 @@ impl SocketWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = SocketLane {
-                body_a,
-                body_b,
-                dynamic_a: true,
-                dynamic_b: true,
-                anchor_a: GVec3::new(0.05, 0.1, 0.0),
-                anchor_b: GVec3::new(-0.05, -0.1, 0.0),
-                frame_a: GQuat::IDENTITY,
-                frame_b: GQuat::from_rotation_z(0.3),
+                pair: PairLane {
+                    body_a,
+                    body_b,
+                    dynamic_a: true,
+                    dynamic_b: true,
+                },
+                frames: JointFrames {
+                    anchor_a: GVec3::new(0.05, 0.1, 0.0),
+                    anchor_b: GVec3::new(-0.05, -0.1, 0.0),
+                    frame_a: GQuat::IDENTITY,
+                    frame_b: GQuat::from_rotation_z(0.3),
+                },
                 swing_max: 0.2,
                 twist: [-0.1, 0.1],
                 drive: drive.then_some(DriveLane {
@@ -315,14 +319,18 @@ impl HingeWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = HingeLane {
-                body_a,
-                body_b,
-                dynamic_a: true,
-                dynamic_b: true,
-                anchor_a: GVec3::new(0.05, 0.1, 0.0),
-                anchor_b: GVec3::new(-0.05, -0.1, 0.0),
-                frame_a: GQuat::IDENTITY,
-                frame_b: GQuat::from_rotation_z(0.3),
+                pair: PairLane {
+                    body_a,
+                    body_b,
+                    dynamic_a: true,
+                    dynamic_b: true,
+                },
+                frames: JointFrames {
+                    anchor_a: GVec3::new(0.05, 0.1, 0.0),
+                    anchor_b: GVec3::new(-0.05, -0.1, 0.0),
+                    frame_a: GQuat::IDENTITY,
+                    frame_b: GQuat::from_rotation_z(0.3),
+                },
                 range: [0.0, 0.05],
                 softness: vertebra_kernels::limited::LimitLane::HARD,
                 drive: None,
@@ -368,14 +376,18 @@ impl FixedWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = FixedLane {
-                body_a,
-                body_b,
-                dynamic_a: true,
-                dynamic_b: true,
-                anchor_a: GVec3::new(0.05, 0.1, 0.0),
-                anchor_b: GVec3::new(-0.05, -0.1, 0.0),
-                frame_a: GQuat::IDENTITY,
-                frame_b: GQuat::from_rotation_z(0.3),
+                pair: PairLane {
+                    body_a,
+                    body_b,
+                    dynamic_a: true,
+                    dynamic_b: true,
+                },
+                frames: JointFrames {
+                    anchor_a: GVec3::new(0.05, 0.1, 0.0),
+                    anchor_b: GVec3::new(-0.05, -0.1, 0.0),
+                    frame_a: GQuat::IDENTITY,
+                    frame_b: GQuat::from_rotation_z(0.3),
+                },
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }
@@ -418,10 +430,12 @@ impl RodWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = RodLane {
-                body_a,
-                body_b,
-                dynamic_a: true,
-                dynamic_b: true,
+                pair: PairLane {
+                    body_a,
+                    body_b,
+                    dynamic_a: true,
+                    dynamic_b: true,
+                },
                 frame_a: GQuat::from_rotation_z(0.1),
                 frame_b: GQuat::from_rotation_z(0.5),
                 rest_length: 0.12,
@@ -483,10 +497,12 @@ impl ContactWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = ContactLane {
-                body_a,
-                body_b,
-                dynamic_a: true,
-                dynamic_b: true,
+                pair: PairLane {
+                    body_a,
+                    body_b,
+                    dynamic_a: true,
+                    dynamic_b: true,
+                },
                 point_a: GVec3::new(0.05, 0.12, 0.0),
                 point_b: GVec3::new(-0.04, -0.13, 0.01),
                 normal: GVec3::new(0.1, 1.0, 0.05).normalize(),

@@ -4,7 +4,7 @@
 use core::f32::consts::PI;
 
 use glam::{Mat3, Vec3};
-use vertebra_kernels::body::{BodyRows, StartLane};
+use vertebra_kernels::body::{BodyRows, JointFrames, LaneBlock, PairLane, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::direct::{self, JointLane, JointRows, SwingRows, Topology, TreeBlock};
 use vertebra_kernels::driven::{DriveLane, StartPass};
@@ -97,14 +97,18 @@ fn socket_block(input: &mut Input, rows: &RawRows) -> SocketBlock {
     for k in 0..BLOCK_LANES {
         let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
         let lane = SocketLane {
-            body_a,
-            body_b,
-            dynamic_a,
-            dynamic_b,
-            anchor_a: input.vec3(1.0),
-            anchor_b: input.vec3(1.0),
-            frame_a: input.quat(),
-            frame_b: input.quat(),
+            pair: PairLane {
+                body_a,
+                body_b,
+                dynamic_a,
+                dynamic_b,
+            },
+            frames: JointFrames {
+                anchor_a: input.vec3(1.0),
+                anchor_b: input.vec3(1.0),
+                frame_a: input.quat(),
+                frame_b: input.quat(),
+            },
             swing_max: input.float(PI).abs().min(PI),
             twist: sorted_range(input),
             drive: input.flag().then(|| drive_lane(input)),
@@ -152,14 +156,18 @@ fn hinge_block(input: &mut Input, rows: &RawRows) -> HingeBlock {
     for k in 0..BLOCK_LANES {
         let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
         let lane = HingeLane {
-            body_a,
-            body_b,
-            dynamic_a,
-            dynamic_b,
-            anchor_a: input.vec3(1.0),
-            anchor_b: input.vec3(1.0),
-            frame_a: input.quat(),
-            frame_b: input.quat(),
+            pair: PairLane {
+                body_a,
+                body_b,
+                dynamic_a,
+                dynamic_b,
+            },
+            frames: JointFrames {
+                anchor_a: input.vec3(1.0),
+                anchor_b: input.vec3(1.0),
+                frame_a: input.quat(),
+                frame_b: input.quat(),
+            },
             range: sorted_range(input),
             softness: limit_lane(input),
             drive: input.flag().then(|| drive_lane(input)),
@@ -175,14 +183,18 @@ fn fixed_block(input: &mut Input, rows: &RawRows) -> FixedBlock {
     for k in 0..BLOCK_LANES {
         let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
         let lane = FixedLane {
-            body_a,
-            body_b,
-            dynamic_a,
-            dynamic_b,
-            anchor_a: input.vec3(1.0),
-            anchor_b: input.vec3(1.0),
-            frame_a: input.quat(),
-            frame_b: input.quat(),
+            pair: PairLane {
+                body_a,
+                body_b,
+                dynamic_a,
+                dynamic_b,
+            },
+            frames: JointFrames {
+                anchor_a: input.vec3(1.0),
+                anchor_b: input.vec3(1.0),
+                frame_a: input.quat(),
+                frame_b: input.quat(),
+            },
         };
         block.set(k, &lane);
         block.bodies.set_start(k, &start(input));
@@ -195,10 +207,12 @@ fn rod_block(input: &mut Input, rows: &RawRows) -> RodBlock {
     for k in 0..BLOCK_LANES {
         let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
         let lane = RodLane {
-            body_a,
-            body_b,
-            dynamic_a,
-            dynamic_b,
+            pair: PairLane {
+                body_a,
+                body_b,
+                dynamic_a,
+                dynamic_b,
+            },
             frame_a: input.quat(),
             frame_b: input.quat(),
             rest_length: input.float(2.0).abs().max(1e-3),
@@ -235,10 +249,12 @@ fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
     for k in 0..BLOCK_LANES {
         let (body_a, body_b, dynamic_a, dynamic_b) = lane_bodies(input, rows, k);
         let lane = ContactLane {
-            body_a,
-            body_b,
-            dynamic_a,
-            dynamic_b,
+            pair: PairLane {
+                body_a,
+                body_b,
+                dynamic_a,
+                dynamic_b,
+            },
             point_a: input.vec3(1.0),
             point_b: input.vec3(1.0),
             normal: input.vec3(1.0).try_normalize().unwrap_or(Vec3::Y),
@@ -270,7 +286,7 @@ fn pad(input: &mut Input, blocks: &mut Blocks) {
         if live & (1 << lane) == 0 {
             blocks.0.clear(lane);
             blocks.1.clear(lane);
-            blocks.2.bodies.set(lane, 0, 0, false, false);
+            blocks.2.bodies.set(lane, &PairLane::NULL);
             blocks.3.clear(lane);
             blocks.4.clear(lane);
         }

@@ -324,6 +324,82 @@ pub struct BodyPairs {
     pub _align: [u32; 6],
 }
 
+/// The header of every constraint lane: the two bodies it joins, as rows
+/// (slot + 1; row 0 is the null row), and whether each is dynamic (its
+/// row written). [`BodyPairs`] holds eight.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PairLane {
+    /// Row of body a.
+    pub body_a: u32,
+    /// Row of body b.
+    pub body_b: u32,
+    /// Whether body a is dynamic (written).
+    pub dynamic_a: bool,
+    /// Whether body b is dynamic (written).
+    pub dynamic_b: bool,
+}
+
+impl PairLane {
+    /// A padding lane's pair: the null row on both sides, no writes.
+    pub const NULL: Self = Self {
+        body_a: 0,
+        body_b: 0,
+        dynamic_a: false,
+        dynamic_b: false,
+    };
+}
+
+/// Where a joint sits on its two bodies (one lane): an anchor on each
+/// (m, its body's frame) and a joint frame on each (rotations from the
+/// joint's axes to its body's). Sockets, hinges and fixed joints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointFrames {
+    /// Anchor on a (m, a's body frame).
+    pub anchor_a: glam::Vec3,
+    /// Anchor on b (m, b's body frame).
+    pub anchor_b: glam::Vec3,
+    /// Joint frame in a's body frame.
+    pub frame_a: glam::Quat,
+    /// Joint frame in b's body frame.
+    pub frame_b: glam::Quat,
+}
+
+impl JointFrames {
+    /// A padding lane's: anchors at the origins, frames the bodies'.
+    pub const NONE: Self = Self {
+        anchor_a: glam::Vec3::ZERO,
+        anchor_b: glam::Vec3::ZERO,
+        frame_a: glam::Quat::IDENTITY,
+        frame_b: glam::Quat::IDENTITY,
+    };
+}
+
+/// A block of eight constraint lanes (AoSoA), written lane by lane from
+/// its lane type; every block's first field is its [`BodyPairs`].
+pub trait LaneBlock: Zeroable {
+    /// One lane's data, whose header is a [`PairLane`].
+    type Lane;
+    /// What a padding lane holds: [`PairLane::NULL`], nothing enabled.
+    const PADDING: Self::Lane;
+    /// Writes `value` into `lane` (below `BLOCK_LANES`).
+    fn set(&mut self, lane: usize, value: &Self::Lane);
+    /// Makes `lane` a padding lane: null rows, no writes.
+    fn clear(&mut self, lane: usize) {
+        self.set(lane, &Self::PADDING);
+    }
+    /// A block of padding lanes.
+    fn padding() -> Self
+    where
+        Self: Sized,
+    {
+        let mut block = Self::zeroed();
+        for lane in 0..BLOCK_LANES {
+            block.clear(lane);
+        }
+        block
+    }
+}
+
 /// Where a pair of body points stood when the step began: their separation
 /// `gap = (P_b + arm_b) - (P_a + arm_a)`, measured in double precision from
 /// the bodies' coordinates `P`, and the lever arms `arm = q local` of that
@@ -381,6 +457,13 @@ pub struct StartLane {
 }
 
 impl StartLane {
+    /// Both points at the origin, no lever arms.
+    pub const ZERO: Self = Self {
+        gap: glam::Vec3::ZERO,
+        arm_a: glam::Vec3::ZERO,
+        arm_b: glam::Vec3::ZERO,
+    };
+
     /// Points `local_a` on a and `local_b` on b (m, body frames) of bodies
     /// at coordinates `pa`, `pb` (m, world, double precision) turned by
     /// `qa`, `qb`. The arms are rotated by the kernels' own rotation (the
@@ -412,7 +495,13 @@ fn lever_arm(q: glam::Quat, local: glam::Vec3) -> glam::Vec3 {
 
 impl BodyPairs {
     /// Sets lane `lane`: rows `a` and `b`, written where dynamic.
-    pub fn set(&mut self, lane: usize, a: u32, b: u32, dynamic_a: bool, dynamic_b: bool) {
+    pub fn set(&mut self, lane: usize, pair: &PairLane) {
+        let PairLane {
+            body_a: a,
+            body_b: b,
+            dynamic_a,
+            dynamic_b,
+        } = *pair;
         self.body_a[lane] = a;
         self.body_b[lane] = b;
         self.write_a[lane] = if dynamic_a { a } else { NO_WRITE };

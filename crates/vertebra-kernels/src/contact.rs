@@ -57,7 +57,9 @@ use glam::Vec3 as GVec3;
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel, Vec3};
 
-use crate::body::{BodyLanes, BodyPairs, BodyRows, StartLane, VelocityLanes, safe_ratio};
+use crate::body::{
+    BodyLanes, BodyPairs, BodyRows, LaneBlock, PairLane, StartLane, VelocityLanes, safe_ratio,
+};
 use crate::parts::point;
 
 /// Eight contacts, field by field.
@@ -111,14 +113,8 @@ pub struct ContactBlock {
 /// One contact's solver data.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactLane {
-    /// Row of body a.
-    pub body_a: u32,
-    /// Row of body b.
-    pub body_b: u32,
-    /// Whether body a is dynamic (written).
-    pub dynamic_a: bool,
-    /// Whether body b is dynamic (written).
-    pub dynamic_b: bool,
+    /// The two bodies.
+    pub pair: PairLane,
     /// Contact point on a (a's body frame).
     pub point_a: GVec3,
     /// Contact point on b (b's body frame).
@@ -137,23 +133,27 @@ pub struct ContactLane {
     pub start: StartLane,
 }
 
-impl ContactBlock {
-    /// A block of padding lanes: null rows, zero normal, so nothing acts,
-    /// and no writes, as every kernel's padding (zeroed, its lanes wrote the
-    /// null row, so that a colour's padding lanes shared a written row and
-    /// no colour of contacts could be split over threads).
-    pub fn padding() -> Self {
-        let mut block = Self::zeroed();
-        for lane in 0..BLOCK_LANES {
-            block.bodies.set(lane, 0, 0, false, false);
-        }
-        block
-    }
+/// A padding lane: null rows, zero normal, so nothing acts, and no writes
+/// (as every kernel's padding: were its lanes to write the null row, a
+/// colour's padding lanes would share a written row and no colour of
+/// contacts could be split over threads).
+impl LaneBlock for ContactBlock {
+    type Lane = ContactLane;
+    const PADDING: ContactLane = ContactLane {
+        pair: PairLane::NULL,
+        point_a: GVec3::ZERO,
+        point_b: GVec3::ZERO,
+        normal: GVec3::ZERO,
+        friction: 0.0,
+        restitution: 0.0,
+        approach: 0.0,
+        overlap: 0.0,
+        start: StartLane::ZERO,
+    };
 
     /// Writes one contact into `lane`.
-    pub fn set(&mut self, lane: usize, c: &ContactLane) {
-        self.bodies
-            .set(lane, c.body_a, c.body_b, c.dynamic_a, c.dynamic_b);
+    fn set(&mut self, lane: usize, c: &ContactLane) {
+        self.bodies.set(lane, &c.pair);
         self.bodies.set_start(lane, &c.start);
         self.point_a.set(lane, c.point_a);
         self.point_b.set(lane, c.point_b);
@@ -170,7 +170,9 @@ impl ContactBlock {
         self.kicked_n[lane] = 0.0;
         self.kicked_t.set(lane, GVec3::ZERO);
     }
+}
 
+impl ContactBlock {
     /// Starts a substep: the multipliers reset, and the overlap allowed at
     /// its end set to `remaining` (in [0, 1]) of the contact's overlap.
     pub fn start_substep(&mut self, remaining: f32) {

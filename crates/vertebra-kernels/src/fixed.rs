@@ -2,11 +2,10 @@
 //! solved together in one lane-generic kernel: two bodies welded.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Quat as GQuat, Vec3 as GVec3};
-use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
+use vertebra_math::block::{LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel};
 
-use crate::body::{BodyPairs, BodyRows};
+use crate::body::{BodyPairs, BodyRows, JointFrames, LaneBlock, PairLane};
 use crate::parts::{lock, point};
 use crate::reaction::ReactionBlock;
 use crate::residual::{Measured, Residual};
@@ -33,61 +32,30 @@ pub struct FixedBlock {
 /// One fixed joint's solver data (one lane of a block).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FixedLane {
-    /// Row of body a.
-    pub body_a: u32,
-    /// Row of body b.
-    pub body_b: u32,
-    /// Whether body a is dynamic (written).
-    pub dynamic_a: bool,
-    /// Whether body b is dynamic (written).
-    pub dynamic_b: bool,
-    /// Anchor on a (m, a's body frame).
-    pub anchor_a: GVec3,
-    /// Anchor on b (m, b's body frame).
-    pub anchor_b: GVec3,
-    /// Joint frame in a's body frame.
-    pub frame_a: GQuat,
-    /// Joint frame in b's body frame.
-    pub frame_b: GQuat,
+    /// The two bodies.
+    pub pair: PairLane,
+    /// Where the joint sits on each body.
+    pub frames: JointFrames,
 }
 
-impl FixedBlock {
-    /// A block of padding lanes.
-    pub fn padding() -> Self {
-        let mut block = Self::zeroed();
-        for lane in 0..BLOCK_LANES {
-            block.clear(lane);
-        }
-        block
-    }
-
-    /// Makes `lane` a padding lane: null rows, no writes.
-    pub fn clear(&mut self, lane: usize) {
-        self.set(
-            lane,
-            &FixedLane {
-                body_a: 0,
-                body_b: 0,
-                dynamic_a: false,
-                dynamic_b: false,
-                anchor_a: GVec3::ZERO,
-                anchor_b: GVec3::ZERO,
-                frame_a: GQuat::IDENTITY,
-                frame_b: GQuat::IDENTITY,
-            },
-        );
-    }
+impl LaneBlock for FixedBlock {
+    type Lane = FixedLane;
+    const PADDING: FixedLane = FixedLane {
+        pair: PairLane::NULL,
+        frames: JointFrames::NONE,
+    };
 
     /// Writes one fixed joint into `lane`.
-    pub fn set(&mut self, lane: usize, f: &FixedLane) {
-        self.bodies
-            .set(lane, f.body_a, f.body_b, f.dynamic_a, f.dynamic_b);
-        self.anchor_a.set(lane, f.anchor_a);
-        self.anchor_b.set(lane, f.anchor_b);
-        self.frame_a.set(lane, f.frame_a);
-        self.frame_b.set(lane, f.frame_b);
+    fn set(&mut self, lane: usize, f: &FixedLane) {
+        self.bodies.set(lane, &f.pair);
+        self.anchor_a.set(lane, f.frames.anchor_a);
+        self.anchor_b.set(lane, f.frames.anchor_b);
+        self.frame_a.set(lane, f.frames.frame_a);
+        self.frame_b.set(lane, f.frames.frame_b);
     }
 }
+
+impl FixedBlock {}
 
 /// One XPBD iteration over `blocks`: the lock, then the point (last, as
 /// for every joint).

@@ -13,11 +13,10 @@
 //! substep start.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel, Quat};
 
-use crate::body::{BodyLanes, BodyPairs, BodyRows};
+use crate::body::{BodyLanes, BodyPairs, BodyRows, JointFrames, LaneBlock, PairLane};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{hinge_axis, limit, point, swing, twist};
@@ -60,22 +59,10 @@ pub struct HingeBlock {
 /// One hinge's solver data (one lane of a block).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HingeLane {
-    /// Row of body a.
-    pub body_a: u32,
-    /// Row of body b.
-    pub body_b: u32,
-    /// Whether body a is dynamic (written).
-    pub dynamic_a: bool,
-    /// Whether body b is dynamic (written).
-    pub dynamic_b: bool,
-    /// Anchor on a (m, a's body frame).
-    pub anchor_a: GVec3,
-    /// Anchor on b (m, b's body frame).
-    pub anchor_b: GVec3,
-    /// Joint frame in a's body frame (+X the hinge axis).
-    pub frame_a: GQuat,
-    /// Joint frame in b's body frame.
-    pub frame_b: GQuat,
+    /// The two bodies.
+    pub pair: PairLane,
+    /// Where the hinge sits on each body (its frames' +X the hinge axis).
+    pub frames: JointFrames,
     /// Hinge range (rad), `[-pi, pi]` when unlimited.
     pub range: [f32; 2],
     /// The range's softness ([`LimitLane::HARD`] is hard).
@@ -84,51 +71,32 @@ pub struct HingeLane {
     pub drive: Option<DriveLane>,
 }
 
-impl HingeBlock {
-    /// A block of padding lanes.
-    pub fn padding() -> Self {
-        let mut block = Self::zeroed();
-        for lane in 0..BLOCK_LANES {
-            block.clear(lane);
-        }
-        block
-    }
-
-    /// Makes `lane` a padding lane: null rows, no writes, nothing enabled.
-    pub fn clear(&mut self, lane: usize) {
-        self.set(
-            lane,
-            &HingeLane {
-                body_a: 0,
-                body_b: 0,
-                dynamic_a: false,
-                dynamic_b: false,
-                anchor_a: GVec3::ZERO,
-                anchor_b: GVec3::ZERO,
-                frame_a: GQuat::IDENTITY,
-                frame_b: GQuat::IDENTITY,
-                range: [-core::f32::consts::PI, core::f32::consts::PI],
-                softness: LimitLane::HARD,
-                drive: None,
-            },
-        );
-    }
+impl LaneBlock for HingeBlock {
+    type Lane = HingeLane;
+    const PADDING: HingeLane = HingeLane {
+        pair: PairLane::NULL,
+        frames: JointFrames::NONE,
+        range: [-core::f32::consts::PI, core::f32::consts::PI],
+        softness: LimitLane::HARD,
+        drive: None,
+    };
 
     /// Writes one hinge into `lane`.
-    pub fn set(&mut self, lane: usize, h: &HingeLane) {
-        self.bodies
-            .set(lane, h.body_a, h.body_b, h.dynamic_a, h.dynamic_b);
-        self.anchor_a.set(lane, h.anchor_a);
-        self.anchor_b.set(lane, h.anchor_b);
-        self.frame_a.set(lane, h.frame_a);
-        self.frame_b.set(lane, h.frame_b);
+    fn set(&mut self, lane: usize, h: &HingeLane) {
+        self.bodies.set(lane, &h.pair);
+        self.anchor_a.set(lane, h.frames.anchor_a);
+        self.anchor_b.set(lane, h.frames.anchor_b);
+        self.frame_a.set(lane, h.frames.frame_a);
+        self.frame_b.set(lane, h.frames.frame_b);
         (self.range_min[lane], self.range_max[lane]) = (h.range[0], h.range[1]);
         self.limit_softness.set(lane, &h.softness);
         self.limit_lambda[lane] = 0.0;
         self.limit_start[lane] = 0.0;
         self.drive.set(lane, h.drive.as_ref());
     }
+}
 
+impl HingeBlock {
     /// Zeroes the accumulated multipliers, as each substep begins.
     pub fn reset_lambdas(&mut self) {
         self.drive.lambda = Vec3Block::default();

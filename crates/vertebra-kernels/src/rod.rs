@@ -20,7 +20,7 @@ use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel};
 
-use crate::body::{BodyPairs, BodyRows};
+use crate::body::{BodyPairs, BodyRows, LaneBlock, PairLane};
 use crate::parts::angle::Softness;
 use crate::parts::axis_x;
 use crate::parts::rod::drive::{self, Drive};
@@ -137,14 +137,8 @@ impl RodSoftness {
 /// One rod's solver data (one lane of a block).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RodLane {
-    /// Row of body a.
-    pub body_a: u32,
-    /// Row of body b.
-    pub body_b: u32,
-    /// Whether body a is dynamic (written).
-    pub dynamic_a: bool,
-    /// Whether body b is dynamic (written).
-    pub dynamic_b: bool,
+    /// The two bodies.
+    pub pair: PairLane,
     /// Material frame at a (a's body frame).
     pub frame_a: GQuat,
     /// Material frame at b (b's body frame).
@@ -173,45 +167,27 @@ pub struct RodLane {
     pub max_torque: f32,
 }
 
-impl RodBlock {
-    /// A block of padding lanes.
-    pub fn padding() -> Self {
-        let mut block = Self::zeroed();
-        for lane in 0..BLOCK_LANES {
-            block.clear(lane);
-        }
-        block
-    }
-
-    /// Makes `lane` a padding lane: null rows, no writes, nothing pulls.
-    pub fn clear(&mut self, lane: usize) {
-        self.set(
-            lane,
-            &RodLane {
-                body_a: 0,
-                body_b: 0,
-                dynamic_a: false,
-                dynamic_b: false,
-                frame_a: GQuat::IDENTITY,
-                frame_b: GQuat::IDENTITY,
-                rest_length: 0.0,
-                bend_rest: GVec3::X,
-                twist_rest: 0.0,
-                bend_rest_velocity: GVec3::ZERO,
-                twist_rest_velocity: 0.0,
-                bend: RodSoftness::Relaxation(0.0),
-                twist: RodSoftness::Relaxation(0.0),
-                bend_max: core::f32::consts::PI,
-                twist_range: [-core::f32::consts::PI, core::f32::consts::PI],
-                max_torque: f32::INFINITY,
-            },
-        );
-    }
+impl LaneBlock for RodBlock {
+    type Lane = RodLane;
+    const PADDING: RodLane = RodLane {
+        pair: PairLane::NULL,
+        frame_a: GQuat::IDENTITY,
+        frame_b: GQuat::IDENTITY,
+        rest_length: 0.0,
+        bend_rest: GVec3::X,
+        twist_rest: 0.0,
+        bend_rest_velocity: GVec3::ZERO,
+        twist_rest_velocity: 0.0,
+        bend: RodSoftness::Relaxation(0.0),
+        twist: RodSoftness::Relaxation(0.0),
+        bend_max: core::f32::consts::PI,
+        twist_range: [-core::f32::consts::PI, core::f32::consts::PI],
+        max_torque: f32::INFINITY,
+    };
 
     /// Writes one rod into `lane`.
-    pub fn set(&mut self, lane: usize, r: &RodLane) {
-        self.bodies
-            .set(lane, r.body_a, r.body_b, r.dynamic_a, r.dynamic_b);
+    fn set(&mut self, lane: usize, r: &RodLane) {
+        self.bodies.set(lane, &r.pair);
         self.frame_a.set(lane, r.frame_a);
         self.frame_b.set(lane, r.frame_b);
         self.bend_rest.set(lane, r.bend_rest);
@@ -239,7 +215,9 @@ impl RodBlock {
         self.bend_start.set(lane, GVec3::ZERO);
         self.twist_start[lane] = 0.0;
     }
+}
 
+impl RodBlock {
     /// Resets the soft parts' multipliers (every substep).
     pub fn reset_lambdas(&mut self) {
         self.bend_lambda = [0.0; BLOCK_LANES];

@@ -14,11 +14,10 @@
 //! Padding lanes name the null row and write nothing.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Quat as GQuat, Vec3 as GVec3};
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::{Lane, LaneKernel, Quat, Vec3};
 
-use crate::body::{BodyLanes, BodyPairs, BodyRows};
+use crate::body::{BodyLanes, BodyPairs, BodyRows, JointFrames, LaneBlock, PairLane};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{ellipse, limit, point, pyramid, swing, swing_direction, twist};
@@ -100,22 +99,10 @@ impl ShapedLimits {
 /// One socket's solver data (one lane of a block).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SocketLane {
-    /// Row of body a.
-    pub body_a: u32,
-    /// Row of body b.
-    pub body_b: u32,
-    /// Whether body a is dynamic (written).
-    pub dynamic_a: bool,
-    /// Whether body b is dynamic (written).
-    pub dynamic_b: bool,
-    /// Anchor on a (m, a's body frame).
-    pub anchor_a: GVec3,
-    /// Anchor on b (m, b's body frame).
-    pub anchor_b: GVec3,
-    /// Joint frame in a's body frame.
-    pub frame_a: GQuat,
-    /// Joint frame in b's body frame.
-    pub frame_b: GQuat,
+    /// The two bodies.
+    pub pair: PairLane,
+    /// Where the joint sits on each body.
+    pub frames: JointFrames,
     /// Swing cone half-angle (rad), pi when unlimited.
     pub swing_max: f32,
     /// Twist range (rad), `[-pi, pi]` when unlimited.
@@ -126,45 +113,24 @@ pub struct SocketLane {
     pub shaped: ShapedLimits,
 }
 
-impl SocketBlock {
-    /// A block of padding lanes.
-    pub fn padding() -> Self {
-        let mut block = Self::zeroed();
-        for lane in 0..BLOCK_LANES {
-            block.clear(lane);
-        }
-        block
-    }
-
-    /// Makes `lane` a padding lane: null rows, no writes, nothing enabled.
-    pub fn clear(&mut self, lane: usize) {
-        self.set(
-            lane,
-            &SocketLane {
-                body_a: 0,
-                body_b: 0,
-                dynamic_a: false,
-                dynamic_b: false,
-                anchor_a: GVec3::ZERO,
-                anchor_b: GVec3::ZERO,
-                frame_a: GQuat::IDENTITY,
-                frame_b: GQuat::IDENTITY,
-                swing_max: core::f32::consts::PI,
-                twist: [-core::f32::consts::PI, core::f32::consts::PI],
-                drive: None,
-                shaped: ShapedLimits::FREE,
-            },
-        );
-    }
+impl LaneBlock for SocketBlock {
+    type Lane = SocketLane;
+    const PADDING: SocketLane = SocketLane {
+        pair: PairLane::NULL,
+        frames: JointFrames::NONE,
+        swing_max: core::f32::consts::PI,
+        twist: [-core::f32::consts::PI, core::f32::consts::PI],
+        drive: None,
+        shaped: ShapedLimits::FREE,
+    };
 
     /// Writes one socket into `lane`.
-    pub fn set(&mut self, lane: usize, s: &SocketLane) {
-        self.bodies
-            .set(lane, s.body_a, s.body_b, s.dynamic_a, s.dynamic_b);
-        self.anchor_a.set(lane, s.anchor_a);
-        self.anchor_b.set(lane, s.anchor_b);
-        self.frame_a.set(lane, s.frame_a);
-        self.frame_b.set(lane, s.frame_b);
+    fn set(&mut self, lane: usize, s: &SocketLane) {
+        self.bodies.set(lane, &s.pair);
+        self.anchor_a.set(lane, s.frames.anchor_a);
+        self.anchor_b.set(lane, s.frames.anchor_b);
+        self.frame_a.set(lane, s.frames.frame_a);
+        self.frame_b.set(lane, s.frames.frame_b);
         self.swing_max[lane] = s.swing_max;
         (self.twist_min[lane], self.twist_max[lane]) = (s.twist[0], s.twist[1]);
         self.drive.set(lane, s.drive.as_ref());
@@ -182,7 +148,9 @@ impl SocketBlock {
             c0[lane] = 0.0;
         }
     }
+}
 
+impl SocketBlock {
     /// Zeroes every accumulated multiplier (the drive's and the shaped
     /// limits'), as each substep begins.
     pub fn reset_lambdas(&mut self) {

@@ -9,6 +9,7 @@ use common::{
 use glam::Vec3;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
+use vertebra_kernels::body::{LaneBlock, PairLane};
 use vertebra_kernels::contact::{ContactBlock, ContactLane, PositionPass, VelocityPass};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
@@ -36,10 +37,12 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<ContactBl
             block.set(
                 lane,
                 &ContactLane {
-                    body_a,
-                    body_b,
-                    dynamic_a: dynamic(&rows, body_a),
-                    dynamic_b: dynamic(&rows, body_b),
+                    pair: PairLane {
+                        body_a,
+                        body_b,
+                        dynamic_a: dynamic(&rows, body_a),
+                        dynamic_b: dynamic(&rows, body_b),
+                    },
                     point_a,
                     point_b,
                     normal,
@@ -103,7 +106,7 @@ fn adversarial_contacts_agree_on_every_backend_and_stay_finite() {
 
 /// A padding lane as `ContactBlock::padding` makes it: null rows, no writes.
 fn clear(block: &mut ContactBlock, lane: usize) {
-    block.bodies.set(lane, 0, 0, false, false);
+    block.bodies.set(lane, &PairLane::NULL);
 }
 
 #[test]

@@ -14,7 +14,7 @@ use common::{RawRows, flatten, moved, to_rows, turned, unit_quat, vec};
 use glam::{DVec3, Mat3, Quat as GQuat, Vec3 as GVec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::body::{BodyLanes, BodyRows, PairStart, StartLane};
+use vertebra_kernels::body::{BodyLanes, BodyRows, LaneBlock, PairStart, StartLane};
 use vertebra_kernels::direct::ldl::{self, MAX, PACKED, at};
 use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows, SwingRows};
 use vertebra_kernels::direct::{

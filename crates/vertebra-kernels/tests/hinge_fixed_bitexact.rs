@@ -9,6 +9,7 @@ use common::{
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
+use vertebra_kernels::body::{JointFrames, LaneBlock, PairLane};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
@@ -135,14 +136,18 @@ fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlo
             block.set(
                 lane,
                 &HingeLane {
-                    body_a: j.body_a,
-                    body_b: j.body_b,
-                    dynamic_a: dynamic(&rows, j.body_a),
-                    dynamic_b: dynamic(&rows, j.body_b),
-                    anchor_a: j.anchor_a,
-                    anchor_b: j.anchor_b,
-                    frame_a: j.frame_a,
-                    frame_b: j.frame_b,
+                    pair: PairLane {
+                        body_a: j.body_a,
+                        body_b: j.body_b,
+                        dynamic_a: dynamic(&rows, j.body_a),
+                        dynamic_b: dynamic(&rows, j.body_b),
+                    },
+                    frames: JointFrames {
+                        anchor_a: j.anchor_a,
+                        anchor_b: j.anchor_b,
+                        frame_a: j.frame_a,
+                        frame_b: j.frame_b,
+                    },
                     range,
                     softness: common::limit_softness(&mut r, limit),
                     drive: r.random_bool(0.6).then(|| DriveLane {
@@ -183,14 +188,18 @@ fn fixed_joints(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<Fi
             block.set(
                 lane,
                 &FixedLane {
-                    body_a: j.body_a,
-                    body_b: j.body_b,
-                    dynamic_a: dynamic(&rows, j.body_a),
-                    dynamic_b: dynamic(&rows, j.body_b),
-                    anchor_a: j.anchor_a,
-                    anchor_b: j.anchor_b,
-                    frame_a: j.frame_a,
-                    frame_b: j.frame_b,
+                    pair: PairLane {
+                        body_a: j.body_a,
+                        body_b: j.body_b,
+                        dynamic_a: dynamic(&rows, j.body_a),
+                        dynamic_b: dynamic(&rows, j.body_b),
+                    },
+                    frames: JointFrames {
+                        anchor_a: j.anchor_a,
+                        anchor_b: j.anchor_b,
+                        frame_a: j.frame_a,
+                        frame_b: j.frame_b,
+                    },
                 },
             );
             block

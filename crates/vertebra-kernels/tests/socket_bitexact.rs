@@ -10,6 +10,7 @@ use common::{
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
+use vertebra_kernels::body::{JointFrames, LaneBlock, PairLane};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::limited;
 use vertebra_kernels::residual::ResidualPass;
@@ -72,14 +73,18 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
             block.set(
                 lane,
                 &SocketLane {
-                    body_a,
-                    body_b,
-                    dynamic_a: dynamic(&rows, body_a),
-                    dynamic_b: dynamic(&rows, body_b),
-                    anchor_a,
-                    anchor_b,
-                    frame_a,
-                    frame_b,
+                    pair: PairLane {
+                        body_a,
+                        body_b,
+                        dynamic_a: dynamic(&rows, body_a),
+                        dynamic_b: dynamic(&rows, body_b),
+                    },
+                    frames: JointFrames {
+                        anchor_a,
+                        anchor_b,
+                        frame_a,
+                        frame_b,
+                    },
                     swing_max: if r.random_bool(0.7) {
                         r.random_range(0.0..3.2f32).min(pi)
                     } else {

@@ -6,13 +6,14 @@
 use core::ops::Range;
 
 use glam::Vec3;
-use vertebra_kernels::body::{BodyPairs, StartLane};
+use vertebra_kernels::body::{BodyPairs, LaneBlock, StartLane};
 use vertebra_kernels::contact::{ContactBlock, ContactImpulse, ContactLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::MAX_COLOURS;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_point, check_unit_vec};
 
 use crate::bins::Bins;
+use crate::layout::pair;
 
 /// A contact between two bodies for the next step.
 ///
@@ -129,10 +130,7 @@ impl Contact {
             )
         };
         ContactLane {
-            body_a: ia as u32 + 1,
-            body_b: ib as u32 + 1,
-            dynamic_a: bodies.kind[ia] == BodyKind::Dynamic,
-            dynamic_b: bodies.kind[ib] == BodyKind::Dynamic,
+            pair: pair(self.body_a, self.body_b, bodies),
             point_a,
             point_b,
             normal: n,

@@ -12,7 +12,7 @@
 use glam::Vec3;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore, Error, check_finite};
 
-use crate::step::limit;
+use crate::integrate::limit;
 
 /// Adds `linear` (N s) and `angular` (N m s, about the centre of mass),
 /// both world frame, to a dynamic body's momentum, and holds the new

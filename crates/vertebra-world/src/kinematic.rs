@@ -19,7 +19,7 @@ use vertebra_store::{
     check_unit_quat,
 };
 
-use crate::{World, checks, layout::ROD_KEY, step};
+use crate::{World, checks, integrate, layout::ROD_KEY};
 
 impl World {
     /// Switches a body between dynamic and kinematic at run time, as
@@ -134,7 +134,7 @@ impl World {
         }
         let travel = position.as_dvec3() - self.bodies.precise_position(i);
         let linear = (travel / f64::from(dt)).as_vec3();
-        let angular = step::angular_velocity(
+        let angular = integrate::angular_velocity(
             orientation.normalize_portable(),
             self.bodies.orientation[i],
             dt,

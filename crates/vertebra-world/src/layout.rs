@@ -16,7 +16,7 @@ use core::ops::Range;
 use std::collections::BTreeSet;
 use vertebra_math::PortableQuat;
 
-use vertebra_kernels::body::BodyPairs;
+use vertebra_kernels::body::{BodyPairs, JointFrames, LaneBlock, PairLane};
 use vertebra_kernels::fixed::{FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{HingeBlock, HingeLane};
 use vertebra_kernels::rod::{RodBlock, RodLane};
@@ -28,57 +28,13 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 
 use crate::bins::Bins;
 use crate::joint::{JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
+use crate::kinds::{BlockKind, Group, JointBlock, Vector};
 use crate::rod::RodDesc;
 use crate::start::start_blocks;
 use crate::trees::Trees;
 
 /// Added to a rod's slot to make its colouring key.
 pub(crate) const ROD_KEY: u64 = 1 << 32;
-
-/// One colour's (or the overflow set's) blocks, by kind.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Group {
-    /// Socket blocks with drives (plain path).
-    pub driven: Range<usize>,
-    /// Socket blocks without (plain path).
-    pub plain: Range<usize>,
-    /// Shaped-path socket blocks with drives.
-    pub shaped_driven: Range<usize>,
-    /// Shaped-path socket blocks without.
-    pub shaped_plain: Range<usize>,
-    /// Hinge blocks with drives.
-    pub hinges_driven: Range<usize>,
-    /// Hinge blocks without.
-    pub hinges_plain: Range<usize>,
-    /// Fixed-joint blocks.
-    pub fixed: Range<usize>,
-    /// Rod blocks.
-    pub rods: Range<usize>,
-}
-
-impl Group {
-    fn is_empty(&self) -> bool {
-        self.socket_ranges().iter().all(|(r, ..)| r.is_empty())
-            && self.hinge_ranges().iter().all(|(r, _)| r.is_empty())
-            && self.fixed.is_empty()
-            && self.rods.is_empty()
-    }
-
-    /// The socket blocks: (range, driven, shaped).
-    pub fn socket_ranges(&self) -> [(&Range<usize>, bool, bool); 4] {
-        [
-            (&self.driven, true, false),
-            (&self.plain, false, false),
-            (&self.shaped_driven, true, true),
-            (&self.shaped_plain, false, true),
-        ]
-    }
-
-    /// The hinge blocks: (range, driven).
-    pub fn hinge_ranges(&self) -> [(&Range<usize>, bool); 2] {
-        [(&self.hinges_driven, true), (&self.hinges_plain, false)]
-    }
-}
 
 /// Blocks of one joint type, with each slot's place.
 #[derive(Clone, Debug)]
@@ -284,20 +240,39 @@ impl Layout {
 
     /// The body pairs of every block of `group`.
     fn pairs<'a>(&'a self, g: &'a Group) -> impl Iterator<Item = &'a BodyPairs> + Clone + 'a {
-        let sockets = g
-            .socket_ranges()
-            .into_iter()
-            .flat_map(|(r, ..)| &self.sockets.blocks[r.clone()]);
-        let hinges = g
-            .hinge_ranges()
-            .into_iter()
-            .flat_map(|(r, _)| &self.hinges.blocks[r.clone()]);
-        let fixed = &self.fixed.blocks[g.fixed.clone()];
-        let rods = &self.rods.blocks[g.rods.clone()];
-        (sockets.map(|b| &b.bodies))
-            .chain(hinges.map(|b| &b.bodies))
-            .chain(fixed.iter().map(|b| &b.bodies))
-            .chain(rods.iter().map(|b| &b.bodies))
+        g.kinds()
+            .flat_map(move |(kind, range)| range.clone().map(move |b| self.block_pairs(kind, b)))
+    }
+
+    /// Block `block` of `kind`'s vector: its body pairs.
+    fn block_pairs(&self, kind: BlockKind, block: usize) -> &BodyPairs {
+        match kind.vector() {
+            Vector::Sockets => self.sockets.blocks[block].pairs(),
+            Vector::Hinges => self.hinges.blocks[block].pairs(),
+            Vector::Fixed => self.fixed.blocks[block].pairs(),
+            Vector::Rods => self.rods.blocks[block].pairs(),
+        }
+    }
+
+    /// Zeroes the multipliers every joint block accumulates over a
+    /// substep.
+    pub fn reset_lambdas(&mut self) {
+        self.sockets
+            .blocks
+            .iter_mut()
+            .for_each(JointBlock::reset_lambdas);
+        self.hinges
+            .blocks
+            .iter_mut()
+            .for_each(JointBlock::reset_lambdas);
+        self.fixed
+            .blocks
+            .iter_mut()
+            .for_each(JointBlock::reset_lambdas);
+        self.rods
+            .blocks
+            .iter_mut()
+            .for_each(JointBlock::reset_lambdas);
     }
 
     /// Writes a joint's new settings into its lane in place (its kind and
@@ -372,85 +347,96 @@ impl Layout {
                 .map(|&k| k as usize)
                 .filter(|&s| joints[s].is_some())
         };
-        let sockets = |driven: bool, shaped: bool| {
-            joint_slots().filter(move |&s| {
-                let d = joint(s);
-                matches!(d.kind, JointKind::Socket(l) if l.is_plain() != shaped)
-                    && d.drive.is_some() == driven
-            })
-        };
-        let set_socket = |block: &mut SocketBlock, lane: usize, slot: usize| {
-            let d = joint(slot);
-            if let JointKind::Socket(limits) = &d.kind {
-                block.set(lane, &socket_lane(d, limits, bodies));
-            }
-        };
-        let padding = SocketBlock::padding();
-        let trees = &self.trees;
-        let held = |s: usize| trees.has_joint(s);
-        let driven = (self.sockets).append(sockets(true, false), held, padding, set_socket);
-        let plain = (self.sockets).append(sockets(false, false), held, padding, set_socket);
-        let shaped_driven = (self.sockets).append(sockets(true, true), held, padding, set_socket);
-        let shaped_plain = (self.sockets).append(sockets(false, true), held, padding, set_socket);
-        let hinges = |driven: bool| {
-            joint_slots().filter(move |&s| {
-                let d = joint(s);
-                matches!(d.kind, JointKind::Hinge { .. }) && d.drive.is_some() == driven
-            })
-        };
-        let set_hinge = |block: &mut HingeBlock, lane: usize, slot: usize| {
-            let d = joint(slot);
-            if let JointKind::Hinge { range, softness } = d.kind {
-                block.set(lane, &hinge_lane(d, range, softness, bodies));
-            }
-        };
-        let padding = HingeBlock::padding();
-        let hinges_driven = self.hinges.append(hinges(true), held, padding, set_hinge);
-        let hinges_plain = self.hinges.append(hinges(false), held, padding, set_hinge);
-        let fixed = joint_slots().filter(|&s| joint(s).kind == JointKind::Fixed);
-        let fixed = self
-            .fixed
-            .append(fixed, held, FixedBlock::padding(), |block, lane, slot| {
-                block.set(lane, &fixed_lane(joint(slot), bodies));
-            });
+        let of_kind =
+            |kind: BlockKind| joint_slots().filter(move |&s| block_kind(joint(s)) == kind);
         let rod_slots = keys
             .iter()
             .filter(|&&k| k >= ROD_KEY)
             .map(|&k| (k - ROD_KEY) as usize)
             .filter(|&s| rods[s].is_some());
-        let rod_held = |s: usize| trees.has_rod(s);
-        let rods = self.rods.append(
-            rod_slots,
-            rod_held,
-            RodBlock::padding(),
-            |block, lane, slot| {
-                block.set(
-                    lane,
-                    &rod_lane(
-                        rods[slot].as_ref().expect("awake rods are laid out"),
-                        bodies,
-                    ),
-                );
-            },
-        );
-        Group {
-            driven,
-            plain,
-            shaped_driven,
-            shaped_plain,
-            hinges_driven,
-            hinges_plain,
-            fixed,
-            rods,
+        let trees = &self.trees;
+        let held = |s: usize| trees.has_joint(s);
+        let mut group = Group::default();
+        for kind in BlockKind::ALL {
+            let range = match kind.vector() {
+                Vector::Sockets => {
+                    let set = |block: &mut SocketBlock, lane: usize, slot: usize| {
+                        let d = joint(slot);
+                        if let JointKind::Socket(limits) = &d.kind {
+                            block.set(lane, &socket_lane(d, limits, bodies));
+                        }
+                    };
+                    (self.sockets).append(of_kind(kind), held, SocketBlock::padding(), set)
+                }
+                Vector::Hinges => {
+                    let set = |block: &mut HingeBlock, lane: usize, slot: usize| {
+                        let d = joint(slot);
+                        if let JointKind::Hinge { range, softness } = d.kind {
+                            block.set(lane, &hinge_lane(d, range, softness, bodies));
+                        }
+                    };
+                    (self.hinges).append(of_kind(kind), held, HingeBlock::padding(), set)
+                }
+                Vector::Fixed => {
+                    let set = |block: &mut FixedBlock, lane: usize, slot: usize| {
+                        block.set(lane, &fixed_lane(joint(slot), bodies));
+                    };
+                    (self.fixed).append(of_kind(kind), held, FixedBlock::padding(), set)
+                }
+                Vector::Rods => {
+                    let set = |block: &mut RodBlock, lane: usize, slot: usize| {
+                        let desc = rods[slot].as_ref().expect("awake rods are laid out");
+                        block.set(lane, &rod_lane(desc, bodies));
+                    };
+                    let rod_held = |s: usize| trees.has_rod(s);
+                    (self.rods).append(rod_slots.clone(), rod_held, RodBlock::padding(), set)
+                }
+            };
+            group.set(kind, range);
         }
+        group
     }
 }
 
-/// Body rows are slots + 1 (row 0 is the null row).
-fn rows(a: BodyHandle, b: BodyHandle, bodies: &BodyStore) -> (u32, u32, bool, bool) {
+/// The block kind a joint is laid out in: its type, its drive, and (for a
+/// socket) the path its limits take.
+fn block_kind(desc: &JointDesc) -> BlockKind {
+    let driven = desc.drive.is_some();
+    match desc.kind {
+        JointKind::Socket(limits) => match (driven, limits.is_plain()) {
+            (true, true) => BlockKind::DrivenSocket,
+            (false, true) => BlockKind::Socket,
+            (true, false) => BlockKind::DrivenShapedSocket,
+            (false, false) => BlockKind::ShapedSocket,
+        },
+        JointKind::Hinge { .. } if driven => BlockKind::DrivenHinge,
+        JointKind::Hinge { .. } => BlockKind::Hinge,
+        JointKind::Fixed => BlockKind::Fixed,
+    }
+}
+
+/// The lane header of a constraint between bodies `a` and `b`: their rows
+/// (slots + 1, row 0 is the null row) and which are dynamic.
+pub(crate) fn pair(a: BodyHandle, b: BodyHandle, bodies: &BodyStore) -> PairLane {
     let (ia, ib) = (a.index(), b.index());
     let dynamic = |i: usize| bodies.kind[i] == BodyKind::Dynamic;
-    (ia as u32 + 1, ib as u32 + 1, dynamic(ia), dynamic(ib))
+    PairLane {
+        body_a: ia as u32 + 1,
+        body_b: ib as u32 + 1,
+        dynamic_a: dynamic(ia),
+        dynamic_b: dynamic(ib),
+    }
+}
+
+/// Where a joint sits on its bodies, its frames normalised by the
+/// project's own square root (the same bits on every platform).
+fn frames(desc: &JointDesc) -> JointFrames {
+    JointFrames {
+        anchor_a: desc.anchor_a,
+        anchor_b: desc.anchor_b,
+        frame_a: desc.frame_a.normalize_portable(),
+        frame_b: desc.frame_b.normalize_portable(),
+    }
 }
 
 /// A socket's lane data: the plain path's cone, or the shaped path's
@@ -458,20 +444,13 @@ fn rows(a: BodyHandle, b: BodyHandle, bodies: &BodyStore) -> (u32, u32, bool, bo
 /// project's own sine, so that every platform lays out the same bits) and
 /// pyramid.
 pub(crate) fn socket_lane(desc: &JointDesc, limits: &SwingTwist, bodies: &BodyStore) -> SocketLane {
-    let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
     let plain_cone = match limits.swing {
         Swing::Cone(half) if limits.is_plain() => half,
         _ => PI,
     };
     SocketLane {
-        body_a,
-        body_b,
-        dynamic_a,
-        dynamic_b,
-        anchor_a: desc.anchor_a,
-        anchor_b: desc.anchor_b,
-        frame_a: desc.frame_a.normalize_portable(),
-        frame_b: desc.frame_b.normalize_portable(),
+        pair: pair(desc.body_a, desc.body_b, bodies),
+        frames: frames(desc),
         swing_max: plain_cone,
         twist: limits.twist.unwrap_or([-PI, PI]),
         drive: desc.drive.map(|d| d.lane()),
@@ -504,16 +483,9 @@ pub(crate) fn hinge_lane(
     softness: LimitSoftness,
     bodies: &BodyStore,
 ) -> HingeLane {
-    let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
     HingeLane {
-        body_a,
-        body_b,
-        dynamic_a,
-        dynamic_b,
-        anchor_a: desc.anchor_a,
-        anchor_b: desc.anchor_b,
-        frame_a: desc.frame_a.normalize_portable(),
-        frame_b: desc.frame_b.normalize_portable(),
+        pair: pair(desc.body_a, desc.body_b, bodies),
+        frames: frames(desc),
         range: range.unwrap_or([-PI, PI]),
         softness: softness.lane(),
         drive: desc.drive.map(|d| d.lane()),
@@ -522,27 +494,16 @@ pub(crate) fn hinge_lane(
 
 /// A fixed joint's lane data.
 pub(crate) fn fixed_lane(desc: &JointDesc, bodies: &BodyStore) -> FixedLane {
-    let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
     FixedLane {
-        body_a,
-        body_b,
-        dynamic_a,
-        dynamic_b,
-        anchor_a: desc.anchor_a,
-        anchor_b: desc.anchor_b,
-        frame_a: desc.frame_a.normalize_portable(),
-        frame_b: desc.frame_b.normalize_portable(),
+        pair: pair(desc.body_a, desc.body_b, bodies),
+        frames: frames(desc),
     }
 }
 
 /// A rod's lane data.
 pub(crate) fn rod_lane(desc: &RodDesc, bodies: &BodyStore) -> RodLane {
-    let (body_a, body_b, dynamic_a, dynamic_b) = rows(desc.body_a, desc.body_b, bodies);
     RodLane {
-        body_a,
-        body_b,
-        dynamic_a,
-        dynamic_b,
+        pair: pair(desc.body_a, desc.body_b, bodies),
         frame_a: desc.frame_a.normalize_portable(),
         frame_b: desc.frame_b.normalize_portable(),
         rest_length: desc.rest_length,

@@ -29,14 +29,17 @@ mod contact;
 mod drive;
 mod forces;
 mod impulse;
+mod integrate;
 mod islands;
 mod joint;
 mod joint_wire;
+mod kinds;
 mod kinematic;
 mod layout;
 mod lend;
 mod metrics;
 mod parallel;
+mod passes;
 mod rod;
 mod rollback;
 mod sleep;
@@ -44,6 +47,7 @@ mod snapshot;
 mod stages;
 mod start;
 mod step;
+mod substep;
 mod tasks;
 mod trees;
 
@@ -757,7 +761,7 @@ impl World {
         self.refresh_layout();
         let (max_linear, max_angular) =
             (self.config.max_linear_speed, self.config.max_angular_speed);
-        step::hold_speeds(&mut self.bodies, &self.islands, max_linear, max_angular);
+        integrate::hold_speeds(&mut self.bodies, &self.islands, max_linear, max_angular);
         let max_depth = self.config.max_push_out_speed * dt;
         let asleep = self.islands.asleep();
         self.contact_layout
@@ -768,7 +772,7 @@ impl World {
         self.contact_layout.check();
         // Each substep launches the task system's workers once
         // (step::solve_substep).
-        step::step(self, dt, workers);
+        step::solve(self, dt, workers);
         let h = dt / self.config.substeps as f32;
         self.contact_layout
             .impulses(self.contacts.len(), h, &mut self.impulses);

@@ -90,6 +90,7 @@ pub(crate) fn colour_is_disjoint<'a>(
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
+    use vertebra_kernels::body::{LaneBlock, PairLane};
     use vertebra_scheduler::Colouring;
 
     use super::*;
@@ -138,8 +139,14 @@ mod tests {
     fn pairs(lanes: &[(u32, u32, bool, bool)]) -> BodyPairs {
         // A padding block's pairs: the null row, written nowhere.
         let mut p = vertebra_kernels::socket::SocketBlock::padding().bodies;
-        for (lane, &(a, b, da, db)) in lanes.iter().enumerate() {
-            p.set(lane, a, b, da, db);
+        for (lane, &(body_a, body_b, dynamic_a, dynamic_b)) in lanes.iter().enumerate() {
+            let pair = PairLane {
+                body_a,
+                body_b,
+                dynamic_a,
+                dynamic_b,
+            };
+            p.set(lane, &pair);
         }
         p
     }

@@ -274,56 +274,6 @@ impl<T: Send, F: Fn(usize, &mut [T]) + Sync> Part for SliceChunks<'_, T, F> {
     }
 }
 
-/// `blocks[range]` in chunks of `size` blocks: `run` gets each chunk.
-pub(crate) struct BlockChunks<'s, 'a, B, F> {
-    blocks: &'s SharedBlocks<'a, B>,
-    range: Range<usize>,
-    size: usize,
-    run: F,
-}
-
-impl<'s, 'a, B, F> BlockChunks<'s, 'a, B, F> {
-    /// `blocks[range]` in chunks of `size` (at least 1) blocks.
-    ///
-    /// # Safety
-    /// No other part of the stage this part is given to may lend any of
-    /// these blocks.
-    // SAFETY: unsafe to call: `run` below relies on this contract.
-    pub unsafe fn new(
-        blocks: &'s SharedBlocks<'a, B>,
-        range: Range<usize>,
-        size: usize,
-        run: F,
-    ) -> Self {
-        assert!(range.start <= range.end && range.end <= blocks.len);
-        Self {
-            blocks,
-            range,
-            size: size.max(1),
-            run,
-        }
-    }
-}
-
-impl<B: Send, F: Fn(&mut [B]) + Sync> Part for BlockChunks<'_, '_, B, F> {
-    fn chunks(&self) -> usize {
-        self.range.len().div_ceil(self.size)
-    }
-    fn run(&self, chunk: usize) {
-        let start = self.range.start + chunk * self.size;
-        let end = (start + self.size).min(self.range.end);
-        // A stage hands each chunk of each part to one worker once, the
-        // chunks of a part do not overlap, the parts of a stage lend
-        // different blocks (`new`'s contract), and a stage starts only
-        // when the one before it has finished (the counters' release and
-        // acquire order every chunk of one stage before every chunk of
-        // the next).
-        // SAFETY: so no two workers hold the same block at once.
-        let blocks = unsafe { self.blocks.range(start..end) };
-        (self.run)(blocks)
-    }
-}
-
 /// One kind of block, lent to the workers of a launch: each worker
 /// reaches the blocks of the chunks it claims.
 pub(crate) struct SharedBlocks<'a, B> {
@@ -349,7 +299,7 @@ impl<'a, B> SharedBlocks<'a, B> {
     /// result is.
     #[allow(clippy::mut_from_ref)]
     // SAFETY: unsafe to call: the result is a `&mut` to blocks others hold.
-    unsafe fn range(&self, range: Range<usize>) -> &mut [B] {
+    pub unsafe fn range(&self, range: Range<usize>) -> &mut [B] {
         assert!(range.start <= range.end && range.end <= self.len);
         // SAFETY: the range lies inside the lent slice (asserted), which
         // is borrowed mutably for 'a; the caller promises no other

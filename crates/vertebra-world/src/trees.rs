@@ -17,6 +17,7 @@
 use core::f32::consts::PI;
 use std::collections::BTreeMap;
 
+use vertebra_kernels::body::LaneBlock;
 use vertebra_kernels::body::StartLane;
 use vertebra_kernels::direct::{
     BodyNode, JointLane, JointNode, JointRows, SwingRows, Topology, TreeBlock,

@@ -39,7 +39,7 @@ use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_li
 use vertebra_math::row::NO_WRITE;
 use vertebra_math::{Backend, Lane, LaneKernel};
 
-use crate::body::{BodyPairs, BodyRows};
+use crate::body::{BodyPairs, BodyRows, LaneBlock, PairLane};
 use crate::limited::{LimitLane, SoftnessBlock};
 use ldl::{MAX, PACKED};
 use rows::{Geometry, LIMIT_RECORD, MAX_LIMITS};
@@ -462,19 +462,21 @@ impl JointLane {
     };
 }
 
-impl JointNode {
-    /// Padding: null rows, nothing measured.
-    pub fn padding() -> Self {
-        let mut node = Self::zeroed();
-        for lane in 0..BLOCK_LANES {
-            node.set(lane, &JointLane::FREE);
-        }
-        node
-    }
+/// Padding: null rows, nothing measured.
+impl LaneBlock for JointNode {
+    type Lane = JointLane;
+    const PADDING: JointLane = JointLane::FREE;
 
-    /// Writes one joint into `lane`.
-    pub fn set(&mut self, lane: usize, j: &JointLane) {
-        self.bodies.set(lane, j.body_a, j.body_b, false, false);
+    /// Writes one joint into `lane` (the tree's solve writes the bodies,
+    /// never the node's pass: no row written).
+    fn set(&mut self, lane: usize, j: &JointLane) {
+        let pair = PairLane {
+            body_a: j.body_a,
+            body_b: j.body_b,
+            dynamic_a: false,
+            dynamic_b: false,
+        };
+        self.bodies.set(lane, &pair);
         self.anchor_a.set(lane, j.anchor_a);
         self.anchor_b.set(lane, j.anchor_b);
         self.frame_a.set(lane, j.frame_a);
@@ -490,7 +492,9 @@ impl JointNode {
         }
         self.softness.set(lane, &j.softness);
     }
+}
 
+impl JointNode {
     /// Whether the lane's limits are soft.
     pub fn is_soft(&self, lane: usize) -> bool {
         self.softness.get(lane) != LimitLane::HARD
