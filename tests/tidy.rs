@@ -465,3 +465,350 @@ fn no_import_circles_between_a_crates_files() {
         );
     }
 }
+
+/// Crates other than ours whose items the map may name, by their path
+/// (`std::cell::Cell`): not looked up in our sources.
+const OTHER_CRATES: &[&str] = &[
+    "alloc",
+    "arbitrary",
+    "bytemuck",
+    "cbindgen",
+    "clap",
+    "clippy",
+    "core",
+    "criterion",
+    "glam",
+    "gltf",
+    "iai_callgrind",
+    "indicatif",
+    "libfuzzer_sys",
+    "libm",
+    "parry3d",
+    "postcard",
+    "proptest",
+    "rapier3d",
+    "rayon",
+    "serde",
+    "std",
+    "toml",
+    "wide",
+    "xxhash_rust",
+];
+
+/// A name in backticks in the map: its text, its line, and the directory
+/// of the crate whose section it is in (a heading whose first name in
+/// backticks is a directory with a `Cargo.toml` opens that crate's
+/// section; any other heading closes it).
+struct Named {
+    text: String,
+    line: usize,
+    section: Option<String>,
+}
+
+/// Every name in backticks in `map`, outside fenced code blocks.
+fn map_names(map: &str) -> Vec<Named> {
+    let root = root();
+    let (mut out, mut section, mut fenced) = (Vec::new(), None, false);
+    for (n, line) in map.lines().enumerate() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        assert!(
+            line.matches('`').count() % 2 == 0,
+            "docs/architecture.md:{}: a backtick left open",
+            n + 1
+        );
+        let spans: Vec<&str> = line.split('`').skip(1).step_by(2).collect();
+        if line.starts_with('#') {
+            section = spans
+                .first()
+                .map(|s| s.trim_end_matches('/').to_string())
+                .filter(|dir| root.join(dir).join("Cargo.toml").is_file());
+        }
+        out.extend(spans.into_iter().map(|text| Named {
+            text: text.to_string(),
+            line: n + 1,
+            section: section.clone(),
+        }));
+    }
+    out
+}
+
+/// A name that looks like a file or directory: only path characters, a
+/// letter, and a `/` or a known extension.
+fn looks_like_path(s: &str) -> bool {
+    s.chars().any(|c| c.is_ascii_alphabetic())
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_-./".contains(c))
+        && (s.contains('/')
+            || [".rs", ".md", ".toml", ".h", ".sh", ".c", ".cpp"]
+                .iter()
+                .any(|e| s.ends_with(e)))
+}
+
+/// Where a path of the map is, relative to the root: in a crate's section
+/// under its `src/`, then its directory, then the root; elsewhere from the
+/// root. `None` when it is nowhere (a path ending in `/` must be a
+/// directory).
+fn resolve(section: Option<&str>, path: &str) -> Option<String> {
+    let root = root();
+    let dir = path.ends_with('/');
+    let path = path.trim_end_matches('/');
+    let mut candidates = Vec::new();
+    if let Some(krate) = section {
+        candidates.push(format!("{krate}/src/{path}"));
+        candidates.push(format!("{krate}/{path}"));
+    }
+    candidates.push(path.to_string());
+    candidates.into_iter().find(|c| {
+        if dir {
+            root.join(c).is_dir()
+        } else {
+            root.join(c).exists()
+        }
+    })
+}
+
+fn is_ident_char(c: char) -> bool {
+    c.is_ascii_alphanumeric() || c == '_'
+}
+
+/// `Type`: starts upper-case and has a lower-case letter (`Lane`, `F32x4`).
+fn is_type_name(s: &str) -> bool {
+    s.starts_with(|c: char| c.is_ascii_uppercase()) && s.chars().any(|c| c.is_ascii_lowercase())
+}
+
+/// `CONST`: upper-case, digits and at least one `_` (`MAX_PASSES`).
+fn is_const_name(s: &str) -> bool {
+    s.starts_with(|c: char| c.is_ascii_uppercase())
+        && s.contains('_')
+        && s.chars()
+            .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
+}
+
+/// What a name of the map says exists in our sources.
+#[derive(Debug)]
+enum Item {
+    /// A struct, enum, trait, type alias or union.
+    Type(String),
+    /// A function, field, variant, constant or associated type of a type
+    /// (declared in a file that declares or implements the type).
+    Member(String, String),
+    /// A function, module or macro.
+    Function(String),
+    /// A constant or static.
+    Const(String),
+}
+
+/// An item named `Type`, `Type::member`, `module::item` or `function()`
+/// (generic arguments and call arguments left out; a leading
+/// `vertebra_*` is its crate), with its crate and module path; `None` for
+/// anything else (prose, another crate's item, a bare lower-case word).
+fn parse_item(text: &str) -> Option<(Option<String>, Vec<String>, Item)> {
+    let mut s = text.trim();
+    let mut call = false;
+    if let Some(open) = s.find('(') {
+        if !(s.ends_with(')') || s.ends_with('(')) {
+            return None;
+        }
+        (s, call) = (&s[..open], true);
+    }
+    if let Some(open) = s.find('<') {
+        if !s.ends_with('>') {
+            return None;
+        }
+        s = &s[..open];
+    }
+    let mut segments: Vec<&str> = s.split("::").collect();
+    let valid = |g: &&str| {
+        !g.is_empty()
+            && g.chars().all(is_ident_char)
+            && !g.starts_with(|c: char| c.is_ascii_digit())
+    };
+    if !segments.iter().all(valid) {
+        return None;
+    }
+    if OTHER_CRATES.contains(&segments[0]) || ["crate", "self", "super"].contains(&segments[0]) {
+        return None;
+    }
+    let krate = segments[0]
+        .starts_with("vertebra_")
+        .then(|| segments.remove(0).replace('_', "-"));
+    let name = segments.pop()?.to_string();
+    let parent = segments
+        .last()
+        .filter(|p| is_type_name(p))
+        .map(|p| p.to_string());
+    if parent.is_some() {
+        segments.pop();
+    }
+    let modules: Vec<String> = segments.iter().map(|m| m.to_string()).collect();
+    let item = if let Some(ty) = parent {
+        Item::Member(ty, name)
+    } else if is_type_name(&name) {
+        Item::Type(name)
+    } else if is_const_name(&name) {
+        Item::Const(name)
+    } else if name.starts_with(|c: char| c.is_ascii_lowercase())
+        && (call || !modules.is_empty() || krate.is_some())
+    {
+        Item::Function(name)
+    } else {
+        return None;
+    };
+    Some((krate, modules, item))
+}
+
+/// Whether `text` has `keyword name` with `name` a whole word.
+fn declares(text: &str, keyword: &str, name: &str) -> bool {
+    let pattern = format!("{keyword} {name}");
+    text.match_indices(&pattern).any(|(at, _)| {
+        let before = text[..at].chars().next_back();
+        let after = text[at + pattern.len()..].chars().next();
+        !before.is_some_and(is_ident_char) && !after.is_some_and(is_ident_char)
+    })
+}
+
+/// Whether `line` has `word` as a whole word.
+fn has_word(line: &str, word: &str) -> bool {
+    line.match_indices(word).any(|(at, _)| {
+        let before = line[..at].chars().next_back();
+        let after = line[at + word.len()..].chars().next();
+        !before.is_some_and(is_ident_char) && !after.is_some_and(is_ident_char)
+    })
+}
+
+fn declares_type(text: &str, name: &str) -> bool {
+    ["struct", "enum", "trait", "type", "union"]
+        .iter()
+        .any(|k| declares(text, k, name))
+}
+
+/// Whether `text` declares `member` of some type: a function, constant,
+/// static or associated type, or a line that begins with it as a field
+/// (`name:`) or a variant (`Name,`, `Name(`, `Name {`, `Name =`).
+fn declares_member(text: &str, member: &str) -> bool {
+    ["fn", "const", "static", "type"]
+        .iter()
+        .any(|k| declares(text, k, member))
+        || text.lines().any(|line| {
+            let t = line.trim_start();
+            let t = t
+                .strip_prefix("pub(crate) ")
+                .or(t.strip_prefix("pub "))
+                .unwrap_or(t);
+            let Some(rest) = t.strip_prefix(member) else {
+                return false;
+            };
+            rest.is_empty()
+                || (rest.starts_with(':') && !rest.starts_with("::"))
+                || [",", "(", " {", " =", " ("]
+                    .iter()
+                    .any(|p| rest.starts_with(p))
+        })
+}
+
+/// Whether the file at `path` (from the root) is in crate `krate` (its
+/// directory name) and inside every module of `modules` (a directory or
+/// file of that name on its path, or an inline `mod m { .. }` it holds).
+fn within(path: &str, text: &str, krate: Option<&str>, modules: &[String]) -> bool {
+    krate.is_none_or(|k| path.starts_with(&format!("crates/{k}/")))
+        && modules.iter().all(|m| {
+            path.split('/')
+                .any(|part| part == m || part == format!("{m}.rs"))
+                || text.contains(&format!("mod {m} {{"))
+        })
+}
+
+/// Whether the item exists in `sources`.
+fn item_exists(
+    sources: &[(String, String)],
+    krate: Option<&str>,
+    modules: &[String],
+    item: &Item,
+) -> bool {
+    let mut files = sources
+        .iter()
+        .filter(|(path, text)| within(path, text, krate, modules));
+    match item {
+        Item::Type(name) => files.any(|(_, text)| declares_type(text, name)),
+        Item::Const(name) => {
+            files.any(|(_, text)| declares(text, "const", name) || declares(text, "static", name))
+        }
+        Item::Function(name) => files.any(|(path, text)| {
+            declares(text, "fn", name)
+                || declares(text, "mod", name)
+                || declares(text, "macro_rules!", name)
+                || path.ends_with(&format!("/{name}.rs"))
+                || path.ends_with(&format!("/{name}/mod.rs"))
+        }),
+        Item::Member(ty, member) => {
+            let of_type: Vec<&(String, String)> = files
+                .filter(|(_, text)| {
+                    declares_type(text, ty)
+                        || text.lines().any(|l| has_word(l, "impl") && has_word(l, ty))
+                })
+                .collect();
+            of_type.iter().any(|(_, text)| declares_type(text, ty))
+                && of_type
+                    .iter()
+                    .any(|(_, text)| declares_member(text, member))
+        }
+    }
+}
+
+/// The architecture map stays true: every path it names exists, every
+/// source file of the crates' `src/`, `benches/` and `tests/` is named
+/// (the map's conventions are at its top), and every item it names
+/// (`Type`, `Type::member`, `module::item`, `function()`) is declared in
+/// the sources.
+#[test]
+fn the_architecture_map_is_true() {
+    let root = root();
+    let map = fs::read_to_string(root.join("docs/architecture.md")).expect("docs/architecture.md");
+    let sources = sources();
+    let mut named = std::collections::BTreeSet::new();
+    let mut problems = Vec::new();
+    for n in map_names(&map) {
+        if looks_like_path(&n.text) {
+            match resolve(n.section.as_deref(), &n.text) {
+                Some(path) => {
+                    named.insert(path);
+                }
+                None => problems.push(format!(
+                    "docs/architecture.md:{}: `{}` is no file or directory{}",
+                    n.line,
+                    n.text,
+                    n.section
+                        .as_deref()
+                        .map(|s| format!(" (in {s}'s section)"))
+                        .unwrap_or_default()
+                )),
+            }
+        } else if let Some((krate, modules, item)) = parse_item(&n.text)
+            && !item_exists(&sources, krate.as_deref(), &modules, &item)
+        {
+            problems.push(format!(
+                "docs/architecture.md:{}: `{}` names no item in the sources ({item:?})",
+                n.line, n.text
+            ));
+        }
+    }
+    for (path, _) in &sources {
+        let parts: Vec<&str> = path.split('/').collect();
+        let source = matches!(
+            parts.as_slice(),
+            ["crates", _, "src", ..] | ["benches" | "tests", _]
+        );
+        if source && !named.contains(path) {
+            problems.push(format!(
+                "docs/architecture.md names no `{path}`: add it to its crate's section"
+            ));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
