@@ -313,9 +313,10 @@ pub struct BodyPairs {
     /// header) runs every lane.
     pub padding: u32,
     /// Nonzero: the direct solve (the `direct` module) solves the equality
-    /// parts of every live lane (points, hinge axes, locks, the rod's curve
-    /// and length), so the block's position pass leaves them out and
-    /// solves only its limits, drives and soft parts. Zero (a zeroed
+    /// parts and the limits of every live lane (points, hinge axes, locks,
+    /// swing and twist limits, the rod's curve and length), so the block's
+    /// position pass leaves them out and solves only its drives and the
+    /// rod's soft bend and twist. Zero (a zeroed
     /// header) solves every part. One flag per block, not per lane, so that
     /// every backend, whatever its slices, solves the same parts.
     pub direct: u32,

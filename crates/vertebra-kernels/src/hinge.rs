@@ -250,11 +250,11 @@ impl Residual for HingeBlock {
             L::load(&self.range_min[start..]),
             L::load(&self.range_max[start..]),
         );
-        let (_, overshoot) = twist::violation_local(&a, &b, fa, fb, lo, hi);
+        let (_, violation) = twist::violation_local(&a, &b, fa, fb, lo, hi);
         Measured {
             linear: d.length(),
-            angular: misalignment + overshoot,
-            limit: overshoot,
+            angular: misalignment + violation,
+            limit: violation,
         }
     }
 }

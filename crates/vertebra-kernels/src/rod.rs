@@ -316,7 +316,7 @@ impl LaneSlices for Starts<'_> {
         let bend_rest = block.bend_rest.load(start);
         block.bend_start.store(start, bend::start(&m.f, bend_rest));
         let twist_rest = L::load(&block.twist_rest[start..]);
-        twist::error(&m.f, twist_rest).store(&mut block.twist_start[start..]);
+        twist::signed_rest_violation(&m.f, twist_rest).store(&mut block.twist_start[start..]);
         let velocity = block.bend_rest_velocity.load(start);
         block
             .bend_rest
@@ -441,12 +441,12 @@ impl Residual for RodBlock {
         let rest_length = L::load(&self.rest_length[start..]);
         let (_, c_len) = length::measure(&a, &b, &f, rest_length, &chord);
         let c_curve = curve::measure(&a, &b, &f, &chord).theta;
-        let (_, bend_over) = bend::overshoot(&f, L::load(&self.bend_max[start..]));
+        let (_, bend_over) = bend::violation(&f, L::load(&self.bend_max[start..]));
         let (lo, hi) = (
             L::load(&self.twist_min[start..]),
             L::load(&self.twist_max[start..]),
         );
-        let twist_over = crate::parts::twist::excess(twist::measure(&f), lo, hi).abs();
+        let twist_over = crate::parts::twist::signed_violation(twist::measure(&f), lo, hi).abs();
         Measured {
             linear: c_len.abs(),
             angular: c_curve + bend_over + twist_over,

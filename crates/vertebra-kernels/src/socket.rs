@@ -398,7 +398,7 @@ impl Driven for SocketBlock {
 /// twist axis to the nearest allowed one, rad) and the pyramid (rad): 0 on
 /// the plain path, whose shapes are free.
 #[inline(always)]
-fn shaped_overshoot<L: Lane>(
+fn shaped_violation<L: Lane>(
     block: &SocketBlock,
     a: &BodyLanes<L>,
     b: &BodyLanes<L>,
@@ -413,7 +413,7 @@ fn shaped_overshoot<L: Lane>(
         L::load(&block.ellipse_y[start..]),
         L::load(&block.ellipse_z[start..]),
     );
-    let beyond_ellipse = ellipse::overshoot(&dir, semi_y, semi_z);
+    let beyond_ellipse = ellipse::violation_angle(&dir, semi_y, semi_z);
     let [(_, y), (_, z)] = pyramid::violations(
         &dir,
         load_range(&block.pyramid_y, start),
@@ -443,13 +443,13 @@ impl Residual for SocketBlock {
             L::load(&self.twist_min[start..]),
             L::load(&self.twist_max[start..]),
         );
-        let overshoot = swing::overshoot(theta, L::load(&self.swing_max[start..]))
-            + twist::excess(phi, lo, hi).abs()
-            + shaped_overshoot(self, &a, &b, start);
+        let violation = swing::violation(theta, L::load(&self.swing_max[start..]))
+            + twist::signed_violation(phi, lo, hi).abs()
+            + shaped_violation(self, &a, &b, start);
         Measured {
             linear: d.length(),
-            angular: overshoot,
-            limit: overshoot,
+            angular: violation,
+            limit: violation,
         }
     }
 }

@@ -188,8 +188,8 @@ fn bend_gradients_match_finite_differences() {
             1.0,
         );
         // The limit's angle is psi itself, about t_a x t_b.
-        let (n_psi, psi) = bend::overshoot(&f(&a, &b, fa, fb), 0.0);
-        let c = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| bend::overshoot(&f(a, b, fa, fb), 0.0).1;
+        let (n_psi, psi) = bend::violation(&f(&a, &b, fa, fb), 0.0);
+        let c = |a: &BodyLanes<f32>, b: &BodyLanes<f32>| bend::violation(&f(a, b, fa, fb), 0.0).1;
         if psi > 0.05 && psi < 3.0 {
             check(
                 "bend limit / b",

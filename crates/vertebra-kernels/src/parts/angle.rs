@@ -32,7 +32,7 @@ pub struct Softness<L> {
 /// same `S n` that turns the bodies ([`apply_local`]), with no rotation
 /// into or out of a body.
 #[inline(always)]
-pub fn correct_local<L: Lane>(
+pub fn solve_local<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
     [n_a, n_b]: [Vec3<L>; 2],

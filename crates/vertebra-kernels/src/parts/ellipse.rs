@@ -144,7 +144,7 @@ fn plane_axis<L: Lane>(dir: &Direction<L>, k: L, [ey, ez]: [L; 2]) -> Vec3<L> {
 /// The angle (rad) from b's twist axis to the nearest allowed one in the
 /// swing-sine plane (0 inside): the residual's measure of the overshoot.
 #[inline(always)]
-pub fn overshoot<L: Lane>(dir: &Direction<L>, semi_y: L, semi_z: L) -> L {
+pub fn violation_angle<L: Lane>(dir: &Direction<L>, semi_y: L, semi_z: L) -> L {
     let (one, zero) = (L::splat(1.0), L::splat(0.0));
     let (p, _) = sines(dir);
     let (u, v) = (p[0] / semi_y, p[1] / semi_z);

@@ -14,6 +14,19 @@
 //! `limit` (shaped path); the hinge `point`, `hinge_axis`, `twist` with
 //! `limit`, and `drive`; the fixed joint `point` and `lock`; the rod its
 //! own `rod` parts (curve, length, bend, twist), built on `angle`.
+//!
+//! # One verb set
+//!
+//! - `measure`: the part's value `C` (and its axis or gradient) from the
+//!   poses; a suffix says the frame it is given in (`measure_local`: each
+//!   body's own, `measure_in_a`: a's joint frame).
+//! - `violation`: how far a limit (or a rest shape) is exceeded, `>= 0`
+//!   unless named `signed_violation`; `violation_angle` the same in radians
+//!   where the part works in other units.
+//! - `solve`: one XPBD correction of the part (its `dlambda`, applied to
+//!   both bodies), returning the accumulated `lambda` when it keeps one;
+//!   `solve_local` with the axes in the bodies' own frames.
+//! - `apply`: moves or turns the bodies by a given `dlambda`.
 
 pub mod angle;
 pub mod drive;

@@ -37,7 +37,7 @@ pub fn axis<L: Lane>(ta: Vec3<L>, tb: Vec3<L>) -> (Vec3<L>, L) {
 
 /// How far the swing exceeds `max_angle` (rad, >= 0).
 #[inline(always)]
-pub fn overshoot<L: Lane>(theta: L, max_angle: L) -> L {
+pub fn violation<L: Lane>(theta: L, max_angle: L) -> L {
     (theta - max_angle).max(L::splat(0.0))
 }
 
@@ -73,7 +73,7 @@ pub fn solve<L: Lane>(
     max_angle: L,
 ) -> L {
     let (axes, theta) = measure_local(a, b, frame_a, frame_b);
-    let c = overshoot(theta, max_angle);
-    super::angle::correct_local(a, b, axes, c);
+    let c = violation(theta, max_angle);
+    super::angle::solve_local(a, b, axes, c);
     c
 }

@@ -52,7 +52,7 @@ pub fn angle<L: Lane>(fa: Quat<L>, fb: Quat<L>) -> L {
 
 /// `phi - clamp(phi, lo, hi)`: signed excess beyond the range (rad).
 #[inline(always)]
-pub fn excess<L: Lane>(phi: L, lo: L, hi: L) -> L {
+pub fn signed_violation<L: Lane>(phi: L, lo: L, hi: L) -> L {
     phi - phi.max(lo).min(hi)
 }
 
@@ -88,7 +88,7 @@ pub fn solve<L: Lane>(
     hi: L,
 ) -> L {
     let (axes, c) = violation_local(a, b, frame_a, frame_b, lo, hi);
-    super::angle::correct_local(a, b, axes, c);
+    super::angle::solve_local(a, b, axes, c);
     c
 }
 
@@ -121,7 +121,7 @@ pub fn violation_local<L: Lane>(
     hi: L,
 ) -> ([Vec3<L>; 2], L) {
     let ([axis_a, axis_b], phi) = measure_local(a, b, frame_a, frame_b);
-    let e = excess(phi, lo, hi);
+    let e = signed_violation(phi, lo, hi);
     let sign = L::splat(1.0).copysign(e);
     ([axis_a.scale(sign), axis_b.scale(sign)], e.abs())
 }

@@ -58,12 +58,12 @@ pub fn solve<L: Lane>(
     let (n, c) = measure(&m.f, rest_direction);
     let (ra, rb) = (a.local_response(n), b.local_response(m.in_b(n)));
     let w = bend_weight(a, b, (ra.weight, rb.weight), rest_length);
-    drive::correct(a, b, (&ra, &rb), c, c - start.dot(n), w, d, lambda)
+    drive::solve(a, b, (&ra, &rb), c, c - start.dot(n), w, d, lambda)
 }
 
 /// How far `psi` exceeds the limit (rad, >= 0), and the bend axis.
 #[inline(always)]
-pub fn overshoot<L: Lane>(f: &Frames<L>, max_bend: L) -> (Vec3<L>, L) {
+pub fn violation<L: Lane>(f: &Frames<L>, max_bend: L) -> (Vec3<L>, L) {
     let (n, psi) = bend_angle(f.ta, f.tb);
     (n, (psi - max_bend).max(L::splat(0.0)))
 }
@@ -76,7 +76,7 @@ pub fn limit<L: Lane>(
     m: &LocalFrames<L>,
     max_bend: L,
 ) -> L {
-    let (n, c) = overshoot(&m.f, max_bend);
-    angle::correct_local(a, b, [n, m.in_b(n)], c);
+    let (n, c) = violation(&m.f, max_bend);
+    angle::solve_local(a, b, [n, m.in_b(n)], c);
     c
 }

@@ -157,7 +157,7 @@ pub fn advance_twist<L: Lane>(rest: L, rate: L, h: L) -> L {
 /// Returns the new accumulated `lambda`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub fn correct<L: Lane>(
+pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
     b: &mut BodyLanes<L>,
     (ra, rb): (&Response<L>, &Response<L>),

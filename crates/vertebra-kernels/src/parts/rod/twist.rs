@@ -29,7 +29,7 @@ use super::drive::{self, Drive};
 use super::{Frames, LocalFrames};
 use crate::body::{BodyLanes, safe_ratio};
 use crate::parts::angle;
-use crate::parts::twist::excess;
+use crate::parts::twist::signed_violation;
 
 /// The axes `(n_a, n_b)` with `dtau/dtheta_a = -n_a`, `dtau/dtheta_b = n_b`.
 /// Near `psi = pi` (`1 + t_a . t_b` below 1e-6) `k` is dropped: the twist
@@ -67,7 +67,7 @@ pub fn measure<L: Lane>(f: &Frames<L>) -> L {
 /// The error `tau - rest`, wrapped to [-pi, pi]: a rod twisted past pi
 /// from its rest twist turns back the short way, not the long way round.
 #[inline(always)]
-pub fn error<L: Lane>(f: &Frames<L>, rest: L) -> L {
+pub fn signed_rest_violation<L: Lane>(f: &Frames<L>, rest: L) -> L {
     poly::wrap_angle(measure(f) - rest)
 }
 
@@ -85,11 +85,11 @@ pub fn solve<L: Lane>(
     start: L,
     lambda: L,
 ) -> L {
-    let c = error(&m.f, rest);
+    let c = signed_rest_violation(&m.f, rest);
     let (n_a, n_b) = axes(&m.f);
     let (ra, rb) = (a.local_response(n_a), b.local_response(m.in_b(n_b)));
     let rate = poly::wrap_angle(c - start);
-    drive::correct(a, b, (&ra, &rb), c, rate, ra.weight + rb.weight, d, lambda)
+    drive::solve(a, b, (&ra, &rb), c, rate, ra.weight + rb.weight, d, lambda)
 }
 
 /// Enforces `lo <= tau <= hi`; returns |excess| before the correction.
@@ -101,8 +101,8 @@ pub fn limit<L: Lane>(
     lo: L,
     hi: L,
 ) -> L {
-    let e = excess(measure(&m.f), lo, hi);
+    let e = signed_violation(measure(&m.f), lo, hi);
     let (n_a, n_b) = axes(&m.f);
-    angle::correct_local(a, b, [n_a, m.in_b(n_b)], e);
+    angle::solve_local(a, b, [n_a, m.in_b(n_b)], e);
     e.abs()
 }
