@@ -140,7 +140,7 @@ fn figure_1(out: &Path, config: &SceneConfig) -> Result<(), String> {
     image.ok_or("no frame to draw")?.save_png(&path)
 }
 
-/// One scene's block of the table: each figure's median [band] per spine,
+/// One scene's block of the table: each figure's median \[band\] per spine,
 /// then the rod against the sockets seed by seed.
 fn write_table(table: &mut String, scene: Scene, runs: &[(SpineMode, Seeded)]) {
     let seeds = runs[0].1.runs.len();

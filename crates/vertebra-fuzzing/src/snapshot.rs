@@ -597,7 +597,7 @@ fn sealed(header: &[u8], payload: &[u8]) -> Snapshot {
 
 /// Builds a small world from the input, snapshots it, checks that fresh
 /// worlds restoring its snapshots step on bit for bit as it does
-/// ([`continues_bit_for_bit`]) and puts it back to the snapshot; then
+/// (`continues_bit_for_bit`) and puts it back to the snapshot; then
 /// changes the decoded state (up to 4 field changes: floats to NaN,
 /// infinities, huge values; indices, generations, lineages, lengths,
 /// colours) or the payload's bytes (then re-checksummed), and restores the

@@ -6,11 +6,11 @@
 //!
 //! A piece is a [`Topology`] of its own whose root is the joint it was
 //! cut at, with its trunk-side body left out as a static one would be
-//! (`None`); the trunk keeps a [`Child::Port`] where each cut joint was.
+//! (`None`); the trunk keeps a [`super::Child::Port`] where each cut joint was.
 //! The arithmetic is the whole tree's, node for node and in the same
 //! order (children are taken by their joints' indices in the whole tree),
 //! so a tree gives the same bits cut or whole: the choice is only a
-//! matter of cost ([`cost`]).
+//! matter of cost (`cost` in the world crate's `trees.rs`).
 
 use super::{NONE, NodeKind, Topology, children_in_order};
 

@@ -63,7 +63,7 @@ pub fn measure_local<L: Lane>(
 
 /// Enforces the cone; returns the overshoot before the correction (rad).
 /// Measured and corrected in the bodies' own frames ([`measure_local`],
-/// [`super::angle::correct_local`]).
+/// [`super::angle::solve_local`]).
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,

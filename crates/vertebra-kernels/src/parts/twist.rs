@@ -18,7 +18,7 @@
 //! twist about +X is `2 atan2(r_x, r_w)` (the sign of `r_w` taken out),
 //! and the axis `t_b` is `(q_a* q_b F_b) x` in a's frame and `F_b x` in
 //! b's, ready for [`super::limit::solve_local`] and
-//! [`super::angle::correct_local`], which then need no rotation into or
+//! [`super::angle::solve_local`], which then need no rotation into or
 //! out of either body. [`measure`] (world) is the residual's.
 
 use vertebra_math::{Lane, Quat, Vec3, poly};
@@ -77,7 +77,7 @@ pub fn signed<L: Lane>(phi: L, lo: L, hi: L, free: L) -> (L, L) {
 
 /// Enforces the range; returns the |excess| before the correction (rad).
 /// Measured and corrected in the bodies' own frames
-/// ([`violation_local`], [`super::angle::correct_local`]).
+/// ([`violation_local`], [`super::angle::solve_local`]).
 #[inline(always)]
 pub fn solve<L: Lane>(
     a: &mut BodyLanes<L>,
