@@ -284,7 +284,7 @@ impl Collider {
         let shape = match self.shape {
             ColliderShape::Solid(s) => solid(s)?,
             ColliderShape::Plane(n) => {
-                vertebra_world::check_unit_vec("plane normal", n)?;
+                vertebra_store::check_unit_vec("plane normal", n)?;
                 SharedShape::halfspace(n.normalize())
             }
         };
@@ -773,7 +773,7 @@ impl Collisions {
     ) -> Result<(), Error> {
         contacts.clear();
         self.check_serves(world)?;
-        vertebra_world::check_positive("time step", dt)?;
+        vertebra_store::check_positive("time step", dt)?;
         self.sleep_state(world, scratch)?;
         if !scratch.acts.contains(&true) {
             // Every body asleep or still (a settled pile): no pair has a

@@ -27,10 +27,8 @@ use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNode, BvhWorkspace};
 use parry3d::query::{Ray, ShapeCastOptions};
 use parry3d::shape::{Ball, Capsule, Shape as ParryShape};
 use vertebra_math::{DefaultFloatMode, PortableQuat};
-use vertebra_world::{
-    BodyHandle, BodyKind, Error, MAX_COORDINATE, Timeline, World, check_point, check_unit_quat,
-    check_unit_vec,
-};
+use vertebra_store::{check_point, check_unit_quat, check_unit_vec};
+use vertebra_world::{BodyHandle, BodyKind, Error, MAX_COORDINATE, Timeline, World};
 
 use crate::{
     ColliderShape, CollisionGroups, Collisions, MAX_COLLIDER_EXTENT, RagdollPart, relative_pose,

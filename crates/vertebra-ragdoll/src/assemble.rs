@@ -6,7 +6,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use vertebra_world::check_coordinate;
+use vertebra_store::check_coordinate;
 
 use crate::drive::{DriveSettings, Strength};
 use crate::drive_def::damping_for_compliance;

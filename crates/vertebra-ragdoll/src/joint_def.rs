@@ -8,9 +8,10 @@ use vertebra_math::PortableQuat;
 
 use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::Deserialize;
+use vertebra_store::{check_coordinate, check_unit_quat};
 use vertebra_world::{
     JointBreaking, JointKind, LimitSoftness, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
-    MIN_DRIVE_FREQUENCY, Swing, SwingTwist, check_coordinate, check_unit_quat,
+    MIN_DRIVE_FREQUENCY, Swing, SwingTwist,
 };
 
 use crate::drive::Strength;

@@ -160,7 +160,9 @@ pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
 pub use model::{BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef, SpineMode};
 pub use pose::Pose;
-pub use ragdoll::{BuildOptions, JointAnchors, Ragdoll, RodRest, body_masses};
+#[cfg(feature = "harness")]
+pub use ragdoll::body_masses;
+pub use ragdoll::{BuildOptions, JointAnchors, Ragdoll, RodRest};
 pub use skeleton::{Bone, LocalPose, MAX_BONES, ModelPose, Skeleton, Transform};
 pub use skeleton_file::REFERENCE_SKELETON;
 pub use spec::{BodyShape, BodySpec, SpineSpec};

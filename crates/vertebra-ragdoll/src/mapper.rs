@@ -407,7 +407,7 @@ impl SkeletonMapper {
         bodies.validate(&self.desc)?;
         if let Some((a, b)) = rod_frames {
             for (field, q) in [("rod frame_a", a), ("rod frame_b", b)] {
-                vertebra_world::check_unit_quat(field, q).map_err(|e| RagdollError::World {
+                vertebra_store::check_unit_quat(field, q).map_err(|e| RagdollError::World {
                     context: rod_name(&self.desc),
                     error: e,
                 })?;

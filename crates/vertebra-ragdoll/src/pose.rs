@@ -5,7 +5,7 @@
 
 use glam::{Quat, Vec3};
 use vertebra_math::PortableQuat;
-use vertebra_world::{check_coordinate, check_unit_quat};
+use vertebra_store::{check_coordinate, check_unit_quat};
 
 use crate::error::RagdollError;
 use crate::model::RagdollDesc;

@@ -146,7 +146,10 @@ pub struct Ragdoll {
 /// the ends in rod mode; stabilised if asked), total unchanged. Refused
 /// for a description that fails [`RagdollDesc::validate`], options that
 /// fail [`BuildOptions::validate`], and a rod spine of a description
-/// without a `[spine]` ([`RagdollDesc::check_spine`]).
+/// without a `[spine]` ([`RagdollDesc::check_spine`]). For this
+/// workspace's tests (the `harness` feature): a built ragdoll's bodies
+/// carry these masses.
+#[cfg(feature = "harness")]
 pub fn body_masses(desc: &RagdollDesc, options: &BuildOptions) -> Result<Vec<f32>, RagdollError> {
     let _mode = DefaultFloatMode::enter();
     desc.validate()?;
@@ -155,7 +158,7 @@ pub fn body_masses(desc: &RagdollDesc, options: &BuildOptions) -> Result<Vec<f32
     Ok(masses_of(desc, options))
 }
 
-/// [`body_masses`] of a checked description and options.
+/// Masses per described body of a checked description and options.
 fn masses_of(desc: &RagdollDesc, options: &BuildOptions) -> Vec<f32> {
     let mut masses: Vec<f32> = desc.bodies.iter().map(|b| b.mass).collect();
     if let (SpineMode::Rod, Some(spine)) = (options.spine, &desc.spine) {

@@ -14,7 +14,8 @@ use core::ops::Mul;
 use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
-use vertebra_world::{MAX_COORDINATE, check_unit_quat};
+use vertebra_store::check_unit_quat;
+use vertebra_world::MAX_COORDINATE;
 
 use crate::error::RagdollError;
 use vertebra_math::DefaultFloatMode;

@@ -85,8 +85,7 @@ pub use vertebra_kernels::direct::MAX_LIMIT_RETURN_SPEED;
 pub use vertebra_math::BackendChoice;
 pub use vertebra_store::{
     BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore, Error, MASS_RANGE, MAX_COORDINATE,
-    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, SIZE_RANGE, Shape, check_coordinate, check_point,
-    check_positive, check_unit_quat, check_unit_vec,
+    MAX_TIME_STEP, MIN_TIME_STEP, MassProperties, SIZE_RANGE, Shape,
 };
 
 /// Bodies, joints and the solver that steps them.
@@ -539,12 +538,14 @@ impl World {
     }
 
     /// How many colours the joints use (after the last step's layout).
+    #[cfg(feature = "harness")]
     pub fn colour_count(&self) -> usize {
         self.layout.colour_count
     }
 
     /// How many joints are in the overflow set (solved one at a time by
     /// the scalar kernel because their bodies used every colour).
+    #[cfg(feature = "harness")]
     pub fn overflow_count(&self) -> usize {
         self.colouring.overflow().len()
     }
