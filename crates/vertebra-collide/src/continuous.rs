@@ -35,8 +35,8 @@
 //! thickness (a capsule or sphere of half the radius, a box inset by half
 //! its smallest half extent). A body that only sinks into a wall or floor
 //! by less than that (a ragdoll landing 1 cm deep) is left to the contacts
-//! exactly as before: no pose is changed, so worlds whose bodies never
-//! pass that deep (every paper scene) keep every bit. A core that starts
+//! alone: no pose is changed, so worlds whose bodies never pass that deep
+//! (every paper scene) step bit for bit as without the sweep. A core that starts
 //! the step within `SKIN` of static geometry (a limb pressed against a
 //! wall, or put back against it the step before) is swept instead as a
 //! ball of a quarter of its thickness at its centre (Box2D v3's fallback):

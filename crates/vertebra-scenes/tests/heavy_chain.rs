@@ -1,7 +1,7 @@
 //! The heavy chain (8 links of 1 kg, a 1000 kg body at the end, hanging
 //! from a fixed anchor): under the iterative joint solve the mass ratio
 //! across the last joint stretches the chain by metres; the direct solve
-//! holds it together, at the same 1 substep (issue 18).
+//! holds it together, at the same 1 substep.
 
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{HEAVY_MASS, LINK_MASS, LINKS, Quantity, Scene, SceneConfig, build, run};

@@ -1,4 +1,4 @@
-//! The hit reaction (issue 15): the anatomical humanoid, hips held, driven
+//! The hit reaction: the anatomical humanoid, hips held, driven
 //! to its bind pose by springs, hit on the chest and then on the head
 //! (`docs/joints.md`, "Hit reaction").
 

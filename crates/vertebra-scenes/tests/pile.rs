@@ -1,5 +1,5 @@
-//! The substepped pile comes to rest (issue 14; docs/contacts.md, "The
-//! jammed pile").
+//! The substepped pile comes to rest (docs/contacts.md, "The jammed
+//! pile").
 
 use glam::Vec3;
 use vertebra_collide::{Collider, ColliderShape};

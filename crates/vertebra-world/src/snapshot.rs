@@ -492,8 +492,8 @@ mod tests {
     /// One change to a decoded state.
     type Change = Box<dyn FnOnce(&mut State)>;
 
-    /// Payloads that were accepted and put NaN into the world, or panicked
-    /// in `restore` or the next step, before restore validated the state.
+    /// Payloads that, unvalidated, would put NaN into the world or panic in
+    /// `restore` or the next step.
     #[test]
     fn crafted_states_are_refused_by_name_and_change_nothing() {
         let mut world = world();
@@ -878,8 +878,8 @@ mod tests {
         world.restore(&world.snapshot()).unwrap();
     }
 
-    /// The attack's other state: every island of a world with a moving
-    /// drive put to sleep as it moves.
+    /// The other sleep state a crafted snapshot can hold: every island of a
+    /// world with a moving drive put to sleep as it moves.
     #[test]
     fn every_island_put_to_sleep_while_a_drive_moves_is_refused() {
         let mut world = world();
