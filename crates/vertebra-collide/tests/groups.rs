@@ -247,10 +247,10 @@ fn resealed(mut bytes: Vec<u8>) -> CollisionSnapshot {
     CollisionSnapshot::from_bytes(bytes)
 }
 
-/// The self-collision setting is in the snapshot (since format 2): restored, it
-/// is off again, and it follows a recreated ragdoll to its new bodies. A
-/// snapshot of format 1, or whose next group is one already given, is
-/// refused by name with the set unchanged.
+/// The self-collision setting is in the snapshot: restored, it is off
+/// again, and it follows a recreated ragdoll to its new bodies. A snapshot
+/// of another format version, or whose next group is one already given,
+/// is refused by name with the set unchanged.
 #[test]
 fn self_collision_settings_are_saved_restored_and_checked() {
     let (mut w, mut c) = ground();

@@ -63,10 +63,8 @@ use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 use crate::islands::{Islands, links};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
-/// Bump with every change to [`State`] or anything in it.
-/// 8: rods' rest shapes gained their rates (`bend_rest_velocity`,
-/// `twist_rest_velocity`). 9: islands and sleep state. A: stillness in
-/// double precision.
+/// The format: bumped with every change to [`State`] or anything in it, so
+/// bytes of another layout are refused by their magic rather than misread.
 const FORMAT: u8 = b'A';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
