@@ -114,8 +114,8 @@ impl Sweep {
 /// A body's motion is fast when it exceeds this fraction of its thickness
 /// in a step. Box2D v3 sweeps from half; at half, a limb of the 30-ragdoll
 /// drop (rod spines, direct joints) turning at 9 rad/s while pressed 3 cm
-/// into an obstacle of the pit was swept and nudged (a core grazing the
-/// box at the step's start, not a body passing through), which moved
+/// into an obstacle of the pit is swept and nudged (a core grazing the
+/// box at the step's start, not a body passing through), which moves
 /// every bit of the scene after it. A body moving less than its thickness
 /// in a step meets its speculative contacts before its core can reach
 /// the far side of anything as thick as it is.
