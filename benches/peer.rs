@@ -213,8 +213,8 @@ fn whole_runs() {
 }
 
 /// The split each joint solve is timed at by criterion: iterated at the
-/// paper's 1x20, solved directly at 1x4 (where it meets the issue's
-/// errors: `docs/performance.md`).
+/// paper's 1x20, solved directly at 1x4 (where it meets the direct
+/// solve's error targets: `docs/performance.md`).
 fn timed_split(joints: JointSolver) -> (u32, u32) {
     match joints {
         JointSolver::Iterative => (1, 20),

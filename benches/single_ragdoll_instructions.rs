@@ -64,7 +64,7 @@ fn step_standard(mut scene: SceneWorld) -> SceneWorld {
     black_box(scene)
 }
 
-// The same ragdoll with its joints solved directly (issue 18).
+// The same ragdoll with its joints solved directly.
 #[library_benchmark]
 #[benches::backend(args = [0, 2, 3], setup = simplified_direct)]
 fn step_simplified_direct(mut scene: SceneWorld) -> SceneWorld {

@@ -1348,8 +1348,7 @@ fn dropped_box(collider: impl Fn(VtBody) -> VtCollider) -> f32 {
     unsafe { state.assume_init() }.position.y
 }
 
-/// Issue 31, item 12. A zero-initialised `VtCollider` (groups 0) collides
-/// with nothing: a box on one falls through the ground without an error.
+/// A zero-initialised `VtCollider` (groups 0) collides with nothing: a box on one falls through the ground without an error.
 /// `vt_collider_default` gives the Rust API's `Collider::new`: every
 /// group, friction 0.6, no restitution; a box on it rests on the ground.
 /// Its shape left as written (a sphere of radius 0) is refused by
@@ -1496,12 +1495,11 @@ fn a_snapshot_restored_into_a_fresh_world_steps_as_the_original() {
     assert_ne!(fresh.hash(), CWorld::new().hash(), "the ragdoll moved");
 }
 
-/// Issue 31, item 10, through C: a world restored without its layer's
-/// snapshot (here, to before its ragdoll fell 20 frames) is refused by
-/// every layer call that takes it (`VT_RESULT_WORLD_MISMATCH`), the
-/// layer unchanged, until the layer's snapshot taken with the world's is
-/// restored; a new layer refuses a restored world until it is restored
-/// or attached.
+/// Through C, a world restored without its layer's snapshot (here, to
+/// before its ragdoll fell 20 frames) is refused by every layer call that
+/// takes it (`VT_RESULT_WORLD_MISMATCH`), the layer unchanged, until the
+/// layer's snapshot taken with the world's is restored; a new layer refuses
+/// a restored world until it is restored or attached.
 #[test]
 fn a_world_restored_without_its_layer_is_refused_through_c() {
     let scene = Drop_::new(VtSpineMode::Rod);
@@ -1615,12 +1613,12 @@ fn with_group_counter(bytes: &[u8], mut given: u64) -> Vec<u8> {
     out
 }
 
-/// Issue 31, item 1, through C: a layer's snapshot whose group counter is
-/// `u64::MAX` (checksum made right) was restored by `vt_collisions_restore`
-/// as `VT_RESULT_OK`, and the next ragdoll's self-collision turned off
-/// wrapped it. Refused now, the layer unchanged; at the limit it restores,
-/// and the group past it is refused (`VT_RESULT_COLLIDER`, the ragdoll's
-/// first body named), the layer unchanged.
+/// Through C, a layer's snapshot whose group counter is `u64::MAX`
+/// (checksum made right) is refused by `vt_collisions_restore`, the layer
+/// unchanged (accepted, the next ragdoll's self-collision turned off would
+/// wrap it); at the limit it restores, and the group past it is refused
+/// (`VT_RESULT_COLLIDER`, the ragdoll's first body named), the layer
+/// unchanged.
 #[test]
 fn a_crafted_group_counter_is_refused_through_c() {
     let scene = Drop_::new(VtSpineMode::Sockets);
@@ -2979,10 +2977,10 @@ fn a_pose_mapped_in_place_equals_one_mapped_into_another_array() {
     unsafe { vt_skeleton_mapper_destroy(mapper) };
 }
 
-/// Issue 31, item 7: the C ABI's string entry points read any length
-/// (the Rust loaders behind them then parsed it). A string longer than
-/// `MAX_FILE_BYTES` is refused before it is parsed, with the Rust API's
-/// message; nothing is written.
+/// The C ABI's string entry points read at most `MAX_FILE_BYTES` (the
+/// Rust loaders behind them would parse any length): a string longer than
+/// that is refused before it is parsed, with the Rust API's message;
+/// nothing is written.
 #[test]
 fn a_string_longer_than_a_file_may_be_is_refused_before_it_is_parsed() {
     let cap = vertebra_ragdoll::MAX_FILE_BYTES as usize;
@@ -3015,12 +3013,12 @@ fn a_string_longer_than_a_file_may_be_is_refused_before_it_is_parsed() {
     );
 }
 
-/// Issue 31, item 4: a removed ragdoll mapped onto the skeleton as `Ok`
-/// (`vt_skeleton_mapper_map_to_skeleton`, `vt_transition_skeleton_pose`),
-/// every bone at the world origin, and the drives and a second removal
-/// took it as `Ok`. Every call that takes it is refused as a stale
-/// handle, naming the ragdoll, with the world, the layer and every output
-/// as they were.
+/// A removed ragdoll is refused by every call that takes it (mapped onto
+/// the skeleton by `vt_skeleton_mapper_map_to_skeleton` or
+/// `vt_transition_skeleton_pose` it would put every bone at the world
+/// origin; driven or removed again it would do nothing): a stale handle,
+/// naming the ragdoll, with the world, the layer and every output as they
+/// were.
 #[test]
 fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
     let c = Drop_::new(VtSpineMode::Rod);
@@ -3208,9 +3206,9 @@ fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
     }
 }
 
-/// Issue 31, item 11: a rod spine asked of a description without a
-/// `[spine]` through the C ABI (`vt_ragdoll_build`, with and without the
-/// collision layer, and `vt_skeleton_mapper_create`) is refused by name.
+/// A rod spine asked of a description without a `[spine]` through the C ABI
+/// (`vt_ragdoll_build`, with and without the collision layer, and
+/// `vt_skeleton_mapper_create`) is refused by name.
 #[test]
 fn a_rod_spine_of_a_description_without_a_spine_is_refused_through_c() {
     let reference = vertebra_ragdoll::REFERENCE_HUMANOID;

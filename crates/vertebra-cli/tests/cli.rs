@@ -1122,12 +1122,11 @@ fn vertebra_guarded(args: &[&str], limit: std::time::Duration) -> Option<(i32, S
     }
 }
 
-/// Issue 31, item 5: `vertebra check` opened its file (to tell a ragdoll
-/// from a skeleton file) before the loaders' reader checked its type, so
-/// `check` on a FIFO waited for a writer for ever. Every path of the
-/// command that reads a file (`check FILE`, `check --skeleton FILE`,
-/// `scene --ragdoll FILE`) goes through the one reader, which refuses
-/// anything but a regular file without opening it.
+/// Every path of the command that reads a file (`check FILE`, `check
+/// --skeleton FILE`, `scene --ragdoll FILE`) goes through the one reader,
+/// which refuses anything but a regular file without opening it: opening
+/// a FIFO (to tell a ragdoll from a skeleton file, say) would wait for a
+/// writer for ever.
 #[test]
 fn every_file_the_command_reads_is_refused_when_it_is_a_fifo() {
     let dir = std::env::temp_dir().join(format!("vertebra-cli-fifo-{}", std::process::id()));
@@ -1167,9 +1166,9 @@ fn every_file_the_command_reads_is_refused_when_it_is_a_fifo() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Issue 31, item 11: `--spine rod` on a ragdoll without a `[spine]` ran
-/// the standard ragdoll and said nothing; it is refused naming the file,
-/// the description and the missing table. A scene whose own ragdoll has
+/// `--spine rod` on a ragdoll without a `[spine]` is refused naming the
+/// file, the description and the missing table, rather than running the
+/// standard ragdoll without a word. A scene whose own ragdoll has
 /// no spine (the heavy chain) is refused the same way, by name.
 #[test]
 fn a_rod_spine_of_a_ragdoll_without_a_spine_is_refused_by_name() {
@@ -1210,9 +1209,9 @@ fn a_rod_spine_of_a_ragdoll_without_a_spine_is_refused_by_name() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Issue 31, item 8: a refused `reproduce` (`--seeds 0`, or more than a
-/// run may take) left an empty output directory behind. Everything the
-/// command is given is checked before anything is written.
+/// A refused `reproduce` (`--seeds 0`, or more than a run may take)
+/// leaves no empty output directory behind: everything the command is
+/// given is checked before anything is written.
 #[test]
 fn a_refused_reproduce_leaves_no_output_directory() {
     let dir = std::env::temp_dir().join(format!("vertebra-cli-refused-{}", std::process::id()));

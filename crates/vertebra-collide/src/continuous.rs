@@ -35,8 +35,8 @@
 //! thickness (a capsule or sphere of half the radius, a box inset by half
 //! its smallest half extent). A body that only sinks into a wall or floor
 //! by less than that (a ragdoll landing 1 cm deep) is left to the contacts
-//! exactly as before: no pose is changed, so worlds whose bodies never
-//! pass that deep (every paper scene) keep every bit. A core that starts
+//! alone: no pose is changed, so worlds whose bodies never pass that deep
+//! (every paper scene) step bit for bit as without the sweep. A core that starts
 //! the step within `SKIN` of static geometry (a limb pressed against a
 //! wall, or put back against it the step before) is swept instead as a
 //! ball of a quarter of its thickness at its centre (Box2D v3's fallback):
@@ -114,8 +114,8 @@ impl Sweep {
 /// A body's motion is fast when it exceeds this fraction of its thickness
 /// in a step. Box2D v3 sweeps from half; at half, a limb of the 30-ragdoll
 /// drop (rod spines, direct joints) turning at 9 rad/s while pressed 3 cm
-/// into an obstacle of the pit was swept and nudged (a core grazing the
-/// box at the step's start, not a body passing through), which moved
+/// into an obstacle of the pit is swept and nudged (a core grazing the
+/// box at the step's start, not a body passing through), which moves
 /// every bit of the scene after it. A body moving less than its thickness
 /// in a step meets its speculative contacts before its core can reach
 /// the far side of anything as thick as it is.

@@ -325,7 +325,7 @@ fn solid(shape: Shape) -> Result<SharedShape, Error> {
 /// The largest size (m) of a collider: a sphere's radius, a box's half
 /// extent, a capsule's half segment plus radius. 10 km is larger than any
 /// level's floor, and at 1e4 m an `f32` still resolves a millimetre; far
-/// beyond it parry's contact points are no longer finite (1e30 gave NaN).
+/// beyond it parry's contact points stop being finite (NaN at 1e30).
 pub const MAX_COLLIDER_EXTENT: f32 = 1.0e4;
 
 /// Checks a solid's size against [`MAX_COLLIDER_EXTENT`] (after

@@ -17,9 +17,9 @@
 //! parry geometry is rebuilt from the shapes, exactly as
 //! [`Collisions::add`] builds it.
 //!
-//! Format versions: 1, without the self-collision settings; 2, with them;
-//! 3, with the world's bodies; 4, with the ragdolls' parts and the pairs
-//! touching.
+//! The format version changes with every change to the payload's layout,
+//! so bytes of another layout are refused by their version rather than
+//! misread.
 //!
 //! The bytes are untrusted input: the checksum only catches accidents (it
 //! is not keyed), so [`Collisions::restore`] checks every value as

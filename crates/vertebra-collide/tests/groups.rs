@@ -247,10 +247,10 @@ fn resealed(mut bytes: Vec<u8>) -> CollisionSnapshot {
     CollisionSnapshot::from_bytes(bytes)
 }
 
-/// The self-collision setting is in the snapshot (since format 2): restored, it
-/// is off again, and it follows a recreated ragdoll to its new bodies. A
-/// snapshot of format 1, or whose next group is one already given, is
-/// refused by name with the set unchanged.
+/// The self-collision setting is in the snapshot: restored, it is off
+/// again, and it follows a recreated ragdoll to its new bodies. A snapshot
+/// of another format version, or whose next group is one already given,
+/// is refused by name with the set unchanged.
 #[test]
 fn self_collision_settings_are_saved_restored_and_checked() {
     let (mut w, mut c) = ground();
@@ -298,14 +298,14 @@ fn varint(mut value: u64, bytes: &mut Vec<u8>) {
     bytes.push(value as u8);
 }
 
-/// Issue 31, item 1. A collision snapshot's group counter (the next group
-/// to give, the payload's last varint) set to `u64::MAX` with the checksum
-/// made right was restored as `Ok`; turning one more ragdoll's
-/// self-collision off then overflowed it (a panic in debug builds, 0 in
-/// release: two ragdolls in one group, which pass through each other, and
-/// a set whose own next snapshot is refused). Now the counter is refused
-/// beyond `MAX_SELF_COLLISION_GROUPS` with the set unchanged; at the limit
-/// it is accepted, and the call that would give a group past it is refused
+/// A collision snapshot's group counter (the next group to give, the
+/// payload's last varint) set to `u64::MAX` with the checksum made right
+/// is refused: accepted, turning one more ragdoll's self-collision off
+/// would overflow it (a panic in debug builds, 0 in release: two ragdolls
+/// in one group, which pass through each other, and a set whose own next
+/// snapshot is refused). The counter is refused beyond
+/// `MAX_SELF_COLLISION_GROUPS` with the set unchanged; at the limit it is
+/// accepted, and the call that would give a group past it is refused
 /// naming the ragdoll's first body and collider, with nothing changed: the
 /// two overlapping ragdolls still meet.
 #[test]

@@ -66,13 +66,14 @@ fn contents(c: &Collisions, r: &Ragdoll) -> (Vec<Collider>, f32, Vec<bool>) {
     (c.colliders().copied().collect(), c.prediction(), excluded)
 }
 
-/// Issue 31, item 10, the set kept. A world restored to a moment before
-/// its ragdoll was removed has the ragdoll back, and the set kept from
-/// after the removal has no colliders for it: detection gave the ground's
-/// contacts only, and the ragdoll fell 23 m through the floor in 2 s with
-/// no error. Now every call of the set that takes the world refuses it
-/// (`WorldMismatch`), everything unchanged, until the set's snapshot taken
-/// with the world's is restored after it: the ragdoll stands.
+/// The set kept. A world restored to a moment before its ragdoll was
+/// removed has the ragdoll back, and the set kept from after the removal
+/// has no colliders for it: served, detection would give the ground's
+/// contacts only, and the ragdoll would fall 23 m through the floor in
+/// 2 s with no error. So every call of the set that takes the world
+/// refuses it (`WorldMismatch`), everything unchanged, until the set's
+/// snapshot taken with the world's is restored after it: the ragdoll
+/// stands.
 #[test]
 fn a_world_restored_without_its_collision_set_is_refused_until_the_set_is_restored() {
     let (mut w, mut c, mut r) = settled();
@@ -128,12 +129,12 @@ fn a_world_restored_without_its_collision_set_is_refused_until_the_set_is_restor
     );
 }
 
-/// Issue 31, item 10, a fresh set. A world restored from a save (here a
-/// fresh world) and a new, empty set: no contacts, and the ragdoll fell
-/// through the floor. A set that never served a world now refuses a
-/// restored one; the set's snapshot restored after the world's serves it,
-/// and a set built by hand for it is declared with `attach` (refused,
-/// naming the collider, while a collider's body is not in the world).
+/// A fresh set. A world restored from a save (here a fresh world) and a
+/// new, empty set would find no contacts, and the ragdoll would fall
+/// through the floor. A set that never served a world refuses a restored
+/// one; the set's snapshot restored after the world's serves it, and a
+/// set built by hand for it is declared with `attach` (refused, naming
+/// the collider, while a collider's body is not in the world).
 #[test]
 fn a_fresh_collision_set_is_refused_for_a_restored_world() {
     let (w, c, r) = settled();
@@ -178,12 +179,12 @@ fn a_fresh_collision_set_is_refused_for_a_restored_world() {
     );
 }
 
-/// Issue 31, item 10, both restored from different moments. The world's
-/// snapshot from before the ragdoll was removed, the set's from after:
-/// the set's restored as `Ok`, and the ragdoll fell through the floor.
-/// A set's snapshot records the world's bodies it was taken with and is
-/// refused for a world with others, the set unchanged; one of another
-/// moment with the same bodies (frames later) restores, as it is right.
+/// Both restored, from different moments. The world's snapshot from
+/// before the ragdoll was removed, the set's from after: accepted, the
+/// ragdoll would fall through the floor. A set's snapshot records the
+/// world's bodies it was taken with and is refused for a world with
+/// others, the set unchanged; one of another moment with the same bodies
+/// (frames later) restores, as it is right.
 #[test]
 fn a_collision_snapshot_of_another_moment_of_the_world_is_refused() {
     let (mut w, mut c, mut r) = settled();

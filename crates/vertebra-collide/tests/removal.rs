@@ -79,7 +79,7 @@ fn all_live(w: &World, c: &Collisions) -> bool {
 
 #[test]
 fn add_jointed_adds_nothing_when_one_shape_is_refused() {
-    // Failed before the fix: the first capsule was added, then the error.
+    // Nothing is added, not even the colliders before the refused one.
     let (w, mut c, [_, a, b]) = boxes();
     let before = c.snapshot(&w).unwrap();
     let good = Shape::Sphere { radius: 0.1 };
@@ -100,8 +100,8 @@ fn add_jointed_adds_nothing_when_one_shape_is_refused() {
 
 #[test]
 fn colliders_beyond_the_size_limit_are_refused() {
-    // Failed before the fix: a box of half extent 1e30 m was accepted and
-    // its contacts had NaN points (found by the crafted snapshots below).
+    // Beyond the limit a collider's contacts are not finite (a box of half
+    // extent 1e30 m gives NaN points).
     let (mut w, mut c, [_, _, b]) = boxes();
     let before = c.snapshot(&w).unwrap();
     for shape in [
@@ -125,8 +125,8 @@ fn colliders_beyond_the_size_limit_are_refused() {
             "{shape:?}"
         );
     }
-    // A restitution outside [0, 1], in words (it read "invalid restitution
-    // (must be in [0, 1]) limit").
+    // A restitution outside [0, 1], refused in words that read as a
+    // sentence.
     let mut bouncy = Collider::new(b, ColliderShape::Solid(Shape::Sphere { radius: 0.1 }));
     bouncy.restitution = 1.5;
     let refused = c.add(bouncy).unwrap_err();
@@ -159,8 +159,8 @@ fn a_bad_prediction_margin_is_refused() {
 
 #[test]
 fn a_collider_whose_body_is_gone_is_named() {
-    // Failed before the fix: `find_contacts` said only "stale or unknown
-    // body handle".
+    // Not only "stale or unknown body handle": which collider, on which
+    // body.
     let (mut w, c, [_, _, b]) = boxes();
     w.remove_body(b).unwrap();
     let refused = c.find_contacts(&w, DT).unwrap_err();
@@ -177,8 +177,8 @@ fn a_collider_whose_body_is_gone_is_named() {
 
 #[test]
 fn removing_a_ragdoll_takes_its_colliders_and_contacts_keep_coming() {
-    // Before the fix `Ragdoll::remove` left 13 colliders behind and every
-    // later `find_contacts` failed.
+    // A collider left behind would name a removed body, and every later
+    // `find_contacts` would fail.
     let (mut w, mut c, mut ragdolls) = pile();
     for _ in 0..20 {
         step(&mut w, &c);
@@ -492,12 +492,13 @@ fn crafted(good: &CollisionSnapshot, change: impl FnOnce(&mut Payload)) -> Colli
     resealed([&bytes[..20], &body[..]].concat())
 }
 
-/// Issue 31, item 1 (every value a collision snapshot carries): the lists
-/// the set writes in a canonical order (so equal sets give equal bytes)
-/// were put back in any order, with entries repeated and a pair's bodies
-/// swapped, and normalised without a word. A set writes each excluded pair
-/// once, its bodies in slot order, and both lists ascending by their
-/// encoding: anything else is refused by name with the set unchanged.
+/// Every value a collision snapshot carries is checked as the set would
+/// have written it: the lists the set writes in a canonical order (so
+/// equal sets give equal bytes) are not normalised on the way in. A set
+/// writes each excluded pair once, its bodies in slot order, and both
+/// lists ascending by their encoding: anything else (an entry repeated, a
+/// pair's bodies swapped, two entries exchanged) is refused by name with
+/// the set unchanged.
 #[test]
 fn lists_the_set_could_not_have_written_are_refused_by_name() {
     let (w, mut c, ragdolls) = pile();

@@ -16,8 +16,7 @@
 //! that enters it and one on every worker for each chunk it solves; every
 //! other public call of the world, ragdoll, collision and scene layers
 //! that computes what enters a world, or what a game reads back, holds
-//! one for its length (`docs/robustness.md`, "Soundness and numerics
-//! found by review").
+//! one for its length (`docs/robustness.md`, "Soundness and numerics").
 //!
 //! | target | register | what is set |
 //! | --- | --- | --- |

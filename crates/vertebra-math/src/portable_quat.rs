@@ -20,7 +20,7 @@
 //! Everything that enters a world (bodies' orientations, joint frames,
 //! the step's integration, contacts' relative poses) goes through these
 //! instead, written in the order of glam's SSE2 code: x86-64's results
-//! are what they were, and every other target now computes them. So do
+//! are glam's own, and every other target computes the same bits. So do
 //! rotations made from an angle: glam takes their sine and cosine from
 //! the platform's C library, these from [`crate::trig`].
 //! (Nothing refuses glam's own at compile time: tests use them freely,

@@ -45,8 +45,8 @@ impl SkeletonMapper {
 
     /// The bodies' world poses and the rod's frames, read from `world`.
     pub(crate) fn read(&self, ragdoll: &Ragdoll, world: &World) -> Result<Bodies, RagdollError> {
-        // A removed ragdoll has no bodies to read: refused by name, where
-        // it used to map with every body at the world origin.
+        // A removed ragdoll has no bodies to read: refused by name (mapped,
+        // every body would be at the world origin).
         ragdoll.check_not_removed()?;
         if ragdoll.options.spine != self.spine
             || ragdoll.desc.name != self.desc.name

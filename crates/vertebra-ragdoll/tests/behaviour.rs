@@ -390,8 +390,8 @@ fn removal_state(w: &World, ragdoll: &Ragdoll) -> impl PartialEq + std::fmt::Deb
 
 #[test]
 fn a_ragdoll_held_by_a_foreign_joint_is_not_removed_at_all() {
-    // Failed before the fix: the rod and every socket were removed, then
-    // the hips were refused (a pin still held them), leaving half a ragdoll.
+    // The refusal comes before anything is removed: refusing the pinned
+    // hips after the rod and the sockets would leave half a ragdoll.
     let desc = RagdollDesc::reference_humanoid();
     let mut w = world();
     let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Rod);
@@ -415,8 +415,7 @@ fn a_ragdoll_held_by_a_foreign_joint_is_not_removed_at_all() {
 
 #[test]
 fn a_ragdoll_missing_a_joint_is_not_removed_at_all() {
-    // Failed before the fix: the rod and the sockets before the missing one
-    // were removed, then the stale socket was refused without a name.
+    // The missing joint is found, and named, before anything is removed.
     let desc = RagdollDesc::reference_humanoid();
     let mut w = world();
     let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Rod);
@@ -434,8 +433,8 @@ fn a_ragdoll_missing_a_joint_is_not_removed_at_all() {
 
 #[test]
 fn a_ragdoll_that_cannot_be_removed_is_not_recreated() {
-    // Failed before the fix: the new ragdoll was built and swapped in, then
-    // removing the old one failed, leaving both in the world.
+    // The old ragdoll's removal is checked before the new one is built:
+    // otherwise both would be left in the world.
     let desc = RagdollDesc::reference_humanoid();
     let mut w = world();
     let mut ragdoll = at_bind(&mut w, &desc, SpineMode::Sockets);

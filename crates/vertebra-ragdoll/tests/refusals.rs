@@ -1,6 +1,5 @@
 //! Values a ragdoll accepts give a finite ragdoll; values it cannot use are
-//! refused with the item (line, body, joint, option) and field named
-//! (issue 13, classes 5 and 6).
+//! refused with the item (line, body, joint, option) and field named.
 
 use glam::{Quat, Vec3};
 use vertebra_ragdoll::{
@@ -229,11 +228,11 @@ fn without_spine() -> String {
     REFERENCE_HUMANOID[..at].to_owned()
 }
 
-/// Issue 31, item 11: a rod spine asked of a description without a
-/// `[spine]` built the standard ragdoll (no rod) and said nothing.
-/// Refused by the description's name and the missing table, by the build
-/// (with nothing added to the world) and by the mapper, which would map
-/// a rod that is not there.
+/// A rod spine asked of a description without a `[spine]` is refused,
+/// naming the description and the missing table, rather than building the
+/// standard ragdoll (no rod) without a word: by the build (with nothing
+/// added to the world) and by the mapper, which would map a rod that is
+/// not there.
 #[test]
 fn a_rod_spine_of_a_description_without_a_spine_is_refused_by_name() {
     let desc = RagdollDesc::from_toml(&without_spine()).unwrap();
@@ -280,11 +279,10 @@ fn long_text(len: usize) -> String {
     text
 }
 
-/// Issue 31, item 7: the string entry points parsed any length (an
-/// 11.5 MB description took 16-37 s) where files are capped at
-/// `MAX_FILE_BYTES`. Every one refuses a longer text before parsing it:
-/// the text starts with a syntax error that a parser would name, and the
-/// refusal is the size, not that.
+/// The string entry points are capped at `MAX_FILE_BYTES`, as files are
+/// (parsing a description megabytes long takes seconds). Every one refuses a
+/// longer text before parsing it: the text starts with a syntax error
+/// that a parser would name, and the refusal is the size, not that.
 #[test]
 fn a_text_longer_than_a_file_may_be_is_refused_before_it_is_parsed() {
     use vertebra_ragdoll::{MAX_FILE_BYTES, RagdollGenerator, Skeleton};
@@ -337,11 +335,10 @@ fn a_text_longer_than_a_file_may_be_is_refused_before_it_is_parsed() {
     }
 }
 
-/// Issue 31, item 7: a 45,000-body description spent 11-31 s before it
-/// was refused for a skeleton it was never given. The counts are checked
-/// before any body or joint is: a description with more bodies (or
-/// joints) than a ragdoll may have is refused with that one problem,
-/// however many others its items have.
+/// The counts are checked before any body or joint is, so a description of
+/// tens of thousands of bodies costs no time to refuse: a description with
+/// more bodies (or joints) than a ragdoll may have is refused with that one
+/// problem, however many others its items have.
 #[test]
 fn more_bodies_or_joints_than_a_ragdoll_may_have_are_refused_before_any_is_read() {
     use vertebra_ragdoll::{BodySpec, JointSpec, MAX_BONES};

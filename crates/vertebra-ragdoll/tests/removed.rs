@@ -62,7 +62,7 @@ fn every_call_on_a_removed_ragdoll_is_refused_naming_it() {
         let hash = world.state_hash();
         let animation = skeleton.bind_pose();
         let place = Transform::IDENTITY;
-        // The two the issue found: Ok, with every bone at the origin.
+        // Mapped, a removed ragdoll would put every bone at the origin.
         names_the_removed_ragdoll(
             "map_to_skeleton",
             mapper.map_to_skeleton(&ragdoll, &world, &animation, place, SpineMapping::Arc),
@@ -87,14 +87,15 @@ fn every_call_on_a_removed_ragdoll_is_refused_naming_it() {
             "Ragdoll::skeleton_pose",
             ragdoll.skeleton_pose(&world, SpineMapping::Arc),
         );
-        // The drives took it as Ok and did nothing.
+        // Driven, it would do nothing and say `Ok`.
         names_the_removed_ragdoll("drive_to", ragdoll.drive_to(&mut world, &pose, &settings));
         names_the_removed_ragdoll(
             "drive_following",
             ragdoll.drive_following(&mut world, &pose, &pose, 1.0 / 60.0, &settings),
         );
         names_the_removed_ragdoll("release_drives", ragdoll.release_drives(&mut world));
-        // Those that refused it named only its root body.
+        // These would refuse it anyway: they name the ragdoll, not only its
+        // root body.
         names_the_removed_ragdoll("root_transform", ragdoll.root_transform(&world));
         names_the_removed_ragdoll("bounds", ragdoll.bounds(&world));
         names_the_removed_ragdoll(

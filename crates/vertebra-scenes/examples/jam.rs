@@ -1,5 +1,5 @@
-//! Diagnostic: what holds a jammed pile apart (issue 14; docs/contacts.md,
-//! "The jammed pile").
+//! Diagnostic: what holds a jammed pile apart (docs/contacts.md, "The
+//! jammed pile").
 //!
 //! `cargo run --release -p vertebra-scenes --example jam -- S I SEED [FRAMES [EVERY]]`
 //! runs the socket ragdoll drop at S substeps x I iterations from SEED and

@@ -1,6 +1,6 @@
 //! Diagnostic: which joints of the anatomical drop go past their limits,
-//! and which only fail to hold their axes (issue 15; docs/joints.md, "The
-//! anatomical drop").
+//! and which only fail to hold their axes (docs/joints.md, "The anatomical
+//! drop").
 //!
 //! `cargo run --release -p vertebra-scenes --example limits -- SPINE S I SEED [JOINTS [SCENE]]`
 //! (`SPINE` is `rod` or `sockets`; `JOINTS` is `iterative`, the default, or

@@ -3,7 +3,7 @@
 //! under gravity. Gauss-Seidel over the joints converges slowly across
 //! large mass ratios (each light link is pulled back and forth between
 //! its neighbours), so the iterative solve lets the chain stretch; a direct
-//! solve of the whole chain does not (issue 18).
+//! solve of the whole chain does not.
 
 use glam::Vec3;
 use vertebra_ragdoll::{

@@ -1,4 +1,5 @@
-//! The 30-ragdoll drop on the anatomical humanoid (issue 15).
+//! The 30-ragdoll drop on the anatomical humanoid (`docs/joints.md`, "The
+//! anatomical drop").
 
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Quantity, Scene, SceneConfig, run};

@@ -1,7 +1,7 @@
 //! The heavy chain (8 links of 1 kg, a 1000 kg body at the end, hanging
 //! from a fixed anchor): under the iterative joint solve the mass ratio
 //! across the last joint stretches the chain by metres; the direct solve
-//! holds it together, at the same 1 substep (issue 18).
+//! holds it together, at the same 1 substep.
 
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{HEAVY_MASS, LINK_MASS, LINKS, Quantity, Scene, SceneConfig, build, run};
@@ -42,7 +42,7 @@ fn the_direct_solve_holds_the_heavy_chain_together() {
     config.joints = JointSolver::Direct;
     let r = run(&config, |_, _| {}).unwrap();
     let lin = r.stats(Quantity::EpsLin);
-    // The issue's target is 1 cm at 1 substep; measured under 1e-4 cm.
+    // The target is 1 cm at 1 substep; measured under 1e-4 cm.
     assert!(lin.max < 0.01, "max separation {} cm", lin.max);
     // The heavy body hangs where the unstretched chain holds it.
     let heavy = r.final_positions.last().unwrap().1;

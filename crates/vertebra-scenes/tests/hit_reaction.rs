@@ -1,4 +1,4 @@
-//! The hit reaction (issue 15): the anatomical humanoid, hips held, driven
+//! The hit reaction: the anatomical humanoid, hips held, driven
 //! to its bind pose by springs, hit on the chest and then on the head
 //! (`docs/joints.md`, "Hit reaction").
 
@@ -59,9 +59,9 @@ fn a_torque_limit_lets_the_hit_turn_the_body_further() {
     assert!(chest(&hit(SpineMode::Rod, 16.0, 10.0)).frames.is_some());
 }
 
-/// The issue's target: no joint past its limit by more than 2 degrees at
-/// 20 iterations, in every frame (hinges included: no elbow bends
-/// backwards). Seed 0 here; `docs/joints.md` gives 8 seeds.
+/// The hit reaction's target: no joint past its limit by more than 2
+/// degrees at 20 iterations, in every frame (hinges included: no elbow
+/// bends backwards). Seed 0 here; `docs/joints.md` gives 8 seeds.
 #[test]
 fn no_joint_passes_its_limit_by_more_than_two_degrees() {
     for spine in BOTH {

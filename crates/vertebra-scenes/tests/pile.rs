@@ -1,5 +1,5 @@
-//! The substepped pile comes to rest (issue 14; docs/contacts.md, "The
-//! jammed pile").
+//! The substepped pile comes to rest (docs/contacts.md, "The jammed
+//! pile").
 
 use glam::Vec3;
 use vertebra_collide::{Collider, ColliderShape};
@@ -11,14 +11,14 @@ const DT: f32 = 1.0 / 60.0;
 
 #[test]
 fn a_substepped_pile_comes_to_rest_in_its_pit() {
-    // 20 substeps x 5 iterations from seed 1. When an overlap found at
-    // detection was removed in the first substep, bodies came out at
-    // overlap / h (20 times faster than at one substep): the pile boiled
-    // at up to 57 m/s for all 600 frames, ragdolls were thrown out of the
-    // pit, and ragdoll 3's left forearm was fired into the wall, past its
-    // middle, where the wall pushed it out the far side while its upper
-    // arm was pushed back in: 4.85 cm of elbow separation, frame after
-    // frame.
+    // 20 substeps x 5 iterations from seed 1. An overlap found at
+    // detection and removed in the first substep would bring bodies out
+    // at overlap / h (20 times faster than at one substep): the pile would
+    // boil at up to 57 m/s for all 600 frames, ragdolls would be thrown
+    // out of the pit, and ragdoll 3's left forearm would be fired into the
+    // wall, past its middle, where the wall pushes it out the far side
+    // while its upper arm is pushed back in: 4.85 cm of elbow separation,
+    // frame after frame.
     let mut config = SceneConfig::new(Scene::RagdollDrop, SpineMode::Sockets);
     config.substeps = 20;
     config.iterations = 5;
@@ -49,8 +49,8 @@ fn a_substepped_pile_comes_to_rest_in_its_pit() {
 fn the_pile_falls_asleep_and_stays_put() {
     // The paper's 1 x 20 drop with sleeping on. Its limbs keep twisting back
     // and forth at their twist limits (a shin by 2 degrees a frame, at
-    // 2 rad/s) and the pile never slept while sleep was judged by turning
-    // rates; by the mean speed of each body's mass it sleeps within 40 s
+    // 2 rad/s), so judged by turning rates the pile would never sleep; by
+    // the mean speed of each body's mass it sleeps within 40 s
     // (after 20-25 s with the socket spine, 30-35 s with the rod).
     for spine in [SpineMode::Sockets, SpineMode::Rod] {
         let mut config = SceneConfig::new(Scene::RagdollDrop, spine);

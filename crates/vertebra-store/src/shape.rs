@@ -203,7 +203,7 @@ fn positive_size(what: &'static str, x: f32) -> Result<(), Error> {
 /// segment lengths, a millimetre to a kilometre. Over this range a unit
 /// density's volume (about `s^3`) and inertia (about `s^5`) stay normal
 /// `f32` numbers (1e-15 to 1e16), so the scale from them to any mass in
-/// [`MASS_RANGE`] is finite and non-zero. A capsule radius of 1e-30 m had
+/// [`MASS_RANGE`] is finite and non-zero. A capsule radius of 1e-30 m has
 /// a volume of zero and a mass of NaN; at 1e6 m coordinates an `f32`
 /// resolves 6 cm, so nothing below a millimetre could be placed anyway.
 pub const SIZE_RANGE: core::ops::RangeInclusive<f32> = 1.0e-3..=1.0e3;

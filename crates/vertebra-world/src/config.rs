@@ -23,7 +23,7 @@ pub const MAX_THREADS: usize = 256;
 /// most [`MAX_TIME_STEP`] a body then moves at most [`MAX_COORDINATE`], so
 /// a body in range ends a step within twice the range, and positions stay
 /// 32 orders of magnitude below `f32` overflow for any game's lifetime
-/// (`f32::MAX` was accepted, and bodies reached 3e38 m).
+/// (with `f32::MAX` bodies would reach 3e38 m).
 pub const MAX_LINEAR_SPEED_LIMIT: f32 = MAX_COORDINATE / MAX_TIME_STEP;
 
 /// The highest `max_angular_speed` (rad/s) a world accepts: `|w|^2` (1e12)

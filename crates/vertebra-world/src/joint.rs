@@ -172,8 +172,8 @@ impl SwingTwist {
     }
 
     /// Whether the plain socket path solves it (a hard circular cone, or
-    /// none, and a hard twist range): the one every socket took before
-    /// joint kinds, bit for bit.
+    /// none, and a hard twist range): the cheaper path, without the shaped
+    /// path's terms.
     pub(crate) fn is_plain(&self) -> bool {
         matches!(self.swing, Swing::Free | Swing::Cone(_)) && self.softness == LimitSoftness::Hard
     }

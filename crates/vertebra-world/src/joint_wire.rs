@@ -1,17 +1,19 @@
-//! How a [`JointDesc`] is encoded (snapshots, the state hash).
+//! How a [`JointDesc`] is encoded (snapshots, the state hash): its bodies,
+//! anchors and frames, then its kind, then its drive, the last two as
+//! postcard enums (the variant's index, then its fields).
 //!
-//! A socket with a hard circular cone (or none) and a hard twist range is
-//! encoded exactly as the sockets of snapshot format 3 were: the swing
-//! limit as an optional angle, then the twist range, then the drive. So a
-//! world of such sockets, the only joints there were before joint kinds,
-//! keeps its state hash bit for bit (the golden hashes of
-//! `crates/vertebra-scenes/tests/golden.rs`). Every other kind is
-//! encoded after a third tag. Postcard encodes an enum's variant as its
-//! index and an `Option` as 0 or 1 before the value, so variant 0 with the
-//! twist range is format 3's `None` swing limit, variant 1 its `Some`.
-//! The drive and the breaking thresholds follow the same rule: a joint
-//! without thresholds encodes its drive as the `Option` it always was
-//! (variants 0 and 1), one with them after a third tag.
+//! The kind: a socket with hard limits and no swing limit is variant 0
+//! (its twist range), one with a hard circular cone variant 1 (the cone's
+//! half-angle, then the twist range), and every other kind variant 2 (the
+//! whole [`JointKind`]). The drive: none is variant 0, a drive variant 1,
+//! and breaking thresholds, with the drive if any, variant 2. So the plain
+//! socket, the commonest joint, is a few bytes without a [`JointKind`]'s
+//! tags and fields.
+//!
+//! The encoding is part of the state hash, which the golden hashes of
+//! `crates/vertebra-scenes/tests/golden.rs` hold: a new kind or field is
+//! encoded after the variants there are, so the bytes of every joint that
+//! does not use it stay as they are.
 
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};

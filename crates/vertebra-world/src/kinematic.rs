@@ -103,7 +103,7 @@ impl World {
     ) -> Result<(), Error> {
         let (linear, angular) = self.kinematic_velocities(handle, position, orientation, dt)?;
         self.bodies.set_velocity(handle, linear, angular)?;
-        self.stir(handle);
+        self.wake_islands_of(handle);
         Ok(())
     }
 

@@ -278,7 +278,7 @@ impl World {
         let _mode = DefaultFloatMode::enter();
         self.bodies.set_pose(handle, position, orientation)?;
         self.pose_version += 1;
-        self.stir(handle);
+        self.wake_islands_of(handle);
         Ok(())
     }
 
@@ -290,7 +290,7 @@ impl World {
         angular: Vec3,
     ) -> Result<(), Error> {
         self.bodies.set_velocity(handle, linear, angular)?;
-        self.stir(handle);
+        self.wake_islands_of(handle);
         Ok(())
     }
 
@@ -298,7 +298,7 @@ impl World {
     pub fn add_force(&mut self, handle: BodyHandle, force: Vec3) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         self.bodies.add_force(handle, force)?;
-        self.stir(handle);
+        self.wake_islands_of(handle);
         Ok(())
     }
 
@@ -311,7 +311,7 @@ impl World {
     ) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         self.bodies.add_force_at(handle, force, point)?;
-        self.stir(handle);
+        self.wake_islands_of(handle);
         Ok(())
     }
 
@@ -319,7 +319,7 @@ impl World {
     pub fn add_torque(&mut self, handle: BodyHandle, torque: Vec3) -> Result<(), Error> {
         let _mode = DefaultFloatMode::enter();
         self.bodies.add_torque(handle, torque)?;
-        self.stir(handle);
+        self.wake_islands_of(handle);
         Ok(())
     }
 
@@ -377,7 +377,7 @@ impl World {
         let _mode = DefaultFloatMode::enter();
         let limits = (self.config.max_linear_speed, self.config.max_angular_speed);
         impulse::apply(&mut self.bodies, handle, linear, angular, limits)?;
-        self.stir(handle);
+        self.wake_islands_of(handle);
         Ok(())
     }
 
@@ -456,8 +456,8 @@ impl World {
         }
         desc.validate()?;
         self.rods[handle.index()] = Some(desc);
-        self.stir(desc.body_a);
-        self.stir(desc.body_b);
+        self.wake_islands_of(desc.body_a);
+        self.wake_islands_of(desc.body_b);
         if !self.layout_dirty {
             self.layout.update_rod(handle.index(), &desc, &self.bodies);
         }
@@ -525,8 +525,8 @@ impl World {
         let regroup = desc.drive.is_some() != drive.is_some();
         desc.drive = drive;
         self.joints[handle.index()] = Some(desc);
-        self.stir(desc.body_a);
-        self.stir(desc.body_b);
+        self.wake_islands_of(desc.body_a);
+        self.wake_islands_of(desc.body_b);
         if regroup {
             // Driven and plain joints live in different blocks.
             self.layout_dirty = true;

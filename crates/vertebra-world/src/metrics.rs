@@ -173,14 +173,14 @@ struct Hashed<'a> {
     contacts: &'a [Contact],
 }
 
-/// A rod slot as the state hash encodes it. A rod whose rest shape is still
-/// is hashed exactly as before rest shapes could move, so worlds of such
-/// rods keep their state hashes (the golden hashes of
-/// `crates/vertebra-scenes/tests/golden.rs`): postcard encodes an `Option`
-/// as 0 or 1 before the value and an enum as its variant index, so `Free`
-/// and `Still` are the old `None` and `Some(desc)` byte for byte. A moving
-/// rest follows a third tag, with its rates. (Snapshots, whose format
-/// changed, store the description as it is.)
+/// A rod slot as the state hash encodes it: `Free` (no rod), `Still` (a
+/// rod whose rest shape is still: its description alone) or `Moving` (the
+/// description, then the rest's rates). Postcard encodes an enum as its
+/// variant index, so the first two are the bytes of an `Option` of the
+/// description: a world whose rods' rest shapes never move hashes no
+/// rates, and its hash does not depend on a feature it does not use (the
+/// golden hashes of `crates/vertebra-scenes/tests/golden.rs` hold it).
+/// Snapshots store the description as it is.
 #[derive(serde::Serialize)]
 enum HashedRod<'a> {
     Free,

@@ -11,7 +11,7 @@ impl World {
     /// island: waking one wakes the islands jointed to it.
     pub fn wake(&mut self, body: BodyHandle) -> Result<(), Error> {
         self.bodies.index(body)?;
-        self.stir(body);
+        self.wake_islands_of(body);
         Ok(())
     }
 
@@ -48,11 +48,12 @@ impl World {
         Ok(self.islands.allowed(self.bodies.index(body)?))
     }
 
-    /// `body` was set or pushed: its island wakes; a static or kinematic
-    /// body (in no island) wakes the islands jointed to it, as
-    /// [`World::wake`] promises (a fixed anchor moved by hand drags its
-    /// sleeping chain along). `body` is live.
-    pub(crate) fn stir(&mut self, body: BodyHandle) {
+    /// Wakes the islands `body` reaches, as every call that sets or pushes
+    /// a body must: a dynamic body's own island; for a static or kinematic
+    /// body (in no island), the islands jointed to it, as [`World::wake`]
+    /// promises (a fixed anchor moved by hand drags its sleeping chain
+    /// along). `body` is live.
+    pub(crate) fn wake_islands_of(&mut self, body: BodyHandle) {
         let i = body.index();
         let mut woke = self.islands.wake(i);
         if self.bodies.kind[i] != BodyKind::Dynamic && self.joints_at[i] > 0 {

@@ -63,10 +63,8 @@ use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 use crate::islands::{Islands, links};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
-/// Bump with every change to [`State`] or anything in it.
-/// 8: rods' rest shapes gained their rates (`bend_rest_velocity`,
-/// `twist_rest_velocity`). 9: islands and sleep state. A: stillness in
-/// double precision.
+/// The format: bumped with every change to [`State`] or anything in it, so
+/// bytes of another layout are refused by their magic rather than misread.
 const FORMAT: u8 = b'A';
 const MAGIC: &[u8; 8] = &[b'V', b'T', b'B', b'S', b'N', b'A', b'P', FORMAT];
 const HEADER: usize = 24;
@@ -492,8 +490,8 @@ mod tests {
     /// One change to a decoded state.
     type Change = Box<dyn FnOnce(&mut State)>;
 
-    /// Payloads that were accepted and put NaN into the world, or panicked
-    /// in `restore` or the next step, before restore validated the state.
+    /// Payloads that, unvalidated, would put NaN into the world or panic in
+    /// `restore` or the next step.
     #[test]
     fn crafted_states_are_refused_by_name_and_change_nothing() {
         let mut world = world();
@@ -878,8 +876,8 @@ mod tests {
         world.restore(&world.snapshot()).unwrap();
     }
 
-    /// The attack's other state: every island of a world with a moving
-    /// drive put to sleep as it moves.
+    /// The other sleep state a crafted snapshot can hold: every island of a
+    /// world with a moving drive put to sleep as it moves.
     #[test]
     fn every_island_put_to_sleep_while_a_drive_moves_is_refused() {
         let mut world = world();

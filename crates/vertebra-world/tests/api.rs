@@ -626,9 +626,8 @@ fn bad_rest_rates_are_refused_by_name_and_change_nothing() {
     w.step(1.0 / 60.0).unwrap();
 }
 
-/// Issue 31, item 8: `set_rod` with other bodies was refused as an
-/// "invalid solver setting". It is refused naming the rod and saying its
-/// bodies cannot change, with the world as it was; the same bodies in the
+/// `set_rod` with other bodies is refused naming the rod and saying its
+/// bodies cannot change (not as an invalid solver setting), with the world as it was; the same bodies in the
 /// other order are other bodies too (`body_a` is the rod's base).
 #[test]
 fn set_rod_refuses_other_bodies_naming_the_rod() {

@@ -168,9 +168,9 @@ fn removal_world(contact: bool) -> (World, BodyHandle, BodyHandle) {
 
 #[test]
 fn removing_a_body_drops_its_pending_contacts() {
-    // Failed before the fix: the contacts named the removed body's slot, so
-    // the step pushed the body that reused the slot up out of the ground
-    // and the other box away from a ghost.
+    // Kept, the contacts would name the removed body's slot: the step would
+    // push the body that reused the slot up out of the ground and the
+    // other box away from a ghost.
     let (mut w, first, reborn) = removal_world(true);
     let (mut reference, reference_first, reference_reborn) = removal_world(false);
     assert!(w.contacts().is_empty(), "no contact names a removed body");

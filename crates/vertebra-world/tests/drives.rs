@@ -143,8 +143,8 @@ fn following_two_poses_reaches_the_second_at_the_end_of_the_step() {
 
 #[test]
 fn following_refuses_a_time_step_that_is_not_one() {
-    // A negative dt used to give the velocity that turns the target away
-    // from the pose, accepted by the world.
+    // A negative dt would give the velocity that turns the target away
+    // from the pose, which the world would accept.
     let (prev, pose) = (Quat::from_rotation_z(0.1), Quat::from_rotation_z(0.15));
     let drive = AngularDrive::spring(prev, 4.0, 1.0);
     let cases = [

@@ -15,7 +15,7 @@ use vertebra_world::{
 };
 
 const DT: f32 = 1.0 / 60.0;
-/// The target: no limit exceeded by more than 2 degrees.
+/// The joints' target: no limit exceeded by more than 2 degrees.
 const TWO_DEGREES: f32 = 2.0 * PI / 180.0;
 
 /// A static body at the origin and a 1 kg, 0.5 m capsule hanging from it
@@ -346,7 +346,7 @@ fn a_hinge_turned_far_off_its_axis_comes_back_aligned_not_inside_out() {
                 first.to_degrees(),
                 last.to_degrees()
             );
-            // Back within the 2 degrees in one step, and held.
+            // Back within the 2 degrees in one step, and held.
             assert!(
                 first < TWO_DEGREES && last < 1e-2,
                 "{degrees} degrees off, {substeps}x{iterations}: {first} rad after a step, {last} rad after 1 s"

@@ -1,6 +1,6 @@
 //! Every value the API accepts gives a finite, bounded step with the
 //! last-line NaN guard silent; values beyond the documented ranges are
-//! refused with the field named (issue 13, class 5).
+//! refused with the field named.
 
 mod common;
 
@@ -75,7 +75,7 @@ fn hard_corrections_report_within_the_speed_limits() {
 }
 
 /// An accepted spin of 1.8e38 rad/s on a body in contact steps finite and
-/// within the limits (the world now holds it to the limit before the
+/// within the limits (the world holds it to the limit before the
 /// contact measures its approach speed, where `w x r` can overflow).
 #[test]
 fn accepted_spins_are_held_before_contacts_measure_them() {

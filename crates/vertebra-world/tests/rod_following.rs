@@ -1,6 +1,6 @@
 //! A rod whose rest shape moves (`RodDesc::bend_rest_velocity`,
 //! `twist_rest_velocity`) against the closed form of a damped spring
-//! following a ramp, and against the old way of moving a rest shape (set
+//! following a ramp, and against the other way of moving a rest shape (set
 //! anew before every step, still in between: how `drive_to` moves a rod).
 //!
 //! The rig: a static base and a ball 0.4 m above it on a straight rod, no
@@ -237,8 +237,8 @@ fn the_advanced_rest_is_written_back() {
 
 #[test]
 fn following_refuses_a_time_step_that_is_not_one() {
-    // A negative dt used to give rates that move the rest away from the
-    // pose, accepted by the world.
+    // A negative dt would give rates that move the rest away from the
+    // pose, which the world would accept.
     let (w, _, handle) = rig(RodStiffness::Kirchhoff(1.0));
     let rod = w.rod(handle).unwrap();
     let (prev, pose) = ((Vec3::X, 0.0), (Vec3::new(0.8, 0.6, 0.0), 0.2));

@@ -92,7 +92,8 @@ fn a_handle_issued_after_a_snapshot_stays_stale_after_restoring_it() {
 
 #[test]
 fn another_worlds_handles_are_refused() {
-    // Two worlds built by the same calls: their handles used to be equal.
+    // Two worlds built by the same calls: their handles would be equal
+    // without the world's lineage in them.
     let mut ours = swinging_chain();
     let mut theirs = swinging_chain();
     let body = theirs.bodies().handle_at(3).unwrap();

@@ -1,9 +1,9 @@
-//! An outsider's attack on the direct joint solve (`JointSolver::Direct`),
-//! through the public API only: trees of every kind, huge trees, extreme
-//! mass ratios, degenerate joints, kinds and constraints changed between
-//! steps, sleep, snapshots, backends and threads, far from the origin.
-//! Every world must stay finite, keep its joints together (no worse than
-//! the iterative solver) and keep the bit-identity the library promises.
+//! The direct joint solve (`JointSolver::Direct`) at its extremes, through
+//! the public API only: trees of every kind, huge trees, extreme mass
+//! ratios, degenerate joints, kinds and constraints changed between steps,
+//! sleep, snapshots, backends and threads, far from the origin. Every
+//! world stays finite, keeps its joints together (no worse than the
+//! iterative solver) and keeps the bit-identity the library promises.
 
 mod common;
 

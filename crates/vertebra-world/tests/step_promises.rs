@@ -1,7 +1,8 @@
-//! The stepping API's promises tried as an outsider would: task systems that lie
-//! about their workers or panic, sleep settings out of range, every call
-//! that should wake a sleeping island, sleep far from the origin, snapshots
-//! taken asleep (and damaged), and contact lists that must be refused.
+//! The stepping API's promises held at their edges and against a caller
+//! that breaks the rules: task systems that lie about their workers or
+//! panic, sleep settings out of range, every call that should wake a
+//! sleeping island, sleep far from the origin, snapshots taken asleep (and
+//! damaged), and contact lists that must be refused.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
@@ -285,12 +286,12 @@ fn fails_and_retries(
     }
 }
 
-/// The attack: a task system that runs its items and then panics made the
-/// step unwind with part of its motion applied (a pendulum retried after
-/// it had fallen two steps' worth); and one that panics before running
-/// them, or in one of its threads, or asks for its workers and panics, at
-/// any substep, in the step's start with many contacts, and in a step whose
-/// contacts woke a sleeping island.
+/// A task system that panics leaves the world as it was before the step,
+/// so a retry does not apply part of the motion twice (a pendulum
+/// retried would fall two steps' worth): one that runs its items and then
+/// panics, one that panics before running them, or in one of its threads,
+/// or asks for its workers and panics, at any substep, in the step's start
+/// with many contacts, and in a step whose contacts woke a sleeping island.
 #[test]
 fn a_task_system_that_panics_leaves_the_world_as_it_was() {
     let swinging = || {
