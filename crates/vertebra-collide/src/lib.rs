@@ -137,11 +137,13 @@
 //! # }
 //! ```
 
+mod collider;
 mod continuous;
 mod events;
 mod frame;
 mod groups;
 mod pairing;
+mod part;
 mod query;
 mod snapshot;
 
@@ -163,187 +165,15 @@ use vertebra_world::{
     BodyHandle, BodyKind, Contact, Error, MAX_COORDINATE, Shape, Timeline, World,
 };
 
+pub use collider::{Collider, ColliderShape, CollisionGroups, MAX_COLLIDER_EXTENT, collider_pose};
 pub use events::{ContactEnded, ContactEvents, Touching};
 pub use groups::MAX_SELF_COLLISION_GROUPS;
+pub use part::RagdollPart;
 pub use query::{Overlap, QueryFilter, QueryHit, QueryShape};
 pub use snapshot::CollisionSnapshot;
 
-/// The ragdoll part of each body the set knows as a ragdoll's, by slot
-/// (looked up for every hit and every touching pair: an index and a
-/// handle compare, no hashing).
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Parts {
-    by_slot: Vec<Option<(BodyHandle, RagdollPart)>>,
-}
-
-impl Parts {
-    /// `body`'s part, if the set knows it.
-    pub(crate) fn get(&self, body: BodyHandle) -> Option<RagdollPart> {
-        match self.by_slot.get(body.index()) {
-            Some(Some((b, part))) if *b == body => Some(*part),
-            _ => None,
-        }
-    }
-
-    /// Records `body`'s part.
-    pub(crate) fn insert(&mut self, body: BodyHandle, part: RagdollPart) {
-        if self.by_slot.len() <= body.index() {
-            self.by_slot.resize(body.index() + 1, None);
-        }
-        self.by_slot[body.index()] = Some((body, part));
-    }
-
-    /// Forgets `body`'s part (nothing to forget is not an error).
-    pub(crate) fn remove(&mut self, body: BodyHandle) {
-        if self.get(body).is_some() {
-            self.by_slot[body.index()] = None;
-        }
-    }
-
-    /// Every body's part, in slot order.
-    pub(crate) fn iter(&self) -> impl Iterator<Item = (BodyHandle, RagdollPart)> + '_ {
-        self.by_slot.iter().flatten().copied()
-    }
-}
-
-/// Which ragdoll and bone a body is, in hits and events.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub struct RagdollPart {
-    /// The ragdoll, named by its first body (`Ragdoll::first_body`).
-    pub ragdoll: BodyHandle,
-    /// The body's index in the ragdoll's description
-    /// (`Ragdoll::description().bodies[bone]`, whose `name` is the
-    /// bone's).
-    pub bone: u32,
-}
-
-/// Which colliders may touch (Rapier's `InteractionGroups`): a pair is
-/// tested when each one's `membership` meets the other's `filter` (both
-/// bit sets): `a.membership & b.filter != 0 && b.membership & a.filter !=
-/// 0`. The default is every group, colliding with every group.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-pub struct CollisionGroups {
-    /// The groups this collider is in.
-    pub membership: u32,
-    /// The groups it collides with.
-    pub filter: u32,
-}
-
-impl Default for CollisionGroups {
-    fn default() -> Self {
-        Self {
-            membership: u32::MAX,
-            filter: u32::MAX,
-        }
-    }
-}
-
-/// A collider's geometry, in its body's frame (centred on the centre of
-/// mass, as the store's shapes are).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub enum ColliderShape {
-    /// A body shape: sphere, box or capsule.
-    Solid(Shape),
-    /// The half space below the plane through the body's origin with the
-    /// given outward unit normal (body frame): the ground.
-    Plane(Vec3),
-}
-
-/// A collider on a body.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Collider {
-    /// The body it moves with.
-    pub body: BodyHandle,
-    /// Its geometry.
-    pub shape: ColliderShape,
-    /// Friction coefficient (a pair uses the geometric mean).
-    pub friction: f32,
-    /// Restitution (a pair uses the larger).
-    pub restitution: f32,
-    /// Filtering.
-    pub groups: CollisionGroups,
-}
-
-impl Collider {
-    /// A collider of `shape` on `body`, friction 0.6, no restitution, in
-    /// every group.
-    pub fn new(body: BodyHandle, shape: ColliderShape) -> Self {
-        Self {
-            body,
-            shape,
-            friction: 0.6,
-            restitution: 0.0,
-            groups: CollisionGroups::default(),
-        }
-    }
-
-    /// Its parry geometry (body frame), or why it is refused: a degenerate
-    /// shape or one beyond [`MAX_COLLIDER_EXTENT`], a non-unit plane
-    /// normal, bad friction or restitution.
-    fn geometry(&self) -> Result<SharedShape, Error> {
-        let shape = match self.shape {
-            ColliderShape::Solid(s) => solid(s)?,
-            ColliderShape::Plane(n) => {
-                vertebra_world::check_unit_vec("plane normal", n)?;
-                SharedShape::halfspace(n.normalize())
-            }
-        };
-        if !(self.friction.is_finite() && self.friction >= 0.0) {
-            return Err(Error::NonPositive("collider friction"));
-        }
-        if !(0.0..=1.0).contains(&self.restitution) {
-            return Err(Error::OutOfRange("collider restitution (0 to 1)"));
-        }
-        Ok(shape)
-    }
-
-    /// `reason` as the refusal of this collider at `index`.
-    fn refused(&self, index: usize, reason: Error) -> Error {
-        Error::Collider {
-            index,
-            body: self.body,
-            reason: Box::new(reason),
-        }
-    }
-}
-
-/// The parry geometry of a solid (body frame), or why it is refused: a
-/// degenerate shape or one beyond [`MAX_COLLIDER_EXTENT`].
-fn solid(shape: Shape) -> Result<SharedShape, Error> {
-    shape.validate()?;
-    check_extent(&shape)?;
-    Ok(match shape {
-        Shape::Sphere { radius } => SharedShape::ball(radius),
-        Shape::Box { half_extents: h } => SharedShape::cuboid(h.x, h.y, h.z),
-        Shape::Capsule {
-            half_segment,
-            radius,
-        } => SharedShape::capsule(-half_segment, half_segment, radius),
-    })
-}
-
-/// The largest size (m) of a collider: a sphere's radius, a box's half
-/// extent, a capsule's half segment plus radius. 10 km is larger than any
-/// level's floor, and at 1e4 m an `f32` still resolves a millimetre; far
-/// beyond it parry's contact points are no longer finite (1e30 gave NaN).
-pub const MAX_COLLIDER_EXTENT: f32 = 1.0e4;
-
-/// Checks a solid's size against [`MAX_COLLIDER_EXTENT`] (after
-/// `Shape::validate`: finite and positive).
-fn check_extent(shape: &Shape) -> Result<(), Error> {
-    let extent = match *shape {
-        Shape::Sphere { radius } => radius,
-        Shape::Box { half_extents } => half_extents.max_element(),
-        Shape::Capsule {
-            half_segment,
-            radius,
-        } => half_segment.length() + radius,
-    };
-    if extent > MAX_COLLIDER_EXTENT {
-        return Err(Error::OutOfRange("collider size (at most 1e4 m)"));
-    }
-    Ok(())
-}
+use collider::solid;
+use part::Parts;
 
 /// Checks a prediction margin (m): finite, not negative.
 fn check_prediction(prediction: f32) -> Result<(), Error> {
@@ -1091,12 +921,6 @@ fn unserved(error: Error) -> RagdollError {
         context: "the collision set".into(),
         error,
     }
-}
-
-/// The world pose of a body's collider frame (for callers drawing them).
-pub fn collider_pose(world: &World, body: BodyHandle) -> Result<(Vec3, Quat), Error> {
-    let _mode = DefaultFloatMode::enter();
-    world.body(body).map(|s| (s.position, s.orientation))
 }
 
 #[cfg(test)]
