@@ -32,9 +32,8 @@ use vertebra_world::{
     check_unit_vec,
 };
 
-use crate::{
-    ColliderShape, CollisionGroups, Collisions, MAX_COLLIDER_EXTENT, RagdollPart, relative_pose,
-};
+use crate::pose::relative_pose;
+use crate::{ColliderShape, CollisionGroups, Collisions, MAX_COLLIDER_EXTENT, RagdollPart};
 
 /// Which colliders a query sees (Rapier's `QueryFilter`).
 #[derive(Clone, Copy, Debug, PartialEq)]
