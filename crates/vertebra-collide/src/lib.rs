@@ -137,12 +137,17 @@
 //! # }
 //! ```
 
+mod broad_phase;
 mod collider;
 mod continuous;
+mod detect;
+mod detection;
 mod events;
 mod frame;
 mod groups;
+mod islands;
 mod manifold;
+mod narrow_phase;
 mod pairing;
 mod part;
 mod pose;
@@ -152,9 +157,8 @@ mod snapshot;
 use std::collections::{HashMap, HashSet};
 
 use glam::{Quat, Vec3};
-use parry3d::bounding_volume::{Aabb, BoundingVolume};
+use parry3d::bounding_volume::Aabb;
 use parry3d::math::Pose;
-use parry3d::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d::shape::SharedShape;
 use vertebra_math::DefaultFloatMode;
 use vertebra_ragdoll::{BuildOptions, Ragdoll, RagdollDesc, RagdollError};
@@ -168,9 +172,8 @@ pub use query::{Overlap, QueryFilter, QueryHit, QueryShape};
 pub use snapshot::CollisionSnapshot;
 
 use collider::solid;
-use manifold::{fresh, plane_manifold, push_manifold};
+use detection::Detection;
 use part::Parts;
-use pose::relative_pose;
 
 /// Checks a prediction margin (m): finite, not negative.
 fn check_prediction(prediction: f32) -> Result<(), Error> {
@@ -227,38 +230,6 @@ pub struct Collisions {
     /// as every call rewrites it).
     scratch: Detection,
 }
-
-/// A detection's working memory, kept between calls so that a steady
-/// scene's detection allocates nothing.
-#[derive(Clone, Default)]
-struct Detection {
-    /// Each collider's body pose.
-    poses: Vec<Pose>,
-    /// How far each collider's body can move in the step (m).
-    reach: Vec<f32>,
-    /// Each collider's bounds, loosened by the prediction and its reach.
-    aabbs: Vec<Aabb>,
-    /// The solid colliders in sweep order.
-    solids: Vec<usize>,
-    /// The candidate pairs of collider indices, ascending.
-    pairs: Vec<(usize, usize)>,
-    /// Parry's output for one pair.
-    manifolds: Vec<ContactManifold<(), ()>>,
-    /// Each collider's body moves on its own (awake and dynamic, or
-    /// kinematic with a velocity).
-    acts: Vec<bool>,
-    /// Each collider's body's island while it sleeps, else `NO_ISLAND`.
-    asleep_in: Vec<u32>,
-    /// Per island id: [`UNTOUCHED`], [`WAKING`] (touched by the last
-    /// round's contacts: its pairs are found in this round) or [`DONE`].
-    islands: Vec<u8>,
-}
-
-/// A collider whose body does not sleep.
-const NO_ISLAND: u32 = u32::MAX;
-const UNTOUCHED: u8 = 0;
-const WAKING: u8 = 1;
-const DONE: u8 = 2;
 
 fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {
     if a.index() <= b.index() {
@@ -523,236 +494,6 @@ impl Collisions {
         }
     }
 
-    /// Every contact between the colliders at the bodies' current poses, in
-    /// a deterministic order; feed them to `World::set_contacts` before a
-    /// step of `dt` seconds. Contacts are speculative: a pair is caught up
-    /// to `prediction` plus how far its bodies can close in within `dt`
-    /// (linear speed plus angular speed times the collider's extent), so a
-    /// fast body meets the floor instead of passing into it; a gap does
-    /// nothing until it closes. `Err(Error::Collider)` names the first
-    /// collider whose body is no longer in `world` (remove a body's
-    /// colliders with [`Collisions::remove_body`]); `Err(WorldMismatch)`
-    /// for a world the set does not serve: one that restored a snapshot
-    /// since without the set's own restored after it, or another world
-    /// (see [`Collisions::attach`]). Allocates its list and
-    /// working memory every call: a game's loop uses
-    /// [`Collisions::find_contacts_into`].
-    pub fn find_contacts(&self, world: &World, dt: f32) -> Result<Vec<Contact>, Error> {
-        let _mode = DefaultFloatMode::enter();
-        let mut contacts = Vec::new();
-        self.detect(world, dt, &mut Detection::default(), &mut contacts)?;
-        Ok(contacts)
-    }
-
-    /// [`Collisions::find_contacts`] into `contacts` (emptied first, and
-    /// empty on error), with the set's own working memory (bounds, sweep
-    /// order, pairs, parry's manifolds) kept from call to call: once it and
-    /// `contacts` have grown to the scene's size, a call allocates nothing.
-    /// Hand the list to the world without a copy with
-    /// `World::swap_contacts`, which gives back the world's previous
-    /// list for the next call.
-    pub fn find_contacts_into(
-        &mut self,
-        world: &World,
-        dt: f32,
-        contacts: &mut Vec<Contact>,
-    ) -> Result<(), Error> {
-        let _mode = DefaultFloatMode::enter();
-        // Taken out and put back (moving a vector allocates nothing), so
-        // that the detection reads the set while it writes its memory.
-        let mut scratch = core::mem::take(&mut self.scratch);
-        let found = self.detect(world, dt, &mut scratch, contacts);
-        self.scratch = scratch;
-        if found.is_ok() {
-            self.serve(world);
-            let mut record = core::mem::take(&mut self.found);
-            record.record(self, world, contacts);
-            self.found = record;
-        }
-        found
-    }
-
-    /// Every contact into `contacts` (emptied first), with `scratch` as
-    /// working memory.
-    fn detect(
-        &self,
-        world: &World,
-        dt: f32,
-        scratch: &mut Detection,
-        contacts: &mut Vec<Contact>,
-    ) -> Result<(), Error> {
-        contacts.clear();
-        self.check_serves(world)?;
-        vertebra_world::check_positive("time step", dt)?;
-        self.sleep_state(world, scratch)?;
-        if !scratch.acts.contains(&true) {
-            // Every body asleep or still (a settled pile): no pair has a
-            // body that moves, so no bounds, sweep or round is needed.
-            return Ok(());
-        }
-        scratch.poses.clear();
-        scratch.reach.clear();
-        for (index, (c, shape)) in self.colliders.iter().enumerate() {
-            let s = world.body(c.body).map_err(|e| c.refused(index, e))?;
-            scratch
-                .poses
-                .push(Pose::from_parts(s.position, s.orientation));
-            let extent = shape.compute_local_bounding_sphere().radius;
-            let extent = if extent.is_finite() { extent } else { 0.0 };
-            scratch
-                .reach
-                .push((s.linear_velocity.length() + s.angular_velocity.length() * extent) * dt);
-        }
-        self.bounds(scratch);
-        // Pairs where a body moves; then, round after round, the pairs of
-        // the sleeping islands those contacts touch (the step wakes them,
-        // and they need their contacts with the ground and each other).
-        let mut first = true;
-        loop {
-            self.candidate_pairs(world, scratch, first);
-            first = false;
-            let from = contacts.len();
-            self.narrow(scratch, contacts);
-            if !wake_touched(scratch, world, &contacts[from..]) {
-                return Ok(());
-            }
-        }
-    }
-
-    /// Each collider's body's sleep state into `scratch`.
-    fn sleep_state(&self, world: &World, scratch: &mut Detection) -> Result<(), Error> {
-        scratch.acts.clear();
-        scratch.asleep_in.clear();
-        scratch.islands.clear();
-        for (index, (c, _)) in self.colliders.iter().enumerate() {
-            let refused = |e| c.refused(index, e);
-            let s = world.body(c.body).map_err(refused)?;
-            let asleep = world.is_asleep(c.body).map_err(refused)?;
-            let moving = s.linear_velocity != Vec3::ZERO || s.angular_velocity != Vec3::ZERO;
-            scratch
-                .acts
-                .push(match world.bodies().kind[c.body.index()] {
-                    BodyKind::Dynamic => !asleep,
-                    BodyKind::Kinematic => moving,
-                    BodyKind::Static => false,
-                });
-            let island = world.island(c.body).map_err(refused)?.filter(|_| asleep);
-            let island = island.unwrap_or(NO_ISLAND);
-            if island != NO_ISLAND && scratch.islands.len() <= island as usize {
-                scratch.islands.resize(island as usize + 1, UNTOUCHED);
-            }
-            scratch.asleep_in.push(island);
-        }
-        Ok(())
-    }
-
-    /// Every pair's contacts into `contacts` (appended).
-    fn narrow(&self, scratch: &mut Detection, contacts: &mut Vec<Contact>) {
-        let (poses, reach) = (&scratch.poses, &scratch.reach);
-        for &(i, j) in &scratch.pairs {
-            let ((ci, si), (cj, sj)) = (&self.colliders[i], &self.colliders[j]);
-            fresh(&mut scratch.manifolds);
-            let relative = relative_pose(&poses[i], &poses[j]);
-            let prediction = self.prediction + reach[i] + reach[j];
-            let on_plane = plane_manifold(
-                &relative,
-                si.as_ref(),
-                sj.as_ref(),
-                prediction,
-                &mut scratch.manifolds,
-            );
-            if !on_plane
-                && DefaultQueryDispatcher
-                    .contact_manifolds(
-                        &relative,
-                        si.as_ref(),
-                        sj.as_ref(),
-                        prediction,
-                        &mut scratch.manifolds,
-                        &mut None,
-                    )
-                    .is_err()
-            {
-                continue; // a pair parry has no algorithm for (none of ours)
-            }
-            let friction = (ci.friction * cj.friction).sqrt();
-            let restitution = ci.restitution.max(cj.restitution);
-            for m in &scratch.manifolds {
-                push_manifold(
-                    contacts,
-                    m,
-                    (ci.body, &poses[i]),
-                    (cj.body, &poses[j]),
-                    friction,
-                    restitution,
-                );
-            }
-        }
-    }
-
-    /// Each collider's bounds, and the solids in sweep order.
-    fn bounds(&self, scratch: &mut Detection) {
-        let (poses, reach) = (&scratch.poses, &scratch.reach);
-        scratch.aabbs.clear();
-        scratch.aabbs.extend((0..self.colliders.len()).map(|k| {
-            self.colliders[k]
-                .1
-                .compute_aabb(&poses[k])
-                .loosened(self.prediction + reach[k])
-        }));
-        let aabbs = &scratch.aabbs;
-        let is_plane = |k: usize| matches!(self.colliders[k].0.shape, ColliderShape::Plane(_));
-        let solids = &mut scratch.solids;
-        solids.clear();
-        solids.extend((0..self.colliders.len()).filter(|&k| !is_plane(k)));
-        // Unstable but in place (no buffer): the index breaks ties, so the
-        // order is the one a stable sort gives.
-        solids
-            .sort_unstable_by(|&a, &b| aabbs[a].mins.x.total_cmp(&aabbs[b].mins.x).then(a.cmp(&b)));
-    }
-
-    /// Into `scratch.pairs`, the pairs of collider indices whose bounds
-    /// overlap and that may collide (sort-and-sweep along x for solids,
-    /// every solid against every plane), of this round: in the `first`,
-    /// those with a body that moves on its own; in each later one, those
-    /// of the islands the last round woke (and of no island woken before).
-    fn candidate_pairs(&self, world: &World, scratch: &mut Detection, first: bool) {
-        let (aabbs, solids) = (&scratch.aabbs, &scratch.solids);
-        let is_plane = |k: usize| matches!(self.colliders[k].0.shape, ColliderShape::Plane(_));
-        let pairs = &mut scratch.pairs;
-        pairs.clear();
-        for (n, &a) in solids.iter().enumerate() {
-            for &b in &solids[n + 1..] {
-                if aabbs[b].mins.x > aabbs[a].maxs.x {
-                    break;
-                }
-                if aabbs[a].intersects(&aabbs[b]) {
-                    pairs.push((a.min(b), a.max(b)));
-                }
-            }
-        }
-        for plane in (0..self.colliders.len()).filter(|&k| is_plane(k)) {
-            pairs.extend(solids.iter().map(|&s| (plane.min(s), plane.max(s))));
-        }
-        let (acts, asleep_in, islands) = (&scratch.acts, &scratch.asleep_in, &scratch.islands);
-        let mark = |k: usize| {
-            let island = asleep_in[k];
-            (island != NO_ISLAND).then(|| islands[island as usize])
-        };
-        let in_round = |a: usize, b: usize| {
-            if first {
-                return acts[a] || acts[b];
-            }
-            let (ma, mb) = (mark(a), mark(b));
-            !(acts[a] || acts[b])
-                && (ma == Some(WAKING) || mb == Some(WAKING))
-                && ma != Some(DONE)
-                && mb != Some(DONE)
-        };
-        pairs.retain(|&(a, b)| in_round(a, b) && self.may_collide(world, a, b));
-        pairs.sort_unstable();
-    }
-
     fn may_collide(&self, world: &World, a: usize, b: usize) -> bool {
         let (ca, cb) = (&self.colliders[a].0, &self.colliders[b].0);
         let dynamic = |h: BodyHandle| world.bodies().kind[h.index()] == BodyKind::Dynamic;
@@ -763,37 +504,6 @@ impl Collisions {
             && cb.groups.membership & ca.groups.filter != 0
             && !self.kept_apart(ca.body, cb.body)
     }
-}
-
-/// Marks the sleeping islands `found` touches (the step will wake them) as
-/// waking, and those that were waking as done; true when any island is
-/// newly waking.
-fn wake_touched(scratch: &mut Detection, world: &World, found: &[Contact]) -> bool {
-    for mark in &mut scratch.islands {
-        if *mark == WAKING {
-            *mark = DONE;
-        }
-    }
-    // The contacts' bodies are live: they were just read.
-    let marks = scratch.islands.len();
-    let island_of = |body: BodyHandle| {
-        let asleep = world.is_asleep(body).unwrap_or(false);
-        let island = world.island(body).ok().flatten().filter(|_| asleep)?;
-        Some(island as usize).filter(|&k| k < marks)
-    };
-    let mut woke = false;
-    for c in found {
-        for island in [island_of(c.body_a), island_of(c.body_b)]
-            .into_iter()
-            .flatten()
-        {
-            if scratch.islands[island] == UNTOUCHED {
-                scratch.islands[island] = WAKING;
-                woke = true;
-            }
-        }
-    }
-    woke
 }
 
 /// A refusal of the set's own check on the world, in a ragdoll call.
