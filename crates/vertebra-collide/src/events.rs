@@ -25,7 +25,8 @@
 use glam::Vec3;
 use vertebra_world::{BodyHandle, BodyKind, World};
 
-use crate::{Collisions, RagdollPart, ordered};
+use crate::filter::ordered;
+use crate::{Collisions, RagdollPart};
 
 /// A pair of bodies touching in a step.
 #[derive(Clone, Copy, Debug, PartialEq)]

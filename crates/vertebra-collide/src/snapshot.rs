@@ -29,10 +29,10 @@
 use serde::{Deserialize, Serialize};
 use vertebra_world::{BodyHandle, Error, World};
 
+use crate::filter::ordered;
 use crate::pairing::{OTHER_BODIES, census};
-use crate::{
-    Collider, Collisions, MAX_SELF_COLLISION_GROUPS, RagdollPart, check_prediction, ordered,
-};
+use crate::set::check_prediction;
+use crate::{Collider, Collisions, MAX_SELF_COLLISION_GROUPS, RagdollPart};
 use vertebra_math::DefaultFloatMode;
 
 const MAGIC: &[u8; 8] = b"VTBCOLLS";
