@@ -11,8 +11,9 @@
 use parry3d::bounding_volume::BoundingVolume;
 use vertebra_world::World;
 
+use crate::collider::ColliderShape;
 use crate::detection::{DONE, Detection, NO_ISLAND, WAKING};
-use crate::{ColliderShape, Collisions};
+use crate::set::Collisions;
 
 impl Collisions {
     /// Each collider's bounds, and the solids in sweep order.

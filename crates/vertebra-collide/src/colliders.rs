@@ -12,7 +12,8 @@ use parry3d::shape::SharedShape;
 use vertebra_math::DefaultFloatMode;
 use vertebra_world::{BodyHandle, Error, Shape};
 
-use crate::{Collider, ColliderShape, Collisions};
+use crate::collider::{Collider, ColliderShape};
+use crate::set::Collisions;
 
 impl Collisions {
     /// Adds a collider; returns its index in [`Collisions::colliders`]

@@ -12,9 +12,9 @@ use parry3d::math::Pose;
 use vertebra_math::DefaultFloatMode;
 use vertebra_world::{Contact, Error, World};
 
-use crate::Collisions;
 use crate::detection::Detection;
 use crate::islands::wake_touched;
+use crate::set::Collisions;
 
 impl Collisions {
     /// Every contact between the colliders at the bodies' current poses, in
@@ -59,9 +59,8 @@ impl Collisions {
         self.scratch = scratch;
         if found.is_ok() {
             self.serve(world);
-            let mut record = core::mem::take(&mut self.found);
-            record.record(self, world, contacts);
-            self.found = record;
+            self.found
+                .record(self.version, &self.colliders, world, contacts);
         }
         found
     }

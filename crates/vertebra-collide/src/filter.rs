@@ -12,7 +12,7 @@
 
 use vertebra_world::{BodyHandle, BodyKind, World};
 
-use crate::Collisions;
+use crate::set::Collisions;
 
 /// A pair of bodies in one order: the lower slot first.
 pub(crate) fn ordered(a: BodyHandle, b: BodyHandle) -> (BodyHandle, BodyHandle) {

@@ -11,8 +11,8 @@
 use glam::Vec3;
 use vertebra_world::{BodyHandle, BodyKind, Contact, Error, World};
 
-use crate::Collisions;
 use crate::detection::{DONE, Detection, NO_ISLAND, UNTOUCHED, WAKING};
+use crate::set::Collisions;
 
 impl Collisions {
     /// Each collider's body's sleep state into `scratch`.

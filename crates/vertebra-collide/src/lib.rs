@@ -140,11 +140,13 @@
 mod broad_phase;
 mod collider;
 mod colliders;
+mod contact_events;
 mod continuous;
 mod detect;
 mod detection;
 mod events;
 mod filter;
+mod found;
 mod frame;
 mod groups;
 mod islands;
@@ -154,12 +156,13 @@ mod pairing;
 mod part;
 mod pose;
 mod query;
+mod query_tree;
 mod ragdoll;
 mod set;
 mod snapshot;
 
 pub use collider::{Collider, ColliderShape, CollisionGroups, MAX_COLLIDER_EXTENT, collider_pose};
-pub use events::{ContactEnded, ContactEvents, Touching};
+pub use contact_events::{ContactEnded, ContactEvents, Touching};
 pub use groups::MAX_SELF_COLLISION_GROUPS;
 pub use part::RagdollPart;
 pub use query::{Overlap, QueryFilter, QueryHit, QueryShape};

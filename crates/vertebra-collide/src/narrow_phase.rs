@@ -9,10 +9,10 @@
 use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 use vertebra_world::Contact;
 
-use crate::Collisions;
 use crate::detection::Detection;
 use crate::manifold::{fresh, plane_manifold, push_manifold};
 use crate::pose::relative_pose;
+use crate::set::Collisions;
 
 impl Collisions {
     /// Every pair's contacts into `contacts` (appended).

@@ -16,10 +16,10 @@ use vertebra_math::DefaultFloatMode;
 use vertebra_ragdoll::{BuildOptions, Ragdoll, RagdollDesc, RagdollError};
 use vertebra_world::{BodyHandle, Error, World};
 
-use crate::collider::solid;
+use crate::collider::{Collider, ColliderShape, solid};
 use crate::filter::ordered;
-use crate::part::Parts;
-use crate::{Collider, ColliderShape, Collisions, RagdollPart};
+use crate::part::{Parts, RagdollPart};
+use crate::set::Collisions;
 
 impl Collisions {
     /// Adds a ragdoll's capsules (one per body, default friction and

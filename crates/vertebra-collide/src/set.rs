@@ -16,10 +16,11 @@ use parry3d::shape::SharedShape;
 use vertebra_world::{BodyHandle, Contact, Error, Timeline};
 
 use crate::collider::Collider;
+use crate::contact_events::ContactEvents;
 use crate::detection::Detection;
-use crate::events::ContactEvents;
+use crate::found::Found;
 use crate::part::Parts;
-use crate::{frame, query};
+use crate::query_tree::QueryTree;
 
 /// Checks a prediction margin (m): finite, not negative.
 pub(crate) fn check_prediction(prediction: f32) -> Result<(), Error> {
@@ -54,12 +55,14 @@ pub struct Collisions {
     /// a detection's record still hold. Not part of the set's state.
     pub(crate) version: u64,
     /// What the last `find_contacts_into` found, for `after_step`
-    /// (`frame.rs`). Not part of the set's state.
-    pub(crate) found: frame::Found,
-    /// The last step's events (`events.rs`). Output, not state.
+    /// (`found.rs`, `frame.rs`). Not part of the set's state.
+    pub(crate) found: Found,
+    /// The last step's events (`contact_events.rs`, filled by
+    /// `events.rs`). Output, not state.
     pub(crate) events: ContactEvents,
-    /// The scene queries' tree (`query.rs`). Not part of the set's state.
-    pub(crate) tree: query::QueryTree,
+    /// The scene queries' tree (`query_tree.rs`, built and read by
+    /// `query.rs`). Not part of the set's state.
+    pub(crate) tree: QueryTree,
     /// The list [`Collisions::step`] finds contacts into (working memory).
     pub(crate) frame_contacts: Vec<Contact>,
     /// Scratch of continuous collision: the bodies it puts back.
