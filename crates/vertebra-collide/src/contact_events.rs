@@ -52,14 +52,15 @@ pub struct ContactEnded {
     pub part_b: Option<RagdollPart>,
 }
 
-/// The last step's contact events ([`Collisions::events`]).
+/// The last step's contact events
+/// ([`Collisions::events`](crate::Collisions::events)).
 #[derive(Clone, Debug, Default)]
 pub struct ContactEvents {
     pub(crate) began: Vec<Touching>,
     pub(crate) ended: Vec<ContactEnded>,
     pub(crate) touching: Vec<Touching>,
-    /// Scratch: each solved contact's pair (by [`live_order`]) and index,
-    /// sorted.
+    /// Scratch: each solved contact's pair (by `live_order`, `events.rs`)
+    /// and index, sorted.
     pub(crate) order: Vec<(u64, u32)>,
     /// Scratch: the pairs touching after the step.
     pub(crate) next: Vec<(BodyHandle, BodyHandle)>,

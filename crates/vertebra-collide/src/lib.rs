@@ -30,6 +30,9 @@
 //! taken with. Restore both, the world first; [`Collisions::attach`]
 //! declares a set right for a world as it is.
 //!
+//! [`Error::Collider`]: vertebra_world::Error::Collider
+//! [`Error::WorldMismatch`]: vertebra_world::Error::WorldMismatch
+//!
 //! # Quick start: a game's frame
 //!
 //! What a game wires in, from the switch to physics to a limb torn off
