@@ -5,12 +5,12 @@
 //! poses (world transforms, one per described body) or on a skeleton's
 //! local poses (parent-local transforms, one per bone).
 
-use vertebra_ragdoll::{BlendBack, LocalPose, Pose, RagdollDesc, Skeleton};
+use vertebra_ragdoll::{Blend, BlendBack, LocalPose, Pose, RagdollDesc, Skeleton};
 
 use crate::error::{Failure, VtResult};
-use crate::ffi::{Object, boxed, call, enter, free, out, shared, slice, slice_mut};
+use crate::ffi::{Object, Out, boxed, call, enter, free, out, shared, slice, slice_mut};
 use crate::ragdoll::{VtRagdollDesc, pose_from, write_pose};
-use crate::skeleton::{VtSkeleton, write_bones};
+use crate::skeleton::{VtSkeleton, local_pose, write_bones};
 use crate::types::VtTransform;
 
 /// A blend back under way (opaque; `vt_blend_back_create_ragdoll` or
@@ -32,22 +32,6 @@ impl Object for VtBlendBack {
 enum Blending {
     Ragdoll(BlendBack<Pose>, Box<RagdollDesc>),
     Skeleton(BlendBack<LocalPose>, Box<Skeleton>),
-}
-
-/// `count` parent-local transforms at `local` as a skeleton pose.
-///
-/// # Safety
-/// `local` points to `count` readable transforms.
-unsafe fn local_pose(
-    local: *const VtTransform,
-    count: usize,
-    what: &str,
-) -> Result<LocalPose, Failure> {
-    // SAFETY: the function's contract.
-    let bones = unsafe { slice(local, count, what) }?;
-    Ok(LocalPose {
-        bones: bones.iter().map(|&t| t.into()).collect(),
-    })
 }
 
 /// Blends two ragdoll poses bone by bone: body `k` of the output (`out`)
@@ -122,6 +106,28 @@ pub unsafe extern "C" fn vt_skeleton_pose_blend(
     })
 }
 
+/// A blend back from `simulated` to the animation over `duration` seconds,
+/// checked against `rig`, written into `place` as the object C frees with
+/// `vt_blend_back_destroy`; `kind` holds it with its own copy of the rig
+/// (a ragdoll description or a skeleton) to check each frame's animation.
+fn start<P: Blend>(
+    place: Out<*mut VtBlendBack>,
+    rig: &P::Rig,
+    simulated: P,
+    duration: f32,
+    kind: fn(BlendBack<P>, Box<P::Rig>) -> Blending,
+) -> Result<(), Failure>
+where
+    P::Rig: Clone,
+{
+    let made = BlendBack::new(rig, simulated, duration)?;
+    place.set(boxed(VtBlendBack {
+        blend: kind(made, Box::new(rig.clone())),
+        poisoned: false,
+    }));
+    Ok(())
+}
+
 /// Starts a blend back from a ragdoll's last simulated pose `simulated`
 /// (`count` world transforms, one per described body; held from now on)
 /// to the animation over `duration` seconds (finite, positive): each
@@ -150,12 +156,7 @@ pub unsafe extern "C" fn vt_blend_back_create_ragdoll(
                 out(blend, "blend")?,
             )
         };
-        let made = BlendBack::new(&desc.desc, simulated, duration)?;
-        place.set(boxed(VtBlendBack {
-            blend: Blending::Ragdoll(made, Box::new(desc.desc.clone())),
-            poisoned: false,
-        }));
-        Ok(())
+        start(place, &desc.desc, simulated, duration, Blending::Ragdoll)
     })
 }
 
@@ -183,12 +184,13 @@ pub unsafe extern "C" fn vt_blend_back_create_skeleton(
                 out(blend, "blend")?,
             )
         };
-        let made = BlendBack::new(&skeleton.skeleton, simulated, duration)?;
-        place.set(boxed(VtBlendBack {
-            blend: Blending::Skeleton(made, Box::new(skeleton.skeleton.clone())),
-            poisoned: false,
-        }));
-        Ok(())
+        start(
+            place,
+            &skeleton.skeleton,
+            simulated,
+            duration,
+            Blending::Skeleton,
+        )
     })
 }
 
