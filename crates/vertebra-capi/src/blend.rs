@@ -5,12 +5,12 @@
 //! poses (world transforms, one per described body) or on a skeleton's
 //! local poses (parent-local transforms, one per bone).
 
-use vertebra_ragdoll::{BlendBack, LocalPose, Pose, RagdollDesc, Skeleton};
+use vertebra_ragdoll::{Blend, BlendBack, LocalPose, Pose, RagdollDesc, RagdollError, Skeleton};
 
 use crate::error::{Failure, VtResult};
 use crate::ffi::{Object, boxed, call, enter, free, out, shared, slice, slice_mut};
 use crate::ragdoll::{VtRagdollDesc, pose_from, write_pose};
-use crate::skeleton::{VtSkeleton, write_bones};
+use crate::skeleton::{VtSkeleton, local_pose, write_bones};
 use crate::types::VtTransform;
 
 /// A blend back under way (opaque; `vt_blend_back_create_ragdoll` or
@@ -34,20 +34,101 @@ enum Blending {
     Skeleton(BlendBack<LocalPose>, Box<Skeleton>),
 }
 
-/// `count` parent-local transforms at `local` as a skeleton pose.
+/// A pose kind C passes as an array of transforms: a ragdoll's (world
+/// transforms, one per described body) or a skeleton's local pose
+/// (parent-local transforms, one per bone). The blends below are written
+/// once over it.
+trait Transforms: Blend {
+    /// `count` transforms at `at` as a pose (`what` names the array).
+    ///
+    /// # Safety
+    /// `at` points to `count` readable transforms.
+    unsafe fn read(at: *const VtTransform, count: usize, what: &str) -> Result<Self, Failure>;
+
+    /// Writes the pose into `place`, which must be as long.
+    fn write(&self, place: &mut [VtTransform]) -> Result<(), Failure>;
+
+    /// This pose blended bone by bone with `other` at `weights`
+    /// (`Pose::blend`, `LocalPose::blend`).
+    fn blend_bones(
+        &self,
+        rig: &Self::Rig,
+        other: &Self,
+        weights: &[f32],
+    ) -> Result<Self, RagdollError>;
+}
+
+impl Transforms for Pose {
+    /// # Safety
+    /// As the trait's.
+    unsafe fn read(at: *const VtTransform, count: usize, what: &str) -> Result<Self, Failure> {
+        // SAFETY: the function's contract.
+        unsafe { pose_from(at, count, what) }
+    }
+
+    fn write(&self, place: &mut [VtTransform]) -> Result<(), Failure> {
+        write_pose(self, place)
+    }
+
+    fn blend_bones(
+        &self,
+        desc: &RagdollDesc,
+        other: &Self,
+        weights: &[f32],
+    ) -> Result<Self, RagdollError> {
+        self.blend(desc, other, weights)
+    }
+}
+
+impl Transforms for LocalPose {
+    /// # Safety
+    /// As the trait's.
+    unsafe fn read(at: *const VtTransform, count: usize, what: &str) -> Result<Self, Failure> {
+        // SAFETY: the function's contract.
+        unsafe { local_pose(at, count, what) }
+    }
+
+    fn write(&self, place: &mut [VtTransform]) -> Result<(), Failure> {
+        write_bones(&self.bones, place)
+    }
+
+    fn blend_bones(
+        &self,
+        skeleton: &Skeleton,
+        other: &Self,
+        weights: &[f32],
+    ) -> Result<Self, RagdollError> {
+        self.blend(skeleton, other, weights)
+    }
+}
+
+/// `a` and `b` (each `count` transforms of kind `P`) blended bone by bone
+/// at `weights` against `rig`, into `out`: what `vt_ragdoll_pose_blend`
+/// and `vt_skeleton_pose_blend` do.
 ///
 /// # Safety
-/// `local` points to `count` readable transforms.
-unsafe fn local_pose(
-    local: *const VtTransform,
+/// `a`, `b` and `weights` point to `count` readable items, `out` to
+/// `count` writable transforms (it may be `a` or `b`).
+unsafe fn blend_poses<P: Transforms>(
+    rig: &P::Rig,
+    a: *const VtTransform,
+    b: *const VtTransform,
+    weights: *const f32,
     count: usize,
-    what: &str,
-) -> Result<LocalPose, Failure> {
+    out: *mut VtTransform,
+) -> Result<(), Failure> {
     // SAFETY: the function's contract.
-    let bones = unsafe { slice(local, count, what) }?;
-    Ok(LocalPose {
-        bones: bones.iter().map(|&t| t.into()).collect(),
-    })
+    let (a, b, weights) = unsafe {
+        (
+            P::read(a, count, "a")?,
+            P::read(b, count, "b")?,
+            slice(weights, count, "weights")?,
+        )
+    };
+    let blended = a.blend_bones(rig, &b, weights)?;
+    // SAFETY: the function's contract; the inputs were copied above.
+    let place = unsafe { slice_mut(out, count, "out") }?;
+    blended.write(place)
 }
 
 /// Blends two ragdoll poses bone by bone: body `k` of the output (`out`)
@@ -72,18 +153,9 @@ pub unsafe extern "C" fn vt_ragdoll_pose_blend(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (desc, a, b, weights) = unsafe {
-            (
-                shared(desc, "desc")?,
-                pose_from(a, count, "a")?,
-                pose_from(b, count, "b")?,
-                slice(weights, count, "weights")?,
-            )
-        };
-        let blended = a.blend(&desc.desc, &b, weights)?;
-        // SAFETY: the function's contract; the inputs were copied above.
-        let place = unsafe { slice_mut(out, count, "out") }?;
-        write_pose(&blended, place)
+        let desc = unsafe { shared(desc, "desc") }?;
+        // SAFETY: the function's contract.
+        unsafe { blend_poses::<Pose>(&desc.desc, a, b, weights, count, out) }
     })
 }
 
@@ -107,19 +179,45 @@ pub unsafe extern "C" fn vt_skeleton_pose_blend(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (skeleton, a, b, weights) = unsafe {
-            (
-                shared(skeleton, "skeleton")?,
-                local_pose(a, count, "a")?,
-                local_pose(b, count, "b")?,
-                slice(weights, count, "weights")?,
-            )
-        };
-        let blended = a.blend(&skeleton.skeleton, &b, weights)?;
-        // SAFETY: the function's contract; the inputs were copied above.
-        let place = unsafe { slice_mut(out, count, "out") }?;
-        write_bones(&blended.bones, place)
+        let skeleton = unsafe { shared(skeleton, "skeleton") }?;
+        // SAFETY: the function's contract.
+        unsafe { blend_poses::<LocalPose>(&skeleton.skeleton, a, b, weights, count, out) }
     })
+}
+
+/// A blend back from `simulated` (`count` transforms of kind `P`, held
+/// from now on) to the animation over `duration` seconds, checked against
+/// `rig`, written into `blend` as the object C frees with
+/// `vt_blend_back_destroy`; `kind` holds it with its own copy of the rig
+/// to check each frame's animation against. What both
+/// `vt_blend_back_create_*` do.
+///
+/// # Safety
+/// `simulated` points to `count` readable transforms; `blend` is writable.
+unsafe fn start<P: Transforms>(
+    rig: &P::Rig,
+    simulated: *const VtTransform,
+    count: usize,
+    duration: f32,
+    blend: *mut *mut VtBlendBack,
+    kind: fn(BlendBack<P>, Box<P::Rig>) -> Blending,
+) -> Result<(), Failure>
+where
+    P::Rig: Clone,
+{
+    // SAFETY: the function's contract.
+    let (simulated, place) = unsafe {
+        (
+            P::read(simulated, count, "simulated")?,
+            out(blend, "blend")?,
+        )
+    };
+    let made = BlendBack::new(rig, simulated, duration)?;
+    place.set(boxed(VtBlendBack {
+        blend: kind(made, Box::new(rig.clone())),
+        poisoned: false,
+    }));
+    Ok(())
 }
 
 /// Starts a blend back from a ragdoll's last simulated pose `simulated`
@@ -143,19 +241,10 @@ pub unsafe extern "C" fn vt_blend_back_create_ragdoll(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (desc, simulated, place) = unsafe {
-            (
-                shared(desc, "desc")?,
-                pose_from(simulated, count, "simulated")?,
-                out(blend, "blend")?,
-            )
-        };
-        let made = BlendBack::new(&desc.desc, simulated, duration)?;
-        place.set(boxed(VtBlendBack {
-            blend: Blending::Ragdoll(made, Box::new(desc.desc.clone())),
-            poisoned: false,
-        }));
-        Ok(())
+        let desc = unsafe { shared(desc, "desc") }?;
+        let rig = &desc.desc;
+        // SAFETY: the function's contract.
+        unsafe { start(rig, simulated, count, duration, blend, Blending::Ragdoll) }
     })
 }
 
@@ -176,19 +265,10 @@ pub unsafe extern "C" fn vt_blend_back_create_skeleton(
 ) -> VtResult {
     call(|| {
         // SAFETY: the function's contract.
-        let (skeleton, simulated, place) = unsafe {
-            (
-                shared(skeleton, "skeleton")?,
-                local_pose(simulated, count, "simulated")?,
-                out(blend, "blend")?,
-            )
-        };
-        let made = BlendBack::new(&skeleton.skeleton, simulated, duration)?;
-        place.set(boxed(VtBlendBack {
-            blend: Blending::Skeleton(made, Box::new(skeleton.skeleton.clone())),
-            poisoned: false,
-        }));
-        Ok(())
+        let skeleton = unsafe { shared(skeleton, "skeleton") }?;
+        let rig = &skeleton.skeleton;
+        // SAFETY: the function's contract.
+        unsafe { start(rig, simulated, count, duration, blend, Blending::Skeleton) }
     })
 }
 
@@ -200,6 +280,27 @@ pub unsafe extern "C" fn vt_blend_back_create_skeleton(
 pub unsafe extern "C" fn vt_blend_back_destroy(blend: *mut VtBlendBack) {
     // SAFETY: the function's contract.
     unsafe { free(blend) }
+}
+
+/// This frame's output of `back` (checked against `rig`) for `animation`
+/// (`count` transforms of its kind), into `pose`: what
+/// `vt_blend_back_pose` does for either kind.
+///
+/// # Safety
+/// `animation` points to `count` readable transforms, `pose` to `count`
+/// writable ones (it may be `animation`).
+unsafe fn frame<P: Transforms>(
+    back: &BlendBack<P>,
+    rig: &P::Rig,
+    animation: *const VtTransform,
+    count: usize,
+    pose: *mut VtTransform,
+) -> Result<(), Failure> {
+    // SAFETY: the function's contract.
+    let animation = unsafe { P::read(animation, count, "animation") }?;
+    let output = back.pose(rig, &animation)?;
+    // SAFETY: the function's contract; the input was copied.
+    output.write(unsafe { slice_mut(pose, count, "pose") }?)
 }
 
 /// This frame's output: `animation` (this frame's animation pose, `count`
@@ -222,20 +323,11 @@ pub unsafe extern "C" fn vt_blend_back_pose(
     call(|| {
         // SAFETY: the function's contract.
         let blend = unsafe { enter(blend) }?;
-        match &blend.blend {
-            Blending::Ragdoll(back, desc) => {
-                // SAFETY: the function's contract.
-                let animation = unsafe { pose_from(animation, count, "animation") }?;
-                let output = back.pose(desc, &animation)?;
-                // SAFETY: the function's contract; the input was copied.
-                write_pose(&output, unsafe { slice_mut(pose, count, "pose") }?)
-            }
-            Blending::Skeleton(back, skeleton) => {
-                // SAFETY: the function's contract.
-                let animation = unsafe { local_pose(animation, count, "animation") }?;
-                let output = back.pose(skeleton, &animation)?;
-                // SAFETY: the function's contract; the input was copied.
-                write_bones(&output.bones, unsafe { slice_mut(pose, count, "pose") }?)
+        // SAFETY: the function's contract.
+        unsafe {
+            match &blend.blend {
+                Blending::Ragdoll(back, desc) => frame(back, desc, animation, count, pose),
+                Blending::Skeleton(back, skeleton) => frame(back, skeleton, animation, count, pose),
             }
         }
     })

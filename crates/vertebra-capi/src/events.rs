@@ -4,7 +4,7 @@
 //! error and a body's island (`docs/contacts.md`, "Events";
 //! `docs/joints.md`, "Forces and breaking").
 
-use vertebra_collide::{ContactEnded, Touching};
+use vertebra_collide::{ContactEnded, ContactEvents, Touching};
 use vertebra_world::{BrokenJoint, ContactImpulse, JointForce};
 
 use crate::collide::{VtCollisions, with_layer};
@@ -198,6 +198,30 @@ pub unsafe extern "C" fn vt_collisions_after_step(
     }
 }
 
+/// One of the last step's event lists, `list` of the layer's events, into
+/// `items` (room for `capacity`), their number into `count`, as
+/// `vt_collisions_began` says; `what` names `items` in a refusal.
+///
+/// # Safety
+/// `collisions` is live; `items` points to `capacity` writable items;
+/// `count` is writable.
+unsafe fn copy_events<E, T: for<'e> From<&'e E>>(
+    collisions: *mut VtCollisions,
+    list: fn(&ContactEvents) -> &[E],
+    items: *mut T,
+    capacity: usize,
+    count: *mut usize,
+    what: &str,
+) -> VtResult {
+    // SAFETY: the function's contract.
+    unsafe {
+        with_layer(collisions, |layer| {
+            let events = list(layer.collisions.events()).iter().map(T::from);
+            copy_out(events, items, capacity, count, what)
+        })
+    }
+}
+
 /// The pairs that began touching in the last step (with the impulse and
 /// speed of the hit) into `began` (room for `capacity`), their number into
 /// `count`; `VT_RESULT_BUFFER_TOO_SMALL` (only `count` written) when they
@@ -215,15 +239,14 @@ pub unsafe extern "C" fn vt_collisions_began(
 ) -> VtResult {
     // SAFETY: the function's contract.
     unsafe {
-        with_layer(collisions, |layer| {
-            let items = layer
-                .collisions
-                .events()
-                .began()
-                .iter()
-                .map(VtTouching::from);
-            copy_out(items, began, capacity, count, "began")
-        })
+        copy_events(
+            collisions,
+            ContactEvents::began,
+            began,
+            capacity,
+            count,
+            "began",
+        )
     }
 }
 
@@ -241,15 +264,14 @@ pub unsafe extern "C" fn vt_collisions_ended(
 ) -> VtResult {
     // SAFETY: the function's contract.
     unsafe {
-        with_layer(collisions, |layer| {
-            let items = layer
-                .collisions
-                .events()
-                .ended()
-                .iter()
-                .map(VtContactEnded::from);
-            copy_out(items, ended, capacity, count, "ended")
-        })
+        copy_events(
+            collisions,
+            ContactEvents::ended,
+            ended,
+            capacity,
+            count,
+            "ended",
+        )
     }
 }
 
@@ -267,15 +289,14 @@ pub unsafe extern "C" fn vt_collisions_touching(
 ) -> VtResult {
     // SAFETY: the function's contract.
     unsafe {
-        with_layer(collisions, |layer| {
-            let items = layer
-                .collisions
-                .events()
-                .touching()
-                .iter()
-                .map(VtTouching::from);
-            copy_out(items, touching, capacity, count, "touching")
-        })
+        copy_events(
+            collisions,
+            ContactEvents::touching,
+            touching,
+            capacity,
+            count,
+            "touching",
+        )
     }
 }
 

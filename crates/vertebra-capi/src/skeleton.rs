@@ -224,6 +224,23 @@ pub unsafe extern "C" fn vt_skeleton_bind_pose(
     })
 }
 
+/// The `count` parent-local transforms at `local` as a skeleton's local
+/// pose (one per bone; `write_bones` writes one back).
+///
+/// # Safety
+/// `local` points to `count` readable transforms.
+pub(crate) unsafe fn local_pose(
+    local: *const VtTransform,
+    count: usize,
+    what: &str,
+) -> Result<LocalPose, Failure> {
+    // SAFETY: the function's contract.
+    let bones = unsafe { slice(local, count, what) }?;
+    Ok(LocalPose {
+        bones: bones.iter().map(|&t| t.into()).collect(),
+    })
+}
+
 /// Copies bones into `place`, which must be as long.
 pub(crate) fn write_bones(bones: &[Transform], place: &mut [VtTransform]) -> Result<(), Failure> {
     if place.len() != bones.len() {
@@ -348,15 +365,12 @@ pub unsafe extern "C" fn vt_skeleton_mapper_map_to_skeleton(
         let (mapper, animation) = unsafe {
             (
                 shared(mapper, "mapper")?,
-                slice(animation, count, "animation")?,
+                local_pose(animation, count, "animation")?,
             )
         };
         // SAFETY: the function's contract.
         let (ragdoll, world) = unsafe { (enter(ragdoll)?, enter(world)?) };
         let mapping = spine_mapping(mapping)?;
-        let animation = LocalPose {
-            bones: animation.iter().map(|&t| t.into()).collect(),
-        };
         let mapped = mapper.mapper.map_to_skeleton(
             &ragdoll.ragdoll,
             &world.world,

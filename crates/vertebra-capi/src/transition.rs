@@ -3,12 +3,12 @@
 //! (`Transition` in Rust; `docs/ragdolls.md`), and a skeleton's local
 //! poses taken to the model frame.
 
-use vertebra_ragdoll::{LocalPose, Transition};
+use vertebra_ragdoll::Transition;
 
-use crate::error::{Failure, VtResult};
-use crate::ffi::{boxed, call, enter, free, out, shared, slice, slice_mut};
+use crate::error::VtResult;
+use crate::ffi::{boxed, call, enter, free, out, shared, slice_mut};
 use crate::ragdoll::VtRagdoll;
-use crate::skeleton::{VtSkeleton, VtSkeletonMapper, spine_mapping, write_bones};
+use crate::skeleton::{VtSkeleton, VtSkeletonMapper, local_pose, spine_mapping, write_bones};
 use crate::types::VtTransform;
 use crate::world::VtWorld;
 
@@ -16,22 +16,6 @@ use crate::world::VtWorld;
 /// `vt_transition_destroy`).
 pub struct VtTransition {
     transition: Transition,
-}
-
-/// The `count` parent-local transforms at `local` as a pose.
-///
-/// # Safety
-/// `local` points to `count` readable transforms.
-unsafe fn local_pose(
-    local: *const VtTransform,
-    count: usize,
-    what: &str,
-) -> Result<LocalPose, Failure> {
-    // SAFETY: the function's contract.
-    let bones = unsafe { slice(local, count, what) }?;
-    Ok(LocalPose {
-        bones: bones.iter().map(|&t| t.into()).collect(),
-    })
 }
 
 /// Takes a local pose (`count` parent-local transforms) to the model frame

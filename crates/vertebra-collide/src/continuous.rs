@@ -53,7 +53,9 @@ use parry3d::shape::{Ball, Capsule, Cuboid, Shape as ParryShape};
 use vertebra_math::PortableQuat;
 use vertebra_world::{BodyHandle, BodyKind, Error, Shape, World};
 
-use crate::{ColliderShape, Collisions, relative_pose};
+use crate::collider::ColliderShape;
+use crate::pose::relative_pose;
+use crate::set::Collisions;
 
 /// How far short of a static solid (m) a swept core (or centre ball) is
 /// put back: the advancement aims for this gap and stops within

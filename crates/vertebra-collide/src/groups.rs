@@ -15,7 +15,8 @@
 use vertebra_ragdoll::{Ragdoll, RagdollError};
 use vertebra_world::{BodyHandle, Error};
 
-use crate::{CollisionGroups, Collisions};
+use crate::collider::CollisionGroups;
+use crate::set::Collisions;
 
 /// The most groups a set gives ragdolls whose self-collision is off: 2^48
 /// (a ragdoll's turned off a million times a second for nine years), as a

@@ -35,7 +35,7 @@
 
 use vertebra_world::{Error, World};
 
-use crate::Collisions;
+use crate::set::Collisions;
 
 /// Why a set refuses a world on a timeline it does not serve.
 const NOT_SERVED: &str = "this collision set does not serve the world as it is: the world restored a snapshot since the set last served it, or it is another world; restore the set's snapshot taken with the world's after the world's (or declare the set as it is with attach)";

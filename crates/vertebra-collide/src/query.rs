@@ -23,16 +23,17 @@ use core::cell::Cell;
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::math::Pose;
-use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNode, BvhWorkspace};
+use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhNode};
 use parry3d::query::{Ray, ShapeCastOptions};
 use parry3d::shape::{Ball, Capsule, Shape as ParryShape};
 use vertebra_math::{DefaultFloatMode, PortableQuat};
 use vertebra_store::{check_point, check_unit_quat, check_unit_vec};
 use vertebra_world::{BodyHandle, BodyKind, Error, MAX_COORDINATE, Timeline, World};
 
-use crate::{
-    ColliderShape, CollisionGroups, Collisions, MAX_COLLIDER_EXTENT, RagdollPart, relative_pose,
-};
+use crate::collider::{ColliderShape, CollisionGroups, MAX_COLLIDER_EXTENT};
+use crate::part::RagdollPart;
+use crate::pose::relative_pose;
+use crate::set::Collisions;
 
 /// Which colliders a query sees (Rapier's `QueryFilter`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,29 +116,6 @@ pub struct Overlap {
     pub body: BodyHandle,
     /// The ragdoll and bone of the body, if it is a ragdoll's.
     pub part: Option<RagdollPart>,
-}
-
-/// The set's tree of its solid colliders' bounds, and what it was built
-/// from.
-#[derive(Clone, Default)]
-pub(crate) struct QueryTree {
-    bvh: Bvh,
-    /// The world's timeline, pose version and the set's collider version
-    /// the tree holds; `None`: never built.
-    stamp: Option<(Timeline, u64, u64)>,
-    /// Scratch: the solid colliders' bounds, leaf by leaf.
-    bounds: Vec<Aabb>,
-    /// Each leaf's collider index (leaves are numbered densely: parry's
-    /// tree of one or two leaves assumes so).
-    leaves: Vec<usize>,
-    /// The collider version the tree's leaves are of (refit while it
-    /// holds, built anew when it changes).
-    built_for: Option<u64>,
-    /// parry's working memory for a refit.
-    workspace: BvhWorkspace,
-    /// The planes (half spaces, in no tree), by collider index: every
-    /// query tests them.
-    planes: Vec<usize>,
 }
 
 /// The longest query (m): twice the world's range.

@@ -29,10 +29,12 @@
 use serde::{Deserialize, Serialize};
 use vertebra_world::{BodyHandle, Error, World};
 
+use crate::collider::Collider;
+use crate::filter::ordered;
+use crate::groups::MAX_SELF_COLLISION_GROUPS;
 use crate::pairing::{OTHER_BODIES, census};
-use crate::{
-    Collider, Collisions, MAX_SELF_COLLISION_GROUPS, RagdollPart, check_prediction, ordered,
-};
+use crate::part::RagdollPart;
+use crate::set::{Collisions, check_prediction};
 use vertebra_math::DefaultFloatMode;
 
 const MAGIC: &[u8; 8] = b"VTBCOLLS";
