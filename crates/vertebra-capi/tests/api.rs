@@ -1765,10 +1765,10 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
                 d.kind = JointKind::Socket(SwingTwist {
                     swing: rust_swing,
                     twist: Some([-0.4, 0.7]),
-                    softness: LimitSoftness::Spring {
+                    softness: LimitSoftness::Soft(vertebra_world::Spring::Frequency {
                         frequency: 4.0,
                         damping_ratio: 0.7,
-                    },
+                    }),
                 });
             }),
         ));
@@ -1787,7 +1787,7 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
             d.drive = Some(AngularDrive {
                 target: Quat::from_rotation_z(0.3),
                 target_velocity: Vec3::new(0.0, 0.0, 0.5),
-                strength: vertebra_world::DriveStrength::Compliance {
+                strength: vertebra_world::Spring::Compliance {
                     compliance: 1e-3,
                     damping: 2.0,
                 },
@@ -1818,15 +1818,15 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
             d.kind = JointKind::Socket(SwingTwist {
                 swing: Swing::Cone(0.2),
                 twist: None,
-                softness: LimitSoftness::Compliance {
+                softness: LimitSoftness::Soft(vertebra_world::Spring::Compliance {
                     compliance: 1e-4,
                     damping: 0.5,
-                },
+                }),
             });
             d.drive = Some(AngularDrive {
                 target: Quat::from_rotation_z(0.3),
                 target_velocity: Vec3::new(0.0, 0.0, 0.5),
-                strength: vertebra_world::DriveStrength::Spring {
+                strength: vertebra_world::Spring::Frequency {
                     frequency: 4.0,
                     damping_ratio: 0.7,
                 },

@@ -8,7 +8,7 @@ use std::path::Path;
 use vertebra_ragdoll::{
     RagdollDesc, RagdollError, RagdollGenerator, Skeleton, Strength, read_text,
 };
-use vertebra_world::{JointKind, LimitSoftness, Swing};
+use vertebra_world::{JointKind, LimitSoftness, Spring, Swing};
 
 /// What the file at `path` holds, as text; or every problem found, one a
 /// line, each naming the file and the line. `skeleton` is the skeleton
@@ -142,16 +142,16 @@ fn strength(s: Strength) -> String {
 fn softness(s: LimitSoftness) -> Option<String> {
     match s {
         LimitSoftness::Hard => None,
-        LimitSoftness::Compliance {
+        LimitSoftness::Soft(Spring::Compliance {
             compliance,
             damping,
-        } => Some(format!(
+        }) => Some(format!(
             "soft: compliance {compliance} rad/(N m), damping {damping} N m s/rad"
         )),
-        LimitSoftness::Spring {
+        LimitSoftness::Soft(Spring::Frequency {
             frequency,
             damping_ratio,
-        } => Some(format!(
+        }) => Some(format!(
             "soft: {} Hz, damping ratio {}",
             number(frequency, 3),
             number(damping_ratio, 3)

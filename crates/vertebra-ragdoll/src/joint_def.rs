@@ -9,13 +9,13 @@ use vertebra_math::PortableQuat;
 use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::Deserialize;
 use vertebra_world::{
-    JointBreaking, JointKind, LimitSoftness, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
-    MIN_DRIVE_FREQUENCY, Swing, SwingTwist, check_coordinate, check_unit_quat,
+    JointBreaking, JointKind, LimitSoftness, Spring, SpringField, Swing, SwingTwist,
+    check_coordinate, check_unit_quat,
 };
 
 use crate::drive::Strength;
 use crate::drive_def::RawStrength;
-use crate::error::{RagdollError, finite, range};
+use crate::error::{RagdollError, check_spring, finite, range};
 
 /// A joint between a parent and a child body.
 #[derive(Clone, Debug, PartialEq)]
@@ -642,14 +642,18 @@ fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, R
         Some(RawSoftness::Compliance(c)) => LimitSoftness::compliant(*c),
         Some(RawSoftness::Table(t)) => {
             match (t.compliance, t.damping, t.frequency, t.damping_ratio) {
-                (Some(compliance), damping, None, None) => LimitSoftness::Compliance {
-                    compliance,
-                    damping: damping.unwrap_or(0.0),
-                },
-                (None, None, Some(frequency), Some(damping_ratio)) => LimitSoftness::Spring {
-                    frequency,
-                    damping_ratio,
-                },
+                (Some(compliance), damping, None, None) => {
+                    LimitSoftness::Soft(Spring::Compliance {
+                        compliance,
+                        damping: damping.unwrap_or(0.0),
+                    })
+                }
+                (None, None, Some(frequency), Some(damping_ratio)) => {
+                    LimitSoftness::Soft(Spring::Frequency {
+                        frequency,
+                        damping_ratio,
+                    })
+                }
                 _ => {
                     return Err(RagdollError::OutOfRange {
                     context: context.to_owned(),
@@ -663,37 +667,20 @@ fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, R
     })
 }
 
-/// A limit softness checked as the world will check it, by name.
+/// A limit softness as a description holds it: finite numbers, in the
+/// world's ranges (its check, whose reason names the number).
 fn check_softness(context: &str, soft: LimitSoftness) -> Result<(), RagdollError> {
-    let numbers = match soft {
-        LimitSoftness::Hard => vec![],
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => vec![compliance, damping],
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => vec![frequency, damping_ratio],
+    let LimitSoftness::Soft(spring) = soft else {
+        return Ok(());
     };
-    finite(context, "softness", &numbers)?;
-    let (ok, reason) = match soft {
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => (
-            compliance >= 0.0 && damping >= 0.0 && compliance * damping <= MAX_DRIVE_DAMPING_TIME,
-            "must be a compliance (rad / (N m)) and damping (N m s / rad) of 0 or more, compliance times damping at most 1e6 s",
-        ),
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => (
-            frequency >= MIN_DRIVE_FREQUENCY
-                && (0.0..=MAX_DRIVE_DAMPING_RATIO).contains(&damping_ratio),
-            "must be a frequency of at least 1e-3 Hz and a damping ratio in [0, 1e3]",
-        ),
-        LimitSoftness::Hard => (true, ""),
-    };
-    range(context, "softness", ok, reason)
+    let (Spring::Compliance {
+        compliance: x,
+        damping: y,
+    }
+    | Spring::Frequency {
+        frequency: x,
+        damping_ratio: y,
+    }) = spring;
+    finite(context, "softness", &[x, y])?;
+    check_spring(context, "softness", spring, SpringField::Limit)
 }

@@ -5,7 +5,7 @@
 //! (and normal) that rebuilds it exactly, or else as the quaternion itself.
 
 use glam::{Quat, Vec3};
-use vertebra_world::{JointKind, LimitSoftness, Swing};
+use vertebra_world::{JointKind, LimitSoftness, Spring, Swing};
 
 use crate::drive::{DriveSettings, Strength};
 use crate::joint_def::{JointDef, frame, kind_name};
@@ -160,27 +160,15 @@ fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
     };
     match softness {
         LimitSoftness::Hard => {}
-        LimitSoftness::Compliance {
+        LimitSoftness::Soft(Spring::Compliance {
             compliance,
             damping,
-        } if same_bits(&[damping], &[0.0]) => {
+        }) if same_bits(&[damping], &[0.0]) => {
             out.push_str(&format!("softness = {}\n", float(compliance)));
         }
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => out.push_str(&format!(
-            "softness = {{ compliance = {}, damping = {} }}\n",
-            float(compliance),
-            float(damping)
-        )),
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => out.push_str(&format!(
-            "softness = {{ frequency = {}, damping_ratio = {} }}\n",
-            float(frequency),
-            float(damping_ratio)
+        LimitSoftness::Soft(spring) => out.push_str(&format!(
+            "softness = {{ {} }}\n",
+            spring_fields(spring, 0.0).join(", ")
         )),
     }
     if let Some(s) = j.drive {
@@ -203,6 +191,30 @@ fn strength(s: Strength) -> Vec<String> {
         Strength::Infinite => vec!["strength = \"infinite\"".to_owned()],
         Strength::Compliance(c) => vec![format!("compliance = {}", float(c))],
         Strength::Spring {
+            frequency,
+            damping_ratio,
+        } => vec![
+            format!("frequency = {}", float(frequency)),
+            format!("damping_ratio = {}", float(damping_ratio)),
+        ],
+    }
+}
+
+/// A spring's fields as `key = value` pairs, its damping only when it
+/// is not `damping` (the one it takes without).
+fn spring_fields(s: Spring, damping: f32) -> Vec<String> {
+    match s {
+        Spring::Compliance {
+            compliance,
+            damping: own,
+        } => {
+            let mut fields = vec![format!("compliance = {}", float(compliance))];
+            if !same_bits(&[own], &[damping]) {
+                fields.push(format!("damping = {}", float(own)));
+            }
+            fields
+        }
+        Spring::Frequency {
             frequency,
             damping_ratio,
         } => vec![

@@ -12,7 +12,7 @@ use vertebra_ragdoll::{
     Pose, REFERENCE_HUMANOID, REFERENCE_SKELETON, Ragdoll, RagdollDesc, RagdollError, Skeleton,
     SpineMode, SpineSpec, Strength, Transform,
 };
-use vertebra_world::{JointKind, LimitSoftness, SolverConfig, Swing, SwingTwist, World};
+use vertebra_world::{JointKind, LimitSoftness, SolverConfig, Spring, Swing, SwingTwist, World};
 
 fn model(skeleton: &Skeleton) -> Vec<Transform> {
     skeleton.bind_pose().to_model(skeleton).unwrap().bones
@@ -400,10 +400,10 @@ fn assorted() -> RagdollDesc {
     let ellipse = SwingTwist {
         swing: Swing::Ellipse { y: 1.1, z: 0.4 },
         twist: None,
-        softness: LimitSoftness::Compliance {
+        softness: LimitSoftness::Soft(Spring::Compliance {
             compliance: 2e-3,
             damping: 5.0,
-        },
+        }),
     };
     let pyramid = SwingTwist {
         swing: Swing::Pyramid {
@@ -411,10 +411,10 @@ fn assorted() -> RagdollDesc {
             z: [-0.1, 0.9],
         },
         twist: Some([-1.0, 1.0]),
-        softness: LimitSoftness::Spring {
+        softness: LimitSoftness::Soft(Spring::Frequency {
             frequency: 8.0,
             damping_ratio: 0.7,
-        },
+        }),
     };
     let skeleton = Skeleton::from_toml(
         "[[bone]]\nname = \"base\"\ntranslation = [0.0, 1.0, 0.0]\n\n\

@@ -145,7 +145,7 @@ fn inconsistent_joints_are_refused_by_joint_and_field() {
         ),
         (
             edited(shoulder, &format!("{shoulder}\nsoftness = -1.0")),
-            "joint `shoulder_l`: softness must be a compliance",
+            "joint `shoulder_l`: softness is refused: limit compliance must be positive",
         ),
         (
             edited(shoulder, &format!("{shoulder}\nsoftness = nan")),

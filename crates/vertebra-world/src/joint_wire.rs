@@ -12,6 +12,12 @@
 //! The drive and the breaking thresholds follow the same rule: a joint
 //! without thresholds encodes its drive as the `Option` it always was
 //! (variants 0 and 1), one with them after a third tag.
+//!
+//! A [`LimitSoftness`] is encoded as it was before its spring became the
+//! drives' [`Spring`]: one enum of three variants, `Hard` (0), the
+//! compliance and damping (1) and the frequency and damping ratio (2), not
+//! `Soft` (1) with the spring's own tag after it. A drive's strength, a
+//! `Spring`, keeps its two tags (compliance 0, frequency 1) by itself.
 
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -19,6 +25,7 @@ use vertebra_store::BodyHandle;
 
 use crate::drive::AngularDrive;
 use crate::joint::{JointBreaking, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
+use crate::spring::Spring;
 
 #[derive(Serialize, Deserialize)]
 pub(crate) struct JointWire {
@@ -127,14 +134,76 @@ impl From<JointWire> for JointDesc {
     }
 }
 
-impl Serialize for JointDesc {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        JointWire::from(*self).serialize(serializer)
+/// Serde's traits for `$ty`, through its wire form `$wire` (`From` each
+/// way).
+macro_rules! through_wire {
+    ($ty:ty, $wire:ty) => {
+        impl Serialize for $ty {
+            fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                <$wire>::from(*self).serialize(serializer)
+            }
+        }
+
+        impl<'de> Deserialize<'de> for $ty {
+            fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+                <$wire>::deserialize(deserializer).map(Self::from)
+            }
+        }
+    };
+}
+
+through_wire!(JointDesc, JointWire);
+through_wire!(LimitSoftness, SoftnessWire);
+
+/// A [`LimitSoftness`] as it is encoded: the spring's variants beside
+/// `Hard`, field for field.
+#[derive(Serialize, Deserialize)]
+enum SoftnessWire {
+    Hard,
+    Compliance { compliance: f32, damping: f32 },
+    Spring { frequency: f32, damping_ratio: f32 },
+}
+
+impl From<LimitSoftness> for SoftnessWire {
+    fn from(s: LimitSoftness) -> Self {
+        match s {
+            LimitSoftness::Hard => Self::Hard,
+            LimitSoftness::Soft(Spring::Compliance {
+                compliance,
+                damping,
+            }) => Self::Compliance {
+                compliance,
+                damping,
+            },
+            LimitSoftness::Soft(Spring::Frequency {
+                frequency,
+                damping_ratio,
+            }) => Self::Spring {
+                frequency,
+                damping_ratio,
+            },
+        }
     }
 }
 
-impl<'de> Deserialize<'de> for JointDesc {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        JointWire::deserialize(deserializer).map(Self::from)
+impl From<SoftnessWire> for LimitSoftness {
+    fn from(w: SoftnessWire) -> Self {
+        match w {
+            SoftnessWire::Hard => Self::Hard,
+            SoftnessWire::Compliance {
+                compliance,
+                damping,
+            } => Self::Soft(Spring::Compliance {
+                compliance,
+                damping,
+            }),
+            SoftnessWire::Spring {
+                frequency,
+                damping_ratio,
+            } => Self::Soft(Spring::Frequency {
+                frequency,
+                damping_ratio,
+            }),
+        }
     }
 }

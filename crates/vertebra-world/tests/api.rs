@@ -7,7 +7,7 @@ use common::capsule;
 use glam::{Mat3, Quat, Vec3};
 use vertebra_world::{
     AngularDrive, BackendChoice, BodyDesc, Error, JointDesc, JointKind, LimitSoftness,
-    MassProperties, Shape, SolverConfig, Swing, SwingTwist, World,
+    MassProperties, Shape, SolverConfig, Spring, Swing, SwingTwist, World,
 };
 
 fn unit_mass() -> MassProperties {
@@ -242,13 +242,17 @@ fn bad_joint_kinds_are_refused_with_the_field_named() {
         range: Some([0.0, 1.0]),
         softness,
     };
-    let spring = |frequency, damping_ratio| LimitSoftness::Spring {
-        frequency,
-        damping_ratio,
+    let spring = |frequency, damping_ratio| {
+        LimitSoftness::Soft(Spring::Frequency {
+            frequency,
+            damping_ratio,
+        })
     };
-    let damped = |compliance, damping| LimitSoftness::Compliance {
-        compliance,
-        damping,
+    let damped = |compliance, damping| {
+        LimitSoftness::Soft(Spring::Compliance {
+            compliance,
+            damping,
+        })
     };
     let cases = [
         (
