@@ -12,11 +12,11 @@ use vertebra_capi::*;
 use vertebra_collide::{Collider, ColliderShape, Collisions};
 use vertebra_ragdoll::{
     BuildOptions, DriveSettings, LocalPose, Pose, Ragdoll, RagdollDesc, Skeleton, SkeletonMapper,
-    SpineMapping, SpineMode, Strength, Transform,
+    SpineMapping, SpineMode, Transform,
 };
 use vertebra_world::{
     AngularDrive, BodyDesc, JointDesc, JointKind, JointSolver, LimitSoftness, RodDesc,
-    RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
+    RodStiffness, Shape, SolverConfig, Spring, Swing, SwingTwist, World,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -1765,7 +1765,7 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
                 d.kind = JointKind::Socket(SwingTwist {
                     swing: rust_swing,
                     twist: Some([-0.4, 0.7]),
-                    softness: LimitSoftness::Soft(vertebra_world::Spring::Frequency {
+                    softness: LimitSoftness::Soft(Spring::Frequency {
                         frequency: 4.0,
                         damping_ratio: 0.7,
                     }),
@@ -1787,7 +1787,7 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
             d.drive = Some(AngularDrive {
                 target: Quat::from_rotation_z(0.3),
                 target_velocity: Vec3::new(0.0, 0.0, 0.5),
-                strength: vertebra_world::Spring::Compliance {
+                strength: Spring::Compliance {
                     compliance: 1e-3,
                     damping: 2.0,
                 },
@@ -1818,7 +1818,7 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
             d.kind = JointKind::Socket(SwingTwist {
                 swing: Swing::Cone(0.2),
                 twist: None,
-                softness: LimitSoftness::Soft(vertebra_world::Spring::Compliance {
+                softness: LimitSoftness::Soft(Spring::Compliance {
                     compliance: 1e-4,
                     damping: 0.5,
                 }),
@@ -1826,7 +1826,7 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
             d.drive = Some(AngularDrive {
                 target: Quat::from_rotation_z(0.3),
                 target_velocity: Vec3::new(0.0, 0.0, 0.5),
-                strength: vertebra_world::Spring::Frequency {
+                strength: Spring::Frequency {
                     frequency: 4.0,
                     damping_ratio: 0.7,
                 },
@@ -2052,11 +2052,10 @@ fn a_ragdoll_driven_and_hit_through_c_moves_as_through_rust() {
                 &settings,
             )
         });
-        let rust_settings = DriveSettings::uniform(Strength::Spring {
+        let rust_settings = DriveSettings::uniform(Spring::Frequency {
             frequency: 5.0,
             damping_ratio: 0.8,
         })
-        .with_damping(0.0)
         .with_max_torque(300.0);
         rust.ragdoll
             .drive_to(&mut rust.world, &target, &rust_settings)

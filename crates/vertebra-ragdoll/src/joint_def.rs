@@ -13,7 +13,6 @@ use vertebra_world::{
     check_coordinate, check_unit_quat,
 };
 
-use crate::drive::Strength;
 use crate::drive_def::RawStrength;
 use crate::error::{RagdollError, check_spring, finite, range};
 
@@ -38,7 +37,7 @@ pub struct JointDef {
     pub kind: JointKind,
     /// The joint's own drive strength (the file's `drive = { ... }`), over
     /// the ragdoll's `[drive]` one; `None` takes the ragdoll's.
-    pub drive: Option<Strength>,
+    pub drive: Option<Spring>,
     /// When it breaks (the file's `break_force`, N, and `break_torque`,
     /// N m; either alone leaves the other infinite): see
     /// `vertebra_world::JointBreaking`. `None`: never.
@@ -127,7 +126,7 @@ pub struct JointSpec {
     /// The kind and its limits (rad), as the world takes them.
     pub kind: JointKind,
     /// The joint's own drive strength, over the ragdoll's `[drive]` one.
-    pub drive: Option<Strength>,
+    pub drive: Option<Spring>,
     /// When it breaks; `None`: never.
     pub breaking: Option<JointBreaking>,
 }
@@ -228,7 +227,7 @@ impl JointSpec {
     }
 
     /// With its own drive strength.
-    pub fn with_drive(mut self, strength: Strength) -> Self {
+    pub fn with_drive(mut self, strength: Spring) -> Self {
         self.drive = Some(strength);
         self
     }
@@ -276,9 +275,14 @@ impl RawJoint {
 
 /// Reads one `[[joint]]` table (`context` names its line and the joint):
 /// its kind and the fields that kind takes, its softness and drive as one
-/// of their forms, its angles in radians. The values are checked when the
-/// joint is resolved.
-pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, RagdollError> {
+/// of their forms (a drive's compliance without its own damping taking
+/// `damping`, the `[drive]` table's), its angles in radians. The values
+/// are checked when the joint is resolved.
+pub(crate) fn joint_spec(
+    j: &RawJoint,
+    context: &str,
+    damping: f32,
+) -> Result<JointSpec, RagdollError> {
     let named = j.kind.as_deref().unwrap_or("socket");
     let kind = joint_kind(
         context,
@@ -288,7 +292,7 @@ pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, Ragdo
         [j.twist, j.range],
         j.softness.as_ref(),
     )?;
-    let drive = j.drive.map(|d| d.read(context)).transpose()?;
+    let drive = j.drive.map(|d| d.read(context, damping)).transpose()?;
     let breaking = (j.break_force.is_some() || j.break_torque.is_some()).then(|| JointBreaking {
         force: j.break_force.unwrap_or(f32::INFINITY),
         torque: j.break_torque.unwrap_or(f32::INFINITY),

@@ -7,7 +7,7 @@
 use glam::{Quat, Vec3};
 use vertebra_world::{JointKind, LimitSoftness, Spring, Swing};
 
-use crate::drive::{DriveSettings, Strength};
+use crate::drive::DriveSettings;
 use crate::joint_def::{JointDef, frame, kind_name};
 use crate::model::{BodyDef, RagdollDesc};
 use crate::skeleton::{Skeleton, Transform};
@@ -40,8 +40,14 @@ impl RagdollDesc {
                 .get(i)
                 .map_or(format!("body {i}"), |b| b.name.clone())
         };
+        // A joint's own compliance without a damping of its own reads
+        // back with the `[drive]` table's.
+        let damping = match self.drive.as_ref().map(|d| d.strength) {
+            Some(Spring::Compliance { damping, .. }) => damping,
+            _ => 0.0,
+        };
         for j in &self.joints {
-            write_joint(&mut out, j, &body(j.parent), &body(j.child));
+            write_joint(&mut out, j, [&body(j.parent), &body(j.child)], damping);
         }
         if let Some(s) = &self.spine {
             let names: Vec<String> = s.bodies.iter().map(|&i| string(&body(i))).collect();
@@ -110,7 +116,9 @@ fn same_transform(a: Transform, b: Transform) -> bool {
         && same_bits(&a.rotation.to_array(), &b.rotation.to_array())
 }
 
-fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
+/// A `[[joint]]` table between `parent` and `child`; its drive's damping
+/// is written unless it is `damping` (the `[drive]` table's).
+fn write_joint(out: &mut String, j: &JointDef, [parent, child]: [&str; 2], damping: f32) {
     out.push_str("[[joint]]\n");
     out.push_str(&format!("name = {}\n", string(&j.name)));
     out.push_str(&format!("parent = {}\n", string(parent)));
@@ -172,7 +180,10 @@ fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
         )),
     }
     if let Some(s) = j.drive {
-        out.push_str(&format!("drive = {{ {} }}\n", strength(s).join(", ")));
+        out.push_str(&format!(
+            "drive = {{ {} }}\n",
+            strength(s, damping).join(", ")
+        ));
     }
     if let Some(b) = j.breaking {
         // An infinite threshold is the one not written.
@@ -185,18 +196,18 @@ fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
     out.push('\n');
 }
 
-/// A strength's fields as `key = value` pairs.
-fn strength(s: Strength) -> Vec<String> {
+/// A drive strength's fields as `key = value` pairs: `strength =
+/// "infinite"` for [`Spring::RIGID`], else the spring's (its damping only
+/// when it is not `damping`, the one it reads back with).
+fn strength(s: Spring, damping: f32) -> Vec<String> {
     match s {
-        Strength::Infinite => vec!["strength = \"infinite\"".to_owned()],
-        Strength::Compliance(c) => vec![format!("compliance = {}", float(c))],
-        Strength::Spring {
-            frequency,
-            damping_ratio,
-        } => vec![
-            format!("frequency = {}", float(frequency)),
-            format!("damping_ratio = {}", float(damping_ratio)),
-        ],
+        Spring::Compliance {
+            compliance,
+            damping: own,
+        } if same_bits(&[compliance, own], &[0.0, 0.0]) => {
+            vec!["strength = \"infinite\"".to_owned()]
+        }
+        _ => spring_fields(s, damping),
     }
 }
 
@@ -226,12 +237,9 @@ fn spring_fields(s: Spring, damping: f32) -> Vec<String> {
 
 fn write_drive(out: &mut String, d: &DriveSettings) {
     out.push_str("[drive]\n");
-    for field in strength(d.strength) {
+    for field in strength(d.strength, 0.0) {
         out.push_str(&field);
         out.push('\n');
-    }
-    if d.damping != 0.0 {
-        out.push_str(&format!("damping = {}\n", float(d.damping)));
     }
     if d.max_torque != f32::INFINITY {
         out.push_str(&format!("max_torque = {}\n", float(d.max_torque)));

@@ -6,11 +6,9 @@
 use core::f32::consts::PI;
 
 use glam::{Quat, Vec3};
-use vertebra_ragdoll::{
-    ANATOMICAL_HUMANOID, BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode, Strength,
-};
+use vertebra_ragdoll::{ANATOMICAL_HUMANOID, BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
 use vertebra_world::{
-    BodyDesc, JointDesc, JointKind, LimitSoftness, SolverConfig, Swing, SwingTwist, World,
+    BodyDesc, JointDesc, JointKind, LimitSoftness, SolverConfig, Spring, Swing, SwingTwist, World,
 };
 
 fn joint<'a>(desc: &'a RagdollDesc, name: &str) -> &'a vertebra_ragdoll::JointDef {
@@ -249,7 +247,7 @@ fn drive_settings_are_read_from_the_file() {
         .expect("the anatomical humanoid has a [drive] table");
     assert_eq!(
         drive.strength,
-        Strength::Spring {
+        Spring::Frequency {
             frequency: 4.0,
             damping_ratio: 1.0
         }
@@ -257,7 +255,7 @@ fn drive_settings_are_read_from_the_file() {
     assert_eq!(drive.max_torque, 400.0);
     let knee = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
     let hip = desc.joints.iter().position(|j| j.name == "hip_l").unwrap();
-    let six = Strength::Spring {
+    let six = Spring::Frequency {
         frequency: 6.0,
         damping_ratio: 1.0,
     };
@@ -288,7 +286,7 @@ fn drive_settings_that_make_no_drive_are_refused_by_field() {
         ),
         (
             edited(table, "[drive]\nfrequency = 0.0\ndamping_ratio = 1.0"),
-            "[drive]: strength (frequency, damping ratio)",
+            "[drive]: strength is refused: drive frequency (at least 1e-3 Hz) is out of range",
         ),
         (
             edited(table, "[drive]\nfrequency = inf\ndamping_ratio = nan"),
