@@ -211,3 +211,57 @@ fn a_step_that_is_no_time_is_refused() {
         assert_eq!(world.state_hash(), before);
     }
 }
+
+/// A strength the world refuses is refused by `drive_to` and
+/// `drive_following` before anything is set, naming the settings' field or
+/// the joint whose override it is, with the world's reason (which names
+/// the number).
+#[test]
+fn bad_strengths_are_refused_naming_the_joint_and_change_nothing() {
+    let desc = RagdollDesc::anatomical_humanoid();
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let bind = Pose::bind(&desc);
+    let ragdoll = Ragdoll::build(
+        &mut world,
+        &desc,
+        BuildOptions::new(SpineMode::Rod),
+        &bind,
+        None,
+    )
+    .unwrap();
+    let bad = Spring::Frequency {
+        frequency: 0.0,
+        damping_ratio: 1.0,
+    };
+    let knee = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
+    let mut overridden = DriveSettings::uniform(Spring::RIGID);
+    overridden.joints = vec![None; desc.joints.len()];
+    overridden.joints[knee] = Some(Spring::Compliance {
+        compliance: 0.01,
+        damping: f32::NAN,
+    });
+    let cases = [
+        (
+            DriveSettings::uniform(bad),
+            "drive: strength is refused: drive frequency (at least 1e-3 Hz) is out of range",
+        ),
+        (
+            overridden,
+            "joint `knee_l`: drive is refused: drive damping is not finite",
+        ),
+    ];
+    for (settings, expected) in cases {
+        let before = world.state_hash();
+        let e = ragdoll.drive_to(&mut world, &bind, &settings).unwrap_err();
+        assert_eq!(e.to_string(), expected);
+        let e = ragdoll
+            .drive_following(&mut world, &bind, &bind, 1.0 / 60.0, &settings)
+            .unwrap_err();
+        assert_eq!(e.to_string(), expected);
+        assert_eq!(
+            world.state_hash(),
+            before,
+            "a refused drive changed the world"
+        );
+    }
+}

@@ -300,6 +300,31 @@ fn drive_settings_that_make_no_drive_are_refused_by_field() {
             edited(table, "").replace("[drive]", ""),
             "joint `knee_l`: drive needs a [drive] table",
         ),
+        (
+            edited(
+                knee,
+                "range = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 2e3 }",
+            ),
+            "joint `knee_l`: drive is refused: drive damping ratio (at most 1e3) is out of range",
+        ),
+        (
+            edited(
+                knee,
+                "range = [0.0, 150.0]\ndrive = { compliance = 0.001, damping = -1.0 }",
+            ),
+            "joint `knee_l`: drive is refused: drive damping must be positive",
+        ),
+        (
+            edited(
+                knee,
+                "range = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 1.0, damping = 2.0 }",
+            ),
+            "joint `knee_l`: damping is for a compliance strength only",
+        ),
+        (
+            edited(table, "[drive]\ncompliance = 1e4\ndamping = 1e3"),
+            "[drive]: strength is refused: drive damping (compliance times damping at most 1e6 s) is out of range",
+        ),
     ];
     for (text, expected) in cases {
         let e = RagdollDesc::from_toml(&text).unwrap_err().to_string();
@@ -315,6 +340,51 @@ fn drive_settings_that_make_no_drive_are_refused_by_field() {
         e.contains("joint `knee_l`: drive is for sockets and hinges only; this joint is a fixed"),
         "{e}"
     );
+}
+
+/// A joint's own compliance takes the `[drive]` table's damping unless it
+/// gives its own (as every compliance took the one damping before a
+/// strength carried its own); either reads back from the written file.
+#[test]
+fn a_joints_compliance_takes_the_tables_damping_unless_it_gives_one() {
+    let table = "[drive]\nfrequency = 4.0\ndamping_ratio = 1.0\nmax_torque = 400.0";
+    let knee = "range = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 1.0 }";
+    let compliant = edited(table, "[drive]\ncompliance = 0.01\ndamping = 4.0");
+    let knee_drive = |desc: &RagdollDesc| {
+        let k = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
+        desc.joints[k].drive
+    };
+    let cases = [
+        ("drive = { compliance = 0.002 }", 4.0),
+        ("drive = { compliance = 0.002, damping = 1.5 }", 1.5),
+        ("drive = { compliance = 0.002, damping = 0.0 }", 0.0),
+    ];
+    for (own, damping) in cases {
+        let text = compliant.replacen(knee, &format!("range = [0.0, 150.0]\n{own}"), 1);
+        let desc = RagdollDesc::from_toml(&text).unwrap();
+        let expected = Spring::Compliance {
+            compliance: 0.002,
+            damping,
+        };
+        assert_eq!(knee_drive(&desc), Some(expected), "{own}");
+        let drive = desc.drive.as_ref().unwrap();
+        let table = Spring::Compliance {
+            compliance: 0.01,
+            damping: 4.0,
+        };
+        assert_eq!(drive.strength, table);
+        let again = RagdollDesc::from_toml(&desc.to_toml()).unwrap();
+        assert_eq!(again, desc, "{own} reads back");
+    }
+    // `strength = "infinite"` is the rigid spring, whatever the table's
+    // damping.
+    let text = compliant.replacen(
+        knee,
+        "range = [0.0, 150.0]\ndrive = { strength = \"infinite\" }",
+        1,
+    );
+    let desc = RagdollDesc::from_toml(&text).unwrap();
+    assert_eq!(knee_drive(&desc), Some(Spring::RIGID));
 }
 
 /// The file's drive settings drive the ragdoll: hanging by its hips under
