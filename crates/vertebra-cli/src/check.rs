@@ -127,8 +127,8 @@ fn strength(s: Spring) -> String {
         _ if s == Spring::RIGID => "infinite".to_owned(),
         Spring::Compliance {
             compliance,
-            damping,
-        } if damping == 0.0 => format!("compliance {compliance} rad/(N m)"),
+            damping: 0.0,
+        } => format!("compliance {compliance} rad/(N m)"),
         Spring::Compliance {
             compliance,
             damping,

@@ -170,8 +170,8 @@ fn a_rod_spine_following_the_animation_does_not_lag() {
     // rad against 0.0600, and 1.1e-5.
     let (compliance, damping) = (0.001, 120.0);
     let settings = DriveSettings::uniform(Spring::Compliance {
-        compliance: compliance,
-        damping: damping,
+        compliance,
+        damping,
     });
     let expected = compliance * damping * SPINE_SPEED;
     let (chasing, following) = (spine_lag(false, &settings), spine_lag(true, &settings));

@@ -80,7 +80,7 @@ impl Rig {
 fn compliant(damping: f32) -> DriveSettings {
     DriveSettings::uniform(Spring::Compliance {
         compliance: COMPLIANCE,
-        damping: damping,
+        damping,
     })
 }
 
