@@ -38,6 +38,7 @@ unsafe fn with_overrides(
             slice(overrides, count, "overrides")?,
         )
     };
+    let damping = settings.damping;
     let mut settings = DriveSettings::try_from(settings)?;
     let joints = desc.joints.len();
     settings.joints = vec![None; joints];
@@ -58,7 +59,7 @@ unsafe fn with_overrides(
                 format!("overrides[{k}] names joint `{name}` again"),
             ));
         }
-        *slot = Some(o.strength.try_into()?);
+        *slot = Some(o.strength.spring(damping)?);
     }
     Ok(settings)
 }

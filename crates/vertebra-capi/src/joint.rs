@@ -2,8 +2,7 @@
 //! softness and drives (`docs/joints.md` gives each kind's parts and units).
 
 use vertebra_world::{
-    AngularDrive, DriveStrength, JointBreaking, JointDesc, JointKind, LimitSoftness, Swing,
-    SwingTwist,
+    AngularDrive, JointBreaking, JointDesc, JointKind, LimitSoftness, Spring, Swing, SwingTwist,
 };
 
 use crate::error::{Failure, VtResult};
@@ -153,27 +152,26 @@ impl TryFrom<VtSoftness> for LimitSoftness {
     fn try_from(s: VtSoftness) -> Result<Self, Failure> {
         Ok(match pick(s.kind, "softness.kind", &[0, 1, 2])? {
             0 => LimitSoftness::Hard,
-            1 => LimitSoftness::Compliance {
+            1 => LimitSoftness::Soft(Spring::Compliance {
                 compliance: s.a,
                 damping: s.b,
-            },
-            _ => LimitSoftness::Spring {
+            }),
+            _ => LimitSoftness::Soft(Spring::Frequency {
                 frequency: s.a,
                 damping_ratio: s.b,
-            },
+            }),
         })
     }
 }
 
-impl From<LimitSoftness> for VtSoftness {
-    fn from(s: LimitSoftness) -> Self {
+impl From<Spring> for VtSoftness {
+    fn from(s: Spring) -> Self {
         let (kind, a, b) = match s {
-            LimitSoftness::Hard => (0, 0.0, 0.0),
-            LimitSoftness::Compliance {
+            Spring::Compliance {
                 compliance,
                 damping,
             } => (1, compliance, damping),
-            LimitSoftness::Spring {
+            Spring::Frequency {
                 frequency,
                 damping_ratio,
             } => (2, frequency, damping_ratio),
@@ -182,30 +180,27 @@ impl From<LimitSoftness> for VtSoftness {
     }
 }
 
+impl From<LimitSoftness> for VtSoftness {
+    fn from(s: LimitSoftness) -> Self {
+        match s {
+            LimitSoftness::Hard => Self {
+                kind: 0,
+                a: 0.0,
+                b: 0.0,
+            },
+            LimitSoftness::Soft(spring) => spring.into(),
+        }
+    }
+}
+
 impl TryFrom<VtDrive> for AngularDrive {
     type Error = Failure;
     fn try_from(d: VtDrive) -> Result<Self, Failure> {
-        let strength = match LimitSoftness::try_from(d.strength)? {
-            LimitSoftness::Compliance {
-                compliance,
-                damping,
-            } => DriveStrength::Compliance {
-                compliance,
-                damping,
-            },
-            LimitSoftness::Spring {
-                frequency,
-                damping_ratio,
-            } => DriveStrength::Spring {
-                frequency,
-                damping_ratio,
-            },
-            LimitSoftness::Hard => {
-                return Err(Failure::new(
-                    VtResult::InvalidEnum,
-                    "drive.strength.kind is VT_SOFTNESS_KIND_HARD; a drive is compliant (0: rigid) or a spring",
-                ));
-            }
+        let LimitSoftness::Soft(strength) = LimitSoftness::try_from(d.strength)? else {
+            return Err(Failure::new(
+                VtResult::InvalidEnum,
+                "drive.strength.kind is VT_SOFTNESS_KIND_HARD; a drive is compliant (0: rigid) or a spring",
+            ));
         };
         Ok(AngularDrive {
             target: d.target.into(),
@@ -218,26 +213,10 @@ impl TryFrom<VtDrive> for AngularDrive {
 
 impl From<AngularDrive> for VtDrive {
     fn from(d: AngularDrive) -> Self {
-        let strength = match d.strength {
-            DriveStrength::Compliance {
-                compliance,
-                damping,
-            } => LimitSoftness::Compliance {
-                compliance,
-                damping,
-            },
-            DriveStrength::Spring {
-                frequency,
-                damping_ratio,
-            } => LimitSoftness::Spring {
-                frequency,
-                damping_ratio,
-            },
-        };
         Self {
             target: d.target.into(),
             target_velocity: d.target_velocity.into(),
-            strength: strength.into(),
+            strength: d.strength.into(),
             max_torque: d.max_torque,
         }
     }

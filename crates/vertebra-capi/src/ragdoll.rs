@@ -7,8 +7,9 @@ use std::path::Path;
 use vertebra_collide::{CollisionGroups, Collisions};
 use vertebra_ragdoll::{
     BuildOptions, DriveSettings, MAX_FILE_BYTES, Pose, Ragdoll, RagdollDesc, RagdollError,
-    SpineMode, Strength,
+    SpineMode,
 };
+use vertebra_world::Spring;
 
 use crate::collide::{VtCollisions, with_layer};
 use crate::error::{Failure, VtResult};
@@ -114,15 +115,19 @@ pub struct VtDriveSettings {
     pub max_torque: f32,
 }
 
-impl TryFrom<VtStrength> for Strength {
-    type Error = Failure;
-    fn try_from(s: VtStrength) -> Result<Self, Failure> {
-        Ok(match pick(s.kind, "strength.kind", &[0, 1, 2])? {
-            0 => Strength::Infinite,
-            1 => Strength::Compliance(s.a),
-            _ => Strength::Spring {
-                frequency: s.a,
-                damping_ratio: s.b,
+impl VtStrength {
+    /// The strength as the world's spring: infinite is [`Spring::RIGID`], a
+    /// compliance takes the settings' `damping`.
+    pub(crate) fn spring(self, damping: f32) -> Result<Spring, Failure> {
+        Ok(match pick(self.kind, "strength.kind", &[0, 1, 2])? {
+            0 => Spring::RIGID,
+            1 => Spring::Compliance {
+                compliance: self.a,
+                damping,
+            },
+            _ => Spring::Frequency {
+                frequency: self.a,
+                damping_ratio: self.b,
             },
         })
     }
@@ -130,10 +135,18 @@ impl TryFrom<VtStrength> for Strength {
 
 impl TryFrom<VtDriveSettings> for DriveSettings {
     type Error = Failure;
+    /// Refuses a damping that is not finite or is negative whatever the
+    /// strength (as before a compliance carried its own damping).
     fn try_from(s: VtDriveSettings) -> Result<Self, Failure> {
-        Ok(DriveSettings::uniform(s.strength.try_into()?)
-            .with_damping(s.damping)
-            .with_max_torque(s.max_torque))
+        if !(s.damping.is_finite() && s.damping >= 0.0) {
+            return Err(RagdollError::OutOfRange {
+                context: "drive".to_owned(),
+                field: "damping",
+                reason: "must be finite and not negative".to_owned(),
+            }
+            .into());
+        }
+        Ok(DriveSettings::uniform(s.strength.spring(s.damping)?).with_max_torque(s.max_torque))
     }
 }
 

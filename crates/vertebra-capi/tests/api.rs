@@ -12,11 +12,11 @@ use vertebra_capi::*;
 use vertebra_collide::{Collider, ColliderShape, Collisions};
 use vertebra_ragdoll::{
     BuildOptions, DriveSettings, LocalPose, Pose, Ragdoll, RagdollDesc, Skeleton, SkeletonMapper,
-    SpineMapping, SpineMode, Strength, Transform,
+    SpineMapping, SpineMode, Transform,
 };
 use vertebra_world::{
     AngularDrive, BodyDesc, JointDesc, JointKind, JointSolver, LimitSoftness, RodDesc,
-    RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
+    RodStiffness, Shape, SolverConfig, Spring, Swing, SwingTwist, World,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -1763,10 +1763,10 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
                 d.kind = JointKind::Socket(SwingTwist {
                     swing: rust_swing,
                     twist: Some([-0.4, 0.7]),
-                    softness: LimitSoftness::Spring {
+                    softness: LimitSoftness::Soft(Spring::Frequency {
                         frequency: 4.0,
                         damping_ratio: 0.7,
-                    },
+                    }),
                 });
             }),
         ));
@@ -1785,7 +1785,7 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
             d.drive = Some(AngularDrive {
                 target: Quat::from_rotation_z(0.3),
                 target_velocity: Vec3::new(0.0, 0.0, 0.5),
-                strength: vertebra_world::DriveStrength::Compliance {
+                strength: Spring::Compliance {
                     compliance: 1e-3,
                     damping: 2.0,
                 },
@@ -1816,15 +1816,15 @@ fn joints_built_through_c_equal_joints_built_through_rust() {
             d.kind = JointKind::Socket(SwingTwist {
                 swing: Swing::Cone(0.2),
                 twist: None,
-                softness: LimitSoftness::Compliance {
+                softness: LimitSoftness::Soft(Spring::Compliance {
                     compliance: 1e-4,
                     damping: 0.5,
-                },
+                }),
             });
             d.drive = Some(AngularDrive {
                 target: Quat::from_rotation_z(0.3),
                 target_velocity: Vec3::new(0.0, 0.0, 0.5),
-                strength: vertebra_world::DriveStrength::Spring {
+                strength: Spring::Frequency {
                     frequency: 4.0,
                     damping_ratio: 0.7,
                 },
@@ -2050,11 +2050,10 @@ fn a_ragdoll_driven_and_hit_through_c_moves_as_through_rust() {
                 &settings,
             )
         });
-        let rust_settings = DriveSettings::uniform(Strength::Spring {
+        let rust_settings = DriveSettings::uniform(Spring::Frequency {
             frequency: 5.0,
             damping_ratio: 0.8,
         })
-        .with_damping(0.0)
         .with_max_torque(300.0);
         rust.ragdoll
             .drive_to(&mut rust.world, &target, &rust_settings)

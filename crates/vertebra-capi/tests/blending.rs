@@ -9,9 +9,9 @@ use glam::{Quat, Vec3};
 use vertebra_capi::*;
 use vertebra_ragdoll::{
     BlendBack, BuildOptions, DriveSettings, LocalPose, Pose, Ragdoll, RagdollDesc, Skeleton,
-    SpineMode, Strength,
+    SpineMode,
 };
-use vertebra_world::{SolverConfig, World};
+use vertebra_world::{SolverConfig, Spring, World};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -179,17 +179,17 @@ fn joints_driven_at_strengths_of_their_own_move_as_in_rust() {
             },
         },
     ];
-    let mut rust = DriveSettings::uniform(Strength::Spring {
+    let mut rust = DriveSettings::uniform(Spring::Frequency {
         frequency: 4.0,
         damping_ratio: 0.8,
     })
     .with_max_torque(200.0);
     rust.joints = vec![None; t.desc.joints.len()];
-    rust.joints[neck as usize] = Some(Strength::Spring {
+    rust.joints[neck as usize] = Some(Spring::Frequency {
         frequency: 12.0,
         damping_ratio: 0.8,
     });
-    rust.joints[elbow as usize] = Some(Strength::Infinite);
+    rust.joints[elbow as usize] = Some(Spring::RIGID);
     // SAFETY: live objects; readable arrays of the counts given.
     ok(unsafe {
         vt_ragdoll_drive_following_with(

@@ -5,10 +5,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use vertebra_ragdoll::{
-    RagdollDesc, RagdollError, RagdollGenerator, Skeleton, Strength, read_text,
-};
-use vertebra_world::{JointKind, LimitSoftness, Swing};
+use vertebra_ragdoll::{RagdollDesc, RagdollError, RagdollGenerator, Skeleton, read_text};
+use vertebra_world::{JointKind, LimitSoftness, Spring, Swing};
 
 /// What the file at `path` holds, as text; or every problem found, one a
 /// line, each naming the file and the line. `skeleton` is the skeleton
@@ -124,11 +122,18 @@ fn range(name: &str, [lo, hi]: [f32; 2]) -> String {
     format!("{name} {} .. {} deg", deg(lo), deg(hi))
 }
 
-fn strength(s: Strength) -> String {
+fn strength(s: Spring) -> String {
     match s {
-        Strength::Infinite => "infinite".to_owned(),
-        Strength::Compliance(c) => format!("compliance {c} rad/(N m)"),
-        Strength::Spring {
+        _ if s == Spring::RIGID => "infinite".to_owned(),
+        Spring::Compliance {
+            compliance,
+            damping: 0.0,
+        } => format!("compliance {compliance} rad/(N m)"),
+        Spring::Compliance {
+            compliance,
+            damping,
+        } => format!("compliance {compliance} rad/(N m), damping {damping} N m s/rad"),
+        Spring::Frequency {
             frequency,
             damping_ratio,
         } => format!(
@@ -142,16 +147,16 @@ fn strength(s: Strength) -> String {
 fn softness(s: LimitSoftness) -> Option<String> {
     match s {
         LimitSoftness::Hard => None,
-        LimitSoftness::Compliance {
+        LimitSoftness::Soft(Spring::Compliance {
             compliance,
             damping,
-        } => Some(format!(
+        }) => Some(format!(
             "soft: compliance {compliance} rad/(N m), damping {damping} N m s/rad"
         )),
-        LimitSoftness::Spring {
+        LimitSoftness::Soft(Spring::Frequency {
             frequency,
             damping_ratio,
-        } => Some(format!(
+        }) => Some(format!(
             "soft: {} Hz, damping ratio {}",
             number(frequency, 3),
             number(damping_ratio, 3)
@@ -266,9 +271,6 @@ fn ragdoll(path: &Path, desc: &RagdollDesc) -> String {
     match &desc.drive {
         Some(d) => {
             let mut parts = vec![strength(d.strength)];
-            if d.damping != 0.0 {
-                parts.push(format!("damping {} N m s/rad", d.damping));
-            }
             if d.max_torque.is_finite() {
                 parts.push(format!("max torque {} N m", number(d.max_torque, 3)));
             }

@@ -44,9 +44,9 @@
 //! use vertebra_collide::{Collider, ColliderShape, Collisions, QueryFilter};
 //! use vertebra_ragdoll::{
 //!     BuildOptions, DriveSettings, RagdollDesc, Skeleton, SkeletonMapper, SpineMapping,
-//!     SpineMode, Strength, Transform, Transition,
+//!     SpineMode, Transform, Transition,
 //! };
-//! use vertebra_world::{BodyDesc, Shape, SolverConfig, World};
+//! use vertebra_world::{BodyDesc, Shape, SolverConfig, Spring, World};
 //!
 //! # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
 //! // The world's default: every joint of a ragdoll solved at once (exact
@@ -89,7 +89,7 @@
 //! let transition =
 //!     Transition::new(&mapper, &ragdoll, &world, &current, place, SpineMapping::Arc, 0.3)?;
 //! // Muscles: powered toward the animation's pose, weak enough to yield.
-//! ragdoll.drive_to(&mut world, &now, &DriveSettings::uniform(Strength::Compliance(1e-2)))?;
+//! ragdoll.drive_to(&mut world, &now, &DriveSettings::uniform(Spring::compliant(1e-2)))?;
 //!
 //! let (mut thuds, mut torn) = (0, false);
 //! for frame in 1..=120 {

@@ -15,10 +15,9 @@ use glam::{Quat, Vec3};
 use vertebra_collide::{Collider, ColliderShape, Collisions};
 use vertebra_ragdoll::{
     ANATOMICAL_HUMANOID, BuildOptions, DriveSettings, Pose, REFERENCE_HUMANOID, Ragdoll,
-    RagdollDesc, Skeleton, SkeletonMapper, SpineMapping, SpineMode, Strength, Transform,
-    Transition,
+    RagdollDesc, Skeleton, SkeletonMapper, SpineMapping, SpineMode, Transform, Transition,
 };
-use vertebra_world::{BodyDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, SolverConfig, Spring, World};
 
 const DT: f32 = 1.0 / 60.0;
 
@@ -116,7 +115,7 @@ fn session(text: &str, spine: SpineMode) -> Session {
                 .unwrap();
         }
         if frame == 10 {
-            let settings = DriveSettings::uniform(Strength::Spring {
+            let settings = DriveSettings::uniform(Spring::Frequency {
                 frequency: 4.0,
                 damping_ratio: 1.0,
             });

@@ -7,9 +7,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use vertebra_world::{
-    AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, DriveStrength, JointDesc, JointHandle,
-    JointKind, LimitSoftness, RodDesc, RodHandle, RodStiffness, Shape, Snapshot, SolverConfig,
-    Swing, SwingTwist, World,
+    AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, JointDesc, JointHandle, JointKind,
+    LimitSoftness, RodDesc, RodHandle, RodStiffness, Shape, Snapshot, SolverConfig, Spring, Swing,
+    SwingTwist, World,
 };
 
 use crate::input::Input;
@@ -139,18 +139,22 @@ fn drive(input: &mut Input, d: &mut AngularDrive) {
         1 => vec3(input, &mut d.target_velocity),
         2 => d.max_torque = value(input),
         _ => {
-            d.strength = if input.flag() {
-                DriveStrength::Compliance {
-                    compliance: value(input),
-                    damping: value(input),
-                }
-            } else {
-                DriveStrength::Spring {
-                    frequency: value(input),
-                    damping_ratio: value(input),
-                }
-            }
+            d.strength = spring(input);
         }
+    }
+}
+
+/// A spring of either form from the special values.
+fn spring(input: &mut Input) -> Spring {
+    match input.flag() {
+        true => Spring::Compliance {
+            compliance: value(input),
+            damping: value(input),
+        },
+        false => Spring::Frequency {
+            frequency: value(input),
+            damping_ratio: value(input),
+        },
     }
 }
 
@@ -240,16 +244,7 @@ fn range(input: &mut Input) -> Option<[f32; 2]> {
 /// Any kind, its limits and softness from the special values.
 fn kind(input: &mut Input) -> JointKind {
     let softness = if input.flag() {
-        match input.flag() {
-            true => LimitSoftness::Compliance {
-                compliance: value(input),
-                damping: value(input),
-            },
-            false => LimitSoftness::Spring {
-                frequency: value(input),
-                damping_ratio: value(input),
-            },
-        }
+        LimitSoftness::Soft(spring(input))
     } else {
         LimitSoftness::Hard
     };

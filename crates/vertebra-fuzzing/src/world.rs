@@ -4,7 +4,7 @@ use glam::Vec3;
 use vertebra_world::{
     AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, Error, JointDesc, JointHandle,
     JointKind, JointSolver, LimitSoftness, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT,
-    RodDesc, RodHandle, RodStiffness, Shape, SolverConfig, Swing, SwingTwist, World,
+    RodDesc, RodHandle, RodStiffness, Shape, SolverConfig, Spring, Swing, SwingTwist, World,
 };
 
 use crate::input::Input;
@@ -117,14 +117,14 @@ fn swing(input: &mut Input) -> Swing {
 fn limit_softness(input: &mut Input) -> LimitSoftness {
     if input.flag() {
         match input.pick(2) {
-            0 => LimitSoftness::Compliance {
+            0 => LimitSoftness::Soft(Spring::Compliance {
                 compliance: input.float(1.0),
                 damping: input.float(100.0),
-            },
-            _ => LimitSoftness::Spring {
+            }),
+            _ => LimitSoftness::Soft(Spring::Frequency {
                 frequency: input.float(50.0),
                 damping_ratio: input.float(2.0),
-            },
+            }),
         }
     } else {
         LimitSoftness::Hard

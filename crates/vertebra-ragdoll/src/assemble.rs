@@ -7,9 +7,9 @@
 use std::collections::{HashMap, HashSet};
 
 use vertebra_store::check_coordinate;
+use vertebra_world::Spring;
 
-use crate::drive::{DriveSettings, Strength};
-use crate::drive_def::damping_for_compliance;
+use crate::drive::DriveSettings;
 use crate::error::{Problems, RagdollError, finite, first, range};
 use crate::joint_def::{JointDef, JointSpec, check_joint, half_turn, resolve};
 use crate::model::{BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef};
@@ -709,7 +709,7 @@ fn rod_limits(
 
 /// The joints' own strengths as the settings' per-joint list: each
 /// joint's, or none when no joint has its own.
-pub(crate) fn own_strengths(joints: &[JointDef]) -> Vec<Option<Strength>> {
+pub(crate) fn own_strengths(joints: &[JointDef]) -> Vec<Option<Spring>> {
     if joints.iter().any(|j| j.drive.is_some()) {
         joints.iter().map(|j| j.drive).collect()
     } else {
@@ -737,26 +737,11 @@ pub(crate) fn check_drive(
             None => Ok(()),
         };
     };
-    damping_for_compliance(context, settings.strength, settings.damping != 0.0)?;
-    settings
-        .validate(joints.len())
-        .map_err(|e| in_context(context, e))?;
+    settings.validate(context, joints.len(), joint)?;
     range(
         context,
         "joints",
         settings.joints == own_strengths(joints),
         "must be each joint's own strength (`JointDef::drive`), or empty when no joint has one",
     )
-}
-
-/// `e`, said of the `[drive]` table at its line.
-fn in_context(context: &str, e: RagdollError) -> RagdollError {
-    match e {
-        RagdollError::OutOfRange { field, reason, .. } => RagdollError::OutOfRange {
-            context: context.to_owned(),
-            field,
-            reason,
-        },
-        other => other,
-    }
 }

@@ -191,13 +191,15 @@ impl RagdollDesc {
                 }
             })
             .collect();
+        // A joint's own compliance without a damping takes the table's.
+        let damping = raw.drive.as_ref().map_or(0.0, |d| d.get_ref().damping());
         let joints = raw
             .joint
             .iter()
             .map(|j| {
                 let (line, r) = (at(j.span()), j.get_ref());
                 let context = item(Some(line), &format!("joint `{}`", r.name));
-                match problems.note(Some(line), joint_spec(r, &context)) {
+                match problems.note(Some(line), joint_spec(r, &context, damping)) {
                     Some(value) => Item::at(value, line),
                     None => Item::refused(r.stand_in(), line),
                 }

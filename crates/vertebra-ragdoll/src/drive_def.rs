@@ -3,12 +3,14 @@
 //! `drive = { ... }` strength; see `docs/ragdolls.md`.
 
 use serde::Deserialize;
+use vertebra_world::Spring;
 
-use crate::drive::{DriveSettings, Strength};
+use crate::drive::DriveSettings;
 use crate::error::{RagdollError, finite, range};
 
 /// A strength as written: `strength = "infinite"`, `frequency` (Hz) with
-/// `damping_ratio`, or `compliance` (rad / (N m)).
+/// `damping_ratio`, or `compliance` (rad / (N m)) with an optional
+/// `damping` (N m s / rad).
 #[derive(Clone, Copy, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawStrength {
@@ -16,6 +18,7 @@ pub(crate) struct RawStrength {
     frequency: Option<f32>,
     damping_ratio: Option<f32>,
     compliance: Option<f32>,
+    damping: Option<f32>,
 }
 
 /// The one word `strength` takes.
@@ -25,8 +28,9 @@ enum RawInfinite {
     Infinite,
 }
 
-/// The `[drive]` table: a strength, and the damping (N m s / rad, for a
-/// compliance) and torque limit (N m) every joint shares.
+/// The `[drive]` table: a strength, and the torque limit (N m) every joint
+/// shares. Its damping is also that of a joint's own compliance that gives
+/// none.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawDrive {
@@ -39,9 +43,15 @@ pub(crate) struct RawDrive {
 }
 
 impl RawStrength {
-    /// The strength, or why the fields do not make one.
-    pub(crate) fn read(&self, context: &str) -> Result<Strength, RagdollError> {
-        let numbers = [self.frequency, self.damping_ratio, self.compliance];
+    /// The strength, or why the fields do not make one; a compliance
+    /// without its own damping takes `damping`.
+    pub(crate) fn read(&self, context: &str, damping: f32) -> Result<Spring, RagdollError> {
+        let numbers = [
+            self.frequency,
+            self.damping_ratio,
+            self.compliance,
+            self.damping,
+        ];
         finite(
             context,
             "drive",
@@ -55,26 +65,46 @@ impl RawStrength {
                 "takes one of: strength = \"infinite\", frequency with damping_ratio, or compliance",
             )
         };
-        match (
+        let strength = match (
             self.strength,
             self.frequency,
             self.damping_ratio,
             self.compliance,
         ) {
-            (Some(RawInfinite::Infinite), None, None, None) => Ok(Strength::Infinite),
-            (None, Some(frequency), Some(damping_ratio), None) => Ok(Strength::Spring {
+            (Some(RawInfinite::Infinite), None, None, None) => Spring::RIGID,
+            (None, Some(frequency), Some(damping_ratio), None) => Spring::Frequency {
                 frequency,
                 damping_ratio,
-            }),
-            (None, None, None, Some(c)) => Ok(Strength::Compliance(c)),
-            _ => one_of(false).map(|()| Strength::Infinite),
-        }
+            },
+            (None, None, None, Some(compliance)) => {
+                return Ok(Spring::Compliance {
+                    compliance,
+                    damping: self.damping.unwrap_or(damping),
+                });
+            }
+            _ => return one_of(false).map(|()| Spring::RIGID),
+        };
+        range(
+            context,
+            "damping",
+            self.damping.is_none(),
+            "is for a compliance strength only (a spring's damping is its ratio)",
+        )?;
+        Ok(strength)
+    }
+}
+
+impl RawDrive {
+    /// The damping a joint's own compliance takes when it gives none: the
+    /// table's (N m s / rad), or none.
+    pub(crate) fn damping(&self) -> f32 {
+        self.damping.unwrap_or(0.0)
     }
 }
 
 /// The `[drive]` table as drive settings without per-joint strengths (the
-/// assembly adds the joints' own): one strength, a damping only for a
-/// compliance, a torque limit. Its values are checked with the whole
+/// assembly adds the joints' own): one strength (a damping only for a
+/// compliance) and a torque limit. Its values are checked with the whole
 /// description (`check_drive`).
 pub(crate) fn drive_settings(raw: &RawDrive, context: &str) -> Result<DriveSettings, RagdollError> {
     let strength = RawStrength {
@@ -82,29 +112,12 @@ pub(crate) fn drive_settings(raw: &RawDrive, context: &str) -> Result<DriveSetti
         frequency: raw.frequency,
         damping_ratio: raw.damping_ratio,
         compliance: raw.compliance,
+        damping: raw.damping,
     }
-    .read(context)?;
+    .read(context, 0.0)?;
     let mut settings = DriveSettings::uniform(strength);
-    if let Some(d) = raw.damping {
-        damping_for_compliance(context, strength, true)?;
-        settings = settings.with_damping(d);
-    }
     if let Some(t) = raw.max_torque {
         settings = settings.with_max_torque(t);
     }
     Ok(settings)
-}
-
-/// A damping (`given`) is for a compliance strength only.
-pub(crate) fn damping_for_compliance(
-    context: &str,
-    strength: Strength,
-    given: bool,
-) -> Result<(), RagdollError> {
-    range(
-        context,
-        "damping",
-        !given || matches!(strength, Strength::Compliance(_)),
-        "is for a compliance strength only (a spring's damping is its ratio)",
-    )
 }

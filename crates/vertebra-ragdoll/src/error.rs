@@ -281,3 +281,21 @@ pub(crate) fn range(
         })
     }
 }
+
+/// `Ok` when the world takes `spring` as `of` ([`Spring::check`]), else
+/// the error naming `context` and `field`, with the world's reason (which
+/// names the number and its range).
+///
+/// [`Spring::check`]: vertebra_world::Spring::check
+pub(crate) fn check_spring(
+    context: &str,
+    field: &'static str,
+    spring: vertebra_world::Spring,
+    of: vertebra_world::SpringField,
+) -> Result<(), RagdollError> {
+    spring.check(of).map_err(|e| RagdollError::OutOfRange {
+        context: context.to_owned(),
+        field,
+        reason: format!("is refused: {e}"),
+    })
+}

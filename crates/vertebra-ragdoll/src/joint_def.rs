@@ -10,13 +10,11 @@ use glam::{DVec3, Mat3, Quat, Vec3};
 use serde::Deserialize;
 use vertebra_store::{check_coordinate, check_unit_quat};
 use vertebra_world::{
-    JointBreaking, JointKind, LimitSoftness, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
-    MIN_DRIVE_FREQUENCY, Swing, SwingTwist,
+    JointBreaking, JointKind, LimitSoftness, Spring, SpringField, Swing, SwingTwist,
 };
 
-use crate::drive::Strength;
 use crate::drive_def::RawStrength;
-use crate::error::{RagdollError, finite, range};
+use crate::error::{RagdollError, check_spring, finite, range};
 
 /// A joint between a parent and a child body.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,7 +37,7 @@ pub struct JointDef {
     pub kind: JointKind,
     /// The joint's own drive strength (the file's `drive = { ... }`), over
     /// the ragdoll's `[drive]` one; `None` takes the ragdoll's.
-    pub drive: Option<Strength>,
+    pub drive: Option<Spring>,
     /// When it breaks (the file's `break_force`, N, and `break_torque`,
     /// N m; either alone leaves the other infinite): see
     /// `vertebra_world::JointBreaking`. `None`: never.
@@ -128,7 +126,7 @@ pub struct JointSpec {
     /// The kind and its limits (rad), as the world takes them.
     pub kind: JointKind,
     /// The joint's own drive strength, over the ragdoll's `[drive]` one.
-    pub drive: Option<Strength>,
+    pub drive: Option<Spring>,
     /// When it breaks; `None`: never.
     pub breaking: Option<JointBreaking>,
 }
@@ -229,7 +227,7 @@ impl JointSpec {
     }
 
     /// With its own drive strength.
-    pub fn with_drive(mut self, strength: Strength) -> Self {
+    pub fn with_drive(mut self, strength: Spring) -> Self {
         self.drive = Some(strength);
         self
     }
@@ -277,9 +275,14 @@ impl RawJoint {
 
 /// Reads one `[[joint]]` table (`context` names its line and the joint):
 /// its kind and the fields that kind takes, its softness and drive as one
-/// of their forms, its angles in radians. The values are checked when the
-/// joint is resolved.
-pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, RagdollError> {
+/// of their forms (a drive's compliance without its own damping taking
+/// `damping`, the `[drive]` table's), its angles in radians. The values
+/// are checked when the joint is resolved.
+pub(crate) fn joint_spec(
+    j: &RawJoint,
+    context: &str,
+    damping: f32,
+) -> Result<JointSpec, RagdollError> {
     let named = j.kind.as_deref().unwrap_or("socket");
     let kind = joint_kind(
         context,
@@ -289,7 +292,7 @@ pub(crate) fn joint_spec(j: &RawJoint, context: &str) -> Result<JointSpec, Ragdo
         [j.twist, j.range],
         j.softness.as_ref(),
     )?;
-    let drive = j.drive.map(|d| d.read(context)).transpose()?;
+    let drive = j.drive.map(|d| d.read(context, damping)).transpose()?;
     let breaking = (j.break_force.is_some() || j.break_torque.is_some()).then(|| JointBreaking {
         force: j.break_force.unwrap_or(f32::INFINITY),
         torque: j.break_torque.unwrap_or(f32::INFINITY),
@@ -643,14 +646,18 @@ fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, R
         Some(RawSoftness::Compliance(c)) => LimitSoftness::compliant(*c),
         Some(RawSoftness::Table(t)) => {
             match (t.compliance, t.damping, t.frequency, t.damping_ratio) {
-                (Some(compliance), damping, None, None) => LimitSoftness::Compliance {
-                    compliance,
-                    damping: damping.unwrap_or(0.0),
-                },
-                (None, None, Some(frequency), Some(damping_ratio)) => LimitSoftness::Spring {
-                    frequency,
-                    damping_ratio,
-                },
+                (Some(compliance), damping, None, None) => {
+                    LimitSoftness::Soft(Spring::Compliance {
+                        compliance,
+                        damping: damping.unwrap_or(0.0),
+                    })
+                }
+                (None, None, Some(frequency), Some(damping_ratio)) => {
+                    LimitSoftness::Soft(Spring::Frequency {
+                        frequency,
+                        damping_ratio,
+                    })
+                }
                 _ => {
                     return Err(RagdollError::OutOfRange {
                     context: context.to_owned(),
@@ -664,37 +671,20 @@ fn softness(context: &str, raw: Option<&RawSoftness>) -> Result<LimitSoftness, R
     })
 }
 
-/// A limit softness checked as the world will check it, by name.
+/// A limit softness as a description holds it: finite numbers, in the
+/// world's ranges (its check, whose reason names the number).
 fn check_softness(context: &str, soft: LimitSoftness) -> Result<(), RagdollError> {
-    let numbers = match soft {
-        LimitSoftness::Hard => vec![],
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => vec![compliance, damping],
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => vec![frequency, damping_ratio],
+    let LimitSoftness::Soft(spring) = soft else {
+        return Ok(());
     };
-    finite(context, "softness", &numbers)?;
-    let (ok, reason) = match soft {
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => (
-            compliance >= 0.0 && damping >= 0.0 && compliance * damping <= MAX_DRIVE_DAMPING_TIME,
-            "must be a compliance (rad / (N m)) and damping (N m s / rad) of 0 or more, compliance times damping at most 1e6 s",
-        ),
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => (
-            frequency >= MIN_DRIVE_FREQUENCY
-                && (0.0..=MAX_DRIVE_DAMPING_RATIO).contains(&damping_ratio),
-            "must be a frequency of at least 1e-3 Hz and a damping ratio in [0, 1e3]",
-        ),
-        LimitSoftness::Hard => (true, ""),
-    };
-    range(context, "softness", ok, reason)
+    let (Spring::Compliance {
+        compliance: x,
+        damping: y,
+    }
+    | Spring::Frequency {
+        frequency: x,
+        damping_ratio: y,
+    }) = spring;
+    finite(context, "softness", &[x, y])?;
+    check_spring(context, "softness", spring, SpringField::Limit)
 }

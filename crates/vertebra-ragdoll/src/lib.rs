@@ -20,9 +20,9 @@
 //!
 //! ```
 //! use vertebra_ragdoll::{
-//!     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMapping, SpineMode, Strength,
+//!     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMapping, SpineMode,
 //! };
-//! use vertebra_world::{SolverConfig, World};
+//! use vertebra_world::{SolverConfig, Spring, World};
 //!
 //! # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
 //! let desc = RagdollDesc::reference_humanoid(); // or RagdollDesc::from_toml(&file_text)?
@@ -35,7 +35,7 @@
 //! let ragdoll = Ragdoll::build(&mut world, &desc, BuildOptions::new(SpineMode::Rod), &current, Some((&previous, 1.0 / 60.0)))?;
 //!
 //! // Optionally powered: follow the animation with stiff joints.
-//! ragdoll.drive_to(&mut world, &current, &DriveSettings::uniform(Strength::Compliance(1e-3)))?;
+//! ragdoll.drive_to(&mut world, &current, &DriveSettings::uniform(Spring::compliant(1e-3)))?;
 //!
 //! for _ in 0..60 {
 //!     world.step(1.0 / 60.0)?;
@@ -54,9 +54,9 @@
 //! use glam::{Quat, Vec3};
 //! use vertebra_ragdoll::{
 //!     BlendBack, BuildOptions, DriveSettings, LocalPose, Ragdoll, RagdollDesc, Skeleton,
-//!     SkeletonMapper, SpineMapping, SpineMode, Strength, Transform, Transition,
+//!     SkeletonMapper, SpineMapping, SpineMode, Transform, Transition,
 //! };
-//! use vertebra_world::{SolverConfig, World};
+//! use vertebra_world::{SolverConfig, Spring, World};
 //!
 //! # fn main() -> Result<(), vertebra_ragdoll::RagdollError> {
 //! let skeleton = Skeleton::reference(); // the engine's skeleton: 63 bones
@@ -89,7 +89,7 @@
 //! for leg in ["thigh_l", "shin_l", "thigh_r", "shin_r"] {
 //!     ragdoll.set_body_kinematic(&mut world, leg, true)?;
 //! }
-//! let drive = DriveSettings::uniform(Strength::Compliance(1e-3));
+//! let drive = DriveSettings::uniform(Spring::compliant(1e-3));
 //! let mut bones = None;
 //! for frame in 1..=30 {
 //!     ragdoll.drive_following(&mut world, &now, &now, dt, &drive)?;
@@ -152,7 +152,7 @@ mod write;
 pub use blend_back::{Blend, BlendBack};
 pub use builder::RagdollBuilder;
 pub use description::{ANATOMICAL_HUMANOID, REFERENCE_HUMANOID};
-pub use drive::{DriveSettings, Strength};
+pub use drive::DriveSettings;
 pub use error::RagdollError;
 pub use generate::{BodyMass, BoneBody, MIN_SEGMENT, RagdollGenerator, RodSpine, SegmentEnd};
 pub use joint_def::{JointDef, JointFrame, JointSpec};

@@ -10,9 +10,9 @@
 
 use glam::Vec3;
 use vertebra_math::{DefaultFloatMode, PortableQuat};
-use vertebra_world::{JointKind, RodDesc, RodStiffness, World};
+use vertebra_world::{JointKind, RodDesc, RodStiffness, Spring, World};
 
-use crate::drive::{DriveSettings, Strength};
+use crate::drive::DriveSettings;
 use crate::error::RagdollError;
 use crate::model::rod_name;
 use crate::pose::Pose;
@@ -24,24 +24,25 @@ use crate::ragdoll::Ragdoll;
 /// each turns by the same `C_i` with `tau = C_i / c + D C_i'`, and the
 /// chain by `C = n C_i`: `tau = C / (n c) + (D / n) C'`. The rod's torque is
 /// `(k / l0) C + (d / l0) C'`, so `k = l0 / (n c)` and `d = l0 D / n` (its
-/// damping time `d / k = c D`, the socket's). A spring strength is the
-/// rod's own spring at that frequency and ratio (on its effective
-/// inertia); infinite strength is a rigid rod. `docs/ragdolls.md`,
-/// "Drives", measures the two spines against each other.
-fn rod_stiffness(
-    strength: Strength,
-    damping: f32,
-    rest_length: f32,
-    joints: usize,
-) -> RodStiffness {
+/// damping time `d / k = c D`, the socket's). A spring given by frequency
+/// is the rod's own spring at that frequency and ratio (on its effective
+/// inertia); zero compliance ([`Spring::RIGID`]) is a rigid rod.
+/// `docs/ragdolls.md`, "Drives", measures the two spines against each
+/// other.
+fn rod_stiffness(strength: Spring, rest_length: f32, joints: usize) -> RodStiffness {
     let n = joints.max(1) as f32;
     match strength {
-        Strength::Infinite => RodStiffness::Kirchhoff(f32::INFINITY),
-        Strength::Compliance(c) => RodStiffness::Damped {
+        Spring::Compliance {
+            compliance: 0.0, ..
+        } => RodStiffness::Kirchhoff(f32::INFINITY),
+        Spring::Compliance {
+            compliance: c,
+            damping,
+        } => RodStiffness::Damped {
             stiffness: rest_length / (n * c),
             damping: rest_length * damping / n,
         },
-        Strength::Spring {
+        Spring::Frequency {
             frequency,
             damping_ratio,
         } => RodStiffness::Spring {
@@ -110,7 +111,10 @@ impl Ragdoll {
     ) -> Result<(), RagdollError> {
         self.check_not_removed()?;
         target.validate(&self.desc)?;
-        settings.validate(self.desc.joints.len())?;
+        let joints = &self.desc.joints;
+        settings.validate("drive", joints.len(), |k| {
+            format!("joint `{}`", joints[k].name)
+        })?;
         let relative = |pose: &Pose, j: &crate::JointDef| {
             let frame = j.frame;
             (pose.bones[j.parent].1.mul_portable(frame).inverse())
@@ -154,7 +158,6 @@ impl Ragdoll {
             };
             let stiffness = rod_stiffness(
                 settings.strength(spine.joints[0]),
-                settings.damping,
                 rest.rest_length,
                 spine.joints.len(),
             );

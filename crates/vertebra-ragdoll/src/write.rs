@@ -5,9 +5,9 @@
 //! (and normal) that rebuilds it exactly, or else as the quaternion itself.
 
 use glam::{Quat, Vec3};
-use vertebra_world::{JointKind, LimitSoftness, Swing};
+use vertebra_world::{JointKind, LimitSoftness, Spring, Swing};
 
-use crate::drive::{DriveSettings, Strength};
+use crate::drive::DriveSettings;
 use crate::joint_def::{JointDef, frame, kind_name};
 use crate::model::{BodyDef, RagdollDesc};
 use crate::skeleton::{Skeleton, Transform};
@@ -40,8 +40,14 @@ impl RagdollDesc {
                 .get(i)
                 .map_or(format!("body {i}"), |b| b.name.clone())
         };
+        // A joint's own compliance without a damping of its own reads
+        // back with the `[drive]` table's.
+        let damping = match self.drive.as_ref().map(|d| d.strength) {
+            Some(Spring::Compliance { damping, .. }) => damping,
+            _ => 0.0,
+        };
         for j in &self.joints {
-            write_joint(&mut out, j, &body(j.parent), &body(j.child));
+            write_joint(&mut out, j, [&body(j.parent), &body(j.child)], damping);
         }
         if let Some(s) = &self.spine {
             let names: Vec<String> = s.bodies.iter().map(|&i| string(&body(i))).collect();
@@ -110,7 +116,9 @@ fn same_transform(a: Transform, b: Transform) -> bool {
         && same_bits(&a.rotation.to_array(), &b.rotation.to_array())
 }
 
-fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
+/// A `[[joint]]` table between `parent` and `child`; its drive's damping
+/// is written unless it is `damping` (the `[drive]` table's).
+fn write_joint(out: &mut String, j: &JointDef, [parent, child]: [&str; 2], damping: f32) {
     out.push_str("[[joint]]\n");
     out.push_str(&format!("name = {}\n", string(&j.name)));
     out.push_str(&format!("parent = {}\n", string(parent)));
@@ -160,31 +168,22 @@ fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
     };
     match softness {
         LimitSoftness::Hard => {}
-        LimitSoftness::Compliance {
+        LimitSoftness::Soft(Spring::Compliance {
             compliance,
             damping,
-        } if same_bits(&[damping], &[0.0]) => {
+        }) if same_bits(&[damping], &[0.0]) => {
             out.push_str(&format!("softness = {}\n", float(compliance)));
         }
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => out.push_str(&format!(
-            "softness = {{ compliance = {}, damping = {} }}\n",
-            float(compliance),
-            float(damping)
-        )),
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => out.push_str(&format!(
-            "softness = {{ frequency = {}, damping_ratio = {} }}\n",
-            float(frequency),
-            float(damping_ratio)
+        LimitSoftness::Soft(spring) => out.push_str(&format!(
+            "softness = {{ {} }}\n",
+            spring_fields(spring, 0.0).join(", ")
         )),
     }
     if let Some(s) = j.drive {
-        out.push_str(&format!("drive = {{ {} }}\n", strength(s).join(", ")));
+        out.push_str(&format!(
+            "drive = {{ {} }}\n",
+            strength(s, damping).join(", ")
+        ));
     }
     if let Some(b) = j.breaking {
         // An infinite threshold is the one not written.
@@ -197,12 +196,36 @@ fn write_joint(out: &mut String, j: &JointDef, parent: &str, child: &str) {
     out.push('\n');
 }
 
-/// A strength's fields as `key = value` pairs.
-fn strength(s: Strength) -> Vec<String> {
+/// A drive strength's fields as `key = value` pairs: `strength =
+/// "infinite"` for [`Spring::RIGID`], else the spring's (its damping only
+/// when it is not `damping`, the one it reads back with).
+fn strength(s: Spring, damping: f32) -> Vec<String> {
     match s {
-        Strength::Infinite => vec!["strength = \"infinite\"".to_owned()],
-        Strength::Compliance(c) => vec![format!("compliance = {}", float(c))],
-        Strength::Spring {
+        Spring::Compliance {
+            compliance,
+            damping: own,
+        } if same_bits(&[compliance, own], &[0.0, 0.0]) => {
+            vec!["strength = \"infinite\"".to_owned()]
+        }
+        _ => spring_fields(s, damping),
+    }
+}
+
+/// A spring's fields as `key = value` pairs, its damping only when it
+/// is not `damping` (the one it takes without).
+fn spring_fields(s: Spring, damping: f32) -> Vec<String> {
+    match s {
+        Spring::Compliance {
+            compliance,
+            damping: own,
+        } => {
+            let mut fields = vec![format!("compliance = {}", float(compliance))];
+            if !same_bits(&[own], &[damping]) {
+                fields.push(format!("damping = {}", float(own)));
+            }
+            fields
+        }
+        Spring::Frequency {
             frequency,
             damping_ratio,
         } => vec![
@@ -214,12 +237,9 @@ fn strength(s: Strength) -> Vec<String> {
 
 fn write_drive(out: &mut String, d: &DriveSettings) {
     out.push_str("[drive]\n");
-    for field in strength(d.strength) {
+    for field in strength(d.strength, 0.0) {
         out.push_str(&field);
         out.push('\n');
-    }
-    if d.damping != 0.0 {
-        out.push_str(&format!("damping = {}\n", float(d.damping)));
     }
     if d.max_torque != f32::INFINITY {
         out.push_str(&format!("max_torque = {}\n", float(d.max_torque)));

@@ -5,10 +5,11 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_ragdoll::{
-    BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMapping, SpineMode, Strength,
-    body_masses,
+    BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMapping, SpineMode, body_masses,
 };
-use vertebra_world::{BodyDesc, JointDesc, JointKind, SolverConfig, Swing, SwingTwist, World};
+use vertebra_world::{
+    BodyDesc, JointDesc, JointKind, SolverConfig, Spring, Swing, SwingTwist, World,
+};
 
 fn world() -> World {
     World::new(SolverConfig::default()).unwrap()
@@ -300,8 +301,7 @@ fn a_driven_ragdoll_with_fixed_hips_returns_to_its_pose_after_a_push() {
         .unwrap();
         w.add_joint(pin.with_drive(vertebra_world::AngularDrive::rigid(Quat::IDENTITY)))
             .unwrap();
-        let mut settings = DriveSettings::uniform(Strength::Infinite);
-        settings.damping = 10.0;
+        let settings = DriveSettings::uniform(Spring::RIGID);
         ragdoll.drive_to(&mut w, &target, &settings).unwrap();
         let chest = ragdoll.bodies[desc.body_index("chest").unwrap()].unwrap();
         let deviation = |w: &World| -> f32 {

@@ -10,9 +10,9 @@ use glam::{Quat, Vec3};
 use vertebra_ragdoll::{
     ANATOMICAL_HUMANOID, BodySpec, BoneBinding, BuildOptions, DriveSettings, JointFrame, JointSpec,
     Pose, REFERENCE_HUMANOID, REFERENCE_SKELETON, Ragdoll, RagdollDesc, RagdollError, Skeleton,
-    SpineMode, SpineSpec, Strength, Transform,
+    SpineMode, SpineSpec, Transform,
 };
-use vertebra_world::{JointKind, LimitSoftness, SolverConfig, Swing, SwingTwist, World};
+use vertebra_world::{JointKind, LimitSoftness, SolverConfig, Spring, Swing, SwingTwist, World};
 
 fn model(skeleton: &Skeleton) -> Vec<Transform> {
     skeleton.bind_pose().to_model(skeleton).unwrap().bones
@@ -400,10 +400,10 @@ fn assorted() -> RagdollDesc {
     let ellipse = SwingTwist {
         swing: Swing::Ellipse { y: 1.1, z: 0.4 },
         twist: None,
-        softness: LimitSoftness::Compliance {
+        softness: LimitSoftness::Soft(Spring::Compliance {
             compliance: 2e-3,
             damping: 5.0,
-        },
+        }),
     };
     let pyramid = SwingTwist {
         swing: Swing::Pyramid {
@@ -411,10 +411,10 @@ fn assorted() -> RagdollDesc {
             z: [-0.1, 0.9],
         },
         twist: Some([-1.0, 1.0]),
-        softness: LimitSoftness::Spring {
+        softness: LimitSoftness::Soft(Spring::Frequency {
             frequency: 8.0,
             damping_ratio: 0.7,
-        },
+        }),
     };
     let skeleton = Skeleton::from_toml(
         "[[bone]]\nname = \"base\"\ntranslation = [0.0, 1.0, 0.0]\n\n\
@@ -444,7 +444,7 @@ fn assorted() -> RagdollDesc {
         ))
         .joint(
             JointSpec::socket("ab", "a", "b", y(0.25), Vec3::new(0.1, 1.0, 0.0), cone)
-                .with_drive(Strength::Infinite),
+                .with_drive(Spring::RIGID),
         )
         .joint(
             JointSpec::socket("bc", "b", "c", y(0.55), Vec3::Y, ellipse)
@@ -453,7 +453,7 @@ fn assorted() -> RagdollDesc {
         .joint(
             JointSpec::socket("cd", "c", "d", y(0.9), Vec3::Y, pyramid)
                 .with_normal(Vec3::Z)
-                .with_drive(Strength::Compliance(0.01)),
+                .with_drive(Spring::compliant(0.01)),
         )
         .joint(JointSpec {
             frame: JointFrame::Rotation(
@@ -467,7 +467,7 @@ fn assorted() -> RagdollDesc {
                 Vec3::X,
                 Some([-0.2, 2.0]),
             )
-            .with_drive(Strength::Spring {
+            .with_drive(Spring::Frequency {
                 frequency: 3.0,
                 damping_ratio: 1.0,
             })
@@ -481,9 +481,11 @@ fn assorted() -> RagdollDesc {
             twist_stiffness: 0.0,
         })
         .drive(
-            DriveSettings::uniform(Strength::Compliance(0.02))
-                .with_damping(3.0)
-                .with_max_torque(50.0),
+            DriveSettings::uniform(Spring::Compliance {
+                compliance: 0.02,
+                damping: 3.0,
+            })
+            .with_max_torque(50.0),
         )
         .build()
         .unwrap()
@@ -587,7 +589,7 @@ fn a_builder_refuses_what_the_file_refuses_naming_the_item() {
                 .joint(socket(Swing::Free))
                 .drive(DriveSettings {
                     joints: vec![None],
-                    ..DriveSettings::uniform(Strength::Infinite)
+                    ..DriveSettings::uniform(Spring::RIGID)
                 })
                 .build(),
             "[drive]: joints must be empty",
@@ -665,7 +667,7 @@ fn validate_refuses_a_hand_edited_description_naming_the_item() {
             "body `spine_lower`: bone `spine_lower` is body `hips`'s bone too",
         ),
         (
-            |d| d.joints[0].drive = Some(Strength::Infinite),
+            |d| d.joints[0].drive = Some(Spring::RIGID),
             "joint `spine_1`: drive needs a [drive] table",
         ),
     ];
@@ -682,7 +684,7 @@ fn validate_refuses_a_hand_edited_description_naming_the_item() {
             == "body `hips`: bone is bone 1, but the ragdoll has no skeleton"
     );
     let mut d = RagdollDesc::anatomical_humanoid();
-    d.drive.as_mut().unwrap().joints = vec![Some(Strength::Infinite); d.joints.len()];
+    d.drive.as_mut().unwrap().joints = vec![Some(Spring::RIGID); d.joints.len()];
     let e = d.validate().unwrap_err().to_string();
     assert!(
         e.contains("[drive]: joints must be each joint's own strength"),

@@ -4,9 +4,9 @@
 
 use glam::{Quat, Vec3};
 use vertebra_ragdoll::{
-    BuildOptions, DriveSettings, JointDef, Pose, Ragdoll, RagdollDesc, SpineMode, Strength,
+    BuildOptions, DriveSettings, JointDef, Pose, Ragdoll, RagdollDesc, SpineMode,
 };
-use vertebra_world::{BodyDesc, JointDesc, SolverConfig, World};
+use vertebra_world::{BodyDesc, JointDesc, SolverConfig, Spring, World};
 
 const DT: f32 = 1.0 / 60.0;
 /// The animations' rate: the elbow's bend, the spine's total bend (rad/s).
@@ -136,7 +136,7 @@ fn a_drive_following_the_animation_does_not_lag() {
     // the target's own motion, it settles on it (e = 0). Measured: 0.0810
     // rad against 0.0796, and -0.001.
     let (frequency, zeta) = (4.0, 1.0);
-    let settings = DriveSettings::uniform(Strength::Spring {
+    let settings = DriveSettings::uniform(Spring::Frequency {
         frequency,
         damping_ratio: zeta,
     });
@@ -169,7 +169,10 @@ fn a_rod_spine_following_the_animation_does_not_lag() {
     // hips, and at 4 Hz rings near 0.7 Hz for seconds. Measured: 0.0599
     // rad against 0.0600, and 1.1e-5.
     let (compliance, damping) = (0.001, 120.0);
-    let settings = DriveSettings::uniform(Strength::Compliance(compliance)).with_damping(damping);
+    let settings = DriveSettings::uniform(Spring::Compliance {
+        compliance,
+        damping,
+    });
     let expected = compliance * damping * SPINE_SPEED;
     let (chasing, following) = (spine_lag(false, &settings), spine_lag(true, &settings));
     eprintln!(
@@ -198,7 +201,7 @@ fn a_step_that_is_no_time_is_refused() {
         None,
     )
     .unwrap();
-    let settings = DriveSettings::uniform(Strength::Infinite);
+    let settings = DriveSettings::uniform(Spring::RIGID);
     for dt in [0.0, -1.0, f32::NAN, f32::INFINITY] {
         let before = world.state_hash();
         let e = ragdoll
@@ -206,5 +209,59 @@ fn a_step_that_is_no_time_is_refused() {
             .unwrap_err();
         assert!(e.to_string().contains("dt"), "{e}");
         assert_eq!(world.state_hash(), before);
+    }
+}
+
+/// A strength the world refuses is refused by `drive_to` and
+/// `drive_following` before anything is set, naming the settings' field or
+/// the joint whose override it is, with the world's reason (which names
+/// the number).
+#[test]
+fn bad_strengths_are_refused_naming_the_joint_and_change_nothing() {
+    let desc = RagdollDesc::anatomical_humanoid();
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let bind = Pose::bind(&desc);
+    let ragdoll = Ragdoll::build(
+        &mut world,
+        &desc,
+        BuildOptions::new(SpineMode::Rod),
+        &bind,
+        None,
+    )
+    .unwrap();
+    let bad = Spring::Frequency {
+        frequency: 0.0,
+        damping_ratio: 1.0,
+    };
+    let knee = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
+    let mut overridden = DriveSettings::uniform(Spring::RIGID);
+    overridden.joints = vec![None; desc.joints.len()];
+    overridden.joints[knee] = Some(Spring::Compliance {
+        compliance: 0.01,
+        damping: f32::NAN,
+    });
+    let cases = [
+        (
+            DriveSettings::uniform(bad),
+            "drive: strength is refused: drive frequency (at least 1e-3 Hz) is out of range",
+        ),
+        (
+            overridden,
+            "joint `knee_l`: drive is refused: drive damping is not finite",
+        ),
+    ];
+    for (settings, expected) in cases {
+        let before = world.state_hash();
+        let e = ragdoll.drive_to(&mut world, &bind, &settings).unwrap_err();
+        assert_eq!(e.to_string(), expected);
+        let e = ragdoll
+            .drive_following(&mut world, &bind, &bind, 1.0 / 60.0, &settings)
+            .unwrap_err();
+        assert_eq!(e.to_string(), expected);
+        assert_eq!(
+            world.state_hash(),
+            before,
+            "a refused drive changed the world"
+        );
     }
 }

@@ -6,11 +6,9 @@
 use core::f32::consts::PI;
 
 use glam::{Quat, Vec3};
-use vertebra_ragdoll::{
-    ANATOMICAL_HUMANOID, BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode, Strength,
-};
+use vertebra_ragdoll::{ANATOMICAL_HUMANOID, BuildOptions, Pose, Ragdoll, RagdollDesc, SpineMode};
 use vertebra_world::{
-    BodyDesc, JointDesc, JointKind, LimitSoftness, SolverConfig, Swing, SwingTwist, World,
+    BodyDesc, JointDesc, JointKind, LimitSoftness, SolverConfig, Spring, Swing, SwingTwist, World,
 };
 
 fn joint<'a>(desc: &'a RagdollDesc, name: &str) -> &'a vertebra_ragdoll::JointDef {
@@ -145,7 +143,7 @@ fn inconsistent_joints_are_refused_by_joint_and_field() {
         ),
         (
             edited(shoulder, &format!("{shoulder}\nsoftness = -1.0")),
-            "joint `shoulder_l`: softness must be a compliance",
+            "joint `shoulder_l`: softness is refused: limit compliance must be positive",
         ),
         (
             edited(shoulder, &format!("{shoulder}\nsoftness = nan")),
@@ -249,7 +247,7 @@ fn drive_settings_are_read_from_the_file() {
         .expect("the anatomical humanoid has a [drive] table");
     assert_eq!(
         drive.strength,
-        Strength::Spring {
+        Spring::Frequency {
             frequency: 4.0,
             damping_ratio: 1.0
         }
@@ -257,7 +255,7 @@ fn drive_settings_are_read_from_the_file() {
     assert_eq!(drive.max_torque, 400.0);
     let knee = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
     let hip = desc.joints.iter().position(|j| j.name == "hip_l").unwrap();
-    let six = Strength::Spring {
+    let six = Spring::Frequency {
         frequency: 6.0,
         damping_ratio: 1.0,
     };
@@ -288,7 +286,7 @@ fn drive_settings_that_make_no_drive_are_refused_by_field() {
         ),
         (
             edited(table, "[drive]\nfrequency = 0.0\ndamping_ratio = 1.0"),
-            "[drive]: strength (frequency, damping ratio)",
+            "[drive]: strength is refused: drive frequency (at least 1e-3 Hz) is out of range",
         ),
         (
             edited(table, "[drive]\nfrequency = inf\ndamping_ratio = nan"),
@@ -301,6 +299,31 @@ fn drive_settings_that_make_no_drive_are_refused_by_field() {
         (
             edited(table, "").replace("[drive]", ""),
             "joint `knee_l`: drive needs a [drive] table",
+        ),
+        (
+            edited(
+                knee,
+                "range = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 2e3 }",
+            ),
+            "joint `knee_l`: drive is refused: drive damping ratio (at most 1e3) is out of range",
+        ),
+        (
+            edited(
+                knee,
+                "range = [0.0, 150.0]\ndrive = { compliance = 0.001, damping = -1.0 }",
+            ),
+            "joint `knee_l`: drive is refused: drive damping must be positive",
+        ),
+        (
+            edited(
+                knee,
+                "range = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 1.0, damping = 2.0 }",
+            ),
+            "joint `knee_l`: damping is for a compliance strength only",
+        ),
+        (
+            edited(table, "[drive]\ncompliance = 1e4\ndamping = 1e3"),
+            "[drive]: strength is refused: drive damping (compliance times damping at most 1e6 s) is out of range",
         ),
     ];
     for (text, expected) in cases {
@@ -317,6 +340,51 @@ fn drive_settings_that_make_no_drive_are_refused_by_field() {
         e.contains("joint `knee_l`: drive is for sockets and hinges only; this joint is a fixed"),
         "{e}"
     );
+}
+
+/// A joint's own compliance takes the `[drive]` table's damping unless it
+/// gives its own (as every compliance took the one damping before a
+/// strength carried its own); either reads back from the written file.
+#[test]
+fn a_joints_compliance_takes_the_tables_damping_unless_it_gives_one() {
+    let table = "[drive]\nfrequency = 4.0\ndamping_ratio = 1.0\nmax_torque = 400.0";
+    let knee = "range = [0.0, 150.0]\ndrive = { frequency = 6.0, damping_ratio = 1.0 }";
+    let compliant = edited(table, "[drive]\ncompliance = 0.01\ndamping = 4.0");
+    let knee_drive = |desc: &RagdollDesc| {
+        let k = desc.joints.iter().position(|j| j.name == "knee_l").unwrap();
+        desc.joints[k].drive
+    };
+    let cases = [
+        ("drive = { compliance = 0.002 }", 4.0),
+        ("drive = { compliance = 0.002, damping = 1.5 }", 1.5),
+        ("drive = { compliance = 0.002, damping = 0.0 }", 0.0),
+    ];
+    for (own, damping) in cases {
+        let text = compliant.replacen(knee, &format!("range = [0.0, 150.0]\n{own}"), 1);
+        let desc = RagdollDesc::from_toml(&text).unwrap();
+        let expected = Spring::Compliance {
+            compliance: 0.002,
+            damping,
+        };
+        assert_eq!(knee_drive(&desc), Some(expected), "{own}");
+        let drive = desc.drive.as_ref().unwrap();
+        let table = Spring::Compliance {
+            compliance: 0.01,
+            damping: 4.0,
+        };
+        assert_eq!(drive.strength, table);
+        let again = RagdollDesc::from_toml(&desc.to_toml()).unwrap();
+        assert_eq!(again, desc, "{own} reads back");
+    }
+    // `strength = "infinite"` is the rigid spring, whatever the table's
+    // damping.
+    let text = compliant.replacen(
+        knee,
+        "range = [0.0, 150.0]\ndrive = { strength = \"infinite\" }",
+        1,
+    );
+    let desc = RagdollDesc::from_toml(&text).unwrap();
+    assert_eq!(knee_drive(&desc), Some(Spring::RIGID));
 }
 
 /// The file's drive settings drive the ragdoll: hanging by its hips under

@@ -6,9 +6,9 @@
 use glam::{Quat, Vec3};
 use vertebra_ragdoll::{
     BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, RagdollError, Skeleton,
-    SkeletonMapper, SpineMapping, SpineMode, Strength, Transform, Transition,
+    SkeletonMapper, SpineMapping, SpineMode, Transform, Transition,
 };
-use vertebra_world::{SolverConfig, World};
+use vertebra_world::{SolverConfig, Spring, World};
 
 /// A ragdoll built in `world` at bind pose lifted 1 m, with its mapper
 /// onto the reference skeleton and a transition measured at the build.
@@ -57,7 +57,7 @@ fn every_call_on_a_removed_ragdoll_is_refused_naming_it() {
         let desc = ragdoll.description().clone();
         let skeleton = mapper.skeleton().clone();
         let pose = Pose::bind(&desc);
-        let settings = DriveSettings::uniform(Strength::Infinite);
+        let settings = DriveSettings::uniform(Spring::RIGID);
         ragdoll.remove(&mut world).unwrap();
         let hash = world.state_hash();
         let animation = skeleton.bind_pose();

@@ -11,10 +11,8 @@
 use core::f32::consts::TAU;
 
 use glam::{Quat, Vec3};
-use vertebra_ragdoll::{
-    BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMode, Strength,
-};
-use vertebra_world::{AngularDrive, BodyDesc, BodyHandle, JointDesc, SolverConfig, World};
+use vertebra_ragdoll::{BuildOptions, DriveSettings, Pose, Ragdoll, RagdollDesc, SpineMode};
+use vertebra_world::{AngularDrive, BodyDesc, BodyHandle, JointDesc, SolverConfig, Spring, World};
 
 const DT: f32 = 1.0 / 60.0;
 /// Compliance of every drive (rad / (N m)).
@@ -80,7 +78,10 @@ impl Rig {
 }
 
 fn compliant(damping: f32) -> DriveSettings {
-    DriveSettings::uniform(Strength::Compliance(COMPLIANCE)).with_damping(damping)
+    DriveSettings::uniform(Spring::Compliance {
+        compliance: COMPLIANCE,
+        damping,
+    })
 }
 
 /// The extremes (peaks and troughs, by magnitude) of an oscillation, in

@@ -1,7 +1,7 @@
 //! How to run a scene: spine, solver settings, ragdoll, seed.
 
-use vertebra_ragdoll::{DriveSettings, RagdollDesc, RagdollError, SpineMode, Strength};
-use vertebra_world::{BackendChoice, JointSolver, SleepSettings, SolverConfig, World};
+use vertebra_ragdoll::{DriveSettings, RagdollDesc, RagdollError, SpineMode};
+use vertebra_world::{BackendChoice, JointSolver, SleepSettings, SolverConfig, Spring, World};
 
 use crate::Scene;
 
@@ -114,7 +114,7 @@ impl SceneConfig {
                 "a number, not negative (inf: unlimited)",
             ));
         }
-        let strength = Strength::Spring {
+        let strength = Spring::Frequency {
             frequency: f,
             damping_ratio: r,
         };

@@ -3,8 +3,8 @@
 //! [`SceneWorld::advance`]).
 
 use glam::Vec3;
-use vertebra_ragdoll::{DriveSettings, Pose, RagdollDesc, RagdollError, Strength};
-use vertebra_world::World;
+use vertebra_ragdoll::{DriveSettings, Pose, RagdollDesc, RagdollError};
+use vertebra_world::{Spring, World};
 
 use crate::builder::{ragdoll_with_fixed_hips, seeded, spine_top};
 use crate::{SceneConfig, SceneWorld};
@@ -18,11 +18,7 @@ pub(crate) fn build(
 ) -> Result<SceneWorld, RagdollError> {
     let pose = seeded(Pose::bind(desc), desc, config.seed, 0);
     let ragdoll = ragdoll_with_fixed_hips(&mut world, desc, config.spine, &pose)?;
-    ragdoll.drive_to(
-        &mut world,
-        &pose,
-        &DriveSettings::uniform(Strength::Infinite),
-    )?;
+    ragdoll.drive_to(&mut world, &pose, &DriveSettings::uniform(Spring::RIGID))?;
     let push = ragdoll.bodies[spine_top(desc)].map(|c| (c, Vec3::new(0.0, 0.0, 200.0)));
     Ok(SceneWorld::new(
         world,

@@ -3,52 +3,13 @@
 //! following a target that may move), and its validation. The derivation
 //! is in `vertebra_kernels::parts::drive`; the guide in `docs/ragdolls.md`.
 
-use core::f32::consts::TAU;
 use vertebra_math::PortableQuat;
 
 use glam::{Quat, Vec3};
 use vertebra_kernels::driven::DriveLane;
 use vertebra_store::{Error, check_unit_quat};
 
-/// The lowest drive frequency (Hz): a period of about 17 minutes. Lower
-/// ones are no drive at all, and `1 / omega^2` would leave `f32`.
-pub const MIN_DRIVE_FREQUENCY: f32 = 1e-3;
-
-/// The largest drive damping ratio: far past critical (1), and small
-/// enough that `2 zeta / omega` stays a number.
-pub const MAX_DRIVE_DAMPING_RATIO: f32 = 1e3;
-
-/// The largest damping time `compliance * damping` (s) of a drive given by
-/// compliance (a damping ratio of ~1e6 at 1 Hz).
-pub const MAX_DRIVE_DAMPING_TIME: f32 = 1e6;
-
-/// How strong a drive is.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub enum DriveStrength {
-    /// XPBD compliance and damping coefficient: the torque is
-    /// `-C / compliance - damping dC/dt` for the error rotation `C`.
-    /// Independent of the time step and iteration count; how fast it
-    /// moves a body depends on the body's inertia.
-    Compliance {
-        /// Compliance (rad / (N m)), the inverse of stiffness; 0 is
-        /// infinitely stiff (and then damping does nothing).
-        compliance: f32,
-        /// Damping coefficient (N m s / rad).
-        damping: f32,
-    },
-    /// A damped spring at `frequency` with `damping_ratio` whatever the
-    /// bodies' inertia (as Jolt's `SpringSettings` and Box2D's soft
-    /// constraints): stiffness and damping are scaled by the drive's
-    /// effective inertia, per substep.
-    Spring {
-        /// Natural frequency (Hz), at least [`MIN_DRIVE_FREQUENCY`];
-        /// infinity is infinitely stiff.
-        frequency: f32,
-        /// Damping ratio in [0, [`MAX_DRIVE_DAMPING_RATIO`]]: 1 is
-        /// critical (no overshoot), below it oscillates.
-        damping_ratio: f32,
-    },
-}
+use crate::spring::{Spring, SpringField};
 
 /// Drives a socket's body b toward an orientation relative to body a.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -63,41 +24,46 @@ pub struct AngularDrive {
     /// The target's angular velocity (rad/s, in a's joint frame); damping
     /// acts on the joint's angular velocity relative to it.
     pub target_velocity: Vec3,
-    /// Stiffness and damping.
-    pub strength: DriveStrength,
+    /// Stiffness and damping ([`Spring`]; its errors name the `drive`).
+    pub strength: Spring,
     /// The largest torque the drive exerts (N m, not negative); infinity
     /// is unlimited. A hit beyond it turns the joint away from the target.
     pub max_torque: f32,
 }
 
 impl AngularDrive {
-    /// A drive that holds `target` exactly (zero compliance).
-    pub fn rigid(target: Quat) -> Self {
-        Self::compliant(target, 0.0, 0.0)
-    }
-
-    /// A drive of compliance (rad / (N m)) and damping (N m s / rad).
-    pub fn compliant(target: Quat, compliance: f32, damping: f32) -> Self {
+    /// A drive toward a still `target` at `strength`, without a torque
+    /// limit.
+    pub fn new(target: Quat, strength: Spring) -> Self {
         Self {
             target,
             target_velocity: Vec3::ZERO,
-            strength: DriveStrength::Compliance {
-                compliance,
-                damping,
-            },
+            strength,
             max_torque: f32::INFINITY,
         }
     }
 
+    /// A drive that holds `target` exactly ([`Spring::RIGID`]).
+    pub fn rigid(target: Quat) -> Self {
+        Self::new(target, Spring::RIGID)
+    }
+
+    /// A drive of compliance (rad / (N m)) and damping (N m s / rad).
+    pub fn compliant(target: Quat, compliance: f32, damping: f32) -> Self {
+        let strength = Spring::Compliance {
+            compliance,
+            damping,
+        };
+        Self::new(target, strength)
+    }
+
     /// A drive of natural frequency (Hz) and damping ratio.
     pub fn spring(target: Quat, frequency: f32, damping_ratio: f32) -> Self {
-        Self {
-            strength: DriveStrength::Spring {
-                frequency,
-                damping_ratio,
-            },
-            ..Self::rigid(target)
-        }
+        let strength = Spring::Frequency {
+            frequency,
+            damping_ratio,
+        };
+        Self::new(target, strength)
     }
 
     /// With a torque limit (N m).
@@ -141,25 +107,13 @@ impl AngularDrive {
     /// The kernel's lane data (`parts::drive`: `alpha = compliance +
     /// period2 W`, `gamma h = damping_time`).
     pub(crate) fn lane(&self) -> DriveLane {
-        let (compliance, period2, damping_time) = match self.strength {
-            DriveStrength::Compliance {
-                compliance,
-                damping,
-            } => (compliance, 0.0, compliance * damping),
-            DriveStrength::Spring {
-                frequency,
-                damping_ratio,
-            } => {
-                let omega = TAU * frequency;
-                (0.0, 1.0 / (omega * omega), 2.0 * damping_ratio / omega)
-            }
-        };
+        let spring = self.strength.lane();
         DriveLane {
             target: self.target.normalize_portable(),
             velocity: self.target_velocity,
-            compliance,
-            period2,
-            damping_time,
+            compliance: spring.compliance,
+            period2: spring.period2,
+            damping_time: spring.damping_time,
             max_torque: self.max_torque,
         }
     }
@@ -173,50 +127,12 @@ pub(crate) fn validate_drive(d: &AngularDrive) -> Result<(), Error> {
         "drive target velocity",
         "drive target velocity (at most MAX_ANGULAR_SPEED_LIMIT)",
     )?;
-    match d.strength {
-        DriveStrength::Compliance {
-            compliance,
-            damping,
-        } => {
-            finite_not_negative("drive compliance", compliance)?;
-            finite_not_negative("drive damping", damping)?;
-            if compliance * damping > MAX_DRIVE_DAMPING_TIME {
-                return Err(Error::OutOfRange(
-                    "drive damping (compliance times damping at most 1e6 s)",
-                ));
-            }
-        }
-        DriveStrength::Spring {
-            frequency,
-            damping_ratio,
-        } => {
-            if frequency.is_nan() {
-                return Err(Error::NonFinite("drive frequency"));
-            }
-            if frequency < MIN_DRIVE_FREQUENCY {
-                return Err(Error::OutOfRange("drive frequency (at least 1e-3 Hz)"));
-            }
-            finite_not_negative("drive damping ratio", damping_ratio)?;
-            if damping_ratio > MAX_DRIVE_DAMPING_RATIO {
-                return Err(Error::OutOfRange("drive damping ratio (at most 1e3)"));
-            }
-        }
-    }
+    d.strength.check(SpringField::Drive)?;
     if d.max_torque.is_nan() {
         return Err(Error::NonFinite("drive max torque"));
     }
     if d.max_torque < 0.0 {
         return Err(Error::NonPositive("drive max torque"));
-    }
-    Ok(())
-}
-
-fn finite_not_negative(what: &'static str, x: f32) -> Result<(), Error> {
-    if !x.is_finite() {
-        return Err(Error::NonFinite(what));
-    }
-    if x < 0.0 {
-        return Err(Error::NonPositive(what));
     }
     Ok(())
 }

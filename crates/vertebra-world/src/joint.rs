@@ -4,10 +4,8 @@
 use glam::{Quat, Vec3};
 use vertebra_math::PortableQuat;
 
-use crate::drive::{
-    AngularDrive, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY,
-    validate_drive,
-};
+use crate::drive::{AngularDrive, validate_drive};
+use crate::spring::{Spring, SpringField};
 use serde::{Deserialize, Serialize};
 use vertebra_kernels::limited::LimitLane;
 use vertebra_math::DefaultFloatMode;
@@ -24,72 +22,48 @@ pub type JointHandle = Handle<JointTag>;
 
 /// How a limit holds: hard, or as a damped spring on the excess beyond
 /// it, which acts only while the limit is exceeded and lets go inside
-/// (`crates/vertebra-kernels/src/parts/limit.rs` derives it; the settings
-/// and ranges are the drive's, [`crate::DriveStrength`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+/// (`crates/vertebra-kernels/src/parts/limit.rs` derives it). Serialised
+/// through its wire form (`joint_wire.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum LimitSoftness {
     /// Never exceeded (to the solver's convergence).
     #[default]
     Hard,
-    /// The torque `-C / compliance - damping dC/dt` on the excess `C`.
-    /// Independent of the time step and iteration count (XPBD); how fast
-    /// it moves a body depends on the body's inertia.
-    Compliance {
-        /// Compliance (rad / (N m), finite, not negative), the inverse of
-        /// the stiffness; 0 is hard (and then damping does nothing).
-        compliance: f32,
-        /// Damping coefficient (N m s / rad, finite, not negative), with
-        /// `compliance * damping` at most [`crate::MAX_DRIVE_DAMPING_TIME`].
-        damping: f32,
-    },
-    /// A damped spring at `frequency` with `damping_ratio` whatever the
-    /// bodies' inertia (as Jolt's `SpringSettings`): stiffness and damping
-    /// scaled by the limit's effective inertia, per lane and iteration.
-    Spring {
-        /// Natural frequency (Hz), at least [`crate::MIN_DRIVE_FREQUENCY`];
-        /// infinity is hard.
-        frequency: f32,
-        /// Damping ratio in [0, [`crate::MAX_DRIVE_DAMPING_RATIO`]]: 1 is
-        /// critical (the limb comes to rest against the limit without
-        /// rebounding), 0 undamped (it bounces back off it).
-        damping_ratio: f32,
-    },
+    /// A damped spring on the excess `C` ([`Spring`], as a drive's
+    /// strength; its errors name the `limit`): given by frequency, scaled
+    /// by the limit's effective inertia per lane and iteration; at damping
+    /// ratio 1 the limb comes to rest against the limit without
+    /// rebounding, at 0 it bounces back off it.
+    Soft(Spring),
 }
 
 impl LimitSoftness {
     /// A spring of compliance `c` (rad / (N m)) without damping.
     pub const fn compliant(c: f32) -> Self {
-        Self::Compliance {
-            compliance: c,
-            damping: 0.0,
+        Self::Soft(Spring::compliant(c))
+    }
+
+    /// The kernel's lane data (`parts::limit`), the spring's; all 0 when
+    /// hard.
+    pub(crate) fn lane(&self) -> LimitLane {
+        match self {
+            Self::Hard => LimitLane::HARD,
+            Self::Soft(spring) => {
+                let lane = spring.lane();
+                LimitLane {
+                    compliance: lane.compliance,
+                    period2: lane.period2,
+                    damping_time: lane.damping_time,
+                }
+            }
         }
     }
 
-    /// The kernel's lane data (`parts::limit`: `alpha = compliance +
-    /// period2 w`, `gamma h = damping_time`), as the drive's; all 0 when
-    /// hard (and for an infinite frequency).
-    pub(crate) fn lane(&self) -> LimitLane {
-        match *self {
-            Self::Hard => LimitLane::HARD,
-            Self::Compliance {
-                compliance,
-                damping,
-            } => LimitLane {
-                compliance,
-                period2: 0.0,
-                damping_time: compliance * damping,
-            },
-            Self::Spring {
-                frequency,
-                damping_ratio,
-            } => {
-                let omega = core::f32::consts::TAU * frequency;
-                LimitLane {
-                    compliance: 0.0,
-                    period2: 1.0 / (omega * omega),
-                    damping_time: 2.0 * damping_ratio / omega,
-                }
-            }
+    /// Checks a soft limit's spring; the error names the `limit`'s number.
+    fn check(&self) -> Result<(), Error> {
+        match self {
+            Self::Hard => Ok(()),
+            Self::Soft(spring) => spring.check(SpringField::Limit),
         }
     }
 }
@@ -411,52 +385,6 @@ impl JointDesc {
     }
 }
 
-/// A limit's softness: the drive's ranges, each error naming the limit's
-/// field.
-fn softness(softness: LimitSoftness) -> Result<(), Error> {
-    let not_negative = |what, x: f32| {
-        if !x.is_finite() {
-            Err(Error::NonFinite(what))
-        } else if x < 0.0 {
-            Err(Error::NonPositive(what))
-        } else {
-            Ok(())
-        }
-    };
-    match softness {
-        LimitSoftness::Hard => Ok(()),
-        LimitSoftness::Compliance {
-            compliance,
-            damping,
-        } => {
-            not_negative("limit compliance", compliance)?;
-            not_negative("limit damping", damping)?;
-            if compliance * damping > MAX_DRIVE_DAMPING_TIME {
-                return Err(Error::OutOfRange(
-                    "limit damping (compliance times damping at most 1e6 s)",
-                ));
-            }
-            Ok(())
-        }
-        LimitSoftness::Spring {
-            frequency,
-            damping_ratio,
-        } => {
-            if frequency.is_nan() {
-                return Err(Error::NonFinite("limit frequency"));
-            }
-            if frequency < MIN_DRIVE_FREQUENCY {
-                return Err(Error::OutOfRange("limit frequency (at least 1e-3 Hz)"));
-            }
-            not_negative("limit damping ratio", damping_ratio)?;
-            if damping_ratio > MAX_DRIVE_DAMPING_RATIO {
-                return Err(Error::OutOfRange("limit damping ratio (at most 1e3)"));
-            }
-            Ok(())
-        }
-    }
-}
-
 /// Checks a kind's limits and softness.
 fn validate_kind(kind: &JointKind) -> Result<(), Error> {
     use crate::checks::{angle_range, max_angle, twist_range};
@@ -479,14 +407,14 @@ fn validate_kind(kind: &JointKind) -> Result<(), Error> {
                 }
             }
             twist_range(twist)?;
-            softness(soft)
+            soft.check()
         }
         JointKind::Hinge {
             range,
             softness: soft,
         } => {
             angle_range(range, "hinge range")?;
-            softness(soft)
+            soft.check()
         }
         JointKind::Fixed => Ok(()),
     }

@@ -14,6 +14,13 @@
 //! `crates/vertebra-scenes/tests/golden.rs` hold: a new kind or field is
 //! encoded after the variants there are, so the bytes of every joint that
 //! does not use it stay as they are.
+//!
+//! A [`LimitSoftness`] is one enum of three variants on the wire: `Hard`
+//! (0), a compliance and damping (1), a frequency and damping ratio (2);
+//! not `Soft` (1) with the [`Spring`]'s own tag after it, so a soft limit
+//! is the same few bytes as every other tagged value of the encoding. A
+//! drive's strength, a `Spring`, keeps its own two tags (compliance 0,
+//! frequency 1).
 
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -21,6 +28,7 @@ use vertebra_store::BodyHandle;
 
 use crate::drive::AngularDrive;
 use crate::joint::{JointBreaking, JointDesc, JointKind, LimitSoftness, Swing, SwingTwist};
+use crate::spring::Spring;
 
 #[derive(Serialize, Deserialize)]
 pub(crate) struct JointWire {
@@ -129,14 +137,76 @@ impl From<JointWire> for JointDesc {
     }
 }
 
-impl Serialize for JointDesc {
-    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        JointWire::from(*self).serialize(serializer)
+/// Serde's traits for `$ty`, through its wire form `$wire` (`From` each
+/// way).
+macro_rules! through_wire {
+    ($ty:ty, $wire:ty) => {
+        impl Serialize for $ty {
+            fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                <$wire>::from(*self).serialize(serializer)
+            }
+        }
+
+        impl<'de> Deserialize<'de> for $ty {
+            fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+                <$wire>::deserialize(deserializer).map(Self::from)
+            }
+        }
+    };
+}
+
+through_wire!(JointDesc, JointWire);
+through_wire!(LimitSoftness, SoftnessWire);
+
+/// A [`LimitSoftness`] as it is encoded: the spring's variants beside
+/// `Hard`, field for field.
+#[derive(Serialize, Deserialize)]
+enum SoftnessWire {
+    Hard,
+    Compliance { compliance: f32, damping: f32 },
+    Spring { frequency: f32, damping_ratio: f32 },
+}
+
+impl From<LimitSoftness> for SoftnessWire {
+    fn from(s: LimitSoftness) -> Self {
+        match s {
+            LimitSoftness::Hard => Self::Hard,
+            LimitSoftness::Soft(Spring::Compliance {
+                compliance,
+                damping,
+            }) => Self::Compliance {
+                compliance,
+                damping,
+            },
+            LimitSoftness::Soft(Spring::Frequency {
+                frequency,
+                damping_ratio,
+            }) => Self::Spring {
+                frequency,
+                damping_ratio,
+            },
+        }
     }
 }
 
-impl<'de> Deserialize<'de> for JointDesc {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        JointWire::deserialize(deserializer).map(Self::from)
+impl From<SoftnessWire> for LimitSoftness {
+    fn from(w: SoftnessWire) -> Self {
+        match w {
+            SoftnessWire::Hard => Self::Hard,
+            SoftnessWire::Compliance {
+                compliance,
+                damping,
+            } => Self::Soft(Spring::Compliance {
+                compliance,
+                damping,
+            }),
+            SoftnessWire::Spring {
+                frequency,
+                damping_ratio,
+            } => Self::Soft(Spring::Frequency {
+                frequency,
+                damping_ratio,
+            }),
+        }
     }
 }

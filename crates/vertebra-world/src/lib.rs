@@ -44,6 +44,7 @@ mod rod;
 mod rollback;
 mod sleep;
 mod snapshot;
+mod spring;
 mod stages;
 mod start;
 mod step;
@@ -64,10 +65,7 @@ pub use config::{
     SolverConfig,
 };
 pub use contact::Contact;
-pub use drive::{
-    AngularDrive, DriveStrength, MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME,
-    MIN_DRIVE_FREQUENCY,
-};
+pub use drive::AngularDrive;
 pub use forces::{BrokenJoint, JointForce};
 pub use islands::SleepSettings;
 pub use joint::{
@@ -77,6 +75,9 @@ pub use lend::{TaskLoan, lend};
 pub use metrics::{JointResidual, Residuals};
 pub use rod::{MAX_ROD_LENGTH, RodDesc, RodHandle, RodStiffness, arc_tangent, rod_twist};
 pub use snapshot::{Snapshot, Timeline};
+pub use spring::{
+    MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY, Spring, SpringField,
+};
 #[cfg(feature = "stage-timing")]
 pub use stages::timing as stage_timing;
 pub use tasks::{RayonTasks, SingleThreaded, TaskSystem};

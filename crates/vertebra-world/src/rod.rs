@@ -7,7 +7,7 @@ use vertebra_math::PortableQuat;
 use glam::{Quat, Vec3};
 use vertebra_kernels::rod::RodSoftness;
 
-use crate::drive::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
+use crate::spring::{MAX_DRIVE_DAMPING_RATIO, MAX_DRIVE_DAMPING_TIME, MIN_DRIVE_FREQUENCY};
 use vertebra_math::DefaultFloatMode;
 use vertebra_store::{
     BodyHandle, BodyStore, Error, Handle, MAX_COORDINATE, check_coordinate, check_unit_quat,

@@ -368,7 +368,7 @@ mod tests {
     use crate::islands::{Island, NO_ISLAND};
     use crate::{
         AngularDrive, BodyDesc, BodyKind, JointKind, LimitSoftness, RodStiffness, Shape,
-        SolverConfig, Swing, SwingTwist,
+        SolverConfig, Spring, Swing, SwingTwist,
     };
 
     #[test]
@@ -627,7 +627,7 @@ mod tests {
             (
                 Box::new(|s| {
                     let socket = s.joints[1].as_mut().unwrap();
-                    socket.drive.as_mut().unwrap().strength = crate::DriveStrength::Spring {
+                    socket.drive.as_mut().unwrap().strength = Spring::Frequency {
                         frequency: 0.0,
                         damping_ratio: 1.0,
                     };
@@ -664,10 +664,10 @@ mod tests {
             ),
             (
                 Box::new(|s| {
-                    let spring = LimitSoftness::Spring {
+                    let spring = LimitSoftness::Soft(Spring::Frequency {
                         frequency: 5.0,
                         damping_ratio: f32::NAN,
-                    };
+                    });
                     s.joints[0].as_mut().unwrap().kind = JointKind::Hinge {
                         range: Some([-1.0, 1.0]),
                         softness: spring,

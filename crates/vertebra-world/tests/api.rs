@@ -7,7 +7,8 @@ use common::capsule;
 use glam::{Mat3, Quat, Vec3};
 use vertebra_world::{
     AngularDrive, BackendChoice, BodyDesc, Error, JointDesc, JointKind, LimitSoftness,
-    MassProperties, Shape, SolverConfig, Swing, SwingTwist, World,
+    MAX_DRIVE_DAMPING_RATIO, MIN_DRIVE_FREQUENCY, MassProperties, Shape, SolverConfig, Spring,
+    SpringField, Swing, SwingTwist, World,
 };
 
 fn unit_mass() -> MassProperties {
@@ -242,13 +243,17 @@ fn bad_joint_kinds_are_refused_with_the_field_named() {
         range: Some([0.0, 1.0]),
         softness,
     };
-    let spring = |frequency, damping_ratio| LimitSoftness::Spring {
-        frequency,
-        damping_ratio,
+    let spring = |frequency, damping_ratio| {
+        LimitSoftness::Soft(Spring::Frequency {
+            frequency,
+            damping_ratio,
+        })
     };
-    let damped = |compliance, damping| LimitSoftness::Compliance {
-        compliance,
-        damping,
+    let damped = |compliance, damping| {
+        LimitSoftness::Soft(Spring::Compliance {
+            compliance,
+            damping,
+        })
     };
     let cases = [
         (
@@ -344,6 +349,132 @@ fn bad_joint_kinds_are_refused_with_the_field_named() {
         Error::InvalidJoint("drive (a fixed joint has no rotation to drive)"),
         |w, j| w.set_joint_drive(j, Some(drive)),
     );
+}
+
+/// One spring serves a drive's strength and a soft limit: a value out of
+/// range is refused by its one check wherever it is given (a drive set on
+/// a joint, a joint added with it as its drive or as a hinge's or socket's
+/// softness), the error naming the field (`drive ...` or `limit ...`) and
+/// the number, and the refused call changes nothing.
+#[test]
+fn bad_springs_are_refused_as_drives_and_limits_naming_the_field() {
+    let compliance = |compliance, damping| Spring::Compliance {
+        compliance,
+        damping,
+    };
+    let frequency = |frequency, damping_ratio| Spring::Frequency {
+        frequency,
+        damping_ratio,
+    };
+    // A bad spring, and the drive's and the limit's refusal of it.
+    let cases = [
+        (
+            compliance(-1.0, 0.0),
+            Error::NonPositive("drive compliance"),
+            Error::NonPositive("limit compliance"),
+        ),
+        (
+            compliance(f32::NAN, 0.0),
+            Error::NonFinite("drive compliance"),
+            Error::NonFinite("limit compliance"),
+        ),
+        (
+            compliance(0.1, f32::INFINITY),
+            Error::NonFinite("drive damping"),
+            Error::NonFinite("limit damping"),
+        ),
+        (
+            compliance(0.1, -2.0),
+            Error::NonPositive("drive damping"),
+            Error::NonPositive("limit damping"),
+        ),
+        (
+            compliance(1e4, 1e3),
+            Error::OutOfRange("drive damping (compliance times damping at most 1e6 s)"),
+            Error::OutOfRange("limit damping (compliance times damping at most 1e6 s)"),
+        ),
+        (
+            frequency(f32::NAN, 1.0),
+            Error::NonFinite("drive frequency"),
+            Error::NonFinite("limit frequency"),
+        ),
+        (
+            frequency(5e-4, 1.0),
+            Error::OutOfRange("drive frequency (at least 1e-3 Hz)"),
+            Error::OutOfRange("limit frequency (at least 1e-3 Hz)"),
+        ),
+        (
+            frequency(f32::NEG_INFINITY, 1.0),
+            Error::OutOfRange("drive frequency (at least 1e-3 Hz)"),
+            Error::OutOfRange("limit frequency (at least 1e-3 Hz)"),
+        ),
+        (
+            frequency(5.0, -0.5),
+            Error::NonPositive("drive damping ratio"),
+            Error::NonPositive("limit damping ratio"),
+        ),
+        (
+            frequency(5.0, f32::INFINITY),
+            Error::NonFinite("drive damping ratio"),
+            Error::NonFinite("limit damping ratio"),
+        ),
+        (
+            frequency(5.0, 2e3),
+            Error::OutOfRange("drive damping ratio (at most 1e3)"),
+            Error::OutOfRange("limit damping ratio (at most 1e3)"),
+        ),
+    ];
+    for (spring, as_drive, as_limit) in cases {
+        assert_eq!(spring.check(SpringField::Drive), Err(as_drive.clone()));
+        assert_eq!(spring.check(SpringField::Limit), Err(as_limit.clone()));
+        let drive = AngularDrive::new(Quat::IDENTITY, spring);
+        assert_eq!(drive.validate(), Err(as_drive.clone()));
+        rejected(as_drive.clone(), |w| {
+            let s = w.joints().next().expect("a joint").0;
+            w.set_joint_drive(s, Some(drive))
+        });
+        let hinge = JointKind::Hinge {
+            range: Some([0.0, 1.0]),
+            softness: LimitSoftness::Hard,
+        };
+        rejected(as_drive, |w| add_kind(w, hinge, Some(drive)));
+        let soft = LimitSoftness::Soft(spring);
+        let kinds = [
+            JointKind::Hinge {
+                range: Some([0.0, 1.0]),
+                softness: soft,
+            },
+            JointKind::Socket(SwingTwist::FREE.with_softness(soft)),
+        ];
+        for kind in kinds {
+            rejected(as_limit.clone(), |w| add_kind(w, kind, None));
+        }
+    }
+    // The ends of every range are taken, as a drive and as a limit.
+    let taken = [
+        Spring::RIGID,
+        compliance(0.0, f32::MAX),
+        compliance(1e3, 1e3),
+        frequency(MIN_DRIVE_FREQUENCY, 0.0),
+        frequency(f32::INFINITY, MAX_DRIVE_DAMPING_RATIO),
+    ];
+    for spring in taken {
+        for field in [SpringField::Drive, SpringField::Limit] {
+            assert_eq!(spring.check(field), Ok(()), "{spring:?} as {field:?}");
+        }
+        let (mut w, ..) = world();
+        let kind = JointKind::Hinge {
+            range: Some([0.0, 1.0]),
+            softness: LimitSoftness::Soft(spring),
+        };
+        add_kind(
+            &mut w,
+            kind,
+            Some(AngularDrive::new(Quat::IDENTITY, spring)),
+        )
+        .unwrap();
+        w.step(1.0 / 60.0).unwrap();
+    }
 }
 
 #[test]

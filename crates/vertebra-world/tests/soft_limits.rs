@@ -14,8 +14,8 @@ mod common;
 use common::{capsule, world};
 use glam::{Quat, Vec3};
 use vertebra_world::{
-    BodyDesc, BodyHandle, JointDesc, JointKind, LimitSoftness, SolverConfig, Swing, SwingTwist,
-    World,
+    BodyDesc, BodyHandle, JointDesc, JointKind, LimitSoftness, SolverConfig, Spring, Swing,
+    SwingTwist, World,
 };
 
 const DT: f32 = 1.0 / 60.0;
@@ -123,10 +123,10 @@ fn cone_run(softness: LimitSoftness) -> Run {
 }
 
 fn spring(damping_ratio: f32) -> LimitSoftness {
-    LimitSoftness::Spring {
+    LimitSoftness::Soft(Spring::Frequency {
         frequency: F,
         damping_ratio,
-    }
+    })
 }
 
 /// Critically damped: peaks at `V / (e omega)` and never leaves the limit.
@@ -194,9 +194,9 @@ fn compliance_and_damping_match_the_spring_on_the_bodys_inertia() {
     let props = shape.mass_properties_with_mass(1.0).unwrap();
     let inertia = props.inertia.z_axis.z;
     let omega = core::f32::consts::TAU * F;
-    let r = hinge_run(LimitSoftness::Compliance {
+    let r = hinge_run(LimitSoftness::Soft(Spring::Compliance {
         compliance: 1.0 / (inertia * omega * omega),
         damping: 2.0 * inertia * omega,
-    });
+    }));
     check_critical(&r);
 }
