@@ -28,7 +28,7 @@ use parry3d::query::{Ray, ShapeCastOptions};
 use parry3d::shape::{Ball, Capsule, Shape as ParryShape};
 use vertebra_math::{DefaultFloatMode, PortableQuat};
 use vertebra_store::{check_point, check_unit_quat, check_unit_vec};
-use vertebra_world::{BodyHandle, BodyKind, Error, MAX_COORDINATE, Timeline, World};
+use vertebra_world::{BodyHandle, BodyKind, Error, MAX_COORDINATE, World};
 
 use crate::collider::{ColliderShape, CollisionGroups, MAX_COLLIDER_EXTENT};
 use crate::part::RagdollPart;
