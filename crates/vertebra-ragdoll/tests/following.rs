@@ -188,8 +188,9 @@ fn a_rod_spine_following_the_animation_does_not_lag() {
     );
 }
 
-#[test]
-fn a_step_that_is_no_time_is_refused() {
+/// The anatomical humanoid (rod spine) built at its bind pose in a world
+/// of its own, and that pose.
+fn anatomical_at_bind() -> (RagdollDesc, World, Pose, Ragdoll) {
     let desc = RagdollDesc::anatomical_humanoid();
     let mut world = World::new(SolverConfig::default()).unwrap();
     let bind = Pose::bind(&desc);
@@ -201,6 +202,12 @@ fn a_step_that_is_no_time_is_refused() {
         None,
     )
     .unwrap();
+    (desc, world, bind, ragdoll)
+}
+
+#[test]
+fn a_step_that_is_no_time_is_refused() {
+    let (_, mut world, bind, ragdoll) = anatomical_at_bind();
     let settings = DriveSettings::uniform(Spring::RIGID);
     for dt in [0.0, -1.0, f32::NAN, f32::INFINITY] {
         let before = world.state_hash();
@@ -218,17 +225,7 @@ fn a_step_that_is_no_time_is_refused() {
 /// the number).
 #[test]
 fn bad_strengths_are_refused_naming_the_joint_and_change_nothing() {
-    let desc = RagdollDesc::anatomical_humanoid();
-    let mut world = World::new(SolverConfig::default()).unwrap();
-    let bind = Pose::bind(&desc);
-    let ragdoll = Ragdoll::build(
-        &mut world,
-        &desc,
-        BuildOptions::new(SpineMode::Rod),
-        &bind,
-        None,
-    )
-    .unwrap();
+    let (desc, mut world, bind, ragdoll) = anatomical_at_bind();
     let bad = Spring::Frequency {
         frequency: 0.0,
         damping_ratio: 1.0,
