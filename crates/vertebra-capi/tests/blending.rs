@@ -253,7 +253,11 @@ fn joints_driven_at_strengths_of_their_own_move_as_in_rust() {
     for (list, code, words) in [
         (twice, VtResult::OutOfRange, &["overrides[1]", "neck"][..]),
         (past, VtResult::OutOfRange, &["overrides[0]", "joints"][..]),
-        (bad, VtResult::Ragdoll, &["joint `neck`", "drive frequency"][..]),
+        (
+            bad,
+            VtResult::Ragdoll,
+            &["joint `neck`", "drive frequency"][..],
+        ),
     ] {
         // SAFETY: as above.
         let r = unsafe {
