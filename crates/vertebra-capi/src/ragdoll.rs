@@ -229,7 +229,10 @@ pub(crate) unsafe fn toml_text<'a>(
     // SAFETY: the function's contract.
     unsafe {
         bounded_text(toml, "toml", max, || {
-            Failure::from(RagdollError::TooLarge { file })
+            Failure::from(RagdollError::TooLarge {
+                file,
+                limit: MAX_FILE_BYTES,
+            })
         })
     }
 }

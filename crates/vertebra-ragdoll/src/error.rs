@@ -30,6 +30,8 @@ pub enum RagdollError {
     TooLarge {
         /// What the text holds: `ragdoll`, `skeleton` or `generator`.
         file: &'static str,
+        /// The most bytes a text may have (bytes).
+        limit: u64,
     },
     /// An error in the ragdoll or skeleton file at `path`.
     File {
@@ -139,10 +141,9 @@ impl fmt::Display for RagdollError {
             RagdollError::Unreadable { file, reason } => {
                 write!(f, "cannot read the {file} file: {reason}")
             }
-            RagdollError::TooLarge { file } => write!(
+            RagdollError::TooLarge { file, limit } => write!(
                 f,
-                "the {file} text is larger than MAX_FILE_BYTES ({} bytes) and is refused before it is parsed; a {file} file is a few KB",
-                crate::MAX_FILE_BYTES
+                "the {file} text is larger than MAX_FILE_BYTES ({limit} bytes) and is refused before it is parsed; a {file} file is a few KB"
             ),
             RagdollError::File { path, error } => write!(f, "{path}: {error}"),
             RagdollError::DuplicateName { line, kind, name } => {

@@ -25,7 +25,10 @@ pub(crate) fn within_cap(bytes: u64, file: &'static str) -> Result<(), RagdollEr
     if bytes <= MAX_FILE_BYTES {
         Ok(())
     } else {
-        Err(RagdollError::TooLarge { file })
+        Err(RagdollError::TooLarge {
+            file,
+            limit: MAX_FILE_BYTES,
+        })
     }
 }
 

@@ -9,12 +9,14 @@
 mod error;
 mod handle;
 mod shape;
+mod slots;
 mod store;
 
 pub use error::{
     Error, MAX_COORDINATE, MAX_TIME_STEP, MIN_TIME_STEP, check_coordinate, check_finite,
     check_point, check_positive, check_unit_quat, check_unit_vec,
 };
-pub use handle::{Handle, MAX_GENERATION, Slots, serialize_physical_only};
+pub use handle::{BodyHandle, BodyTag, Handle, serialize_physical_only};
 pub use shape::{MASS_RANGE, MassProperties, SIZE_RANGE, Shape};
-pub use store::{BodyDesc, BodyHandle, BodyKind, BodyState, BodyStore};
+pub use slots::{MAX_GENERATION, Slots};
+pub use store::{BodyDesc, BodyKind, BodyState, BodyStore};

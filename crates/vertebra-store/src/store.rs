@@ -7,15 +7,9 @@ use vertebra_math::PortableQuat;
 use crate::error::{
     Error, MAX_COORDINATE, check_coordinate, check_finite, check_point, check_unit_quat,
 };
-use crate::handle::{Handle, Slots};
+use crate::handle::BodyHandle;
 use crate::shape::MassProperties;
-
-/// Marker for body handles.
-#[derive(Debug)]
-pub enum BodyTag {}
-
-/// A stable reference to a body.
-pub type BodyHandle = Handle<BodyTag>;
+use crate::slots::Slots;
 
 /// How a body moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
