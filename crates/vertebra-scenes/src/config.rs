@@ -134,18 +134,4 @@ impl SceneConfig {
         };
         Ok(World::new(config)?)
     }
-
-    pub(crate) fn description(&self) -> Result<RagdollDesc, RagdollError> {
-        match (self.scene, &self.ragdoll) {
-            (Scene::HeavyChain, None) => crate::heavy_chain(),
-            (Scene::HeavyChain, Some(_)) => Err(RagdollError::OutOfRange {
-                context: "scene".to_owned(),
-                field: "ragdoll",
-                reason: "is given; the heavy chain hangs its own chain of bodies".to_owned(),
-            }),
-            (_, Some(desc)) => Ok(desc.clone()),
-            (scene, None) if scene.is_paper() => Ok(RagdollDesc::reference_humanoid()),
-            (_, None) => Ok(RagdollDesc::anatomical_humanoid()),
-        }
-    }
 }

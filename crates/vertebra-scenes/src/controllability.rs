@@ -6,7 +6,7 @@ use glam::Vec3;
 use vertebra_ragdoll::{DriveSettings, Pose, RagdollDesc, RagdollError};
 use vertebra_world::{Spring, World};
 
-use crate::builder::{ragdoll_with_fixed_hips, seeded, spine_top};
+use crate::setup::{ragdoll_with_fixed_hips, seeded, spine_top};
 use crate::{SceneConfig, SceneWorld};
 
 /// The scene's world: the bind pose, its hips held, driven to itself; the

@@ -11,7 +11,7 @@ use vertebra_ragdoll::{
 };
 use vertebra_world::{BodyDesc, JointDesc, SwingTwist, World};
 
-use crate::builder::seeded;
+use crate::setup::seeded;
 use crate::{SceneConfig, SceneWorld};
 
 /// Light links in the chain.

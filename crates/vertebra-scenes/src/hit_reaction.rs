@@ -7,7 +7,7 @@ use glam::Vec3;
 use vertebra_ragdoll::{DriveSettings, Pose, RagdollDesc, RagdollError};
 use vertebra_world::{BodyHandle, World};
 
-use crate::builder::{ragdoll_with_fixed_hips, seeded, spine_top};
+use crate::setup::{ragdoll_with_fixed_hips, seeded, spine_top};
 use crate::{SceneConfig, SceneWorld};
 
 /// The frames whose step each hit precedes: the chest at 0.5 s, the head

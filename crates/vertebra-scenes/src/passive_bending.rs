@@ -6,7 +6,7 @@ use vertebra_math::PortableQuat;
 use vertebra_ragdoll::{Pose, RagdollDesc, RagdollError};
 use vertebra_world::World;
 
-use crate::builder::{ragdoll_with_fixed_hips, seeded};
+use crate::setup::{ragdoll_with_fixed_hips, seeded};
 use crate::{SceneConfig, SceneWorld};
 
 /// The scene's world: the bind pose leaned 30 degrees about +X through the

@@ -6,7 +6,7 @@ use vertebra_math::{PortableQuat, trig};
 use vertebra_ragdoll::{BuildOptions, Pose, Ragdoll, RagdollDesc, RagdollError, SpineMode};
 use vertebra_world::{BodyDesc, Shape, World};
 
-use crate::builder::seeded;
+use crate::setup::seeded;
 use crate::{SceneConfig, SceneWorld};
 
 /// The scene's world: [`ragdoll_drop`] with `config`'s ragdolls and seed.
