@@ -1,6 +1,5 @@
 //! Solver settings.
 
-use crate::SleepSettings;
 use glam::Vec3;
 use vertebra_math::BackendChoice;
 use vertebra_store::{Error, MAX_COORDINATE, MAX_TIME_STEP, check_finite};
@@ -219,5 +218,55 @@ impl SolverConfig {
             sleep.validate()?;
         }
         check_finite("gravity", self.gravity)
+    }
+}
+
+/// When bodies fall asleep ([`SolverConfig::sleep`](crate::SolverConfig::sleep)):
+/// a body is still while the mean speed of its mass over each window of
+/// `time` stays below `speed`, and an island sleeps when all its bodies
+/// have been still for `time`. Defaults as Box2D's (0.05 m/s, 0.5 s).
+///
+/// The speed is of the body's mass, not of its centre: how far its points
+/// have moved from where the window began, as the root mean square over
+/// its mass (`sqrt(|dx|^2 + v^T (I / m) v)`, `dx` the centre's move, `v`
+/// twice the vector part of the turn, `I` the body-frame inertia, `m` the
+/// mass; exact for any turn). So a turn counts by how far it carries the
+/// body's mass: a limb twisting by 2 degrees about its own axis moves its
+/// surface a millimetre and is still, a limb swinging by the same angle
+/// moves its far end a centimetre (as Jolt tests points on the body, and
+/// Box2D its extent times its angular speed).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SleepSettings {
+    /// The mean speed of a still body's mass stays below this (m/s, at
+    /// least 0).
+    pub speed: f32,
+    /// An island sleeps once every body in it has been still this long (s,
+    /// positive, at most 1e6).
+    pub time: f32,
+}
+
+impl Default for SleepSettings {
+    fn default() -> Self {
+        Self {
+            speed: 0.05,
+            time: 0.5,
+        }
+    }
+}
+
+impl SleepSettings {
+    /// Checks every field; the error names it.
+    pub fn validate(&self) -> Result<(), Error> {
+        if !(self.speed.is_finite() && self.speed >= 0.0) {
+            return Err(Error::InvalidConfig(
+                "sleep.speed must be finite and at least 0",
+            ));
+        }
+        if !(self.time > 0.0 && self.time <= 1.0e6) {
+            return Err(Error::InvalidConfig(
+                "sleep.time must be positive and at most 1e6 s",
+            ));
+        }
+        Ok(())
     }
 }

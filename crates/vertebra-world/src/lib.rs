@@ -26,6 +26,7 @@ mod bins;
 mod checks;
 mod config;
 mod contact;
+mod contact_layout;
 mod drive;
 mod forces;
 mod impulse;
@@ -62,12 +63,11 @@ use vertebra_store::Slots;
 
 pub use config::{
     JointSolver, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS,
-    SolverConfig,
+    SleepSettings, SolverConfig,
 };
 pub use contact::Contact;
 pub use drive::AngularDrive;
 pub use forces::{BrokenJoint, JointForce};
-pub use islands::SleepSettings;
 pub use joint::{
     JointBreaking, JointDesc, JointHandle, JointKind, LimitSoftness, Swing, SwingTwist,
 };
@@ -128,7 +128,7 @@ pub struct World {
     /// Counts every call that may have moved a body or changed which
     /// bodies there are (no part of the state).
     pose_version: u64,
-    contact_layout: contact::ContactLayout,
+    contact_layout: contact_layout::ContactLayout,
     rows: parallel::Scratch,
     previous: Vec<(Vec3, Quat)>,
     /// Scratch of the step: which slots the body passes move (live, not
@@ -189,7 +189,7 @@ impl World {
             joint_forces: Vec::new(),
             broken: Vec::new(),
             pose_version: 0,
-            contact_layout: contact::ContactLayout::default(),
+            contact_layout: contact_layout::ContactLayout::default(),
             rows: parallel::Scratch::default(),
             previous: Vec::new(),
             moving: Vec::new(),

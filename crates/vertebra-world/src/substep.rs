@@ -20,7 +20,7 @@ use vertebra_math::Backend;
 
 use crate::World;
 use crate::bins::Bins;
-use crate::contact::{ContactBin, ContactLayout};
+use crate::contact_layout::{ContactBin, ContactLayout};
 use crate::integrate::{
     BodyChunk, BodyRead, damp, derive_velocities, predict, read_velocities, repair,
 };
