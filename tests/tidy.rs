@@ -377,44 +377,198 @@ fn modules(src: &Path) -> Vec<(Vec<String>, String)> {
     out
 }
 
-/// The modules `code` (in `module`) names by `crate::` or `super::` paths,
-/// each the longest prefix of the path that is a module of the crate
-/// other than its root.
-fn imports(module: &[String], code: &str, known: &[Vec<String>]) -> Vec<usize> {
+/// Code without its `//` comments (doc examples name paths of other
+/// crates' views, not imports).
+fn without_comments(code: &str) -> String {
+    code.lines()
+        .map(|line| line.split("//").next().unwrap_or(""))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Every path a `use` declaration of `code` names, its braces expanded
+/// (`use crate::{a::B, c::{D, E as F}}` gives `crate::a::B`, `crate::c::D`
+/// and `crate::c::E`), each with the name it binds there (`B`, `D`, `F`;
+/// `*` for a glob).
+fn use_paths(code: &str) -> Vec<(Vec<String>, String)> {
+    fn split_top(list: &str) -> Vec<&str> {
+        let (mut depth, mut from, mut out) = (0, 0, Vec::new());
+        for (i, c) in list.char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' => depth -= 1,
+                ',' if depth == 0 => {
+                    out.push(&list[from..i]);
+                    from = i + 1;
+                }
+                _ => {}
+            }
+        }
+        out.push(&list[from..]);
+        out
+    }
+    fn expand(tree: &str, prefix: &[String], out: &mut Vec<(Vec<String>, String)>) {
+        let tree = tree.trim();
+        if tree.is_empty() {
+            return;
+        }
+        let segments = |s: &str| -> Vec<String> {
+            s.split("::")
+                .map(str::trim)
+                .filter(|p| !p.is_empty())
+                .map(String::from)
+                .collect()
+        };
+        if let (Some(open), Some(close)) = (tree.find('{'), tree.rfind('}')) {
+            let mut path = prefix.to_vec();
+            path.extend(segments(&tree[..open]));
+            for part in split_top(&tree[open + 1..close]) {
+                expand(part, &path, out);
+            }
+            return;
+        }
+        let (path, alias) = match tree.split_once(" as ") {
+            Some((path, alias)) => (path, Some(alias.trim().to_string())),
+            None => (tree, None),
+        };
+        let mut full = prefix.to_vec();
+        full.extend(segments(path));
+        if full.last().is_some_and(|s| s == "self") {
+            full.pop();
+        }
+        if let Some(last) = full.last().cloned() {
+            out.push((full, alias.unwrap_or(last)));
+        }
+    }
     let mut out = Vec::new();
-    for (kind, base) in [
-        ("crate", Vec::new()),
-        ("super", module[..module.len().saturating_sub(1)].to_vec()),
-    ] {
+    for (at, _) in code.match_indices("use ") {
+        let before = code[..at].chars().next_back();
+        if before.is_some_and(|c| !(c.is_whitespace() || c == ')' || c == '{' || c == ';')) {
+            continue;
+        }
+        let rest = &code[at + 4..];
+        let Some(end) = rest.find(';') else { continue };
+        expand(&rest[..end], &[], &mut out);
+    }
+    out
+}
+
+/// The `crate::` and `super::` paths `code` names outside its `use`
+/// declarations (`crate::a::f()` in an expression).
+fn inline_paths(code: &str) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    for kind in ["crate", "super"] {
         let pattern = format!("{kind}::");
         for (at, _) in code.match_indices(&pattern) {
             let before = code[..at].chars().next_back();
-            if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
+            if before.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':') {
                 continue;
             }
-            let rest = &code[at + pattern.len()..];
-            let parts: Vec<String> = rest
-                .split("::")
-                .map(|p| {
-                    p.chars()
-                        .take_while(|c| c.is_alphanumeric() || *c == '_')
-                        .collect::<String>()
-                })
-                .take_while(|p| !p.is_empty())
-                .collect();
-            let target = (1..=parts.len()).rev().find_map(|k| {
-                let path: Vec<String> = base.iter().chain(&parts[..k]).cloned().collect();
-                known.iter().position(|m| *m == path)
-            });
-            if let Some(t) = target
-                && known[t] != module
-                && !known[t].is_empty()
-            {
-                out.push(t);
-            }
+            let mut path = vec![kind.to_string()];
+            path.extend(
+                code[at + pattern.len()..]
+                    .split("::")
+                    .map(|p| {
+                        p.chars()
+                            .take_while(|c| c.is_alphanumeric() || *c == '_')
+                            .collect::<String>()
+                    })
+                    .take_while(|p| !p.is_empty()),
+            );
+            out.push(path);
         }
     }
     out
+}
+
+/// A crate's modules and the names each binds by `use` (re-exports
+/// included), to follow `crate::Name` to the file that defines `Name`.
+struct Crate {
+    modules: Vec<Vec<String>>,
+    bindings: Vec<Vec<(Vec<String>, String)>>,
+}
+
+impl Crate {
+    fn new(modules: &[(Vec<String>, String)]) -> Self {
+        Self {
+            modules: modules.iter().map(|(m, _)| m.clone()).collect(),
+            bindings: modules.iter().map(|(_, code)| use_paths(code)).collect(),
+        }
+    }
+
+    fn find(&self, module: &[String]) -> Option<usize> {
+        self.modules.iter().position(|m| m == module)
+    }
+
+    /// The module a path names from `module`: the longest prefix that is
+    /// a module, then through the name it binds there by `use` (a root's
+    /// re-export leads to the file that defines the item); `None` for a
+    /// path into another crate.
+    fn resolve(&self, module: usize, path: &[String], depth: usize) -> Option<usize> {
+        let here = &self.modules[module];
+        let (mut at, rest): (Vec<String>, &[String]) = match path.first().map(String::as_str) {
+            Some("crate") => (Vec::new(), &path[1..]),
+            Some("self") => (here.clone(), &path[1..]),
+            Some("super") => {
+                let mut at = here.clone();
+                let mut rest = path;
+                while rest.first().is_some_and(|s| s == "super") {
+                    at.pop();
+                    rest = &rest[1..];
+                }
+                (at, rest)
+            }
+            Some(first) => {
+                let child: Vec<String> = here.iter().chain([&first.to_string()]).cloned().collect();
+                self.find(&child)?;
+                (here.clone(), path)
+            }
+            None => return None,
+        };
+        for segment in rest {
+            let next: Vec<String> = at.iter().chain([segment]).cloned().collect();
+            if self.find(&next).is_some() {
+                at = next;
+                continue;
+            }
+            let owner = self.find(&at)?;
+            if depth > 0 {
+                let bound = self.bindings[owner]
+                    .iter()
+                    .find(|(_, name)| name == segment)
+                    .or_else(|| self.bindings[owner].iter().find(|(_, name)| name == "*"));
+                if let Some((target, name)) = bound {
+                    let target = if name == "*" {
+                        let mut t = target[..target.len() - 1].to_vec();
+                        t.push(segment.clone());
+                        t
+                    } else {
+                        target.clone()
+                    };
+                    if let Some(found) = self.resolve(owner, &target, depth - 1) {
+                        return Some(found);
+                    }
+                }
+            }
+            return Some(owner);
+        }
+        self.find(&at)
+    }
+
+    /// The modules of the crate that `code` (in `module`) imports, other
+    /// than `module` and the modules inside it: a module that declares
+    /// others is their facade (as the crate root is everyone's), and
+    /// naming what it holds is not an import.
+    fn imports(&self, module: usize, code: &str) -> Vec<usize> {
+        let paths = use_paths(code)
+            .into_iter()
+            .map(|(path, _)| path)
+            .chain(inline_paths(code));
+        paths
+            .filter_map(|path| self.resolve(module, &path, 8))
+            .filter(|&t| !self.modules[t].starts_with(&self.modules[module]))
+            .collect()
+    }
 }
 
 #[test]
@@ -425,16 +579,20 @@ fn no_import_circles_between_a_crates_files() {
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
         .collect();
     names.sort();
+    let mut circles = Vec::new();
     for name in names {
         let src = crates.join(&name).join("src");
         if !src.is_dir() {
             continue;
         }
-        let modules = modules(&src);
-        let known: Vec<Vec<String>> = modules.iter().map(|(m, _)| m.clone()).collect();
-        let edges: Vec<Vec<usize>> = modules
-            .iter()
-            .map(|(m, code)| imports(m, code, &known))
+        let modules: Vec<(Vec<String>, String)> = modules(&src)
+            .into_iter()
+            .map(|(m, code)| (m, without_comments(&code)))
+            .collect();
+        let krate = Crate::new(&modules);
+        let known = &krate.modules;
+        let edges: Vec<Vec<usize>> = (0..modules.len())
+            .map(|m| krate.imports(m, &modules[m].1))
             .collect();
         // Which modules each reaches (depth-first), then the largest set
         // of modules that reach each other.
@@ -455,15 +613,32 @@ fn no_import_circles_between_a_crates_files() {
                 .map(|b| known[b].join("/"))
                 .collect()
         };
-        let largest = (0..known.len())
-            .map(circle)
-            .max_by_key(Vec::len)
-            .unwrap_or_default();
-        assert!(
-            largest.is_empty(),
-            "{name}: these files import each other in a circle: {largest:?}"
-        );
+        for a in 0..known.len() {
+            let members = circle(a);
+            if members.first() != Some(&known[a].join("/")) {
+                continue;
+            }
+            let inside = |m: usize| members.contains(&known[m].join("/"));
+            let links: Vec<String> = (0..known.len())
+                .filter(|&m| inside(m))
+                .flat_map(|m| {
+                    edges[m]
+                        .iter()
+                        .filter(|&&t| inside(t))
+                        .map(move |&t| (m, t))
+                })
+                .map(|(m, t)| format!("{} -> {}", known[m].join("/"), known[t].join("/")))
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            circles.push(format!("{name}: {members:?} by {links:?}"));
+        }
     }
+    assert!(
+        circles.is_empty(),
+        "files that import each other in a circle:\n{}",
+        circles.join("\n")
+    );
 }
 
 /// Crates other than ours whose items the map may name, by their path
