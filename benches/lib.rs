@@ -148,6 +148,17 @@ pub enum Placement {
     OutOfCache,
 }
 
+/// Where the benches' joints sit on their bodies: anchors 11 cm from
+/// each centre, frames 0.3 rad apart about z.
+fn frames() -> JointFrames {
+    JointFrames {
+        anchor_a: GVec3::new(0.05, 0.1, 0.0),
+        anchor_b: GVec3::new(-0.05, -0.1, 0.0),
+        frame_a: GQuat::IDENTITY,
+        frame_b: GQuat::from_rotation_z(0.3),
+    }
+}
+
 /// Joints in an out-of-cache workload: 2^18 joints on 2^19 bodies.
 pub const OUT_OF_CACHE_JOINTS: usize = 1 << 18;
 
@@ -204,18 +215,8 @@ impl SocketWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = SocketLane {
-                pair: PairLane {
-                    body_a,
-                    body_b,
-                    dynamic_a: true,
-                    dynamic_b: true,
-                },
-                frames: JointFrames {
-                    anchor_a: GVec3::new(0.05, 0.1, 0.0),
-                    anchor_b: GVec3::new(-0.05, -0.1, 0.0),
-                    frame_a: GQuat::IDENTITY,
-                    frame_b: GQuat::from_rotation_z(0.3),
-                },
+                pair: PairLane::dynamic(body_a, body_b),
+                frames: frames(),
                 swing_max: 0.2,
                 twist: [-0.1, 0.1],
                 drive: drive.then_some(DriveLane {
@@ -319,18 +320,8 @@ impl HingeWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = HingeLane {
-                pair: PairLane {
-                    body_a,
-                    body_b,
-                    dynamic_a: true,
-                    dynamic_b: true,
-                },
-                frames: JointFrames {
-                    anchor_a: GVec3::new(0.05, 0.1, 0.0),
-                    anchor_b: GVec3::new(-0.05, -0.1, 0.0),
-                    frame_a: GQuat::IDENTITY,
-                    frame_b: GQuat::from_rotation_z(0.3),
-                },
+                pair: PairLane::dynamic(body_a, body_b),
+                frames: frames(),
                 range: [0.0, 0.05],
                 softness: vertebra_kernels::limited::LimitLane::HARD,
                 drive: None,
@@ -376,18 +367,8 @@ impl FixedWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = FixedLane {
-                pair: PairLane {
-                    body_a,
-                    body_b,
-                    dynamic_a: true,
-                    dynamic_b: true,
-                },
-                frames: JointFrames {
-                    anchor_a: GVec3::new(0.05, 0.1, 0.0),
-                    anchor_b: GVec3::new(-0.05, -0.1, 0.0),
-                    frame_a: GQuat::IDENTITY,
-                    frame_b: GQuat::from_rotation_z(0.3),
-                },
+                pair: PairLane::dynamic(body_a, body_b),
+                frames: frames(),
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }
@@ -430,12 +411,7 @@ impl RodWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = RodLane {
-                pair: PairLane {
-                    body_a,
-                    body_b,
-                    dynamic_a: true,
-                    dynamic_b: true,
-                },
+                pair: PairLane::dynamic(body_a, body_b),
                 frame_a: GQuat::from_rotation_z(0.1),
                 frame_b: GQuat::from_rotation_z(0.5),
                 rest_length: 0.12,
@@ -497,12 +473,7 @@ impl ContactWorkload {
         for k in 0..blocks * BLOCK_LANES {
             let (body_a, body_b) = placement.bodies(k, blocks * BLOCK_LANES * 2);
             let lane = ContactLane {
-                pair: PairLane {
-                    body_a,
-                    body_b,
-                    dynamic_a: true,
-                    dynamic_b: true,
-                },
+                pair: PairLane::dynamic(body_a, body_b),
                 point_a: GVec3::new(0.05, 0.12, 0.0),
                 point_b: GVec3::new(-0.04, -0.13, 0.01),
                 normal: GVec3::new(0.1, 1.0, 0.05).normalize(),

@@ -348,6 +348,16 @@ impl PairLane {
         dynamic_a: false,
         dynamic_b: false,
     };
+
+    /// The pair of rows `body_a` and `body_b`, both dynamic (both written).
+    pub const fn dynamic(body_a: u32, body_b: u32) -> Self {
+        Self {
+            body_a,
+            body_b,
+            dynamic_a: true,
+            dynamic_b: true,
+        }
+    }
 }
 
 /// Where a joint sits on its two bodies (one lane): an anchor on each

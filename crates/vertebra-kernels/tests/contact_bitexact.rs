@@ -3,9 +3,7 @@
 
 mod common;
 
-use common::{
-    RawRows, agree_over_seeds, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat, vec,
-};
+use common::{RawRows, agree_over_seeds, flatten, lane_bodies, rows, to_rows, unit_quat, vec};
 use glam::Vec3;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -37,12 +35,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<ContactBl
             block.set(
                 lane,
                 &ContactLane {
-                    pair: PairLane {
-                        body_a,
-                        body_b,
-                        dynamic_a: dynamic(&rows, body_a),
-                        dynamic_b: dynamic(&rows, body_b),
-                    },
+                    pair: common::pair(&rows, body_a, body_b),
                     point_a,
                     point_b,
                     normal,

@@ -3,13 +3,11 @@
 
 mod common;
 
-use common::{
-    RawRows, agree_over_seeds, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat, vec,
-};
+use common::{RawRows, agree_over_seeds, flatten, lane_bodies, rows, to_rows, unit_quat, vec};
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::body::{JointFrames, LaneBlock, PairLane};
+use vertebra_kernels::body::{JointFrames, LaneBlock};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
@@ -136,12 +134,7 @@ fn hinges(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<HingeBlo
             block.set(
                 lane,
                 &HingeLane {
-                    pair: PairLane {
-                        body_a: j.body_a,
-                        body_b: j.body_b,
-                        dynamic_a: dynamic(&rows, j.body_a),
-                        dynamic_b: dynamic(&rows, j.body_b),
-                    },
+                    pair: common::pair(&rows, j.body_a, j.body_b),
                     frames: JointFrames {
                         anchor_a: j.anchor_a,
                         anchor_b: j.anchor_b,
@@ -188,12 +181,7 @@ fn fixed_joints(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<Fi
             block.set(
                 lane,
                 &FixedLane {
-                    pair: PairLane {
-                        body_a: j.body_a,
-                        body_b: j.body_b,
-                        dynamic_a: dynamic(&rows, j.body_a),
-                        dynamic_b: dynamic(&rows, j.body_b),
-                    },
+                    pair: common::pair(&rows, j.body_a, j.body_b),
                     frames: JointFrames {
                         anchor_a: j.anchor_a,
                         anchor_b: j.anchor_b,

@@ -10,7 +10,7 @@ use common::{RawRows, agree_over_seeds, dynamic, flatten, lane_bodies, rows, to_
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::body::{LaneBlock, PairLane};
+use vertebra_kernels::body::LaneBlock;
 use vertebra_kernels::residual::ResidualPass;
 use vertebra_kernels::rod::{PositionPass, RodBlock, RodLane, RodSoftness, StartPass};
 use vertebra_math::Backend;
@@ -128,12 +128,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<RodBlock>
             block.set(
                 lane,
                 &RodLane {
-                    pair: PairLane {
-                        body_a,
-                        body_b,
-                        dynamic_a: dynamic(&rows, body_a),
-                        dynamic_b: dynamic(&rows, body_b),
-                    },
+                    pair: common::pair(&rows, body_a, body_b),
                     frame_a,
                     frame_b,
                     rest_length: if adversarial && r.random_bool(0.1) {

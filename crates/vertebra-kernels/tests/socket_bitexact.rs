@@ -4,13 +4,11 @@
 
 mod common;
 
-use common::{
-    RawRows, agree_over_seeds, dynamic, flatten, lane_bodies, rows, to_rows, unit_quat, vec,
-};
+use common::{RawRows, agree_over_seeds, flatten, lane_bodies, rows, to_rows, unit_quat, vec};
 use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use vertebra_kernels::body::{JointFrames, LaneBlock, PairLane};
+use vertebra_kernels::body::{JointFrames, LaneBlock};
 use vertebra_kernels::driven::{DriveLane, StartPass};
 use vertebra_kernels::limited;
 use vertebra_kernels::residual::ResidualPass;
@@ -73,12 +71,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
             block.set(
                 lane,
                 &SocketLane {
-                    pair: PairLane {
-                        body_a,
-                        body_b,
-                        dynamic_a: dynamic(&rows, body_a),
-                        dynamic_b: dynamic(&rows, body_b),
-                    },
+                    pair: common::pair(&rows, body_a, body_b),
                     frames: JointFrames {
                         anchor_a,
                         anchor_b,

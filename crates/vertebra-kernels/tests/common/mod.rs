@@ -4,7 +4,7 @@
 use glam::{Mat3, Quat, Vec3};
 use rand::RngExt;
 use rand::rngs::StdRng;
-use vertebra_kernels::body::{BodyRows, StartLane};
+use vertebra_kernels::body::{BodyRows, PairLane, StartLane};
 use vertebra_kernels::limited::LimitLane;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::check::same_bits;
@@ -89,6 +89,17 @@ pub fn lane_bodies(r: &mut StdRng, rows: &RawRows, lane: usize, statics: usize) 
 /// Whether a row's body is dynamic.
 pub fn dynamic(rows: &RawRows, row: u32) -> bool {
     rows[row as usize][0][3] > 0.0
+}
+
+/// The lane header of a constraint between rows `a` and `b`, each written
+/// where its body is dynamic.
+pub fn pair(rows: &RawRows, a: u32, b: u32) -> PairLane {
+    PairLane {
+        body_a: a,
+        body_b: b,
+        dynamic_a: dynamic(rows, a),
+        dynamic_b: dynamic(rows, b),
+    }
 }
 
 pub fn to_rows(raw: &RawRows) -> BodyRows {
