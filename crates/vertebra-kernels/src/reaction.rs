@@ -18,7 +18,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3 as GVec3;
 use vertebra_math::block::Vec3Block;
-use vertebra_math::{Lane, Vec3};
+use vertebra_math::{Lane, Quat, Vec3};
 
 use crate::body::{BodyLanes, safe_ratio};
 
@@ -57,10 +57,13 @@ impl ReactionBlock {
         after: (&BodyLanes<L>, &BodyLanes<L>),
     ) {
         let moves_b = after.1.inv_mass.gt(L::splat(0.0));
-        let (pa, ta) = moved(before.0, after.0);
-        let (pb, tb) = moved(before.1, after.1);
-        let impulse = Vec3::select(moves_b, pb, -pa);
-        let turn = Vec3::select(moves_b, tb, ta);
+        let measured = |(a, b): (&BodyLanes<L>, &BodyLanes<L>)| Pose {
+            p: Vec3::select(moves_b, b.p, a.p),
+            q: Quat::select(moves_b, b.q, a.q),
+            inv_mass: L::select(moves_b, b.inv_mass, a.inv_mass),
+        };
+        let (p, turn) = moved(&measured(before), &measured(after));
+        let impulse = Vec3::select(moves_b, p, -p);
         let sum = self.impulse.load::<L>(start) + impulse;
         self.impulse.store(start, sum);
         let sum = self.turn.load::<L>(start) + turn;
@@ -68,11 +71,18 @@ impl ReactionBlock {
     }
 }
 
+/// The measured body's pose, per lane: `b`'s where it moves, else `a`'s.
+struct Pose<L: Lane> {
+    p: Vec3<L>,
+    q: Quat<L>,
+    inv_mass: L,
+}
+
 /// A body's change between two poses as a positional impulse (`m dp`, kg
 /// m; 0 for a body that does not move) and a world turn (`2 vec(q'
 /// q*)`, rad, the shorter way).
 #[inline(always)]
-fn moved<L: Lane>(from: &BodyLanes<L>, to: &BodyLanes<L>) -> (Vec3<L>, Vec3<L>) {
+fn moved<L: Lane>(from: &Pose<L>, to: &Pose<L>) -> (Vec3<L>, Vec3<L>) {
     let dp = to.p - from.p;
     let impulse = Vec3::new(
         safe_ratio(dp.x, to.inv_mass),
