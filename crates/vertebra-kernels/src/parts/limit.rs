@@ -95,7 +95,7 @@ pub fn solve_local<L: Lane>(
     lambda: L,
 ) -> L {
     let (s_a, s_b) = (a.inv_inertia.mul_vec(n_a), b.inv_inertia.mul_vec(n_b));
-    let dlambda = step(n_a.dot(s_a) + n_b.dot(s_b), (c, c0), soft, lambda);
+    let dlambda = multiplier_change(n_a.dot(s_a) + n_b.dot(s_b), (c, c0), soft, lambda);
     angle::apply_local(a, b, (s_a, s_b), dlambda);
     lambda + dlambda
 }
@@ -103,7 +103,7 @@ pub fn solve_local<L: Lane>(
 /// `dlambda` for the generalised inverse mass `w` (the module
 /// documentation's step).
 #[inline(always)]
-fn step<L: Lane>(w: L, (c, c0): (L, L), soft: Softness<L>, lambda: L) -> L {
+fn multiplier_change<L: Lane>(w: L, (c, c0): (L, L), soft: Softness<L>, lambda: L) -> L {
     let zero = L::splat(0.0);
     let active = c.gt(zero);
     let held = L::select(active, lambda, zero);
