@@ -154,6 +154,12 @@ pub struct BodyState {
 
 /// Bodies as structure of arrays. Index `i` of every array belongs to the
 /// body whose handle has slot `i`; freed slots keep stale data until reused.
+///
+/// The columns are public to be read in bulk, as a renderer or a game's
+/// own systems read a structure of arrays. A world hands out its store
+/// only as `&BodyStore`: its bodies change through the world's calls,
+/// which check what they are given. A store of one's own can be written
+/// freely and is checked whole by [`BodyStore::validate`].
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct BodyStore {
     slots: Slots,
