@@ -7,8 +7,9 @@ use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::driven::DriveLane;
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
+use vertebra_kernels::pass::{SubstepScale, run};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
-use vertebra_kernels::socket::{PositionPass, ShapedLimits, SocketBlock, SocketLane};
+use vertebra_kernels::socket::{self, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::map::{LaneMap, map_arrays};
 use vertebra_math::{Backend, BackendChoice, Lane, Quat, Vec3, poly};
@@ -267,34 +268,21 @@ impl SocketWorkload {
     }
 }
 
+/// The substep scales the joint workloads iterate at: a 60 Hz substep.
+const SCALE: SubstepScale = SubstepScale {
+    inv_h: 60.0,
+    inv_h2: 3600.0,
+};
+
 impl ConstraintWorkload for SocketWorkload {
     fn iterate(&mut self) {
         let (blocks, rows) = (&mut self.blocks, &self.rows);
+        let b = self.backend;
         match (self.drive, self.shaped) {
-            (true, false) => self.backend.dispatch(PositionPass::<true, false> {
-                blocks,
-                rows,
-                inv_h: 60.0,
-                inv_h2: 3600.0,
-            }),
-            (false, false) => self.backend.dispatch(PositionPass::<false, false> {
-                blocks,
-                rows,
-                inv_h: 60.0,
-                inv_h2: 3600.0,
-            }),
-            (true, true) => self.backend.dispatch(PositionPass::<true, true> {
-                blocks,
-                rows,
-                inv_h: 60.0,
-                inv_h2: 3600.0,
-            }),
-            (false, true) => self.backend.dispatch(PositionPass::<false, true> {
-                blocks,
-                rows,
-                inv_h: 60.0,
-                inv_h2: 3600.0,
-            }),
+            (true, false) => run::<socket::Positions<true, false>>(b, blocks, rows, SCALE),
+            (false, false) => run::<socket::Positions<false, false>>(b, blocks, rows, SCALE),
+            (true, true) => run::<socket::Positions<true, true>>(b, blocks, rows, SCALE),
+            (false, true) => run::<socket::Positions<false, true>>(b, blocks, rows, SCALE),
         }
     }
     fn probe(&self) -> f32 {
@@ -338,12 +326,8 @@ impl HingeWorkload {
 
 impl ConstraintWorkload for HingeWorkload {
     fn iterate(&mut self) {
-        self.backend.dispatch(hinge::PositionPass::<false> {
-            blocks: &mut self.blocks,
-            rows: &self.rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
+        let (blocks, rows) = (&mut self.blocks, &self.rows);
+        run::<hinge::Positions<false>>(self.backend, blocks, rows, SCALE);
     }
     fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]
@@ -382,10 +366,7 @@ impl FixedWorkload {
 
 impl ConstraintWorkload for FixedWorkload {
     fn iterate(&mut self) {
-        self.backend.dispatch(fixed::PositionPass {
-            blocks: &mut self.blocks,
-            rows: &self.rows,
-        });
+        run::<fixed::Positions>(self.backend, &mut self.blocks, &self.rows, ());
     }
     fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]
@@ -443,12 +424,7 @@ impl RodWorkload {
 impl ConstraintWorkload for RodWorkload {
     fn iterate(&mut self) {
         let (blocks, rows) = (&mut self.blocks, &self.rows);
-        self.backend.dispatch(rod::PositionPass {
-            blocks,
-            rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
+        run::<rod::Positions>(self.backend, blocks, rows, SCALE);
     }
     fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]
@@ -501,8 +477,7 @@ impl ContactWorkload {
 impl ConstraintWorkload for ContactWorkload {
     fn iterate(&mut self) {
         let (blocks, rows) = (&mut self.blocks, &self.rows);
-        self.backend
-            .dispatch(contact::PositionPass { blocks, rows });
+        run::<contact::Positions>(self.backend, blocks, rows, ());
     }
     fn probe(&self) -> f32 {
         self.rows.pose[1].get()[0]

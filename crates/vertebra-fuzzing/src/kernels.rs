@@ -7,10 +7,11 @@ use glam::{Mat3, Vec3};
 use vertebra_kernels::body::{BodyRows, JointFrames, LaneBlock, PairLane, StartLane};
 use vertebra_kernels::contact::{self, ContactBlock, ContactLane};
 use vertebra_kernels::direct::{self, JointLane, JointRows, SwingRows, Topology, TreeBlock};
-use vertebra_kernels::driven::{DriveLane, StartPass};
+use vertebra_kernels::driven::{self, DriveLane};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
 use vertebra_kernels::limited::{self, LimitLane};
+use vertebra_kernels::pass::{self, SubstepScale};
 use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_kernels::socket::{self, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::Backend;
@@ -376,63 +377,23 @@ fn run(
     let (mut sockets, mut rods, mut contacts) = ([blocks.0], [blocks.1], [blocks.2]);
     let (mut hinges, mut fixed) = ([blocks.3], [blocks.4]);
     let h = 1.0 / inv_h2.sqrt();
-    backend.dispatch(StartPass {
-        blocks: &mut sockets,
-        rows: &rows,
-        h,
-    });
-    backend.dispatch(StartPass {
-        blocks: &mut hinges,
-        rows: &rows,
-        h,
-    });
+    let scale = SubstepScale {
+        inv_h: inv_h2.sqrt(),
+        inv_h2,
+    };
+    pass::run::<driven::Starts<SocketBlock>>(backend, &mut sockets, &rows, h);
+    pass::run::<driven::Starts<HingeBlock>>(backend, &mut hinges, &rows, h);
     // The limits' start before the plain pass moves the bodies: the shaped
     // path's damping then sees a nonzero `C - C_0`.
-    backend.dispatch(limited::StartPass {
-        blocks: &mut sockets,
-        rows: &rows,
-    });
-    backend.dispatch(limited::StartPass {
-        blocks: &mut hinges,
-        rows: &rows,
-    });
-    backend.dispatch(socket::PositionPass::<true, false> {
-        blocks: &mut sockets,
-        rows: &rows,
-        inv_h: inv_h2.sqrt(),
-        inv_h2,
-    });
-    backend.dispatch(socket::PositionPass::<true, true> {
-        blocks: &mut sockets,
-        rows: &rows,
-        inv_h: inv_h2.sqrt(),
-        inv_h2,
-    });
-    backend.dispatch(hinge::PositionPass::<true> {
-        blocks: &mut hinges,
-        rows: &rows,
-        inv_h: inv_h2.sqrt(),
-        inv_h2,
-    });
-    backend.dispatch(fixed::PositionPass {
-        blocks: &mut fixed,
-        rows: &rows,
-    });
-    backend.dispatch(rod::StartPass {
-        blocks: &mut rods,
-        rows: &rows,
-        h,
-    });
-    backend.dispatch(rod::PositionPass {
-        blocks: &mut rods,
-        rows: &rows,
-        inv_h: inv_h2.sqrt(),
-        inv_h2,
-    });
-    backend.dispatch(contact::PositionPass {
-        blocks: &mut contacts,
-        rows: &rows,
-    });
+    pass::run::<limited::Starts<SocketBlock>>(backend, &mut sockets, &rows, ());
+    pass::run::<limited::Starts<HingeBlock>>(backend, &mut hinges, &rows, ());
+    pass::run::<socket::Positions<true, false>>(backend, &mut sockets, &rows, scale);
+    pass::run::<socket::Positions<true, true>>(backend, &mut sockets, &rows, scale);
+    pass::run::<hinge::Positions<true>>(backend, &mut hinges, &rows, scale);
+    pass::run::<fixed::Positions>(backend, &mut fixed, &rows, ());
+    pass::run::<rod::Starts>(backend, &mut rods, &rows, h);
+    pass::run::<rod::Positions>(backend, &mut rods, &rows, scale);
+    pass::run::<contact::Positions>(backend, &mut contacts, &rows, ());
     let mut trees = [tree.clone()];
     backend.dispatch(direct::StartPass {
         blocks: &mut trees,
@@ -443,10 +404,7 @@ fn run(
         blocks: &mut trees,
         topologies: core::slice::from_ref(topology),
         rows: &rows,
-        scale: direct::SubstepScale {
-            inv_h: inv_h2.sqrt(),
-            inv_h2,
-        },
+        scale,
         passes: direct::MAX_PASSES,
     }
     .run(backend);

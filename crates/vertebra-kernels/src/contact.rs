@@ -37,7 +37,7 @@
 //!   pull), where `v_approach` is its value when the contact was made; below
 //!   `2 |g| h` of approach the target is 0, so resting contacts do not
 //!   jitter (Müller eq. 34).
-//! - **Relax** (a setting: [`VelocityPass`] with `relax`, run a few times after the
+//! - **Relax** (a setting: [`Velocities`] with `relax`, run a few times after the
 //!   velocity pass): the normal relative velocity is brought to the same
 //!   target from either side, with an accumulated impulse
 //!   `lambda_v >= -lambda_n / h`: it may take back at most the impulse
@@ -54,13 +54,14 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3 as GVec3;
-use vertebra_math::block::{BLOCK_LANES, LaneSlices, Vec3Block, for_live_slices};
-use vertebra_math::{Lane, LaneKernel, Vec3};
+use vertebra_math::block::{BLOCK_LANES, Vec3Block};
+use vertebra_math::{Lane, Vec3};
 
 use crate::body::{
     BodyLanes, BodyPairs, BodyRows, LaneBlock, PairLane, StartLane, VelocityLanes, safe_ratio,
 };
 use crate::parts::point;
+use crate::pass::BlockKernel;
 
 /// Eight contacts, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -263,40 +264,20 @@ fn push<L: Lane>(
     a.apply_impulse(ra, -impulse);
 }
 
-/// One XPBD iteration over contact blocks: non-penetration, then static
-/// friction.
-pub struct PositionPass<'a> {
-    /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a mut [ContactBlock],
-    /// Body rows, read and written.
-    pub rows: &'a BodyRows,
-}
+/// One XPBD iteration of contacts (a [`BlockPass`](crate::pass::BlockPass)
+/// over [`ContactBlock`]s): non-penetration, then static friction.
+pub struct Positions;
 
-impl LaneKernel for PositionPass<'_> {
-    type Output = ();
+impl BlockKernel for Positions {
+    type Block = ContactBlock;
+    type Params = ();
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies.padding;
-            let mut positions = Positions {
-                block,
-                rows: self.rows,
-            };
-            for_live_slices::<L, _>(padding, &mut positions);
-        }
+    fn padding(block: &ContactBlock) -> u32 {
+        block.bodies.padding
     }
-}
-
-/// One block of a [`PositionPass`].
-struct Positions<'a> {
-    block: &'a mut ContactBlock,
-    rows: &'a BodyRows,
-}
-
-impl LaneSlices for Positions<'_> {
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        solve_positions::<L>(self.block, start, self.rows);
+    fn solve<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyRows, (): ()) {
+        solve_positions::<L>(block, start, rows);
     }
 }
 
@@ -334,16 +315,18 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
     block.bodies.scatter(rows, start, &a, &b);
 }
 
-/// A velocity pass over the contacts: dynamic friction and restitution,
-/// or with `relax` a relax pass (module docs, "Relax"): each touching
-/// contact's normal velocity brought to its target, taking back at most
-/// its push-out.
-pub struct VelocityPass<'a> {
-    /// The blocks (a relax pass accumulates `lambda_v` in them; both
-    /// passes add their impulses to `kicked_n` and `kicked_t`).
-    pub blocks: &'a mut [ContactBlock],
-    /// Body rows: poses and inertia read, velocities read and written.
-    pub rows: &'a BodyRows,
+/// A velocity pass over the contacts (a [`BlockPass`](crate::pass::BlockPass)
+/// over [`ContactBlock`]s): dynamic friction and restitution, or with
+/// [`VelocitySettings::relax`] a relax pass (module docs, "Relax"): each
+/// touching contact's normal velocity brought to its target, taking back
+/// at most its push-out. A relax pass accumulates `lambda_v` in the
+/// blocks; both add their impulses to `kicked_n` and `kicked_t`. Body
+/// rows: poses and inertia read, velocities read and written.
+pub struct Velocities;
+
+/// What every block of a velocity pass shares.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VelocitySettings {
     /// The substep `h` (s).
     pub h: f32,
     /// Approach speeds below this bounce not at all (m/s): `2 |g| h`.
@@ -352,41 +335,25 @@ pub struct VelocityPass<'a> {
     pub relax: bool,
 }
 
-impl LaneKernel for VelocityPass<'_> {
-    type Output = ();
+impl BlockKernel for Velocities {
+    type Block = ContactBlock;
+    type Params = VelocitySettings;
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies.padding;
-            let mut velocities = Velocities {
-                block,
-                rows: self.rows,
-                h: self.h,
-                resting_speed: self.resting_speed,
-                relax: self.relax,
-            };
-            for_live_slices::<L, _>(padding, &mut velocities);
-        }
+    fn padding(block: &ContactBlock) -> u32 {
+        block.bodies.padding
     }
-}
-
-/// One block of a [`VelocityPass`].
-struct Velocities<'a> {
-    block: &'a mut ContactBlock,
-    rows: &'a BodyRows,
-    h: f32,
-    resting_speed: f32,
-    relax: bool,
-}
-
-impl LaneSlices for Velocities<'_> {
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let (h, resting_speed) = (L::splat(self.h), L::splat(self.resting_speed));
-        if self.relax {
-            relax::<L>(self.block, start, self.rows, h, resting_speed);
+    fn solve<L: Lane>(
+        block: &mut ContactBlock,
+        start: usize,
+        rows: &BodyRows,
+        v: VelocitySettings,
+    ) {
+        let (h, resting_speed) = (L::splat(v.h), L::splat(v.resting_speed));
+        if v.relax {
+            relax::<L>(block, start, rows, h, resting_speed);
         } else {
-            solve_velocities::<L>(self.block, start, self.rows, h, resting_speed);
+            solve_velocities::<L>(block, start, rows, h, resting_speed);
         }
     }
 }

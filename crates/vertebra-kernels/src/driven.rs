@@ -1,22 +1,25 @@
 //! The angular drive as a block of eight lanes, embedded by every joint
 //! block that can be driven (sockets and hinges), and the drives' substep
-//! start ([`StartPass`]) written once for all of them. The drive's physics
+//! start ([`Starts`]) written once for all of them. The drive's physics
 //! is `parts::drive`.
+
+use core::marker::PhantomData;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
-use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
-use vertebra_math::{Lane, LaneKernel, Quat};
+use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::{Lane, Quat};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::parts::drive;
+use crate::pass::BlockKernel;
 
 /// Eight drives, field by field.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 #[repr(C, align(32))]
 pub struct DriveBlock {
     /// Target of the current substep: b's joint frame relative to a's
-    /// (advanced by [`StartPass`] every substep).
+    /// (advanced by [`Starts`] every substep).
     pub target: QuatBlock,
     /// Target angular velocity (rad/s, a's joint frame).
     pub velocity: Vec3Block,
@@ -34,7 +37,7 @@ pub struct DriveBlock {
     /// The accumulated XPBD multiplier (world vector), reset every substep.
     pub lambda: Vec3Block,
     /// The error at the substep's start (rad, world), measured by
-    /// [`StartPass`].
+    /// [`Starts`].
     pub start: Vec3Block,
 }
 
@@ -118,7 +121,7 @@ impl DriveBlock {
     }
 }
 
-/// A block of joints that embeds drives: what [`StartPass`] needs of it.
+/// A block of joints that embeds drives: what [`Starts`] needs of it.
 pub trait Driven {
     /// The lanes' bodies.
     fn bodies(&self) -> &BodyPairs;
@@ -128,47 +131,23 @@ pub trait Driven {
     fn drive_mut(&mut self) -> &mut DriveBlock;
 }
 
-/// The drives' substep start (before the bodies are predicted): each
-/// error measured against the last substep's target, then the target
-/// advanced by `h` at its angular velocity (`parts::drive`). Only driven
-/// blocks need it.
-pub struct StartPass<'a, B> {
-    /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a mut [B],
-    /// Body rows, read.
-    pub rows: &'a BodyRows,
-    /// The substep (s).
-    pub h: f32,
-}
+/// The drives' substep start (before the bodies are predicted; a
+/// [`BlockPass`](crate::pass::BlockPass) over `B`s, its parameter the
+/// substep `h`, s): each error measured against the last substep's
+/// target, then the target advanced by `h` at its angular velocity
+/// (`parts::drive`). Only driven blocks need it.
+pub struct Starts<B>(PhantomData<fn() -> B>);
 
-impl<B: Driven> LaneKernel for StartPass<'_, B> {
-    type Output = ();
+impl<B: Driven> BlockKernel for Starts<B> {
+    type Block = B;
+    type Params = f32;
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies().padding;
-            let mut starts = Starts {
-                block,
-                rows: self.rows,
-                h: self.h,
-            };
-            for_live_slices::<L, _>(padding, &mut starts);
-        }
+    fn padding(block: &B) -> u32 {
+        block.bodies().padding
     }
-}
-
-/// One block of a [`StartPass`].
-struct Starts<'a, B> {
-    block: &'a mut B,
-    rows: &'a BodyRows,
-    h: f32,
-}
-
-impl<B: Driven> LaneSlices for Starts<'_, B> {
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let block = &mut *self.block;
-        let (a, b) = block.bodies().gather::<L>(self.rows, start);
+    fn solve<L: Lane>(block: &mut B, start: usize, rows: &BodyRows, h: f32) {
+        let (a, b) = block.bodies().gather::<L>(rows, start);
         let (frame_a, frame_b) = block.frames::<L>(start);
         let d = block.drive_mut();
         let target = d.target.load::<L>(start);
@@ -177,6 +156,6 @@ impl<B: Driven> LaneSlices for Starts<'_, B> {
         d.start.store(start, error);
         let velocity = d.velocity.load(start);
         d.target
-            .store(start, drive::advance(target, velocity, L::splat(self.h)));
+            .store(start, drive::advance(target, velocity, L::splat(h)));
     }
 }

@@ -2,11 +2,12 @@
 //! solved together in one lane-generic kernel: two bodies welded.
 
 use bytemuck::{Pod, Zeroable};
-use vertebra_math::block::{LaneSlices, QuatBlock, Vec3Block, for_live_slices};
-use vertebra_math::{Lane, LaneKernel};
+use vertebra_math::Lane;
+use vertebra_math::block::{QuatBlock, Vec3Block};
 
 use crate::body::{BodyPairs, BodyRows, JointFrames, LaneBlock, PairLane};
 use crate::parts::{lock, point};
+use crate::pass::BlockKernel;
 use crate::reaction::ReactionBlock;
 use crate::residual::{Measured, Residual};
 
@@ -57,45 +58,27 @@ impl LaneBlock for FixedBlock {
 
 impl FixedBlock {}
 
-/// One XPBD iteration over `blocks`: the lock, then the point (last, as
-/// for every joint).
-pub struct PositionPass<'a> {
-    /// The blocks to solve (one colour's, or the overflow set).
-    pub blocks: &'a mut [FixedBlock],
-    /// Body rows, read and written.
-    pub rows: &'a BodyRows,
-}
+/// One XPBD iteration of fixed joints (a [`BlockPass`](crate::pass::BlockPass)
+/// over [`FixedBlock`]s): the lock, then the point (last, as for every
+/// joint).
+pub struct Positions;
 
-impl LaneKernel for PositionPass<'_> {
-    type Output = ();
+impl BlockKernel for Positions {
+    type Block = FixedBlock;
+    type Params = ();
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        // A fixed joint is all equality: a block the direct solve holds
-        // has nothing left to iterate.
-        for block in self.blocks.iter_mut() {
-            if block.bodies.direct != 0 {
-                continue;
-            }
-            let padding = block.bodies.padding;
-            let mut positions = Positions {
-                block,
-                rows: self.rows,
-            };
-            for_live_slices::<L, _>(padding, &mut positions);
-        }
+    fn padding(block: &FixedBlock) -> u32 {
+        block.bodies.padding
     }
-}
-
-/// One block of a [`PositionPass`].
-struct Positions<'a> {
-    block: &'a mut FixedBlock,
-    rows: &'a BodyRows,
-}
-
-impl LaneSlices for Positions<'_> {
+    /// A fixed joint is all equality: a block the direct solve holds has
+    /// nothing left to iterate.
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        solve_positions::<L>(self.block, start, self.rows);
+    fn skips(block: &FixedBlock) -> bool {
+        block.bodies.direct != 0
+    }
+    #[inline(always)]
+    fn solve<L: Lane>(block: &mut FixedBlock, start: usize, rows: &BodyRows, (): ()) {
+        solve_positions::<L>(block, start, rows);
     }
 }
 

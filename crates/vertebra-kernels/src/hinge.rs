@@ -13,13 +13,14 @@
 //! substep start.
 
 use bytemuck::{Pod, Zeroable};
-use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
-use vertebra_math::{Lane, LaneKernel, Quat};
+use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::{Lane, Quat};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows, JointFrames, LaneBlock, PairLane};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{hinge_axis, limit, point, swing, twist};
+use crate::pass::{BlockKernel, SubstepScale};
 use crate::reaction::ReactionBlock;
 use crate::residual::{Measured, Residual};
 
@@ -47,7 +48,7 @@ pub struct HingeBlock {
     /// The range's accumulated multiplier (N m s^2), reset every substep.
     pub limit_lambda: [f32; BLOCK_LANES],
     /// The range's violation at the substep's start (rad; the damping's
-    /// `C_0`), measured by [`crate::limited::StartPass`].
+    /// `C_0`), measured by [`crate::limited::Starts`].
     pub limit_start: [f32; BLOCK_LANES],
     /// The angular drives.
     pub drive: DriveBlock,
@@ -133,51 +134,23 @@ impl Limited for HingeBlock {
     }
 }
 
-/// One XPBD iteration over `blocks`: every hinge's parts, in the order
-/// drive, hinge axis, range, point (the point last, as for the socket).
-/// `DRIVE` says whether the blocks' hinges have drives (the layout keeps
-/// driven and plain hinges apart).
-pub struct PositionPass<'a, const DRIVE: bool> {
-    /// The blocks to solve (one colour's, or the overflow set).
-    pub blocks: &'a mut [HingeBlock],
-    /// Body rows, read and written.
-    pub rows: &'a BodyRows,
-    /// `1 / h` for the substep `h` (s^-1): the drive's `gamma`.
-    pub inv_h: f32,
-    /// `1 / h^2` (s^-2).
-    pub inv_h2: f32,
-}
+/// One XPBD iteration of hinges (a [`BlockPass`](crate::pass::BlockPass) over [`HingeBlock`]s):
+/// every hinge's parts, in the order drive, hinge axis, range, point (the
+/// point last, as for the socket). `DRIVE` says whether the blocks' hinges
+/// have drives (the layout keeps driven and plain hinges apart).
+pub struct Positions<const DRIVE: bool>;
 
-impl<const DRIVE: bool> LaneKernel for PositionPass<'_, DRIVE> {
-    type Output = ();
+impl<const DRIVE: bool> BlockKernel for Positions<DRIVE> {
+    type Block = HingeBlock;
+    type Params = SubstepScale;
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies.padding;
-            let mut positions = Positions::<DRIVE> {
-                block,
-                rows: self.rows,
-                inv_h: self.inv_h,
-                inv_h2: self.inv_h2,
-            };
-            for_live_slices::<L, _>(padding, &mut positions);
-        }
+    fn padding(block: &HingeBlock) -> u32 {
+        block.bodies.padding
     }
-}
-
-/// One block of a [`PositionPass`].
-struct Positions<'a, const DRIVE: bool> {
-    block: &'a mut HingeBlock,
-    rows: &'a BodyRows,
-    inv_h: f32,
-    inv_h2: f32,
-}
-
-impl<const DRIVE: bool> LaneSlices for Positions<'_, DRIVE> {
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
-        solve_positions::<L, DRIVE>(self.block, start, self.rows, inv_h, inv_h2);
+    fn solve<L: Lane>(block: &mut HingeBlock, start: usize, rows: &BodyRows, s: SubstepScale) {
+        let (inv_h, inv_h2) = (L::splat(s.inv_h), L::splat(s.inv_h2));
+        solve_positions::<L, DRIVE>(block, start, rows, inv_h, inv_h2);
     }
 }
 

@@ -15,6 +15,8 @@
 //! - [`limited`]: soft limits' settings and their substep start pass.
 //! - [`contact`]: contacts: non-penetration and static friction at the
 //!   position level, dynamic friction and restitution at the velocity level.
+//! - [`pass`]: one pass over any kernel's blocks ([`pass::BlockPass`]), each
+//!   kernel a [`pass::BlockKernel`]: its block, what a pass shares, one slice.
 //! - [`residual`]: one pass that measures any joint block's residual error.
 //! - [`rod`]: the paper's rod constraint: curve, length, bending, twisting
 //!   and limits in one kernel, its lane block and its residual.
@@ -30,6 +32,7 @@ pub mod fixed;
 pub mod hinge;
 pub mod limited;
 pub mod parts;
+pub mod pass;
 pub mod reaction;
 pub mod residual;
 pub mod rod;

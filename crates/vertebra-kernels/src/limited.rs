@@ -1,14 +1,17 @@
 //! Soft limits' settings as blocks hold them, and the limits' substep
-//! start ([`StartPass`]): each limit's violation `C_0` measured before the
+//! start ([`Starts`]): each limit's violation `C_0` measured before the
 //! bodies are predicted, which a damped limit's correction
 //! (`parts::limit`) measures its rate against. Run on the blocks that can
 //! hold soft limits: the socket's shaped path and the hinge.
 
-use vertebra_math::block::{BLOCK_LANES, LaneSlices, for_live_slices};
-use vertebra_math::{Lane, LaneKernel};
+use core::marker::PhantomData;
+
+use vertebra_math::Lane;
+use vertebra_math::block::BLOCK_LANES;
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::parts::limit::Softness;
+use crate::pass::BlockKernel;
 
 /// One joint's limit softness (one lane; see `parts::limit`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,7 +76,7 @@ impl SoftnessBlock {
     }
 }
 
-/// A block of joints with soft-capable limits: what [`StartPass`] needs.
+/// A block of joints with soft-capable limits: what [`Starts`] needs.
 pub trait Limited {
     /// The lanes' bodies.
     fn bodies(&self) -> &BodyPairs;
@@ -82,40 +85,21 @@ pub trait Limited {
     fn start_limits<L: Lane>(&mut self, start: usize, a: &BodyLanes<L>, b: &BodyLanes<L>);
 }
 
-/// The limits' substep start (before the bodies are predicted): every
-/// limit's violation, for the damping of the next iterations.
-pub struct StartPass<'a, B> {
-    /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a mut [B],
-    /// Body rows, read.
-    pub rows: &'a BodyRows,
-}
+/// The limits' substep start (before the bodies are predicted; a
+/// [`BlockPass`](crate::pass::BlockPass) over `B`s): every limit's
+/// violation, for the damping of the next iterations.
+pub struct Starts<B>(PhantomData<fn() -> B>);
 
-impl<B: Limited> LaneKernel for StartPass<'_, B> {
-    type Output = ();
+impl<B: Limited> BlockKernel for Starts<B> {
+    type Block = B;
+    type Params = ();
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies().padding;
-            let mut starts = Starts {
-                block,
-                rows: self.rows,
-            };
-            for_live_slices::<L, _>(padding, &mut starts);
-        }
+    fn padding(block: &B) -> u32 {
+        block.bodies().padding
     }
-}
-
-/// One block of a [`StartPass`].
-struct Starts<'a, B> {
-    block: &'a mut B,
-    rows: &'a BodyRows,
-}
-
-impl<B: Limited> LaneSlices for Starts<'_, B> {
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let (a, b) = self.block.bodies().gather::<L>(self.rows, start);
-        self.block.start_limits(start, &a, &b);
+    fn solve<L: Lane>(block: &mut B, start: usize, rows: &BodyRows, (): ()) {
+        let (a, b) = block.bodies().gather::<L>(rows, start);
+        block.start_limits(start, &a, &b);
     }
 }

@@ -5,9 +5,9 @@
 //! parts (paper section 7).
 //!
 //! The soft bend and twist are drives (`parts::rod::drive`): damped
-//! against their error as the substep began ([`StartPass`]), optionally
+//! against their error as the substep began ([`Starts`]), optionally
 //! given by frequency, and capped at a torque. Their rest shape may move:
-//! [`StartPass`] advances it every substep at its rates, as the drives'
+//! [`Starts`] advances it every substep at its rates, as the drives'
 //! start pass advances their targets (`driven.rs`).
 //!
 //! Part order per iteration: soft bend, soft twist, bend limit, twist
@@ -17,14 +17,15 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Quat as GQuat, Vec3 as GVec3};
-use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
-use vertebra_math::{Lane, LaneKernel};
+use vertebra_math::Lane;
+use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
 
 use crate::body::{BodyPairs, BodyRows, LaneBlock, PairLane};
 use crate::parts::angle::Softness;
 use crate::parts::axis_x;
 use crate::parts::rod::drive::{self, Drive};
 use crate::parts::rod::{LocalFrames, bend, curve, frames, length, twist, world_tangents};
+use crate::pass::{BlockKernel, SubstepScale};
 use crate::residual::{Measured, Residual};
 
 /// Eight rods, field by field.
@@ -38,17 +39,17 @@ pub struct RodBlock {
     /// `F_b`: the material frame at b, in b's body frame.
     pub frame_b: QuatBlock,
     /// Rest bend direction of `t_b`, in a's material frame (unit): the
-    /// current substep's ([`StartPass`] advances it).
+    /// current substep's ([`Starts`] advances it).
     pub bend_rest: Vec3Block,
     /// Rest length `l0` (m).
     pub rest_length: [f32; BLOCK_LANES],
-    /// Rest twist (rad): the current substep's ([`StartPass`] advances
+    /// Rest twist (rad): the current substep's ([`Starts`] advances
     /// it).
     pub twist_rest: [f32; BLOCK_LANES],
     /// The rest direction's angular velocity (rad/s, a's material frame):
-    /// [`StartPass`] turns `bend_rest` by it every substep.
+    /// [`Starts`] turns `bend_rest` by it every substep.
     pub bend_rest_velocity: Vec3Block,
-    /// The rest twist's rate (rad/s): [`StartPass`] advances `twist_rest`
+    /// The rest twist's rate (rad/s): [`Starts`] advances `twist_rest`
     /// by it every substep.
     pub twist_rest_velocity: [f32; BLOCK_LANES],
     /// Bending compliance `l0 / k_b` (rad / (N m)).
@@ -82,10 +83,10 @@ pub struct RodBlock {
     /// Twisting's accumulated multiplier, reset every substep.
     pub twist_lambda: [f32; BLOCK_LANES],
     /// The bend error `C n` as the substep began (rad, a's body frame, as
-    /// the position pass measures it), measured by [`StartPass`].
+    /// the position pass measures it), measured by [`Starts`].
     pub bend_start: Vec3Block,
     /// The twist error as the substep began (rad), measured by
-    /// [`StartPass`].
+    /// [`Starts`].
     pub twist_start: [f32; BLOCK_LANES],
 }
 
@@ -225,92 +226,43 @@ impl RodBlock {
     }
 }
 
-/// One XPBD iteration over `blocks` of rods.
-pub struct PositionPass<'a> {
-    /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a mut [RodBlock],
-    /// Body rows, read and written.
-    pub rows: &'a BodyRows,
-    /// `1 / h` for the substep `h` (s^-1).
-    pub inv_h: f32,
-    /// `1 / h^2` (s^-2).
-    pub inv_h2: f32,
-}
+/// One XPBD iteration of rods (a [`BlockPass`](crate::pass::BlockPass)
+/// over [`RodBlock`]s).
+pub struct Positions;
 
-impl LaneKernel for PositionPass<'_> {
-    type Output = ();
+impl BlockKernel for Positions {
+    type Block = RodBlock;
+    type Params = SubstepScale;
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies.padding;
-            let mut positions = Positions {
-                block,
-                rows: self.rows,
-                inv_h: self.inv_h,
-                inv_h2: self.inv_h2,
-            };
-            for_live_slices::<L, _>(padding, &mut positions);
-        }
+    fn padding(block: &RodBlock) -> u32 {
+        block.bodies.padding
+    }
+    #[inline(always)]
+    fn solve<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows, s: SubstepScale) {
+        let (inv_h, inv_h2) = (L::splat(s.inv_h), L::splat(s.inv_h2));
+        solve_positions(block, start, rows, inv_h, inv_h2);
     }
 }
 
-/// One block of a [`PositionPass`].
-struct Positions<'a> {
-    block: &'a mut RodBlock,
-    rows: &'a BodyRows,
-    inv_h: f32,
-    inv_h2: f32,
-}
+/// The rods' substep start (a [`BlockPass`](crate::pass::BlockPass) over
+/// [`RodBlock`]s, its parameter the substep `h`, s): the soft parts'
+/// errors as the substep begins, before the bodies move, against the last
+/// substep's rest shape; then the rest shape advanced by `h` at its rates
+/// (every substep, for the damping's rate relative to the rest's:
+/// `parts::rod::drive`, "Moving rest").
+pub struct Starts;
 
-impl LaneSlices for Positions<'_> {
+impl BlockKernel for Starts {
+    type Block = RodBlock;
+    type Params = f32;
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
-        solve_positions(self.block, start, self.rows, inv_h, inv_h2);
+    fn padding(block: &RodBlock) -> u32 {
+        block.bodies.padding
     }
-}
-
-/// The soft parts' errors as the substep begins, before the bodies move,
-/// against the last substep's rest shape; then the rest shape advanced by
-/// `h` at its rates (every substep, for the damping's rate relative to the
-/// rest's: `parts::rod::drive`, "Moving rest").
-pub struct StartPass<'a> {
-    /// The blocks (one colour's, or the overflow set).
-    pub blocks: &'a mut [RodBlock],
-    /// Body rows, read.
-    pub rows: &'a BodyRows,
-    /// The substep (s).
-    pub h: f32,
-}
-
-impl LaneKernel for StartPass<'_> {
-    type Output = ();
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies.padding;
-            let mut starts = Starts {
-                block,
-                rows: self.rows,
-                h: self.h,
-            };
-            for_live_slices::<L, _>(padding, &mut starts);
-        }
-    }
-}
-
-/// One block of a [`StartPass`].
-struct Starts<'a> {
-    block: &'a mut RodBlock,
-    rows: &'a BodyRows,
-    h: f32,
-}
-
-impl LaneSlices for Starts<'_> {
-    #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let (block, h) = (&mut *self.block, L::splat(self.h));
-        let (a, b) = block.bodies.gather::<L>(self.rows, start);
+    fn solve<L: Lane>(block: &mut RodBlock, start: usize, rows: &BodyRows, h: f32) {
+        let h = L::splat(h);
+        let (a, b) = block.bodies.gather::<L>(rows, start);
         let frame_a = block.frame_a.load(start);
         let m = LocalFrames::new(&a, &b, frame_a, block.frame_b.load(start), axis_x(frame_a));
         let bend_rest = block.bend_rest.load(start);

@@ -14,13 +14,14 @@
 //! Padding lanes name the null row and write nothing.
 
 use bytemuck::{Pod, Zeroable};
-use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
-use vertebra_math::{Lane, LaneKernel, Quat, Vec3};
+use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::{Lane, Quat, Vec3};
 
 use crate::body::{BodyLanes, BodyPairs, BodyRows, JointFrames, LaneBlock, PairLane};
 use crate::driven::{DriveBlock, DriveLane, Driven};
 use crate::limited::{LimitLane, Limited, SoftnessBlock};
 use crate::parts::{ellipse, limit, point, pyramid, swing, swing_direction, twist};
+use crate::pass::{BlockKernel, SubstepScale};
 use crate::reaction::ReactionBlock;
 use crate::residual::{Measured, Residual};
 
@@ -61,7 +62,7 @@ pub struct SocketBlock {
     pub limit_softness: SoftnessBlock,
     /// Shaped path: the violations of the ellipse, the pyramid's two angles
     /// and the twist range at the substep's start (the damping's `C_0`),
-    /// measured by [`crate::limited::StartPass`].
+    /// measured by [`crate::limited::Starts`].
     pub limit_start: [[f32; BLOCK_LANES]; 4],
     /// Shaped path: accumulated multipliers of the ellipse, the pyramid's
     /// two angles and the twist range, reset every substep.
@@ -159,54 +160,27 @@ impl SocketBlock {
     }
 }
 
-/// One XPBD iteration over `blocks`: every socket's parts, in the order
-/// drive, swing, twist, point (the point last, so that anchors are closest
-/// at the end of an iteration). `DRIVE` says whether the blocks' sockets
-/// have drives, `SHAPED` whether they take the shaped path: the layout
-/// keeps each combination in its own blocks, so a plain socket never pays
-/// for a drive multiplied by zero or an ellipse that cannot bind, and the
-/// choice is made at compile time, not per lane.
-pub struct PositionPass<'a, const DRIVE: bool, const SHAPED: bool> {
-    /// The blocks to solve (one colour's, or the overflow set).
-    pub blocks: &'a mut [SocketBlock],
-    /// Body rows, read and written.
-    pub rows: &'a BodyRows,
-    /// `1 / h` for the substep `h` (s^-1): the drive's `gamma`.
-    pub inv_h: f32,
-    /// `1 / h^2` for the substep `h` (s^-2): `alpha~ = compliance / h^2`.
-    pub inv_h2: f32,
-}
+/// One XPBD iteration of sockets (a [`BlockPass`](crate::pass::BlockPass) over [`SocketBlock`]s):
+/// every socket's parts, in the order drive, swing, twist, point (the
+/// point last, so that anchors are closest at the end of an iteration).
+/// `DRIVE` says whether the blocks' sockets have drives, `SHAPED` whether
+/// they take the shaped path: the layout keeps each combination in its own
+/// blocks, so a plain socket never pays for a drive multiplied by zero or
+/// an ellipse that cannot bind, and the choice is made at compile time,
+/// not per lane.
+pub struct Positions<const DRIVE: bool, const SHAPED: bool>;
 
-impl<const DRIVE: bool, const SHAPED: bool> LaneKernel for PositionPass<'_, DRIVE, SHAPED> {
-    type Output = ();
+impl<const DRIVE: bool, const SHAPED: bool> BlockKernel for Positions<DRIVE, SHAPED> {
+    type Block = SocketBlock;
+    type Params = SubstepScale;
     #[inline(always)]
-    fn run<L: Lane>(self) {
-        for block in self.blocks.iter_mut() {
-            let padding = block.bodies.padding;
-            let mut positions = Positions::<DRIVE, SHAPED> {
-                block,
-                rows: self.rows,
-                inv_h: self.inv_h,
-                inv_h2: self.inv_h2,
-            };
-            for_live_slices::<L, _>(padding, &mut positions);
-        }
+    fn padding(block: &SocketBlock) -> u32 {
+        block.bodies.padding
     }
-}
-
-/// One block of a [`PositionPass`].
-struct Positions<'a, const DRIVE: bool, const SHAPED: bool> {
-    block: &'a mut SocketBlock,
-    rows: &'a BodyRows,
-    inv_h: f32,
-    inv_h2: f32,
-}
-
-impl<const DRIVE: bool, const SHAPED: bool> LaneSlices for Positions<'_, DRIVE, SHAPED> {
     #[inline(always)]
-    fn slice<L: Lane>(&mut self, start: usize) {
-        let (inv_h, inv_h2) = (L::splat(self.inv_h), L::splat(self.inv_h2));
-        solve_positions::<L, DRIVE, SHAPED>(self.block, start, self.rows, inv_h, inv_h2);
+    fn solve<L: Lane>(block: &mut SocketBlock, start: usize, rows: &BodyRows, s: SubstepScale) {
+        let (inv_h, inv_h2) = (L::splat(s.inv_h), L::splat(s.inv_h2));
+        solve_positions::<L, DRIVE, SHAPED>(block, start, rows, inv_h, inv_h2);
     }
 }
 

@@ -8,7 +8,8 @@ use glam::Vec3;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::{LaneBlock, PairLane};
-use vertebra_kernels::contact::{ContactBlock, ContactLane, PositionPass, VelocityPass};
+use vertebra_kernels::contact::{self, ContactBlock, ContactLane, VelocitySettings};
+use vertebra_kernels::pass;
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
@@ -60,20 +61,16 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[ContactBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
     for _ in 0..4 {
-        backend.dispatch(PositionPass {
-            blocks: &mut blocks,
-            rows: &rows,
-        });
+        pass::run::<contact::Positions>(backend, &mut blocks, &rows, ());
     }
     // The velocity pass, then two relax passes.
     for relax in [false, true, true] {
-        backend.dispatch(VelocityPass {
-            blocks: &mut blocks,
-            rows: &rows,
+        let settings = VelocitySettings {
             h: 1.0 / 60.0,
             resting_speed: 0.33,
             relax,
-        });
+        };
+        pass::run::<contact::Velocities>(backend, &mut blocks, &rows, settings);
     }
     let mut out = flatten(&rows);
     for b in &blocks {

@@ -18,11 +18,11 @@ use vertebra_kernels::body::{BodyLanes, BodyRows, LaneBlock, PairStart, StartLan
 use vertebra_kernels::direct::ldl::{self, MAX, PACKED, at};
 use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows, SwingRows};
 use vertebra_kernels::direct::{
-    JointLane, NONE, NodeKind, PositionPass, StartPass, SubstepScale, Topology, TopologyError,
-    TreeBlock, split,
+    JointLane, NONE, NodeKind, PositionPass, StartPass, Topology, TopologyError, TreeBlock, split,
 };
 use vertebra_kernels::limited::LimitLane;
 use vertebra_kernels::parts::limit::Softness;
+use vertebra_kernels::pass::SubstepScale;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Backend, PortableQuat, Sym3, Vec3, trig};
 

@@ -8,13 +8,20 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::{JointFrames, LaneBlock};
-use vertebra_kernels::driven::{DriveLane, StartPass};
+use vertebra_kernels::driven::{self, DriveLane};
 use vertebra_kernels::fixed::{self, FixedBlock, FixedLane};
 use vertebra_kernels::hinge::{self, HingeBlock, HingeLane};
 use vertebra_kernels::limited;
+use vertebra_kernels::pass::{self, SubstepScale};
 use vertebra_kernels::residual::ResidualPass;
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
+
+/// A 60 Hz substep's scales.
+const SCALE: SubstepScale = SubstepScale {
+    inv_h: 60.0,
+    inv_h2: 3600.0,
+};
 
 const STATICS: usize = 4;
 
@@ -203,31 +210,14 @@ fn fixed_joints(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<Fi
 fn run_hinges(backend: Backend, raw: &RawRows, blocks: &[HingeBlock]) -> Vec<f32> {
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
-    backend.dispatch(StartPass {
-        blocks: &mut blocks,
-        rows: &rows,
-        h: 1.0 / 60.0,
-    });
+    pass::run::<driven::Starts<HingeBlock>>(backend, &mut blocks, &rows, 1.0 / 60.0);
     for iteration in 0..2 {
         if iteration == 1 {
             // The range's start on moved bodies: a nonzero `C - C_0`.
-            backend.dispatch(limited::StartPass {
-                blocks: &mut blocks,
-                rows: &rows,
-            });
+            pass::run::<limited::Starts<HingeBlock>>(backend, &mut blocks, &rows, ());
         }
-        backend.dispatch(hinge::PositionPass::<true> {
-            blocks: &mut blocks,
-            rows: &rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
-        backend.dispatch(hinge::PositionPass::<false> {
-            blocks: &mut blocks,
-            rows: &rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
+        pass::run::<hinge::Positions<true>>(backend, &mut blocks, &rows, SCALE);
+        pass::run::<hinge::Positions<false>>(backend, &mut blocks, &rows, SCALE);
     }
     let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {
@@ -255,10 +245,7 @@ fn run_fixed(backend: Backend, raw: &RawRows, blocks: &[FixedBlock]) -> Vec<f32>
     let rows = to_rows(raw);
     let mut blocks = blocks.to_vec();
     for _ in 0..2 {
-        backend.dispatch(fixed::PositionPass {
-            blocks: &mut blocks,
-            rows: &rows,
-        });
+        pass::run::<fixed::Positions>(backend, &mut blocks, &rows, ());
     }
     let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {

@@ -11,10 +11,17 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::LaneBlock;
+use vertebra_kernels::pass::{self, SubstepScale};
 use vertebra_kernels::residual::ResidualPass;
-use vertebra_kernels::rod::{PositionPass, RodBlock, RodLane, RodSoftness, StartPass};
+use vertebra_kernels::rod::{self, RodBlock, RodLane, RodSoftness};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
+
+/// A 60 Hz substep's scales.
+const SCALE: SubstepScale = SubstepScale {
+    inv_h: 60.0,
+    inv_h2: 3600.0,
+};
 
 const STATICS: usize = 4;
 
@@ -171,19 +178,10 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[RodBlock]) -> Vec<f32> {
     // Two substeps: the second damps against a start taken after the first
     // moved the bodies and the rest.
     for _ in 0..2 {
-        backend.dispatch(StartPass {
-            blocks: &mut blocks,
-            rows: &rows,
-            h: 1.0 / 60.0,
-        });
+        pass::run::<rod::Starts>(backend, &mut blocks, &rows, 1.0 / 60.0);
         blocks.iter_mut().for_each(RodBlock::reset_lambdas);
         for _ in 0..4 {
-            backend.dispatch(PositionPass {
-                blocks: &mut blocks,
-                rows: &rows,
-                inv_h: 60.0,
-                inv_h2: 3600.0,
-            });
+            pass::run::<rod::Positions>(backend, &mut blocks, &rows, SCALE);
         }
     }
     let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];

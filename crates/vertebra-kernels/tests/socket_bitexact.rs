@@ -9,12 +9,19 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::{JointFrames, LaneBlock};
-use vertebra_kernels::driven::{DriveLane, StartPass};
+use vertebra_kernels::driven::{self, DriveLane};
 use vertebra_kernels::limited;
+use vertebra_kernels::pass::{self, SubstepScale};
 use vertebra_kernels::residual::ResidualPass;
-use vertebra_kernels::socket::{PositionPass, ShapedLimits, SocketBlock, SocketLane};
+use vertebra_kernels::socket::{self, ShapedLimits, SocketBlock, SocketLane};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
+
+/// A 60 Hz substep's scales.
+const SCALE: SubstepScale = SubstepScale {
+    inv_h: 60.0,
+    inv_h2: 3600.0,
+};
 
 const STATICS: usize = 4;
 
@@ -170,44 +177,17 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
     let mut blocks = blocks.to_vec();
     // Every kernel variant: with the drive part (disabled lanes multiply
     // it by zero) and without, plain and shaped path.
-    backend.dispatch(StartPass {
-        blocks: &mut blocks,
-        rows: &rows,
-        h: 1.0 / 60.0,
-    });
+    pass::run::<driven::Starts<SocketBlock>>(backend, &mut blocks, &rows, 1.0 / 60.0);
     for iteration in 0..2 {
         if iteration == 1 {
             // The limits' start on moved bodies: the damping then acts on
             // a nonzero `C - C_0`.
-            backend.dispatch(limited::StartPass {
-                blocks: &mut blocks,
-                rows: &rows,
-            });
+            pass::run::<limited::Starts<SocketBlock>>(backend, &mut blocks, &rows, ());
         }
-        backend.dispatch(PositionPass::<true, false> {
-            blocks: &mut blocks,
-            rows: &rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
-        backend.dispatch(PositionPass::<false, false> {
-            blocks: &mut blocks,
-            rows: &rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
-        backend.dispatch(PositionPass::<true, true> {
-            blocks: &mut blocks,
-            rows: &rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
-        backend.dispatch(PositionPass::<false, true> {
-            blocks: &mut blocks,
-            rows: &rows,
-            inv_h: 60.0,
-            inv_h2: 3600.0,
-        });
+        pass::run::<socket::Positions<true, false>>(backend, &mut blocks, &rows, SCALE);
+        pass::run::<socket::Positions<false, false>>(backend, &mut blocks, &rows, SCALE);
+        pass::run::<socket::Positions<true, true>>(backend, &mut blocks, &rows, SCALE);
+        pass::run::<socket::Positions<false, true>>(backend, &mut blocks, &rows, SCALE);
     }
     let mut residual = vec![[0.0f32; 3]; blocks.len() * BLOCK_LANES];
     backend.dispatch(ResidualPass {

@@ -15,13 +15,12 @@
 use core::ops::Range;
 
 use vertebra_kernels::body::{BodyPairs, BodyRows};
-use vertebra_kernels::direct::SubstepScale;
-use vertebra_kernels::driven::StartPass;
 use vertebra_kernels::fixed::{self, FixedBlock};
 use vertebra_kernels::hinge::{self, HingeBlock};
-use vertebra_kernels::limited;
+use vertebra_kernels::pass::{SubstepScale, run};
 use vertebra_kernels::rod::{self, RodBlock};
 use vertebra_kernels::socket::{self, SocketBlock};
+use vertebra_kernels::{driven, limited};
 use vertebra_math::Backend;
 
 use crate::start::StartBlock;
@@ -193,32 +192,11 @@ impl JointBlock for SocketBlock {
         rows: &BodyRows,
         b: Backend,
     ) {
-        let SubstepScale { inv_h, inv_h2 } = s;
         match (kind.driven(), kind.shaped()) {
-            (true, false) => b.dispatch(socket::PositionPass::<true, false> {
-                blocks,
-                rows,
-                inv_h,
-                inv_h2,
-            }),
-            (false, false) => b.dispatch(socket::PositionPass::<false, false> {
-                blocks,
-                rows,
-                inv_h,
-                inv_h2,
-            }),
-            (true, true) => b.dispatch(socket::PositionPass::<true, true> {
-                blocks,
-                rows,
-                inv_h,
-                inv_h2,
-            }),
-            (false, true) => b.dispatch(socket::PositionPass::<false, true> {
-                blocks,
-                rows,
-                inv_h,
-                inv_h2,
-            }),
+            (true, false) => run::<socket::Positions<true, false>>(b, blocks, rows, s),
+            (false, false) => run::<socket::Positions<false, false>>(b, blocks, rows, s),
+            (true, true) => run::<socket::Positions<true, true>>(b, blocks, rows, s),
+            (false, true) => run::<socket::Positions<false, true>>(b, blocks, rows, s),
         }
     }
 }
@@ -240,21 +218,9 @@ impl JointBlock for HingeBlock {
         rows: &BodyRows,
         b: Backend,
     ) {
-        let SubstepScale { inv_h, inv_h2 } = s;
-        if kind.driven() {
-            b.dispatch(hinge::PositionPass::<true> {
-                blocks,
-                rows,
-                inv_h,
-                inv_h2,
-            });
-        } else {
-            b.dispatch(hinge::PositionPass::<false> {
-                blocks,
-                rows,
-                inv_h,
-                inv_h2,
-            });
+        match kind.driven() {
+            true => run::<hinge::Positions<true>>(b, blocks, rows, s),
+            false => run::<hinge::Positions<false>>(b, blocks, rows, s),
         }
     }
 }
@@ -266,7 +232,7 @@ impl JointBlock for FixedBlock {
     fn reset_lambdas(&mut self) {}
     fn start_substep(_: &mut [Self], _: BlockKind, _: &BodyRows, _: f32, _: Backend) {}
     fn positions(blocks: &mut [Self], _: BlockKind, _: SubstepScale, rows: &BodyRows, b: Backend) {
-        b.dispatch(fixed::PositionPass { blocks, rows });
+        run::<fixed::Positions>(b, blocks, rows, ());
     }
 }
 
@@ -278,16 +244,10 @@ impl JointBlock for RodBlock {
         RodBlock::reset_lambdas(self);
     }
     fn start_substep(blocks: &mut [Self], _: BlockKind, rows: &BodyRows, h: f32, b: Backend) {
-        b.dispatch(rod::StartPass { blocks, rows, h });
+        run::<rod::Starts>(b, blocks, rows, h);
     }
     fn positions(blocks: &mut [Self], _: BlockKind, s: SubstepScale, rows: &BodyRows, b: Backend) {
-        let SubstepScale { inv_h, inv_h2 } = s;
-        b.dispatch(rod::PositionPass {
-            blocks,
-            rows,
-            inv_h,
-            inv_h2,
-        });
+        run::<rod::Positions>(b, blocks, rows, s);
     }
 }
 
@@ -300,17 +260,13 @@ fn start_drives_and_limits<B>(
     h: f32,
     backend: Backend,
 ) where
-    B: vertebra_kernels::driven::Driven + limited::Limited,
+    B: driven::Driven + limited::Limited,
 {
     if kind.driven() {
-        backend.dispatch(StartPass {
-            blocks: &mut *blocks,
-            rows,
-            h,
-        });
+        run::<driven::Starts<B>>(backend, blocks, rows, h);
     }
     if kind.damped_limits() {
-        backend.dispatch(limited::StartPass { blocks, rows });
+        run::<limited::Starts<B>>(backend, blocks, rows, ());
     }
 }
 

@@ -4,8 +4,9 @@
 //! kernels ([`JointBlock`]), contacts, and the direct solve's trees.
 
 use vertebra_kernels::body::BodyRows;
-use vertebra_kernels::contact::{self, ContactBlock};
-use vertebra_kernels::direct::{self, SubstepScale, Topology, TreeBlock};
+use vertebra_kernels::contact::{self, ContactBlock, VelocitySettings};
+use vertebra_kernels::direct::{self, Topology, TreeBlock};
+use vertebra_kernels::pass::{SubstepScale, run};
 use vertebra_math::Backend;
 use vertebra_math::block::BLOCK_LANES;
 
@@ -13,17 +14,12 @@ use crate::kinds::{BlockKind, JointBlock};
 
 /// One kind of pass over a stage's blocks.
 pub(crate) trait Pass: Sync {
-    /// Whether the pass has work for joints (else their stages are left
-    /// out).
+    /// Whether the pass has work for joints: else the substep leaves their
+    /// stages out, and never calls [`Self::joints`].
     const JOINTS: bool;
-    /// Joint blocks, all of `kind`.
-    fn joints<B: JointBlock>(
-        &self,
-        blocks: &mut [B],
-        kind: BlockKind,
-        rows: &BodyRows,
-        backend: Backend,
-    );
+    /// Joint blocks, all of `kind` (nothing but in a pass with
+    /// [`Self::JOINTS`]).
+    fn joints<B: JointBlock>(&self, _: &mut [B], _: BlockKind, _: &BodyRows, _: Backend) {}
     /// Contacts.
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend);
     /// The direct solve's trees (nothing but in the position pass):
@@ -53,7 +49,7 @@ impl Pass for Positions {
         B::positions(blocks, kind, self.scale, rows, backend);
     }
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
-        backend.dispatch(contact::PositionPass { blocks, rows });
+        run::<contact::Positions>(backend, blocks, rows, ());
     }
     fn trees(
         &self,
@@ -99,24 +95,12 @@ fn backend_for_tree(backend: Backend, block: &TreeBlock) -> Backend {
 
 /// The velocity pass (contact friction and restitution; joints have none:
 /// drives damp at the position level), or with `relax` a relax pass
-/// (`contact::VelocityPass`: the contacts take back their push-out's speed).
-pub(crate) struct Velocities {
-    pub h: f32,
-    pub resting_speed: f32,
-    pub relax: bool,
-}
+/// (`contact::Velocities`: the contacts take back their push-out's speed).
+pub(crate) struct Velocities(pub VelocitySettings);
 
 impl Pass for Velocities {
     const JOINTS: bool = false;
-    fn joints<B: JointBlock>(&self, _: &mut [B], _: BlockKind, _: &BodyRows, _: Backend) {}
     fn contacts(&self, blocks: &mut [ContactBlock], rows: &BodyRows, backend: Backend) {
-        let (h, resting_speed, relax) = (self.h, self.resting_speed, self.relax);
-        backend.dispatch(contact::VelocityPass {
-            blocks,
-            rows,
-            h,
-            resting_speed,
-            relax,
-        });
+        run::<contact::Velocities>(backend, blocks, rows, self.0);
     }
 }

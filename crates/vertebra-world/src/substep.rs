@@ -10,10 +10,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 use vertebra_kernels::body::{BodyPairs, BodyRows};
-use vertebra_kernels::contact::ContactBlock;
-use vertebra_kernels::direct::{self, SubstepScale, Topology, TreeBlock};
+use vertebra_kernels::contact::{ContactBlock, VelocitySettings};
+use vertebra_kernels::direct::{self, Topology, TreeBlock};
 use vertebra_kernels::fixed::FixedBlock;
 use vertebra_kernels::hinge::HingeBlock;
+use vertebra_kernels::pass::SubstepScale;
 use vertebra_kernels::rod::RodBlock;
 use vertebra_kernels::socket::SocketBlock;
 use vertebra_math::Backend;
@@ -212,15 +213,16 @@ impl<'a> Substep<'a> {
         });
         self.body_pass(cursor, |c, rows| derive_velocities(c, bodies, rows, h));
         let resting_speed = 2.0 * bodies.gravity.length() * h;
-        let velocities = Velocities {
+        let settings = VelocitySettings {
             h,
             resting_speed,
             relax: false,
         };
-        let relax = Velocities {
+        let velocities = Velocities(settings);
+        let relax = Velocities(VelocitySettings {
             relax: true,
-            ..velocities
-        };
+            ..settings
+        });
         for pass in core::iter::once(&velocities).chain((0..self.relax_passes).map(|_| &relax)) {
             self.for_each_colour(cursor, 0, pass);
             self.bins_stage(cursor, |bin| self.solve_bin(bin, pass, true));

@@ -41,6 +41,7 @@ use vertebra_math::{Backend, Lane, LaneKernel};
 
 use crate::body::{BodyPairs, BodyRows, LaneBlock, PairLane};
 use crate::limited::{LimitLane, SoftnessBlock};
+use crate::pass::SubstepScale;
 use ldl::{MAX, PACKED};
 use rows::{Geometry, LIMIT_RECORD, MAX_LIMITS};
 pub use rows::{JointRows, SwingRows};
@@ -542,16 +543,6 @@ fn load_pair<L: Lane>(r: &[[f32; BLOCK_LANES]; 2], start: usize) -> [L; 2] {
     [L::load(&r[0][start..]), L::load(&r[1][start..])]
 }
 
-/// The substep's `1 / h` (1/s) and `1 / h^2` (1/s^2), which scale the
-/// soft limits' compliance and damping (`parts::limit`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SubstepScale {
-    /// `1 / h`.
-    pub inv_h: f32,
-    /// `1 / h^2`.
-    pub inv_h2: f32,
-}
-
 /// Values a node's measured block holds ([`NodeScratch::measured`]).
 pub const MEASURED: usize = 7;
 
@@ -887,7 +878,7 @@ impl<const P: u8> LaneSlices for PhaseRun<'_, P> {
 /// The trees' substep start, before the bodies are predicted: every limit
 /// row's multiplier reset, the next solve's active set chosen afresh, and
 /// every limit row's violation measured (a soft limit's damping `C_0`, as
-/// `crate::limited::StartPass` measures the parts'; a hard limit's
+/// `crate::limited::Starts` measures the parts'; a hard limit's
 /// return from far past, [`MAX_LIMIT_RETURN_SPEED`]).
 pub struct StartPass<'a> {
     /// The blocks.

@@ -10,7 +10,7 @@
 //!
 //! with `w = n_a^T I_a^-1 n_a + n_b^T I_b^-1 n_b` (the angle part's),
 //! `alpha~ = K^-1 / h^2`, `gamma = K^-1 D / h`, and `C_0` the error as the
-//! substep began (measured by the rod's `StartPass`, against the rest the
+//! substep began (measured by the rod's `Starts`, against the rest the
 //! previous substep aimed at: see "Moving rest"), so that `(C - C_0) / h`
 //! is the error's rate. The bend's `C` is an angle about an
 //! axis `n` that turns as the bend does (it flips when `t_b` passes through
@@ -37,7 +37,7 @@
 //!
 //! `gamma (C - C_0 - h r)`.
 //!
-//! The rod's `StartPass` gives it without a rate in the iterations, as the
+//! The rod's `Starts` gives it without a rate in the iterations, as the
 //! socket's drive does for its moving target (`parts::drive`, "Moving
 //! target"): it measures the start error against the previous substep's
 //! rest, then advances the rest by `h` ([`advance_direction`],
