@@ -57,12 +57,8 @@ impl ReactionBlock {
         after: (&BodyLanes<L>, &BodyLanes<L>),
     ) {
         let moves_b = after.1.inv_mass.gt(L::splat(0.0));
-        let measured = |(a, b): (&BodyLanes<L>, &BodyLanes<L>)| Pose {
-            p: Vec3::select(moves_b, b.p, a.p),
-            q: Quat::select(moves_b, b.q, a.q),
-            inv_mass: L::select(moves_b, b.inv_mass, a.inv_mass),
-        };
-        let (p, turn) = moved(&measured(before), &measured(after));
+        let (from, to) = (Pose::of(moves_b, before), Pose::of(moves_b, after));
+        let (p, turn) = moved(&from, &to);
         let impulse = Vec3::select(moves_b, p, -p);
         let sum = self.impulse.load::<L>(start) + impulse;
         self.impulse.store(start, sum);
@@ -76,6 +72,18 @@ struct Pose<L: Lane> {
     p: Vec3<L>,
     q: Quat<L>,
     inv_mass: L,
+}
+
+impl<L: Lane> Pose<L> {
+    /// `b`'s pose in the lanes of `moves_b`, `a`'s in the others.
+    #[inline(always)]
+    fn of(moves_b: L::Mask, (a, b): (&BodyLanes<L>, &BodyLanes<L>)) -> Self {
+        Self {
+            p: Vec3::select(moves_b, b.p, a.p),
+            q: Quat::select(moves_b, b.q, a.q),
+            inv_mass: L::select(moves_b, b.inv_mass, a.inv_mass),
+        }
+    }
 }
 
 /// A body's change between two poses as a positional impulse (`m dp`, kg
