@@ -103,20 +103,19 @@ fn moved<L: Lane>(from: &Pose<L>, to: &Pose<L>) -> (Vec3<L>, Vec3<L>) {
 
 /// The mean force (N) and torque (N m) over a step of `dt` seconds in
 /// substeps of `h`, on `b`, about the joint's anchor, from a lane's
-/// record: `F = P / (h dt)`, and from the measured body's angular impulse
-/// `I dtheta` (its world inertia `inertia`, its anchor's lever arm `arm`)
-/// the part that is not the force's moment: `tau = I dtheta - r x P` on
-/// `b`, or its opposite for `a` (`measured_b` false: `P` is then the
-/// opposite of `a`'s).
+/// positional impulse `P` and the measured body's angular impulse
+/// `I dtheta` (`angular`: its turn through its world inertia), its
+/// anchor's lever arm `arm`: `F = P / (h dt)`, and the part of `I dtheta`
+/// that is not the force's moment, `tau = I dtheta - r x P` on `b`, or
+/// its opposite for `a` (`measured_b` false: `P` is then the opposite of
+/// `a`'s).
 pub fn force_and_torque(
-    (impulse, turn): (GVec3, GVec3),
-    inertia: glam::Mat3,
+    (impulse, angular): (GVec3, GVec3),
     arm: GVec3,
     measured_b: bool,
     (h, dt): (f32, f32),
 ) -> (GVec3, GVec3) {
     let scale = 1.0 / (h * dt);
-    let angular = inertia * turn;
     let torque = if measured_b {
         angular - arm.cross(impulse)
     } else {

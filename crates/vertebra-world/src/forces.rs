@@ -15,9 +15,10 @@
 //! decided from bit-exact records in slot order, so a joint breaks in the
 //! same step on every backend and thread count.
 
-use glam::{Mat3, Vec3};
-use vertebra_kernels::direct::{Child, NONE, NodeKind};
+use glam::{DVec3, Vec3};
+use vertebra_kernels::direct::{Child, NONE, NodeKind, TreeBlock};
 use vertebra_kernels::reaction::force_and_torque;
+use vertebra_math::block::BLOCK_LANES;
 
 use crate::joint::{JointDesc, JointHandle, JointKind};
 use crate::{Error, World};
@@ -65,15 +66,20 @@ impl World {
     }
 }
 
-/// A body's world inertia tensor (kg m^2) at its orientation now.
-fn world_inertia(world: &World, body: usize) -> Mat3 {
-    let r = Mat3::from_quat(world.bodies.orientation[body]);
-    r * world.bodies.inertia[body] * r.transpose()
+/// The angular impulse (kg m^2 rad, world) that turns `body` by `turn`
+/// (rad, world) at its orientation now: `R I R^T turn`, applied as two
+/// rotations about the body's own inertia, not as a world tensor.
+fn angular_impulse(world: &World, body: usize, turn: Vec3) -> Vec3 {
+    let q = world.bodies.orientation[body];
+    q * (world.bodies.inertia[body] * (q.conjugate() * turn))
 }
 
 /// Every laid-out joint's force and torque from its lane's record, for a
 /// step of `dt` in substeps of `h` (s), into `world.joint_forces` by slot.
 pub(crate) fn read(world: &mut World, h: f32, dt: f32) {
+    let mut momenta = core::mem::take(&mut world.subtree_momenta);
+    momenta.fill(world);
+    world.subtree_momenta = momenta;
     let mut forces = core::mem::take(&mut world.joint_forces);
     forces.resize(world.joints.len(), super::JointForce::default());
     for (slot, desc) in world.joints.iter().enumerate() {
@@ -104,8 +110,9 @@ pub(crate) fn read(world: &mut World, h: f32, dt: f32) {
             (a, desc.anchor_a)
         };
         let arm = world.bodies.orientation[body] * anchor;
-        let (force, torque) =
-            force_and_torque(record, world_inertia(world, body), arm, measured_b, (h, dt));
+        let (impulse, turn) = record;
+        let angular = angular_impulse(world, body, turn);
+        let (force, torque) = force_and_torque((impulse, angular), arm, measured_b, (h, dt));
         let tree = tree_load(world, slot, desc, (h, dt));
         forces[slot] = JointForce {
             force: force + tree.force,
@@ -121,9 +128,8 @@ pub(crate) fn read(world: &mut World, h: f32, dt: f32) {
 /// side of the tree moved by the joint's impulse alone (every other joint
 /// among them pulls two of them, equal and opposite): its force is their
 /// summed `m dp`, its torque about the anchor their summed
-/// `I dtheta + (x - anchor) x m dp`, turned to `body_b`'s side. The
-/// child side may lie in pieces laid out in other blocks of the pass
-/// (`vertebra_kernels::direct::split`): their ports lead there.
+/// `I dtheta + (x - anchor) x m dp`, turned to `body_b`'s side. The sums
+/// below every node are [`SubtreeMomenta`]'s.
 fn tree_load(world: &World, slot: usize, desc: &JointDesc, (h, dt): (f32, f32)) -> JointForce {
     let trees = &world.layout.trees;
     let Some(Some(place)) = trees.joints.get(slot) else {
@@ -131,84 +137,114 @@ fn tree_load(world: &World, slot: usize, desc: &JointDesc, (h, dt): (f32, f32)) 
     };
     let block = &trees.blocks[place.block];
     let topology = &trees.topologies[block.topology as usize];
-    let joint = topology.nodes.iter().position(
-        |node| matches!(node.kind, NodeKind::Joint { index, .. } if index as usize == place.joint),
-    );
-    let Some(joint) = joint else {
+    let NodeKind::Joint { b, .. } = topology.nodes[place.node].kind else {
         return JointForce::default();
     };
-    let NodeKind::Joint { b, .. } = topology.nodes[joint].kind else {
-        return JointForce::default();
-    };
+    let below = world
+        .subtree_momenta
+        .at(place.block, place.node, place.lane);
     let bodies = &world.bodies;
     let ib = desc.body_b.index();
     let anchor = bodies.position[ib] + bodies.orientation[ib] * desc.anchor_b;
-    // Port sources name blocks of the pass, which starts at its bin's
-    // first tree block.
-    let pass = (world.layout.bins.iter())
-        .find(|bin| bin.trees.contains(&place.block))
-        .map_or(0, |bin| bin.trees.start);
-    let mut sum = ChildSide {
-        world,
-        pass,
-        anchor,
-        impulse: Vec3::ZERO,
-        angular: Vec3::ZERO,
-    };
-    sum.add_below(place.block, place.lane, joint);
+    let angular = below.angular - anchor.as_dvec3().cross(below.linear);
     // `body_b` is on the child side when it is the joint's child node.
-    let b_below = b != NONE && topology.children(joint).contains(&Child::Node(b));
+    let b_below = b != NONE && topology.children(place.node).contains(&Child::Node(b));
     let side = if b_below { 1.0 } else { -1.0 };
     let scale = side / (h * dt);
     JointForce {
-        force: sum.impulse * scale,
-        torque: sum.angular * scale,
+        force: below.linear.as_vec3() * scale,
+        torque: angular.as_vec3() * scale,
     }
 }
 
-/// The summed momentum the tree's solves gave the bodies below a node
-/// (`tree_load`).
-struct ChildSide<'a> {
-    world: &'a World,
-    /// The pass's first block (port sources count from it).
-    pass: usize,
-    /// The point the angular momentum is taken about (m, world).
-    anchor: Vec3,
-    /// Summed `m dp` (N s h).
-    impulse: Vec3,
-    /// Summed `I dtheta + (x - anchor) x m dp` about `anchor`.
-    angular: Vec3,
+/// The momentum a tree's solves gave a set of its bodies over the step:
+/// summed `m dp` (N s h) and summed `I dtheta + x x m dp` about the world
+/// origin, in `f64` so that moving it to a joint's anchor
+/// (`L - anchor x P`) keeps the `f32` inputs' precision far from the
+/// origin.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Momentum {
+    linear: DVec3,
+    angular: DVec3,
 }
 
-impl ChildSide<'_> {
-    /// Adds every body of node `n`'s subtree in `lane` of block `block`,
-    /// and of the pieces its ports lead to (a tree's depth bounds the
-    /// recursion).
-    fn add_below(&mut self, block: usize, lane: usize, n: usize) {
-        let trees = &self.world.layout.trees;
-        let tree_block = &trees.blocks[block];
-        let topology = &trees.topologies[tree_block.topology as usize];
-        if let NodeKind::Body { index } = topology.nodes[n].kind {
-            let bodies = &self.world.bodies;
-            let body = &tree_block.bodies[index as usize];
-            let i = body.row[lane] as usize - 1;
-            let (dp, turn) = body.moved(lane);
-            let p = dp * bodies.mass[i];
-            self.impulse += p;
-            self.angular +=
-                world_inertia(self.world, i) * turn + (bodies.position[i] - self.anchor).cross(p);
-        }
-        for &child in topology.children(n) {
-            match child {
-                Child::Node(c) => self.add_below(block, lane, c as usize),
-                Child::Port(p) => {
-                    if let Some(s) = tree_block.ports[p as usize].source[lane] {
-                        let at = self.pass + s.block as usize;
-                        self.add_below(at, s.lane as usize, s.node as usize);
+/// Every tree node's subtree momentum, lane by lane, filled once a step
+/// in one pass (scratch of the step; it allocates only as the trees
+/// grow): the nodes come in elimination order, a node's children before
+/// it, and a port's subtree lies in an earlier block of its pass, so each
+/// sum is its own body's momentum plus its children's, already summed.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SubtreeMomenta {
+    /// Node `n` of block `b` in lane `l`: `sums[starts[b] + n * 8 + l]`.
+    sums: Vec<Momentum>,
+    starts: Vec<usize>,
+}
+
+impl SubtreeMomenta {
+    /// Node `node`'s subtree momentum in `lane` of tree block `block`.
+    fn at(&self, block: usize, node: usize, lane: usize) -> Momentum {
+        self.sums[self.starts[block] + node * BLOCK_LANES + lane]
+    }
+
+    /// Sums every tree block's nodes, blocks in order.
+    fn fill(&mut self, world: &World) {
+        let trees = &world.layout.trees;
+        self.sums.clear();
+        self.starts.clear();
+        for (index, block) in trees.blocks.iter().enumerate() {
+            let topology = &trees.topologies[block.topology as usize];
+            let start = self.sums.len();
+            self.starts.push(start);
+            let count = topology.nodes.len() * BLOCK_LANES;
+            self.sums.resize(start + count, Momentum::default());
+            // Port sources name blocks of the pass, which starts at its
+            // bin's first tree block.
+            let pass = (world.layout.bins.iter())
+                .find(|bin| bin.trees.contains(&index))
+                .map_or(0, |bin| bin.trees.start);
+            for (n, node) in topology.nodes.iter().enumerate() {
+                for lane in (0..BLOCK_LANES).filter(|l| block.padding & (1 << l) == 0) {
+                    let mut sum = match node.kind {
+                        NodeKind::Body { index } => own(world, block, index as usize, lane),
+                        NodeKind::Joint { .. } => Momentum::default(),
+                    };
+                    for &child in topology.children(n) {
+                        let below = match child {
+                            Child::Node(c) => Some(self.at(index, c as usize, lane)),
+                            Child::Port(p) => (block.ports[p as usize].source[lane])
+                                .filter(|s| pass + (s.block as usize) < index)
+                                .map(|s| {
+                                    self.at(
+                                        pass + s.block as usize,
+                                        s.node as usize,
+                                        s.lane as usize,
+                                    )
+                                }),
+                        };
+                        if let Some(below) = below {
+                            sum.linear += below.linear;
+                            sum.angular += below.angular;
+                        }
                     }
+                    self.sums[start + n * BLOCK_LANES + lane] = sum;
                 }
             }
         }
+    }
+}
+
+/// Body `index` of `block`'s momentum in `lane` (see [`Momentum`]).
+fn own(world: &World, block: &TreeBlock, index: usize, lane: usize) -> Momentum {
+    let bodies = &world.bodies;
+    let body = &block.bodies[index];
+    let i = body.row[lane] as usize - 1;
+    let (dp, turn) = body.moved(lane);
+    let p = dp * bodies.mass[i];
+    let angular = angular_impulse(world, i, turn).as_dvec3();
+    let linear = p.as_dvec3();
+    Momentum {
+        linear,
+        angular: angular + bodies.position[i].as_dvec3().cross(linear),
     }
 }
 
@@ -217,7 +253,9 @@ impl ChildSide<'_> {
 pub(crate) fn break_joints(world: &mut World) {
     world.broken.clear();
     for slot in 0..world.joints.len() {
-        let Some(desc) = world.joints[slot] else {
+        // The description is copied only for a breakable joint.
+        let breakable = world.joints[slot].as_ref().filter(|d| d.breaking.is_some());
+        let Some(desc) = breakable.copied() else {
             continue;
         };
         let Some(limits) = desc.breaking else {
