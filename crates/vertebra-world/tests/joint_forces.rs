@@ -213,9 +213,12 @@ fn thresholds_are_checked_saved_and_change_no_bit_of_a_joint_without_them() {
 /// the direct solve: a tree the SIMD backends cut into pieces (the arms
 /// side by side in lanes, the hub and its anchor joint in a trunk block).
 /// At rest every joint carries the weight below it: the anchor's the
-/// whole tree's, each arm's shoulder its arm's, on every backend.
+/// whole tree's, each arm's shoulder its arm's, on every backend, and
+/// to the bit the same on all of them, cut or whole (what breaking in
+/// the same step everywhere rests on).
 #[test]
 fn a_cut_trees_joints_carry_the_weight_below_them_in_every_piece() {
+    let mut loads = Vec::new();
     for backend in Backend::available() {
         let config = SolverConfig {
             backend: BackendChoice::Forced(backend),
@@ -259,5 +262,13 @@ fn a_cut_trees_joints_carry_the_weight_below_them_in_every_piece() {
                 "{backend}: a shoulder's {load:?}"
             );
         }
+        let bits = (core::iter::once(&top).chain(&shoulders))
+            .map(|&joint| w.joint_force(joint).unwrap())
+            .flat_map(|l| [l.force, l.torque].map(|v| v.to_array().map(f32::to_bits)))
+            .collect::<Vec<_>>();
+        loads.push((backend, bits));
+    }
+    for pair in loads.windows(2) {
+        assert_eq!(pair[0].1, pair[1].1, "{} and {}", pair[0].0, pair[1].0);
     }
 }
