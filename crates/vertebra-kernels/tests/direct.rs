@@ -16,6 +16,7 @@ use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::{BodyLanes, BodyRows, LaneBlock, PairStart, StartLane};
 use vertebra_kernels::direct::ldl::{self, MAX, PACKED, at};
+use vertebra_kernels::direct::load::LoadPass;
 use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows, SwingRows};
 use vertebra_kernels::direct::{
     JointLane, NONE, NodeKind, PositionPass, StartPass, Topology, TopologyError, TreeBlock, split,
@@ -1020,6 +1021,17 @@ fn pass(backend: Backend, rows: &BodyRows, blocks: &mut [TreeBlock], topologies:
     .run(backend);
 }
 
+/// The joints' loads after the passes (a step of 1/60 s in one substep).
+fn loads(backend: Backend, rows: &BodyRows, blocks: &mut [TreeBlock], topologies: &[Topology]) {
+    LoadPass {
+        blocks,
+        topologies,
+        rows,
+        scale: SCALE.inv_h2,
+    }
+    .run(backend);
+}
+
 /// A tree offset by `offsets`: its error before and after each of
 /// `passes` passes.
 fn errors(tree: &Tree, offsets: &Offsets, passes: usize) -> Vec<f64> {
@@ -1573,6 +1585,7 @@ fn run_trees(backend: Backend, raw: &RawRows, trees: &[Trees]) -> Vec<f32> {
     for _ in 0..2 {
         pass(backend, &rows, &mut blocks, &topologies);
     }
+    loads(backend, &rows, &mut blocks, &topologies);
     let mut out = flatten(&rows);
     for (block, topology) in blocks.iter().zip(&topologies) {
         for lane in (0..BLOCK_LANES).filter(|lane| block.padding & (1 << lane) == 0) {
@@ -1586,10 +1599,8 @@ fn run_trees(backend: Backend, raw: &RawRows, trees: &[Trees]) -> Vec<f32> {
             for joint in &block.joints {
                 let limits = joint.limit_lambda.iter().chain(&joint.limit_start);
                 out.extend(limits.map(|v| v[lane]));
-            }
-            // How far the solves moved each body: the joints' forces.
-            for body in &block.bodies {
-                out.extend(body.moved.iter().map(|v| v[lane]));
+                let load = [joint.force.get(lane), joint.torque.get(lane)];
+                out.extend(load.iter().flat_map(|v| v.to_array()));
             }
         }
     }
@@ -1683,8 +1694,8 @@ fn cut_scene(seed: u64, adversarial: bool) -> Cut {
 }
 
 /// A start pass and two passes of the whole trees, or of their pieces
-/// solved together: every row, then every tree's joints' multipliers
-/// (whole-tree joint order) and limit multipliers.
+/// solved together, and their loads: every row, then every tree's joints'
+/// multipliers (whole-tree joint order), limit multipliers and loads.
 fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
     let rows = to_rows(&cut.raw);
     let (mut blocks, topologies) = if pieces {
@@ -1699,6 +1710,7 @@ fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
     for _ in 0..2 {
         pass(backend, &rows, &mut blocks, &topologies);
     }
+    loads(backend, &rows, &mut blocks, &topologies);
     let mut out = flatten(&rows);
     for (tree, placed) in cut.placed.iter().enumerate() {
         for j in 0..cut.whole.topology.joints as u32 {
@@ -1727,8 +1739,10 @@ fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
                     .iter()
                     .map(|v| v[lane]),
             );
-            let limits = &block.joints[index as usize].limit_lambda;
-            out.extend(limits.iter().map(|v| v[lane]));
+            let joint = &block.joints[index as usize];
+            out.extend(joint.limit_lambda.iter().map(|v| v[lane]));
+            let load = [joint.force.get(lane), joint.torque.get(lane)];
+            out.extend(load.iter().flat_map(|v| v.to_array()));
         }
     }
     out

@@ -40,6 +40,13 @@ pub struct QuatBlock {
 }
 
 impl Vec3Block {
+    /// Every lane zero.
+    pub const ZERO: Self = Self {
+        x: [0.0; BLOCK_LANES],
+        y: [0.0; BLOCK_LANES],
+        z: [0.0; BLOCK_LANES],
+    };
+
     /// Item `i` (`i < BLOCK_LANES`).
     pub fn get(&self, i: usize) -> glam::Vec3 {
         glam::Vec3::new(self.x[i], self.y[i], self.z[i])

@@ -125,9 +125,6 @@ pub struct World {
     joint_forces: Vec<JointForce>,
     /// The joints the last step broke (output, not state).
     broken: Vec<BrokenJoint>,
-    /// Scratch of the step: the trees' subtree momenta, from which
-    /// `forces.rs` reads the joints they hold.
-    subtree_momenta: forces::SubtreeMomenta,
     /// Counts every call that may have moved a body or changed which
     /// bodies there are (no part of the state).
     pose_version: u64,
@@ -191,7 +188,6 @@ impl World {
             step_count: 0,
             joint_forces: Vec::new(),
             broken: Vec::new(),
-            subtree_momenta: forces::SubtreeMomenta::default(),
             pose_version: 0,
             contact_layout: contact_layout::ContactLayout::default(),
             rows: parallel::Scratch::default(),

@@ -38,8 +38,6 @@ pub(crate) struct Place {
     pub block: usize,
     /// The joint's index in the block's joints.
     pub joint: usize,
-    /// Its node in the block's topology.
-    pub node: usize,
     /// The lane.
     pub lane: usize,
 }
@@ -188,15 +186,10 @@ impl Trees {
             node.set(lane, row, true, 1.0, glam::Mat3::IDENTITY);
             set_mass(node, lane, bodies);
         }
-        let topology = &self.topologies[block.topology as usize];
         for (k, &j) in at.joints.iter().enumerate() {
-            let node = topology.nodes.iter().position(
-                |node| matches!(node.kind, NodeKind::Joint { index, .. } if index as usize == k),
-            );
             let place = Some(Place {
                 block: at.block,
                 joint: k,
-                node: node.expect("every joint of a block is a node of its topology"),
                 lane,
             });
             let lane_data = match tree.edges[j as usize] {

@@ -83,6 +83,47 @@ fn a_cantilevers_weld_holds_its_weight_and_its_moment() {
     }
 }
 
+/// The cantilever with its bodies either way round (the load is on `b`:
+/// the wall's is the beam's turned about), and 10 km from the origin,
+/// where a coordinate's `f32` step is a millimetre: the loads hold to the
+/// same tolerance, both joint solves.
+#[test]
+fn a_welds_load_is_read_on_either_body_and_far_from_the_origin() {
+    for joints in [JointSolver::Iterative, JointSolver::Direct] {
+        for far in [Vec3::ZERO, Vec3::new(1.0e4, 0.0, -1.0e4)] {
+            for beam_is_b in [true, false] {
+                let mut w = World::new(config(joints)).unwrap();
+                let wall = w.add_body(BodyDesc::fixed().with_position(far)).unwrap();
+                let beam = capsule(&mut w, 2.0, far + Vec3::new(0.25, 0.0, 0.0), Vec3::X);
+                let (a, b) = if beam_is_b {
+                    (wall, beam)
+                } else {
+                    (beam, wall)
+                };
+                let joint = JointDesc::fixed_at(w.bodies(), a, b, far).unwrap();
+                let joint = w.add_joint(joint).unwrap();
+                for _ in 0..60 {
+                    w.step(DT).unwrap();
+                }
+                let load = w.joint_force(joint).unwrap();
+                let arm = w.body(beam).unwrap().position - far;
+                let side = if beam_is_b { 1.0 } else { -1.0 };
+                let weight = side * Vec3::new(0.0, 2.0 * G, 0.0);
+                let moment = side * -(arm.cross(Vec3::new(0.0, -2.0 * G, 0.0)));
+                let case = format!("{joints:?}, {far}, beam is b: {beam_is_b}: {load:?}");
+                assert!(
+                    (load.force - weight).length() < 0.01 * weight.length(),
+                    "{case}"
+                );
+                assert!(
+                    (load.torque - moment).length() < 0.02 * moment.length(),
+                    "{case} against {moment}"
+                );
+            }
+        }
+    }
+}
+
 /// A chain of three links from an anchor with a weight at its end, the
 /// middle link breakable below the load: it breaks in the first step, on
 /// every backend and thread count, and the rest falls.

@@ -30,6 +30,7 @@
 //! backend.
 
 pub mod ldl;
+pub mod load;
 pub mod rows;
 mod solve;
 pub mod split;
@@ -322,7 +323,7 @@ pub struct BodyNode {
     pub inertia: [[f32; BLOCK_LANES]; 6],
     /// How far the tree's solves moved the body this step (never read by
     /// the solve): the sum of every applied `dp` (m, world) and turn (rad,
-    /// world), from which the world reads each joint's force and torque.
+    /// world), from which [`load::LoadPass`] reads each joint's load.
     pub moved: [[f32; BLOCK_LANES]; 6],
 }
 
@@ -410,6 +411,12 @@ pub struct JointNode {
     /// Each limit row's multiplier accumulated over the substep (a soft
     /// limit's spring force; reset by [`StartPass`]).
     pub limit_lambda: [[f32; BLOCK_LANES]; MAX_LIMITS],
+    /// The tree's share of the joint's mean force on `b` over the last
+    /// step (N, world; [`load::LoadPass`]; never read by the solve).
+    pub force: Vec3Block,
+    /// Its share of the mean torque on `b` about `b`'s anchor (N m,
+    /// world).
+    pub torque: Vec3Block,
 }
 
 /// A joint's geometry in one lane, as the world lays it out.
@@ -626,6 +633,9 @@ pub struct Port {
     pub minus_b: [[f32; BLOCK_LANES]; MAX],
     /// The lanes whose subtree was eliminated again this pass.
     pub dirty: u8,
+    /// Its subtree's momentum over the step, copied in before the block's
+    /// [`load::LoadPass`].
+    pub momentum: load::MomentumBlock,
 }
 
 impl Port {
@@ -636,6 +646,7 @@ impl Port {
             minus: [[0.0; BLOCK_LANES]; PACKED],
             minus_b: [[0.0; BLOCK_LANES]; MAX],
             dirty: 0,
+            momentum: [Vec3Block::ZERO; 2],
         }
     }
 }
@@ -678,6 +689,9 @@ pub struct TreeBlock {
     /// That parent body's unknowns, copied in before the block's
     /// substitution (zero for none).
     pub parent_x: [[f32; BLOCK_LANES]; 6],
+    /// Per node, its subtree's momentum over the step, about a body's
+    /// centre ([`load::LoadPass`]; never read by the solve).
+    pub momenta: Vec<load::MomentumBlock>,
 }
 
 impl TreeBlock {
@@ -697,6 +711,7 @@ impl TreeBlock {
             ports: vec![Port::empty(); shape.ports],
             parent: [None; BLOCK_LANES],
             parent_x: [[0.0; BLOCK_LANES]; 6],
+            momenta: vec![[Vec3Block::ZERO; 2]; shape.nodes.len()],
         }
     }
 

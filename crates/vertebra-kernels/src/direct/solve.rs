@@ -52,7 +52,7 @@ macro_rules! by_rows {
 
 /// Loads lane values from scratch arrays.
 #[inline(always)]
-fn load<L: Lane, const N: usize>(src: &[[f32; BLOCK_LANES]], start: usize) -> [L; N] {
+pub(super) fn load<L: Lane, const N: usize>(src: &[[f32; BLOCK_LANES]], start: usize) -> [L; N] {
     let mut out = [L::splat(0.0); N];
     for (o, s) in out.iter_mut().zip(src) {
         *o = L::load(&s[start..]);
