@@ -2127,6 +2127,9 @@ enum VtResult vt_skeleton_to_model(const struct VtSkeleton *skeleton,
 // `model_to_world`) and what `mapping` (a `VtSpineMapping`) gives from
 // the bodies, faded out over `fade` seconds (>= 0; infinity: kept).
 // Writes the transition into `transition` (`vt_transition_destroy`).
+// Refused, naming the joint, for a ragdoll whose joints are apart at the
+// pose by more than 1 mm (built without `at_switch` at a pose whose
+// bodiless bones are turned): its first step would pop.
 //
 // # Safety
 // `mapper`, `ragdoll` and `world` are live; `animation` points to `count`

@@ -25,6 +25,37 @@ use crate::ragdoll::Ragdoll;
 use crate::skeleton::{LocalPose, ModelPose, Transform};
 use vertebra_math::{DefaultFloatMode, PortableQuat};
 
+/// Refuses, naming the joint, a ragdoll one of whose joints has its two
+/// anchors more than [`Transition::MAX_JOINT_GAP`] apart in `world` (a joint no
+/// longer in the world, broken or removed, holds nothing and is passed).
+fn joints_hold(
+    mapper: &SkeletonMapper,
+    ragdoll: &Ragdoll,
+    world: &World,
+) -> Result<(), RagdollError> {
+    let bodies = world.bodies();
+    for (k, handle) in ragdoll.joints.iter().enumerate() {
+        let Some(Ok(joint)) = handle.map(|h| world.joint(h)) else {
+            continue;
+        };
+        let (a, b) = (joint.body_a.index(), joint.body_b.index());
+        // The bodies' offset first, in double precision: far from the
+        // origin only their separation is rounded.
+        let offset = (bodies.precise_position(b) - bodies.precise_position(a)).as_vec3();
+        let gap = (offset + bodies.orientation[b] * joint.anchor_b
+            - bodies.orientation[a] * joint.anchor_a)
+            .length();
+        if gap > Transition::MAX_JOINT_GAP {
+            let name = mapper.desc.joints.get(k).map_or("?", |j| j.name.as_str());
+            return Err(RagdollError::BadPose(format!(
+                "joint `{name}`: its bodies are {:.1} mm apart at its pivot, which the first step would pull together (a pop): build the ragdoll for the switch with BuildOptions::at_switch",
+                gap * 1e3
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// The chain bones' offsets from the mapping at the switch to ragdoll.
 ///
 /// The switch, from an engine's skeleton (here one bone per body; a game's
@@ -58,7 +89,9 @@ use vertebra_math::{DefaultFloatMode, PortableQuat};
 /// let now = mapper.map_to_ragdoll(&current.to_model(&skeleton)?, place)?;
 /// let before = mapper.map_to_ragdoll(&previous.to_model(&skeleton)?, place)?;
 /// let mut world = World::new(SolverConfig::default())?;
-/// let options = BuildOptions::new(SpineMode::Rod);
+/// // Joints made at the switch's pose: a body turned by a bone it has no
+/// // body for (a clavicle, the neck) is not pulled back by the first step.
+/// let options = BuildOptions::at_switch(SpineMode::Rod);
 /// let ragdoll = Ragdoll::build(&mut world, &desc, options, &now, Some((&before, 1.0 / 60.0)))?;
 /// let transition =
 ///     Transition::new(&mapper, &ragdoll, &world, &current, place, SpineMapping::Arc, 0.3)?;
@@ -82,6 +115,10 @@ pub struct Transition {
 }
 
 impl Transition {
+    /// The farthest apart a joint's two anchors may be when a transition
+    /// is made (m): the most a joint's first step may pull its bodies.
+    pub const MAX_JOINT_GAP: f32 = 1.0e-3;
+
     /// Measures the offsets for `ragdoll`, just built in `world` from the
     /// animation pose `animation` (local) placed in the world by
     /// `model_to_world`, mapped from then on by `mapping`. `fade` (s) is
@@ -90,6 +127,14 @@ impl Transition {
     /// smooth at both ends: the offsets' weight is `1 - (3u^2 - 2u^3)` at
     /// `u = t / fade`, so the first frame after the switch drops only
     /// `3 (dt / fade)^2` of them (0.3% at 60 Hz and a 0.5 s fade).
+    ///
+    /// The ragdoll is built for the switch with
+    /// [`BuildOptions::at_switch`](crate::BuildOptions::at_switch), so that
+    /// its joints hold at the pose: refused, naming the joint, when one's
+    /// two anchors are more than [`Self::MAX_JOINT_GAP`] apart (a ragdoll built
+    /// with the description's anchors at a pose whose bodiless bones moved
+    /// a child off its parent's pivot), whose first step would pull them
+    /// together: the pop the transition is there to prevent.
     pub fn new(
         mapper: &SkeletonMapper,
         ragdoll: &Ragdoll,
@@ -109,6 +154,7 @@ impl Transition {
         }
         let (bodies, rod_frames) = mapper.read(ragdoll, world)?;
         model_to_world.validate("model_to_world")?;
+        joints_hold(mapper, ragdoll, world)?;
         let animated = animation
             .to_model(mapper.skeleton())?
             .in_world(model_to_world);

@@ -315,7 +315,15 @@ fn locked_translations_keep_the_animations_local_translations() {
         let locked = free.clone().with_locked_translations(true);
         for _ in 0..10 {
             let animation = random_animation(&skeleton, ALONG, &moving, &mut r);
-            let before = earlier(&skeleton, ALONG, &moving, &animation, 30.0, 0.1, &mut r);
+            let before = earlier(
+                &skeleton,
+                ALONG,
+                &moving,
+                &animation,
+                0.0..=30.0,
+                0.1,
+                &mut r,
+            );
             let place = random_place(&mut r);
             // Bodies from another pose: the joints stretch.
             let bodies = free

@@ -2,6 +2,8 @@
 //! its joint limits. Each bone turns about its axis along the bone, in its
 //! own frame: `along` (+Y on the shipped `Skeleton::reference()`).
 
+use core::ops::RangeInclusive;
+
 use glam::{Quat, Vec3};
 use rand::RngExt;
 use rand::rngs::StdRng;
@@ -70,14 +72,14 @@ pub fn random_animation(
 }
 
 /// The pose `dt` seconds before `pose` of an animation that turns every
-/// bone but the `still` ones at a random angular velocity of at most
-/// `rate` (rad/s) in its own frame and moves the root at up to 1 m/s.
+/// bone but the `still` ones about a random axis of its own frame at a
+/// rate drawn from `rates` (rad/s) and moves the root at up to 1 m/s.
 pub fn earlier(
     skeleton: &Skeleton,
     along: Vec3,
     still: &[bool],
     pose: &LocalPose,
-    rate: f32,
+    rates: RangeInclusive<f32>,
     dt: f32,
     r: &mut StdRng,
 ) -> LocalPose {
@@ -89,8 +91,12 @@ pub fn earlier(
             let axis = across(along, r)
                 .lerp(along, r.random_range(0.0..1.0))
                 .normalize();
-            let rate = if still { 0.0 } else { rate };
-            let back = Quat::from_axis_angle(axis, -r.random_range(0.0..=rate) * dt);
+            let rate = if still {
+                0.0
+            } else {
+                r.random_range(rates.clone())
+            };
+            let back = Quat::from_axis_angle(axis, -rate * dt);
             let mut before = local * Transform::new(Vec3::ZERO, back);
             if bone.parent.is_none() {
                 before.translation -=
