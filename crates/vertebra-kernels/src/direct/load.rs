@@ -160,10 +160,10 @@ impl Loads<'_> {
         (linear, angular)
     }
 
-    /// Joint `index` of the block over its child body
-    /// node `child` (`b` when `child_is_b`, else `a`): its load on `b`
-    /// into the joint, and its child side's momentum moved to its parent
-    /// body's centre, for the parent.
+    /// Joint `index` of the block over its child body node `child` (`b`
+    /// when `child_is_b`, else `a`): its load on `b` into the joint, and
+    /// its child side's momentum moved to its parent body's centre, for
+    /// the parent.
     #[inline(always)]
     fn joint<L: Lane>(
         &mut self,
