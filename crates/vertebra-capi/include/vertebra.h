@@ -454,6 +454,19 @@ typedef struct VtTransform {
   struct VtQuat rotation;
 } VtTransform;
 
+// The get-up clip that fits a lying ragdoll, and where to play it
+// (`vt_get_up_choose`; `GetUp` in Rust, `docs/ragdolls.md`).
+typedef struct VtGetUp {
+  // The clip's index among the first frames given.
+  size_t clip;
+  // Where to play it: its model frame in the world, a turn about up
+  // then a move (m).
+  struct VtTransform place;
+  // The turn (rad) left between the placed clip's root body and the
+  // ragdoll's: how far the clip's lie is from the ragdoll's.
+  float misfit;
+} VtGetUp;
+
 // A solid shape in its body's frame, centred on the centre of mass (m).
 // Only the fields of its kind are read.
 typedef struct VtShape {
@@ -1094,6 +1107,28 @@ enum VtResult vt_blend_back_advance(struct VtBlendBack *blend, float dt);
 // # Safety
 // `blend` is live; `weight` and `done` are writable.
 enum VtResult vt_blend_back_weight(struct VtBlendBack *blend, float *weight, uint32_t *done);
+
+// Of `clips` get-up clips whose first frames are `first_frames` (`clips`
+// poses of `count` transforms each, one per described body, in each
+// clip's model frame, one after another), the one whose root body lies
+// most as the ragdoll's does in `lying` (`count` world transforms: its
+// pose as `vt_ragdoll_skeleton_pose` gives it), placed by a turn about
+// `up` (the world's up, unit: against gravity) and a move that put its
+// root body on the ragdoll's; into `get_up`. Blend back to the placed
+// clip with `vt_blend_back_create_ragdoll` from `lying`. Refused, naming
+// the pose, for a pose that does not fit `desc`, no clip, and an `up`
+// that is not unit.
+//
+// # Safety
+// `desc` is live; `lying` points to `count` readable transforms,
+// `first_frames` to `count * clips`; `get_up` is writable.
+enum VtResult vt_get_up_choose(const struct VtRagdollDesc *desc,
+                               const struct VtTransform *lying,
+                               size_t count,
+                               const struct VtTransform *first_frames,
+                               size_t clips,
+                               struct VtVec3 up,
+                               struct VtGetUp *get_up);
 
 // The mass properties of `shape` with `mass` kg spread evenly through it.
 //

@@ -5,13 +5,15 @@
 //! poses (world transforms, one per described body) or on a skeleton's
 //! local poses (parent-local transforms, one per bone).
 
-use vertebra_ragdoll::{Blend, BlendBack, LocalPose, Pose, RagdollDesc, RagdollError, Skeleton};
+use vertebra_ragdoll::{
+    Blend, BlendBack, GetUp, LocalPose, Pose, RagdollDesc, RagdollError, Skeleton,
+};
 
 use crate::error::{Failure, VtResult};
 use crate::ffi::{Object, boxed, call, enter, free, out, shared, slice, slice_mut};
 use crate::ragdoll::{VtRagdollDesc, pose_from, write_pose};
 use crate::skeleton::{VtSkeleton, local_pose, write_bones};
-use crate::types::VtTransform;
+use crate::types::{VtTransform, VtVec3};
 
 /// A blend back under way (opaque; `vt_blend_back_create_ragdoll` or
 /// `vt_blend_back_create_skeleton`; free it with `vt_blend_back_destroy`).
@@ -372,6 +374,79 @@ pub unsafe extern "C" fn vt_blend_back_weight(
         };
         weight.set(w);
         done.set(u32::from(d));
+        Ok(())
+    })
+}
+
+/// The get-up clip that fits a lying ragdoll, and where to play it
+/// (`vt_get_up_choose`; `GetUp` in Rust, `docs/ragdolls.md`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VtGetUp {
+    /// The clip's index among the first frames given.
+    pub clip: usize,
+    /// Where to play it: its model frame in the world, a turn about up
+    /// then a move (m).
+    pub place: VtTransform,
+    /// The turn (rad) left between the placed clip's root body and the
+    /// ragdoll's: how far the clip's lie is from the ragdoll's.
+    pub misfit: f32,
+}
+
+/// Of `clips` get-up clips whose first frames are `first_frames` (`clips`
+/// poses of `count` transforms each, one per described body, in each
+/// clip's model frame, one after another), the one whose root body lies
+/// most as the ragdoll's does in `lying` (`count` world transforms: its
+/// pose as `vt_ragdoll_skeleton_pose` gives it), placed by a turn about
+/// `up` (the world's up, unit: against gravity) and a move that put its
+/// root body on the ragdoll's; into `get_up`. Blend back to the placed
+/// clip with `vt_blend_back_create_ragdoll` from `lying`. Refused, naming
+/// the pose, for a pose that does not fit `desc`, no clip, and an `up`
+/// that is not unit.
+///
+/// # Safety
+/// `desc` is live; `lying` points to `count` readable transforms,
+/// `first_frames` to `count * clips`; `get_up` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_get_up_choose(
+    desc: *const VtRagdollDesc,
+    lying: *const VtTransform,
+    count: usize,
+    first_frames: *const VtTransform,
+    clips: usize,
+    up: VtVec3,
+    get_up: *mut VtGetUp,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (desc, lying, place) = unsafe {
+            (
+                shared(desc, "desc")?,
+                pose_from(lying, count, "lying")?,
+                out(get_up, "get_up")?,
+            )
+        };
+        let total = count.checked_mul(clips).ok_or_else(|| {
+            Failure::new(
+                VtResult::OutOfRange,
+                format!("first_frames: {clips} clips of {count} transforms overflow"),
+            )
+        })?;
+        // SAFETY: the function's contract.
+        let frames = unsafe { slice(first_frames, total, "first_frames") }?;
+        let first_frames: Vec<Pose> = frames
+            .chunks(count.max(1))
+            .take(clips)
+            .map(|clip| Pose {
+                bones: clip.iter().map(|&t| t.into()).collect(),
+            })
+            .collect();
+        let chosen = GetUp::choose(&desc.desc, &lying, &first_frames, up.into())?;
+        place.set(VtGetUp {
+            clip: chosen.clip,
+            place: (chosen.translation, chosen.turn).into(),
+            misfit: chosen.misfit,
+        });
         Ok(())
     })
 }

@@ -8,7 +8,7 @@ use std::ptr::{null, null_mut};
 use glam::{Quat, Vec3};
 use vertebra_capi::*;
 use vertebra_ragdoll::{
-    BlendBack, BuildOptions, DriveSettings, LocalPose, Pose, Ragdoll, RagdollDesc, Skeleton,
+    BlendBack, BuildOptions, DriveSettings, GetUp, LocalPose, Pose, Ragdoll, RagdollDesc, Skeleton,
     SpineMode,
 };
 use vertebra_world::{SolverConfig, Spring, World};
@@ -493,4 +493,68 @@ fn a_blend_back_fades_to_the_animation_as_in_rust() {
         vt_blend_back_destroy(blend);
         vt_skeleton_destroy(c_skeleton);
     }
+}
+
+/// The get-up clip chosen and placed through the C ABI is the Rust API's,
+/// bit for bit; refusals name the item and write nothing.
+#[test]
+fn a_get_up_clip_is_chosen_and_placed_as_in_rust() {
+    let desc = RagdollDesc::reference_humanoid();
+    let mut c_desc = null_mut();
+    // SAFETY: writable.
+    ok(unsafe { vt_ragdoll_desc_humanoid(VtHumanoid::Reference as u32, &mut c_desc) });
+    let root = Pose::bind(&desc).bones[desc.root].0;
+    let laid = |quarter: f32| {
+        let turn = Quat::from_rotation_x(quarter * core::f32::consts::FRAC_PI_2);
+        Pose::bind(&desc).moved(root, turn, Vec3::Y * 0.1 - root)
+    };
+    let clips = [laid(1.0), laid(-1.0)];
+    let lying = clips[1].moved(root, Quat::from_rotation_y(2.5), Vec3::new(3.0, 0.0, -4.0));
+    let rust = GetUp::choose(&desc, &lying, &clips, Vec3::Y).expect("a clip");
+    let c_lying = c_pose(&lying);
+    let c_frames: Vec<VtTransform> = clips.iter().flat_map(c_pose).collect();
+    let choose = |frames: &[VtTransform], clips: usize, up: Vec3, out: &mut VtGetUp| {
+        // SAFETY: a live description; arrays of the lengths given; writable.
+        unsafe {
+            vt_get_up_choose(
+                c_desc,
+                c_lying.as_ptr(),
+                c_lying.len(),
+                frames.as_ptr(),
+                clips,
+                up.into(),
+                out,
+            )
+        }
+    };
+    let mut c = VtGetUp {
+        clip: usize::MAX,
+        place: (Vec3::ZERO, Quat::IDENTITY).into(),
+        misfit: -1.0,
+    };
+    ok(choose(&c_frames, 2, Vec3::Y, &mut c));
+    assert_eq!(c.clip, rust.clip);
+    assert_eq!(c.clip, 1, "it lies as the second clip starts");
+    let place: (Vec3, Quat) = c.place.into();
+    assert_eq!(place, (rust.translation, rust.turn));
+    assert_eq!(c.misfit, rust.misfit);
+    let untouched = c;
+    refused(
+        choose(&c_frames, 0, Vec3::Y, &mut c),
+        VtResult::Ragdoll,
+        &["first_frames"],
+    );
+    refused(
+        choose(&c_frames, 2, Vec3::Y * 2.0, &mut c),
+        VtResult::Ragdoll,
+        &["up"],
+    );
+    refused(
+        choose(&c_frames[1..], 2, Vec3::Y, &mut c),
+        VtResult::Ragdoll,
+        &["clip 1's first frame"],
+    );
+    assert_eq!(c, untouched, "a refusal writes nothing");
+    // SAFETY: made above, freed once.
+    unsafe { vt_ragdoll_desc_destroy(c_desc) };
 }
