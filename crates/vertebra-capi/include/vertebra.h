@@ -2111,6 +2111,23 @@ enum VtResult vt_skeleton_mapper_map_to_skeleton(const struct VtSkeletonMapper *
                                                  struct VtTransform *bones,
                                                  size_t count);
 
+// Writes the pose of every described body into `pose` (`count` writable
+// transforms, one per described body: world, at its centre of mass,
+// rotation relative to bind), read from the bodies in `world`; a rod
+// spine's interior bodies are placed by `mapping` (a `VtSpineMapping`).
+// What `vt_blend_back_create_ragdoll` and `vt_get_up_choose` take as the
+// ragdoll's last pose (`Ragdoll::skeleton_pose` in Rust). Refused for a
+// `count` that is not the description's body count.
+//
+// # Safety
+// `ragdoll` and `world` are live; `pose` points to `count` writable
+// transforms.
+enum VtResult vt_ragdoll_pose(struct VtRagdoll *ragdoll,
+                              struct VtWorld *world,
+                              uint32_t mapping,
+                              struct VtTransform *pose,
+                              size_t count);
+
 // Writes the address and length of `bytes`' data into `data` and
 // `length`; the data stays valid until `vt_bytes_destroy`.
 //

@@ -384,3 +384,38 @@ pub unsafe extern "C" fn vt_skeleton_mapper_map_to_skeleton(
         write_bones(&mapped.bones, place)
     })
 }
+
+/// Writes the pose of every described body into `pose` (`count` writable
+/// transforms, one per described body: world, at its centre of mass,
+/// rotation relative to bind), read from the bodies in `world`; a rod
+/// spine's interior bodies are placed by `mapping` (a `VtSpineMapping`).
+/// What `vt_blend_back_create_ragdoll` and `vt_get_up_choose` take as the
+/// ragdoll's last pose (`Ragdoll::skeleton_pose` in Rust). Refused for a
+/// `count` that is not the description's body count.
+///
+/// # Safety
+/// `ragdoll` and `world` are live; `pose` points to `count` writable
+/// transforms.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vt_ragdoll_pose(
+    ragdoll: *mut VtRagdoll,
+    world: *mut VtWorld,
+    mapping: u32,
+    pose: *mut VtTransform,
+    count: usize,
+) -> VtResult {
+    call(|| {
+        // SAFETY: the function's contract.
+        let (ragdoll, world, place) = unsafe {
+            (
+                enter(ragdoll)?,
+                enter(world)?,
+                slice_mut(pose, count, "pose")?,
+            )
+        };
+        let read = ragdoll
+            .ragdoll
+            .skeleton_pose(&world.world, spine_mapping(mapping)?)?;
+        write_pose(&read, place)
+    })
+}

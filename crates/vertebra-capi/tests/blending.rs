@@ -9,7 +9,7 @@ use glam::{Quat, Vec3};
 use vertebra_capi::*;
 use vertebra_ragdoll::{
     BlendBack, BuildOptions, DriveSettings, GetUp, LocalPose, Pose, Ragdoll, RagdollDesc, Skeleton,
-    SpineMode,
+    SpineMapping, SpineMode,
 };
 use vertebra_world::{SolverConfig, Spring, World};
 
@@ -493,6 +493,53 @@ fn a_blend_back_fades_to_the_animation_as_in_rust() {
         vt_blend_back_destroy(blend);
         vt_skeleton_destroy(c_skeleton);
     }
+}
+
+/// A rod-spined ragdoll's pose read through the C ABI, as it falls, is the
+/// Rust API's bit for bit, for every spine mapping; a pose of the wrong
+/// length is refused, naming it, and nothing is written.
+#[test]
+fn a_ragdolls_pose_reads_as_in_rust() {
+    let mut t = Twins::new();
+    t.step(20);
+    let mappings = [
+        (VtSpineMapping::Orientation, SpineMapping::Orientation),
+        (
+            VtSpineMapping::PositionOrientation,
+            SpineMapping::PositionOrientation,
+        ),
+        (VtSpineMapping::Arc, SpineMapping::Arc),
+    ];
+    for (c, rust) in mappings {
+        let mut pose = c_pose(&Pose::bind(&t.desc));
+        // SAFETY: live objects; `pose` holds `len` writable transforms.
+        ok(unsafe {
+            vt_ragdoll_pose(
+                t.c_ragdoll,
+                t.c_world,
+                c as u32,
+                pose.as_mut_ptr(),
+                pose.len(),
+            )
+        });
+        let expected = t.ragdoll.skeleton_pose(&t.world, rust).expect("a pose");
+        assert_eq!(rust_pose(&pose), expected, "{rust:?}");
+    }
+    let mut short = c_pose(&Pose::bind(&t.desc));
+    short.pop();
+    let before = short.clone();
+    // SAFETY: as above, one transform short.
+    let r = unsafe {
+        vt_ragdoll_pose(
+            t.c_ragdoll,
+            t.c_world,
+            VtSpineMapping::Arc as u32,
+            short.as_mut_ptr(),
+            short.len(),
+        )
+    };
+    refused(r, VtResult::BufferTooSmall, &["pose"]);
+    assert_eq!(short, before, "a refusal writes nothing");
 }
 
 /// The get-up clip chosen and placed through the C ABI is the Rust API's,
