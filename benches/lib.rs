@@ -490,7 +490,24 @@ pub const DT: f32 = 1.0 / 60.0;
 /// The ragdoll drop with `count` ragdolls (30 per pit) at 20 iterations on
 /// `threads` threads, one second (60 frames) in: piled up, many contacts.
 pub fn drop_scene(spine: SpineMode, count: usize, threads: usize) -> SceneWorld {
-    drop_scene_with(spine, count, threads, BackendChoice::Auto, 60)
+    let mut scene = drop_scene_with(spine, count, threads, BackendChoice::Auto, 0);
+    advance_drop(&mut scene, 0..60);
+    scene
+}
+
+/// [`drop_scene`] as built, before its first frame (its ragdolls as a
+/// switch from animation meets them); [`advance_drop`] runs its frames.
+pub fn drop_scene_built(spine: SpineMode, count: usize, threads: usize) -> SceneWorld {
+    drop_scene_with(spine, count, threads, BackendChoice::Auto, 0)
+}
+
+/// Frames `frames` of a ragdoll drop.
+pub fn advance_drop(scene: &mut SceneWorld, frames: core::ops::Range<usize>) {
+    for frame in frames {
+        scene
+            .advance(Scene::RagdollDrop, frame, DT)
+            .expect("a frame");
+    }
 }
 
 /// [`drop_scene`] on one thread with a forced backend.
@@ -539,9 +556,7 @@ fn drop_scene_with(
     let mut config = SceneConfig::new(Scene::RagdollDrop, spine);
     (config.ragdolls, config.threads, config.backend) = (count, threads, backend);
     let mut scene = build(&config).expect("the drop scene");
-    for frame in 0..frames {
-        scene.advance(config.scene, frame, DT).expect("a frame");
-    }
+    advance_drop(&mut scene, 0..frames);
     scene
 }
 

@@ -397,7 +397,7 @@ pub struct VtGetUp {
 /// poses of `count` transforms each, one per described body, in each
 /// clip's model frame, one after another), the one whose root body lies
 /// most as the ragdoll's does in `lying` (`count` world transforms: its
-/// pose as `vt_ragdoll_skeleton_pose` gives it), placed by a turn about
+/// pose as `vt_ragdoll_pose` gives it), placed by a turn about
 /// `up` (the world's up, unit: against gravity) and a move that put its
 /// root body on the ragdoll's; into `get_up`. Blend back to the placed
 /// clip with `vt_blend_back_create_ragdoll` from `lying`. Refused, naming

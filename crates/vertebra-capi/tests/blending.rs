@@ -596,8 +596,10 @@ fn a_get_up_clip_is_chosen_and_placed_as_in_rust() {
         VtResult::Ragdoll,
         &["up"],
     );
+    let mut broken = c_frames.clone();
+    broken[c_lying.len() + 2].rotation = Quat::from_xyzw(0.0, 0.0, 0.0, 2.0).into();
     refused(
-        choose(&c_frames[1..], 2, Vec3::Y, &mut c),
+        choose(&broken, 2, Vec3::Y, &mut c),
         VtResult::Ragdoll,
         &["clip 1's first frame"],
     );

@@ -62,6 +62,7 @@ impl GetUp {
                 reason: format!("is {up}; must be a unit vector"),
             });
         }
+        let up = up.normalize();
         let (at, facing) = lying.bones[desc.root];
         let mut best: Option<Self> = None;
         for (clip, first) in first_frames.iter().enumerate() {

@@ -48,7 +48,7 @@ fn joints_hold(
         if gap > Transition::MAX_JOINT_GAP {
             let name = mapper.desc.joints.get(k).map_or("?", |j| j.name.as_str());
             return Err(RagdollError::BadPose(format!(
-                "joint `{name}`: its bodies are {:.1} mm apart at its pivot, which the first step would pull together (a pop): build the ragdoll for the switch with BuildOptions::at_switch",
+                "joint `{name}`: its bodies are {:.1} mm apart at its pivot, which the first step would pull together (a pop): a transition is made at the switch, for a ragdoll built then with BuildOptions::at_switch",
                 gap * 1e3
             )));
         }
