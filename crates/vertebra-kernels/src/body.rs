@@ -123,18 +123,12 @@ impl<L: Lane> BodyLanes<L> {
     pub fn gather(rows: &BodyRows, indices: &[u32]) -> Self {
         let [px, py, pz, inv_mass, qx, qy, qz, qw] = L::gather_rows(&rows.pose, indices);
         let [xx, yy, zz, xy, xz, yz, _, _] = L::gather_rows(&rows.inertia, indices);
+        let inv_inertia = Sym3::from_entries([xx, yy, zz, xy, xz, yz]);
         Self {
             p: Vec3::new(px, py, pz),
             inv_mass,
             q: Quat::new(qx, qy, qz, qw),
-            inv_inertia: Sym3 {
-                xx,
-                yy,
-                zz,
-                xy,
-                xz,
-                yz,
-            },
+            inv_inertia,
         }
     }
 

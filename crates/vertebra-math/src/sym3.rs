@@ -24,6 +24,20 @@ pub struct Sym3<L> {
 }
 
 impl<L: Lane> Sym3<L> {
+    /// The matrix of the entries `[xx, yy, zz, xy, xz, yz]` (the order of
+    /// the kernels' inertia rows).
+    #[inline(always)]
+    pub fn from_entries([xx, yy, zz, xy, xz, yz]: [L; 6]) -> Self {
+        Self {
+            xx,
+            yy,
+            zz,
+            xy,
+            xz,
+            yz,
+        }
+    }
+
     /// The diagonal matrix `diag(d)`.
     #[inline(always)]
     pub fn diagonal(d: Vec3<L>) -> Self {

@@ -29,7 +29,7 @@
 //! `h`, a step of `dt`).
 
 use vertebra_math::block::{LaneSlices, Vec3Block, for_live_slices};
-use vertebra_math::{Backend, Lane, LaneKernel, Sym3, Vec3};
+use vertebra_math::{Backend, Lane, LaneKernel, Vec3};
 
 use super::solve::load;
 use super::{Child, NONE, NodeKind, Topology, TreeBlock};
@@ -138,15 +138,7 @@ impl Loads<'_> {
         let q = BodyLanes::<L>::gather(self.rows, &body.row[start..]).q;
         let [dx, dy, dz, tx, ty, tz] = load::<L, 6>(&body.moved, start);
         let (dp, turn) = (Vec3::new(dx, dy, dz), Vec3::new(tx, ty, tz));
-        let [xx, yy, zz, xy, xz, yz] = load::<L, 6>(&body.inertia, start);
-        let inertia = Sym3 {
-            xx,
-            yy,
-            zz,
-            xy,
-            xz,
-            yz,
-        };
+        let inertia = body.inertia_lanes::<L>(start);
         let mut linear = dp.scale(L::load(&body.mass[start..]));
         let mut angular = q.rotate(inertia.mul_vec(q.inverse_rotate(turn)));
         for &child in self.topology.children(n) {

@@ -38,7 +38,7 @@ pub mod split;
 use bytemuck::{Pod, Zeroable};
 use vertebra_math::block::{BLOCK_LANES, LaneSlices, QuatBlock, Vec3Block, for_live_slices};
 use vertebra_math::row::NO_WRITE;
-use vertebra_math::{Backend, Lane, LaneKernel};
+use vertebra_math::{Backend, Lane, LaneKernel, Sym3};
 
 use crate::body::{BodyPairs, BodyRows, LaneBlock, PairLane};
 use crate::limited::{LimitLane, SoftnessBlock};
@@ -331,6 +331,12 @@ impl BodyNode {
     /// Zeroes `moved`, as a step begins.
     pub fn reset_moved(&mut self) {
         self.moved = [[0.0; BLOCK_LANES]; 6];
+    }
+
+    /// The body-frame inertia (kg m^2) of lanes `start ..`.
+    #[inline(always)]
+    pub(crate) fn inertia_lanes<L: Lane>(&self, start: usize) -> Sym3<L> {
+        Sym3::from_entries(solve::load::<L, 6>(&self.inertia, start))
     }
 
     /// `lane`'s `moved`: the displacement (m) and turn (rad), world.

@@ -28,7 +28,7 @@
 //! registers.
 
 use vertebra_math::block::BLOCK_LANES;
-use vertebra_math::{Lane, Mask, Sym3, Vec3};
+use vertebra_math::{Lane, Mask, Vec3};
 
 use super::MAX_LIMIT_RETURN_SPEED;
 use super::ldl::{self, Held, MAX, PACKED, at};
@@ -121,16 +121,7 @@ pub(super) fn measure<L: Lane>(
                 let body = &block.bodies[index as usize];
                 let q = BodyLanes::<L>::gather(rows, &body.row[start..]).q;
                 let mass = L::load(&body.mass[start..]);
-                let [xx, yy, zz, xy, xz, yz] = load::<L, 6>(&body.inertia, start);
-                let inertia = Sym3 {
-                    xx,
-                    yy,
-                    zz,
-                    xy,
-                    xz,
-                    yz,
-                }
-                .rotated(q);
+                let inertia = body.inertia_lanes::<L>(start).rotated(q);
                 measured = [
                     mass, inertia.xx, inertia.xy, inertia.xz, inertia.yy, inertia.yz, inertia.zz,
                 ];
