@@ -297,7 +297,8 @@ fn pad(input: &mut Input, blocks: &mut Blocks) {
 /// A block of direct-solve trees of one shape: each lane's own two rows
 /// joined by a joint of any kind, and now and then a second joint (any
 /// kind) from a static row to the first body, the tree's root; masses and
-/// inertias arbitrary, lanes padding at random.
+/// inertias arbitrary, sockets and hinges driven or not, lanes padding at
+/// random.
 fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
     let kinds = [
         JointRows::Socket(SwingRows::Cone),
@@ -330,8 +331,10 @@ fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
             node.set(lane, own(k), true, input.positive(50.0), inertia);
         }
         let sides = [(own(0), own(1)), (fixed, own(0))];
-        for (joint, &(a, b)) in block.joints.iter_mut().zip(&sides) {
+        for ((joint, &(a, b)), &(kind, ..)) in block.joints.iter_mut().zip(&sides).zip(&shape) {
             let twist = sorted_range(input);
+            let drivable = matches!(kind, JointRows::Socket(_) | JointRows::Hinge);
+            let drive = (drivable && input.flag()).then(|| drive_lane(input));
             joint.set(
                 lane,
                 &JointLane {
@@ -355,9 +358,11 @@ fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
                     } else {
                         LimitLane::HARD
                     },
+                    drive,
                 },
             );
             block.soft |= joint.is_soft(lane);
+            block.driven |= drive.is_some();
             joint.bodies.set_start(lane, &start(input));
         }
     }
@@ -399,6 +404,7 @@ fn run(
         blocks: &mut trees,
         topologies: core::slice::from_ref(topology),
         rows: &rows,
+        h,
     });
     direct::PositionPass {
         blocks: &mut trees,

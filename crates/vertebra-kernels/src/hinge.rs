@@ -147,6 +147,12 @@ impl<const DRIVE: bool> BlockKernel for Positions<DRIVE> {
     fn padding(block: &HingeBlock) -> u32 {
         block.bodies.padding
     }
+    /// A block whose joints the direct solve holds, drives included,
+    /// has nothing left to iterate.
+    #[inline(always)]
+    fn skips(block: &HingeBlock) -> bool {
+        block.bodies.direct != 0
+    }
     #[inline(always)]
     fn solve<L: Lane>(block: &mut HingeBlock, start: usize, rows: &BodyRows, s: SubstepScale) {
         let (inv_h, inv_h2) = (L::splat(s.inv_h), L::splat(s.inv_h2));
@@ -174,29 +180,24 @@ fn solve_positions<L: Lane, const DRIVE: bool>(
             .solve(start, a, b, frame_a, frame_b, inv_h, inv_h2);
     }
 
-    // A block whose joints the direct solve holds leaves it their axes,
-    // ranges and points: only the drive is iterated.
-    let iterated = block.bodies.direct == 0;
-    if iterated {
-        hinge_axis::solve(&mut a, &mut b, frame_a, frame_b);
-        let (lo, hi) = (
-            L::load(&block.range_min[start..]),
-            L::load(&block.range_max[start..]),
-        );
-        let (axes, c) = twist::violation_local(&a, &b, frame_a, frame_b, lo, hi);
-        let soft = block.limit_softness.lanes(start, inv_h, inv_h2);
-        let lambda = L::load(&block.limit_lambda[start..]);
-        let c0 = L::load(&block.limit_start[start..]);
-        limit::solve_local(&mut a, &mut b, axes, (c, c0), soft, lambda)
-            .store(&mut block.limit_lambda[start..]);
-        point::solve(
-            &mut a,
-            &mut b,
-            block.anchor_a.load(start),
-            block.anchor_b.load(start),
-            &block.bodies.start(start),
-        );
-    }
+    hinge_axis::solve(&mut a, &mut b, frame_a, frame_b);
+    let (lo, hi) = (
+        L::load(&block.range_min[start..]),
+        L::load(&block.range_max[start..]),
+    );
+    let (axes, c) = twist::violation_local(&a, &b, frame_a, frame_b, lo, hi);
+    let soft = block.limit_softness.lanes(start, inv_h, inv_h2);
+    let lambda = L::load(&block.limit_lambda[start..]);
+    let c0 = L::load(&block.limit_start[start..]);
+    limit::solve_local(&mut a, &mut b, axes, (c, c0), soft, lambda)
+        .store(&mut block.limit_lambda[start..]);
+    point::solve(
+        &mut a,
+        &mut b,
+        block.anchor_a.load(start),
+        block.anchor_b.load(start),
+        &block.bodies.start(start),
+    );
 
     block
         .reaction

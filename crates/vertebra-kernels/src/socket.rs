@@ -177,6 +177,12 @@ impl<const DRIVE: bool, const SHAPED: bool> BlockKernel for Positions<DRIVE, SHA
     fn padding(block: &SocketBlock) -> u32 {
         block.bodies.padding
     }
+    /// A block whose joints the direct solve holds, drives included,
+    /// has nothing left to iterate.
+    #[inline(always)]
+    fn skips(block: &SocketBlock) -> bool {
+        block.bodies.direct != 0
+    }
     #[inline(always)]
     fn solve<L: Lane>(block: &mut SocketBlock, start: usize, rows: &BodyRows, s: SubstepScale) {
         let (inv_h, inv_h2) = (L::splat(s.inv_h), L::splat(s.inv_h2));
@@ -204,12 +210,9 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
             .solve(start, a, b, frame_a, frame_b, inv_h, inv_h2);
     }
 
-    // A block whose joints the direct solve holds leaves it their limits
-    // and points: only the drive is iterated.
-    let iterated = block.bodies.direct == 0;
-    if SHAPED && iterated {
+    if SHAPED {
         solve_shaped(block, start, &mut a, &mut b, inv_h, inv_h2);
-    } else if iterated {
+    } else {
         swing::solve(
             &mut a,
             &mut b,
@@ -223,15 +226,13 @@ fn solve_positions<L: Lane, const DRIVE: bool, const SHAPED: bool>(
         );
         twist::solve(&mut a, &mut b, frame_a, frame_b, lo, hi);
     }
-    if iterated {
-        point::solve(
-            &mut a,
-            &mut b,
-            block.anchor_a.load(start),
-            block.anchor_b.load(start),
-            &block.bodies.start(start),
-        );
-    }
+    point::solve(
+        &mut a,
+        &mut b,
+        block.anchor_a.load(start),
+        block.anchor_b.load(start),
+        &block.bodies.start(start),
+    );
 
     block
         .reaction

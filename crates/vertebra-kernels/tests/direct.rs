@@ -19,7 +19,8 @@ use vertebra_kernels::direct::ldl::{self, MAX, PACKED, at};
 use vertebra_kernels::direct::load::LoadPass;
 use vertebra_kernels::direct::rows::{Geometry, JointRows, Rows, SwingRows};
 use vertebra_kernels::direct::{
-    JointLane, NONE, NodeKind, PositionPass, StartPass, Topology, TopologyError, TreeBlock, split,
+    JointLane, JointNode, NONE, NodeKind, PositionPass, StartPass, Topology, TopologyError,
+    TreeBlock, split,
 };
 use vertebra_kernels::limited::LimitLane;
 use vertebra_kernels::parts::limit::Softness;
@@ -116,7 +117,10 @@ fn factor_n(f: &mut [f32; PACKED], n: usize) {
         3 => ldl::factor::<f32, 3>(f),
         4 => ldl::factor::<f32, 4>(f),
         5 => ldl::factor::<f32, 5>(f),
-        _ => ldl::factor::<f32, 6>(f),
+        6 => ldl::factor::<f32, 6>(f),
+        7 => ldl::factor::<f32, 7>(f),
+        8 => ldl::factor::<f32, 8>(f),
+        _ => ldl::factor::<f32, 9>(f),
     }
 }
 
@@ -128,7 +132,10 @@ fn solve_n(f: &[f32; PACKED], n: usize, x: &mut [f32; MAX]) {
         3 => ldl::solve::<f32, 3>(f, x),
         4 => ldl::solve::<f32, 4>(f, x),
         5 => ldl::solve::<f32, 5>(f, x),
-        _ => ldl::solve::<f32, 6>(f, x),
+        6 => ldl::solve::<f32, 6>(f, x),
+        7 => ldl::solve::<f32, 7>(f, x),
+        8 => ldl::solve::<f32, 8>(f, x),
+        _ => ldl::solve::<f32, 9>(f, x),
     }
 }
 
@@ -288,6 +295,8 @@ fn pair_start(s: &StartLane) -> PairStart<f32> {
 /// A joint as `Rows::measure` sees it.
 struct Measured {
     kind: JointRows,
+    /// Its drive's rows measured too (a tree with a drive).
+    driven: bool,
     a: BodyLanes<f32>,
     b: BodyLanes<f32>,
     g: Geometry<f32>,
@@ -300,7 +309,20 @@ const ANGULAR: [usize; 6] = [3, 4, 5, 9, 10, 11];
 
 impl Measured {
     fn rows(&self) -> Rows<f32> {
-        Rows::measure(self.kind, &self.a, &self.b, &self.g)
+        self.measure(&self.a, &self.b)
+    }
+
+    /// The rows with the bodies at `a` and `b`, the drive's among them
+    /// where driven, as the solve measures them.
+    fn measure(&self, a: &BodyLanes<f32>, b: &BodyLanes<f32>) -> Rows<f32> {
+        let mut rows = Rows::measure(self.kind, a, b, &self.g);
+        if self.driven {
+            let drive = Rows::measure_drive(self.kind, a, b, &self.g);
+            for k in self.kind.first_drive()..self.kind.count() {
+                (rows.c[k], rows.ja[k], rows.jb[k]) = (drive.c[k], drive.ja[k], drive.jb[k]);
+            }
+        }
+        rows
     }
 
     /// The analytic Jacobian, row by row over the 12 coordinates.
@@ -335,7 +357,7 @@ impl Measured {
                 } else {
                     turned(*body, v)
                 };
-                Rows::measure(self.kind, &a, &b, &self.g).c
+                self.measure(&a, &b).c
             };
             let (plus, minus) = (c(1.0), c(-1.0));
             for (k, row) in out.iter_mut().enumerate() {
@@ -414,6 +436,7 @@ fn joint(r: &mut StdRng, kind: JointRows, misalignment: GQuat) -> Measured {
     let frame = unit_quat(r);
     let start = common::start(r, false);
     Measured {
+        driven: false,
         kind,
         a,
         b,
@@ -428,6 +451,7 @@ fn joint(r: &mut StdRng, kind: JointRows, misalignment: GQuat) -> Measured {
             ellipse: [1.0, 1.0],
             pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
             softness: Softness::hard(),
+            drive_target: GQuat::IDENTITY.into(),
             start: pair_start(&start),
         },
     }
@@ -455,6 +479,7 @@ fn rod(r: &mut StdRng, distance: f32, bend: f32, misalignment: GQuat) -> Measure
         distance
     };
     Measured {
+        driven: false,
         kind: JointRows::Rod,
         a,
         b,
@@ -469,6 +494,7 @@ fn rod(r: &mut StdRng, distance: f32, bend: f32, misalignment: GQuat) -> Measure
             ellipse: [1.0, 1.0],
             pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
             softness: Softness::hard(),
+            drive_target: GQuat::IDENTITY.into(),
             // The rows' displacements measured from the origin: no gap.
             start: pair_start(&StartLane::default()),
         },
@@ -538,7 +564,7 @@ fn chord_scale(d: f32) -> f64 {
 }
 
 #[test]
-fn hinge_axis_lock_and_curve_rows_are_gradients_at_zero_error_and_first_order_beyond() {
+fn hinge_axis_lock_curve_and_drive_rows_are_gradients_at_zero_error_and_first_order_beyond() {
     let mut r = StdRng::seed_from_u64(11);
     for small in [true, false] {
         for _ in 0..300 {
@@ -548,18 +574,35 @@ fn hinge_axis_lock_and_curve_rows_are_gradients_at_zero_error_and_first_order_be
                 r.random_range(0.1..2.5)
             };
             let misalignment = turn(&mut r, angle);
-            let hinge = joint(&mut r, JointRows::Hinge, misalignment);
+            let mut hinge = joint(&mut r, JointRows::Hinge, misalignment);
+            hinge.driven = true;
             let fixed = joint(&mut r, JointRows::Fixed, misalignment);
+            // The socket's drive rows on the hinge's bodies and frames: the
+            // hinge's one drive row is their component along its axis.
+            let socket = Measured {
+                kind: JointRows::Socket(SwingRows::Cone),
+                ..hinge
+            };
             let d = r.random_range(0.2..1.0);
             let bend = r.random_range(0.0..1.5);
             let rod = rod(&mut r, d, bend, misalignment);
             if small {
                 check_first_order("hinge axis", &hinge, 3..5, 1.0, 0.6);
                 check_first_order("lock", &fixed, 3..6, 1.0, 0.6);
+                check_first_order("socket drive", &socket, 5..8, 1.0, 0.6);
+                // The hinge's drive row's Jacobian is first order in the
+                // whole error rotation, not in its component along the axis.
+                let bound = 2e-3 + 0.6 * socket.error(5..8);
+                let deviation = hinge.deviation(6..7, &ANGULAR);
+                assert!(
+                    deviation <= bound,
+                    "hinge drive: {deviation:.2e} > {bound:.2e}"
+                );
                 check_first_order("curve", &rod, 0..2, chord_scale(d), 1.2);
             } else {
                 check_descent("hinge axis", &hinge, 3..5);
                 check_descent("lock", &fixed, 3..6);
+                check_descent("socket drive", &socket, 5..8);
                 check_descent("curve", &rod, 0..2);
             }
         }
@@ -587,6 +630,7 @@ fn curve_rows_stay_gradients_for_a_rod_bent_a_right_angle_in_its_frame_plane() {
         let b = lanes(GVec3::from(a.p) + o * d, unit_quat(&mut r));
         let frame_b = misalignment * q * GQuat::from_rotation_z(core::f32::consts::FRAC_PI_2);
         let rod = Measured {
+            driven: false,
             kind: JointRows::Rod,
             a,
             b,
@@ -602,6 +646,7 @@ fn curve_rows_stay_gradients_for_a_rod_bent_a_right_angle_in_its_frame_plane() {
                 ellipse: [1.0, 1.0],
                 pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
                 softness: Softness::hard(),
+                drive_target: GQuat::IDENTITY.into(),
                 start: pair_start(&StartLane::default()),
             },
         };
@@ -948,6 +993,7 @@ impl Scene {
         let joint = &self.tree.joints[j];
         let gather = |side| BodyLanes::<f32>::gather(rows, &[self.side_row(side)]);
         let mut m = Measured {
+            driven: false,
             kind: joint.kind,
             a: gather(joint.a),
             b: gather(joint.b),
@@ -962,6 +1008,7 @@ impl Scene {
                 ellipse: [1.0, 1.0],
                 pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
                 softness: Softness::hard(),
+                drive_target: GQuat::IDENTITY.into(),
                 start: pair_start(&joint.start),
             },
         };
@@ -1485,10 +1532,16 @@ fn random_lane(
                 let compliance = log_uniform(r, -6.0, -1.0);
                 common::limit_softness(r, compliance)
             },
+            drive: (matches!(kind, JointRows::Socket(_) | JointRows::Hinge) && r.random_bool(0.5))
+                .then(|| {
+                    let compliance = log_uniform(r, -6.0, -1.0);
+                    common::random_drive(r, compliance)
+                }),
         };
         node.set(lane, &joint);
         node.bodies.set_start(lane, &start);
         block.soft |= node.is_soft(lane);
+        block.driven |= joint.drive.is_some();
         data.joints.push((joint, start));
     }
     block.padding &= !(1 << lane);
@@ -1599,6 +1652,7 @@ fn run_trees(backend: Backend, raw: &RawRows, trees: &[Trees]) -> Vec<f32> {
             for joint in &block.joints {
                 let limits = joint.limit_lambda.iter().chain(&joint.limit_start);
                 out.extend(limits.map(|v| v[lane]));
+                out.extend(drive_state(joint, lane));
                 let load = [joint.force.get(lane), joint.torque.get(lane)];
                 out.extend(load.iter().flat_map(|v| v.to_array()));
             }
@@ -1681,6 +1735,7 @@ fn cut_scene(seed: u64, adversarial: bool) -> Cut {
                 b.joints[k].set(p.lane, &joint);
                 b.joints[k].bodies.set_start(p.lane, &start);
                 b.soft |= b.joints[k].is_soft(p.lane);
+                b.driven |= joint.drive.is_some();
             }
         }
     }
@@ -1741,10 +1796,22 @@ fn run_cut(backend: Backend, cut: &Cut, pieces: bool) -> Vec<f32> {
             );
             let joint = &block.joints[index as usize];
             out.extend(joint.limit_lambda.iter().map(|v| v[lane]));
+            out.extend(drive_state(joint, lane));
             let load = [joint.force.get(lane), joint.torque.get(lane)];
             out.extend(load.iter().flat_map(|v| v.to_array()));
         }
     }
+    out
+}
+
+/// A joint's drive in `lane` after the solves: its substep's sums, its
+/// advanced target and whether it capped.
+fn drive_state(joint: &JointNode, lane: usize) -> Vec<f32> {
+    let d = &joint.drive;
+    let sums = (d.start.iter().chain(&d.lambda).chain(&d.moved)).chain(&d.cap);
+    let mut out: Vec<f32> = sums.map(|v| v[lane]).collect();
+    out.extend(d.target.get(lane).to_array());
+    out.push(d.capped[lane]);
     out
 }
 
@@ -2610,7 +2677,7 @@ fn next_limit_pass(
         let mut m = scene.measured(rows, j);
         set_limits(&mut m.g, limits);
         let c = m.rows().c;
-        let limit_rows = m.kind.first_limit()..m.kind.count();
+        let limit_rows = m.kind.first_limit()..m.kind.first_drive();
         let largest = limit_rows.map(|k| c[k] as f64).fold(f64::MIN, f64::max);
         (c[row] as f64, largest)
     };
@@ -2636,7 +2703,7 @@ fn next_limit_pass(
         .map(f64::from)
         .collect();
     let (c, jacobian) = (m.rows().c, m.analytic());
-    let predicted = (m.kind.first_limit()..m.kind.count())
+    let predicted = (m.kind.first_limit()..m.kind.first_drive())
         .map(|k| c[k] as f64 + jacobian[k].iter().zip(&dx).map(|(j, x)| j * x).sum::<f64>())
         .fold(f64::MIN, f64::max);
     LimitPass {
@@ -2812,8 +2879,12 @@ fn a_violated_limit_the_other_rows_carry_inside_is_released_by_the_next_solve() 
 // Soft limits: compliance and damping on the row's diagonal.
 // ---------------------------------------------------------------------------
 
+/// The substep the start passes advance the drives' targets by (s).
+const SUBSTEP: f32 = 1.0 / 600.0;
+
 /// The trees' start pass: every limit's multiplier reset, a soft block's
-/// violations measured (`C_0`).
+/// violations measured (`C_0`), every drive's error measured and its
+/// target advanced.
 fn start_pass(
     backend: Backend,
     rows: &BodyRows,
@@ -2824,6 +2895,7 @@ fn start_pass(
         blocks,
         topologies,
         rows,
+        h: SUBSTEP,
     });
 }
 

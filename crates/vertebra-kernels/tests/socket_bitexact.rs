@@ -9,7 +9,7 @@ use glam::{Quat, Vec3};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use vertebra_kernels::body::{JointFrames, LaneBlock};
-use vertebra_kernels::driven::{self, DriveLane};
+use vertebra_kernels::driven;
 use vertebra_kernels::limited;
 use vertebra_kernels::pass::{self, SubstepScale};
 use vertebra_kernels::residual::ResidualPass;
@@ -96,7 +96,9 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<SocketBlo
                     } else {
                         [-pi, pi]
                     },
-                    drive: r.random_bool(0.6).then(|| drive(&mut r, compliance)),
+                    drive: r
+                        .random_bool(0.6)
+                        .then(|| common::random_drive(&mut r, compliance)),
                     shaped: shaped(&mut r, adversarial, compliance),
                 },
             );
@@ -133,41 +135,6 @@ fn shaped(r: &mut StdRng, adversarial: bool, compliance: f32) -> ShapedLimits {
         ellipse: [semi(r), semi(r)],
         pyramid: [range(r), range(r)],
         softness: common::limit_softness(r, compliance),
-    }
-}
-
-/// A drive of either strength (compliance, or `1 / omega^2` with
-/// compliance 0), moving or still, with or without a torque limit.
-fn drive(r: &mut StdRng, compliance: f32) -> DriveLane {
-    let spring = r.random_bool(0.5);
-    let omega = match r.random_range(0..3) {
-        0 => 1e-2,
-        1 => 1e4,
-        _ => r.random_range(1.0..200.0),
-    };
-    DriveLane {
-        target: unit_quat(r),
-        velocity: if r.random_bool(0.5) {
-            glam::Vec3::new(
-                r.random_range(-20.0..20.0),
-                r.random_range(-20.0..20.0),
-                r.random_range(-20.0..20.0),
-            )
-        } else {
-            glam::Vec3::ZERO
-        },
-        compliance: if spring { 0.0 } else { compliance },
-        period2: if spring { 1.0 / (omega * omega) } else { 0.0 },
-        damping_time: match r.random_range(0..3) {
-            0 => 0.0,
-            1 => 1e6,
-            _ => r.random_range(0.0..1.0),
-        },
-        max_torque: match r.random_range(0..4) {
-            0 => 0.0,
-            1 => r.random_range(0.0..50.0),
-            _ => f32::INFINITY,
-        },
     }
 }
 

@@ -149,6 +149,7 @@ fn start_drives(world: &mut World, h: f32) {
                 blocks: &mut layout.trees.blocks[bin.trees.clone()],
                 topologies: &layout.trees.topologies,
                 rows,
+                h,
             });
         }
     }

@@ -204,6 +204,7 @@ impl Trees {
             };
             block.joints[k].set(lane, &lane_data);
             block.soft |= lane_data.softness != LimitLane::HARD;
+            block.driven |= lane_data.drive.is_some();
         }
     }
 
@@ -325,7 +326,7 @@ pub(crate) fn set_mass(node: &mut BodyNode, lane: usize, bodies: &BodyStore) {
 
 /// A joint's lane, with every limit the direct solve holds: a socket's
 /// swing (cone, ellipse or pyramid) and twist range, a hinge's range, hard
-/// or soft.
+/// or soft; and its drive (a fixed joint takes none).
 fn joint_lane(d: &JointDesc) -> JointLane {
     let free = [-PI, PI];
     let mut lane = JointLane {
@@ -356,6 +357,7 @@ fn joint_lane(d: &JointDesc) -> JointLane {
         }
         JointKind::Fixed => {}
     }
+    lane.drive = d.drive.map(|drive| drive.lane());
     lane
 }
 

@@ -1,4 +1,4 @@
-//! Dense symmetric blocks of at most 6 x 6, one per lane, packed by rows
+//! Dense symmetric blocks of at most 9 x 9, one per lane, packed by rows
 //! of their lower triangle, and their `L D L^T` factorisation: the
 //! diagonal blocks of the direct solve (a body's 6 x 6, a joint's rows).
 //!
@@ -23,11 +23,11 @@
 
 use vertebra_math::Lane;
 
-/// The largest block: a body's six degrees of freedom, a fixed joint's
-/// six rows.
-pub const MAX: usize = 6;
+/// The largest block: a pyramid socket's nine rows (its point, two swing
+/// rows, its twist and its drive's three).
+pub const MAX: usize = 9;
 
-/// Entries of a packed 6 x 6 lower triangle.
+/// Entries of a packed 9 x 9 lower triangle.
 pub const PACKED: usize = MAX * (MAX + 1) / 2;
 
 /// A pivot is kept when it exceeds this fraction of its diagonal entry:

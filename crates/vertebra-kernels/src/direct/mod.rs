@@ -20,7 +20,7 @@
 //! each node's diagonal block takes its children's Schur complements,
 //! `D_p -= A^T D_c^-1 A`, and is factored ([`ldl`]); one pass back from
 //! the root gives every node's unknown. O(bodies), with dense blocks of at
-//! most 6 x 6. Derivation and the handling of joints to static or
+//! most 9 x 9. Derivation and the handling of joints to static or
 //! kinematic bodies (a tree's root) in `docs/direct.md`.
 //!
 //! A [`Topology`] is the elimination order of one tree's shape, computed
@@ -29,6 +29,7 @@
 //! solves them lane by lane with the same lane-generic code on every
 //! backend.
 
+pub mod drive;
 pub mod ldl;
 pub mod load;
 pub mod rows;
@@ -41,10 +42,12 @@ use vertebra_math::row::NO_WRITE;
 use vertebra_math::{Backend, Lane, LaneKernel, Sym3};
 
 use crate::body::{BodyPairs, BodyRows, LaneBlock, PairLane};
+use crate::driven::DriveLane;
 use crate::limited::{LimitLane, SoftnessBlock};
 use crate::pass::SubstepScale;
+use drive::{DRIVE_RECORD, DriveNode};
 use ldl::{MAX, PACKED};
-use rows::{Geometry, LIMIT_RECORD, MAX_LIMITS};
+use rows::{Geometry, LIMIT_RECORD, MAX_DRIVE_ROWS, MAX_LIMITS, MAX_OPTIONAL};
 pub use rows::{JointRows, SwingRows};
 
 /// No node: the root's parent, or a joint's side on a static or kinematic
@@ -423,6 +426,8 @@ pub struct JointNode {
     /// Its share of the mean torque on `b` about `b`'s anchor (N m,
     /// world).
     pub torque: Vec3Block,
+    /// The joint's drive, held by its drive rows ([`drive`]).
+    pub drive: DriveNode,
 }
 
 /// A joint's geometry in one lane, as the world lays it out.
@@ -455,6 +460,8 @@ pub struct JointLane {
     pub pyramid: [[f32; 2]; 2],
     /// The limits' softness ([`LimitLane::HARD`]: hard).
     pub softness: LimitLane,
+    /// The drive, if any (a socket's or a hinge's).
+    pub drive: Option<DriveLane>,
 }
 
 impl JointLane {
@@ -473,6 +480,7 @@ impl JointLane {
         ellipse: [1.0, 1.0],
         pyramid: [[-core::f32::consts::PI, core::f32::consts::PI]; 2],
         softness: LimitLane::HARD,
+        drive: None,
     };
 }
 
@@ -505,6 +513,7 @@ impl LaneBlock for JointNode {
             (axis[0][lane], axis[1][lane]) = (range[0], range[1]);
         }
         self.softness.set(lane, &j.softness);
+        self.drive.set(lane, j.drive.as_ref());
     }
 }
 
@@ -545,6 +554,7 @@ impl JointNode {
             softness: self
                 .softness
                 .lanes(start, L::splat(scale.inv_h), L::splat(scale.inv_h2)),
+            drive_target: self.drive.target.load(start),
             start: self.bodies.start(start),
         }
     }
@@ -589,12 +599,16 @@ pub struct NodeScratch {
     /// generalised inverse mass (`c, J_a, J_b, w`: eight values a row),
     /// which predict where the solve's step takes it.
     pub limits: [[f32; BLOCK_LANES]; MAX_LIMITS * LIMIT_RECORD],
-    /// A joint's limit rows held in this solve (1) or not (0): the active
-    /// set.
-    pub active: [[f32; BLOCK_LANES]; MAX_LIMITS],
+    /// A joint's drive rows as measured: each row's error, generalised
+    /// inverse mass and target (`c, w, T`: [`DRIVE_RECORD`] values a row).
+    pub drive: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS * DRIVE_RECORD],
+    /// A joint's optional rows held in this solve (1) or not (0): its
+    /// limits' active set, then its drive's rows (held where the lane has
+    /// a drive).
+    pub active: [[f32; BLOCK_LANES]; MAX_OPTIONAL],
     /// The active set the last settle chose: a crossing lane's next
     /// pass, and the next solve's start.
-    pub next: [[f32; BLOCK_LANES]; MAX_LIMITS],
+    pub next: [[f32; BLOCK_LANES]; MAX_OPTIONAL],
 }
 
 impl NodeScratch {
@@ -608,8 +622,9 @@ impl NodeScratch {
         measured: [[0.0; BLOCK_LANES]; MEASURED],
         coupling: [[0.0; BLOCK_LANES]; MAX * 6],
         limits: [[0.0; BLOCK_LANES]; MAX_LIMITS * LIMIT_RECORD],
-        active: [[0.0; BLOCK_LANES]; MAX_LIMITS],
-        next: [[0.0; BLOCK_LANES]; MAX_LIMITS],
+        drive: [[0.0; BLOCK_LANES]; MAX_DRIVE_ROWS * DRIVE_RECORD],
+        active: [[0.0; BLOCK_LANES]; MAX_OPTIONAL],
+        next: [[0.0; BLOCK_LANES]; MAX_OPTIONAL],
     };
 }
 
@@ -669,6 +684,9 @@ pub struct TreeBlock {
     /// Some lane has a soft limit (its rows then carry compliance and
     /// damping, and [`StartPass`] measures their start).
     pub soft: bool,
+    /// Some lane has a drive (its joints' drive rows are then measured
+    /// and held).
+    pub driven: bool,
     /// The next solve chooses its limits' active set afresh (the limits
     /// violated then), as the first of a substep does ([`StartPass`] sets
     /// it); a later one starts from the set the solve before settled on.
@@ -682,8 +700,8 @@ pub struct TreeBlock {
     /// Per node, the lanes whose block must be factored again this pass
     /// (a limit row taken or let go, in it or below it).
     pub dirty: Vec<u8>,
-    /// Per joint node, the lanes holding each limit row this pass.
-    pub held: Vec<[u8; MAX_LIMITS]>,
+    /// Per joint node, the lanes holding each optional row this pass.
+    pub held: Vec<[u8; MAX_OPTIONAL]>,
     /// The lanes whose active set crossed in the last settle.
     pub crossing: [f32; BLOCK_LANES],
     /// The topology's ports, each lane's subtree.
@@ -707,12 +725,13 @@ impl TreeBlock {
             topology,
             padding: (1 << BLOCK_LANES) - 1,
             soft: false,
+            driven: false,
             fresh: true,
             bodies: vec![BodyNode::padding(); shape.bodies],
             joints: vec![JointNode::padding(); shape.joints],
             scratch: vec![NodeScratch::ZERO; shape.nodes.len()],
             dirty: vec![0; shape.nodes.len()],
-            held: vec![[0; MAX_LIMITS]; shape.nodes.len()],
+            held: vec![[0; MAX_OPTIONAL]; shape.nodes.len()],
             crossing: [0.0; BLOCK_LANES],
             ports: vec![Port::empty(); shape.ports],
             parent: [None; BLOCK_LANES],
@@ -889,7 +908,7 @@ impl<const P: u8> LaneSlices for PhaseRun<'_, P> {
             SUBSTITUTE => solve::substitute::<L>(self.block, topology, start),
             SETTLE => solve::settle::<L>(self.block, topology, start),
             _ => {
-                solve::accumulate::<L>(self.block, topology, start);
+                solve::accumulate::<L>(self.block, topology, start, scale);
                 solve::apply::<L>(self.block, topology, rows, start);
             }
         }
@@ -900,7 +919,8 @@ impl<const P: u8> LaneSlices for PhaseRun<'_, P> {
 /// row's multiplier reset, the next solve's active set chosen afresh, and
 /// every limit row's violation measured (a soft limit's damping `C_0`, as
 /// `crate::limited::Starts` measures the parts'; a hard limit's
-/// return from far past, [`MAX_LIMIT_RETURN_SPEED`]).
+/// return from far past, [`MAX_LIMIT_RETURN_SPEED`]); every drive's
+/// error measured and its target advanced (`drive::DriveNode::start`).
 pub struct StartPass<'a> {
     /// The blocks.
     pub blocks: &'a mut [TreeBlock],
@@ -908,6 +928,8 @@ pub struct StartPass<'a> {
     pub topologies: &'a [Topology],
     /// Body rows, read.
     pub rows: &'a BodyRows,
+    /// The substep (s).
+    pub h: f32,
 }
 
 impl LaneKernel for StartPass<'_> {
@@ -924,6 +946,7 @@ impl LaneKernel for StartPass<'_> {
                 topology: &self.topologies[block.topology as usize],
                 block,
                 rows: self.rows,
+                h: self.h,
             };
             for_live_slices::<L, _>(padding, &mut starts);
         }
@@ -935,11 +958,12 @@ struct Starts<'a> {
     topology: &'a Topology,
     block: &'a mut TreeBlock,
     rows: &'a BodyRows,
+    h: f32,
 }
 
 impl LaneSlices for Starts<'_> {
     #[inline(always)]
     fn slice<L: Lane>(&mut self, start: usize) {
-        solve::start_limits::<L>(self.block, self.topology, self.rows, start);
+        solve::start_limits::<L>(self.block, self.topology, self.rows, start, self.h);
     }
 }

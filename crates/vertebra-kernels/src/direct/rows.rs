@@ -11,6 +11,7 @@
 //! | rod curve (2) | `C = theta n` (the turn from the reflection `r` of `t_a` to `t_b`, `parts::rod::curve`) along two axes `u` normal to `r + t_b` (from a's +Y reflected likewise); `J_b = [g(u), u]`, `J_a = [-g(u), -(2 (u . o) o - u)]` |
 //! | rod length (1) | `C = |p_b - p_a| - chord(l0, psi)`; `J_b = [o, -chord'(psi) n]`, `J_a = [-o, chord'(psi) n]` (`n` the bend axis: the paper's motion along the chord, and the chord's turn with the bend) |
 //! | limits (socket swing: a cone's or an ellipse's 1, a pyramid's 2; socket twist, hinge range, rod bend and twist: 1 each) | the signed distance past the limit (positive beyond it, negative inside: how far its boundary is), `J_b = [0, j_b]`, `J_a = [0, -j_a]` with the axes the iterative parts turn about; which are held is the solve's active set (the solve's `settle`), and a row not held is zeroed (dropped) |
+//! | drive (socket 3, hinge 1) | the drive's error rotation vector in a's body frame (`parts::drive`, `measure_in_a`) along a's axes (a socket's three, a hinge's axis): `C = e . log((q_a* q_b F_b)(F_a T)*)`, `J_b = [0, R_a e]`, `J_a = [0, -R_a e]`; held where the lane has a drive, its right-hand side and softness the drive's (`direct/drive.rs`) |
 //!
 //! The single angle the iterative parts correct (`hinge_axis`, `curve`)
 //! has no direction where the error is zero: a row along `n` would vanish
@@ -28,7 +29,9 @@ use super::ldl::MAX;
 use crate::body::{BodyLanes, PairStart, safe_ratio};
 use crate::parts::limit::Softness;
 use crate::parts::rod::{curve, length, twist as rod_twist};
-use crate::parts::{axis_x, ellipse, frames, lock, point, pyramid, swing, swing_direction, twist};
+use crate::parts::{
+    axis_x, drive, ellipse, frames, lock, point, pyramid, swing, swing_direction, twist,
+};
 
 /// A limit row's error where the limit has no bound (a cone of pi, a
 /// range of `[-pi, pi]`): far inside, so the row is never held and no
@@ -49,10 +52,10 @@ pub enum SwingRows {
 /// What a joint holds, and so its rows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum JointRows {
-    /// A socket: the point, the swing limit (one row, two for a pyramid)
-    /// and the twist range (5 or 6 rows).
+    /// A socket: the point, the swing limit (one row, two for a pyramid),
+    /// the twist range and the drive (8 or 9 rows).
     Socket(SwingRows),
-    /// A hinge: the point, the axis and the range (6 rows).
+    /// A hinge: the point, the axis, the range and the drive (7 rows).
     Hinge,
     /// A fixed joint: the point and the lock (6 rows).
     Fixed,
@@ -64,13 +67,31 @@ impl JointRows {
     /// How many rows.
     pub const fn count(self) -> usize {
         match self {
+            JointRows::Socket(SwingRows::Pyramid) => 9,
+            JointRows::Socket(_) => 8,
+            JointRows::Hinge => 7,
+            JointRows::Fixed => 6,
+            JointRows::Rod => 5,
+        }
+    }
+
+    /// The first of the drive rows, which run to the last row (`count()`
+    /// for none: a fixed joint, a rod, whose soft bend and twist stay
+    /// iterated).
+    pub const fn first_drive(self) -> usize {
+        match self {
             JointRows::Socket(SwingRows::Pyramid) | JointRows::Hinge | JointRows::Fixed => 6,
             JointRows::Socket(_) | JointRows::Rod => 5,
         }
     }
 
-    /// The first of the limit rows, which run to the last row (`count()`
-    /// for none: a fixed joint).
+    /// How many limit rows.
+    pub const fn limit_count(self) -> usize {
+        self.first_drive() - self.first_limit()
+    }
+
+    /// The first of the limit rows, which run to the first drive row
+    /// (`first_drive()` for none: a fixed joint).
     pub const fn first_limit(self) -> usize {
         match self {
             JointRows::Socket(_) | JointRows::Rod => 3,
@@ -81,7 +102,7 @@ impl JointRows {
 
     /// Whether row `k` is a limit's.
     pub const fn is_limit(self, k: usize) -> bool {
-        k >= self.first_limit() && k < self.count()
+        k >= self.first_limit() && k < self.first_drive()
     }
 
     /// How the softness of row `k` is scaled: a quarter for the ellipse's
@@ -95,6 +116,13 @@ impl JointRows {
 /// The most limit rows a joint has (a pyramid socket's two swing rows and
 /// its twist).
 pub const MAX_LIMITS: usize = 3;
+
+/// The most drive rows a joint has (a socket's three).
+pub const MAX_DRIVE_ROWS: usize = 3;
+
+/// The most rows a joint holds or not ([`super::ldl::Held`]): its limits'
+/// and its drive's.
+pub const MAX_OPTIONAL: usize = MAX_LIMITS + MAX_DRIVE_ROWS;
 
 /// Values the solve records of each limit row (a node scratch's `limits`):
 /// `c`, the angular `J_a` and `J_b`, and `w`.
@@ -138,6 +166,9 @@ pub struct Geometry<L> {
     pub twist: [L; 2],
     /// The limits' softness, scaled to the substep (all zero: hard).
     pub softness: Softness<L>,
+    /// The drive's target this substep: b's joint frame relative to a's
+    /// (the identity where the lane has no drive).
+    pub drive_target: Quat<L>,
     /// Where the pair's points (a rod's centres) stood as the step began.
     pub start: PairStart<L>,
 }
@@ -163,6 +194,26 @@ impl<L: Lane> Rows<L> {
     ) -> Self {
         let mut rows = Self::zero();
         rows.limits(kind, a, b, g);
+        rows
+    }
+
+    /// Measures only the drive rows (from `kind.first_drive()`; the rest
+    /// zero); each row's error, and `J_b`'s angular part (`J_a`'s is its
+    /// negative), the axis it is measured along turned into the world.
+    #[inline(always)]
+    pub fn measure_drive(
+        kind: JointRows,
+        a: &BodyLanes<L>,
+        b: &BodyLanes<L>,
+        g: &Geometry<L>,
+    ) -> Self {
+        let mut rows = Self::zero();
+        let (c, _) = drive::measure_in_a(a, b, g.frame_a, g.frame_b, g.drive_target);
+        let zero = Vec3::zero();
+        for (k, e) in (kind.first_drive()..kind.count()).zip(drive_axes(kind, g.frame_a)) {
+            let j = a.q.rotate(e);
+            rows.set(k, c.dot(e), (zero, j), j);
+        }
         rows
     }
 
@@ -368,6 +419,20 @@ impl<L: Lane> Rows<L> {
         let (o, c) = length::measure(a, b, &f, g.rest_length, &g.start);
         let turn = -length::chord_turn(g.rest_length, &f);
         self.set(at, c, (o, turn), turn);
+    }
+}
+
+/// The axes a joint's drive rows are measured along, in a's body frame:
+/// a socket's three, a hinge's axis (its joint frame's X; the axis rows
+/// hold the other two), as many as `kind` has drive rows.
+#[inline(always)]
+pub fn drive_axes<L: Lane>(kind: JointRows, frame_a: Quat<L>) -> [Vec3<L>; MAX_DRIVE_ROWS] {
+    match kind {
+        JointRows::Hinge => {
+            let zero = Vec3::zero();
+            [axis_x(frame_a), zero, zero]
+        }
+        _ => world_axes(),
     }
 }
 

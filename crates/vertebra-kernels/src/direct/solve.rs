@@ -31,20 +31,24 @@ use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Lane, Mask, Vec3};
 
 use super::MAX_LIMIT_RETURN_SPEED;
+use super::drive::DRIVE_RECORD;
 use super::ldl::{self, Held, MAX, PACKED, at};
-use super::rows::{FREE, JointRows, LIMIT_RECORD as RECORD, MAX_LIMITS, Rows, SwingRows};
+use super::rows::{
+    FREE, JointRows, LIMIT_RECORD as RECORD, MAX_DRIVE_ROWS, MAX_OPTIONAL, Rows, SwingRows,
+};
 use super::{Child, JointNode, MEASURED, NONE, NodeKind, SubstepScale, Topology, TreeBlock};
 use crate::body::{BodyLanes, BodyRows};
 use crate::parts::limit::Softness;
 
 /// Calls `$f::<$L, E, K>($args)` with a joint kind's `E` equality rows and
-/// `K` limit rows as constants.
+/// `K` optional rows (its limits', then its drive's) as constants.
 macro_rules! by_rows {
     ($kind:expr, $f:ident::<$L:ty>($($arg:expr),* $(,)?)) => {
         match $kind {
-            JointRows::Socket(SwingRows::Pyramid) => $f::<$L, 3, 3>($($arg),*),
-            JointRows::Socket(_) | JointRows::Rod => $f::<$L, 3, 2>($($arg),*),
-            JointRows::Hinge => $f::<$L, 5, 1>($($arg),*),
+            JointRows::Socket(SwingRows::Pyramid) => $f::<$L, 3, 6>($($arg),*),
+            JointRows::Socket(_) => $f::<$L, 3, 5>($($arg),*),
+            JointRows::Rod => $f::<$L, 3, 2>($($arg),*),
+            JointRows::Hinge => $f::<$L, 5, 2>($($arg),*),
             JointRows::Fixed => $f::<$L, 6, 0>($($arg),*),
         }
     };
@@ -135,7 +139,24 @@ pub(super) fn measure<L: Lane>(
                 let joint = &block.joints[index as usize];
                 let (body_a, body_b) = joint.bodies.gather::<L>(rows, start);
                 let geometry = joint.geometry(start, scale);
-                let measured_rows = Rows::measure(kind, &body_a, &body_b, &geometry);
+                let mut measured_rows = Rows::measure(kind, &body_a, &body_b, &geometry);
+                let count = if block.driven {
+                    let drive = Rows::measure_drive(kind, &body_a, &body_b, &geometry);
+                    record_drive(
+                        &mut block.scratch[n],
+                        kind,
+                        &drive,
+                        (&body_a, &body_b),
+                        start,
+                    );
+                    for k in kind.first_drive()..kind.count() {
+                        measured_rows.c[k] = drive.c[k];
+                        (measured_rows.ja[k], measured_rows.jb[k]) = (drive.ja[k], drive.jb[k]);
+                    }
+                    kind.count()
+                } else {
+                    kind.first_drive()
+                };
                 let first = kind.first_limit();
                 measured[..first].copy_from_slice(&measured_rows.c[..first]);
                 let back = Return {
@@ -157,7 +178,6 @@ pub(super) fn measure<L: Lane>(
                 } else {
                     (&measured_rows.ja, &measured_rows.jb, b)
                 };
-                let count = kind.count();
                 store(
                     parent[..count].as_flattened(),
                     &mut block.scratch[n].coupling,
@@ -202,7 +222,7 @@ fn record_limits<L: Lane>(
     start: usize,
 ) {
     let zero = L::splat(0.0);
-    for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
+    for (l, k) in (kind.first_limit()..kind.first_drive()).enumerate() {
         let mut record = [zero; RECORD];
         record[1..4].copy_from_slice(&measured.ja[k][3..6]);
         record[4..7].copy_from_slice(&measured.jb[k][3..6]);
@@ -216,6 +236,26 @@ fn record_limits<L: Lane>(
             &mut scratch.limits[l * RECORD..(l + 1) * RECORD],
             start,
         );
+    }
+}
+
+/// Records a joint's drive rows as measured (for their right-hand sides
+/// and [`accumulate`]: each row's error and its generalised inverse mass
+/// `w = j^T I_a^-1 j + j^T I_b^-1 j`, its `J_b`'s angular part `j`).
+#[inline(always)]
+fn record_drive<L: Lane>(
+    scratch: &mut super::NodeScratch,
+    kind: JointRows,
+    measured: &Rows<L>,
+    (a, b): (&BodyLanes<L>, &BodyLanes<L>),
+    start: usize,
+) {
+    for (r, k) in (kind.first_drive()..kind.count()).enumerate() {
+        let jb = &measured.jb[k];
+        let j = Vec3::new(jb[3], jb[4], jb[5]);
+        let w = inverse_mass(a, j) + inverse_mass(b, j);
+        let at = r * DRIVE_RECORD;
+        store(&[measured.c[k], w], &mut scratch.drive[at..at + 2], start);
     }
 }
 
@@ -237,18 +277,30 @@ fn inverse_mass<L: Lane>(body: &BodyLanes<L>, j: Vec3<L>) -> L {
 pub(super) fn hold(block: &mut TreeBlock, topology: &Topology, first_pass: bool) {
     let fresh = block.fresh && first_pass;
     for (n, node) in topology.nodes.iter().enumerate() {
-        let NodeKind::Joint { rows: kind, .. } = node.kind else {
+        let NodeKind::Joint {
+            index, rows: kind, ..
+        } = node.kind
+        else {
             continue;
         };
+        let limits = kind.limit_count();
+        let drive = &block.joints[index as usize].drive;
         let scratch = &mut block.scratch[n];
-        let mut bits = [0u8; MAX_LIMITS];
+        let mut bits = [0u8; MAX_OPTIONAL];
         for (o, lane_bits) in bits
             .iter_mut()
             .enumerate()
             .take(kind.count() - kind.first_limit())
         {
             for lane in 0..BLOCK_LANES {
-                if fresh {
+                if o >= limits {
+                    // A drive's rows: held where the lane has a drive.
+                    scratch.active[o][lane] = if block.driven {
+                        drive.enabled[lane]
+                    } else {
+                        0.0
+                    };
+                } else if fresh {
                     let c = scratch.limits[o * RECORD][lane];
                     scratch.active[o][lane] = if c > 0.0 { 1.0 } else { 0.0 };
                 }
@@ -272,7 +324,7 @@ pub(super) fn take_crossings(block: &mut TreeBlock, topology: &Topology) {
         else {
             continue;
         };
-        let limits = kind.count() - kind.first_limit();
+        let limits = kind.limit_count();
         let scratch = &mut block.scratch[n];
         let mut changed = 0u8;
         for (lane, &crossed) in crossing.iter().enumerate() {
@@ -500,7 +552,7 @@ fn body_out<L: Lane, const E: usize, const K: usize>(
         if !held.computed(E, i) {
             continue;
         }
-        w[i].copy_from_slice(&coupling[i * 6..i * 6 + 6]);
+        w[i][..6].copy_from_slice(&coupling[i * 6..i * 6 + 6]);
         ldl::forward::<L, 6>(factors, &mut w[i]);
         for k in 0..6 {
             scaled[i][k] = w[i][k] * factors[at(k, k)];
@@ -548,25 +600,26 @@ fn joint_node<L: Lane, const E: usize, const K: usize>(
 ) {
     let zero = L::splat(0.0);
     let held = held::<L, E, K>(block, n, start);
-    let NodeKind::Joint { index, .. } = topology.nodes[n].kind else {
+    let NodeKind::Joint {
+        index, rows: kind, ..
+    } = topology.nodes[n].kind
+    else {
         unreachable!("a joint node");
     };
+    let limits = kind.limit_count();
     let mut d = [zero; PACKED];
     let mut b = [zero; MAX];
     {
         let scratch = &block.scratch[n];
         let measured = load::<L, MEASURED>(&scratch.measured, start);
         b[..E].copy_from_slice(&measured[..E]);
-        for o in 0..K {
+        for o in 0..limits {
             if held.any[o] {
                 b[E + o] = L::load(&scratch.limits[o * RECORD][start..]);
             }
         }
     }
-    if block.soft && K > 0 {
-        let NodeKind::Joint { rows: kind, .. } = topology.nodes[n].kind else {
-            unreachable!("a joint node");
-        };
+    if block.soft && limits > 0 {
         let joint = &block.joints[index as usize];
         soften::<L, E, K>(
             block,
@@ -576,6 +629,12 @@ fn joint_node<L: Lane, const E: usize, const K: usize>(
             (start, scale),
             (&mut d, &mut b),
         );
+    }
+    if block.driven && K > limits {
+        let rows = drive_rows::<L, E, K>(block, (n, index as usize, limits), &held, (start, scale));
+        for (k, (dk, bk)) in (E + limits..E + K).zip(rows) {
+            (d[at(k, k)], b[k]) = (dk, bk);
+        }
     }
     for &child in topology.children(n) {
         let Child::Node(c) = child else {
@@ -654,7 +713,7 @@ fn soften<L: Lane, const E: usize, const K: usize>(
         .softness
         .lanes(start, L::splat(scale.inv_h), L::splat(scale.inv_h2));
     let soft: &Softness<L> = &soft;
-    for o in 0..K {
+    for o in 0..kind.limit_count() {
         if !held.any[o] {
             continue;
         }
@@ -676,6 +735,39 @@ fn soften<L: Lane, const E: usize, const K: usize>(
         b[k] = L::select(damped, (c + alpha * lambda + damping) * inv, b[k]);
         d[at(k, k)] = L::select(damped, -(alpha * inv), d[at(k, k)]);
     }
+}
+
+/// A joint's drive rows (`super::drive`): each held row's diagonal entry
+/// and right-hand side (`+0` in a lane that does not hold it; soft in a
+/// lane that holds one of the joint's limits), its target recorded for
+/// [`accumulate`].
+#[inline(always)]
+fn drive_rows<L: Lane, const E: usize, const K: usize>(
+    block: &mut TreeBlock,
+    (n, index, limits): (usize, usize, usize),
+    held: &Held<L, K>,
+    (start, scale): (usize, SubstepScale),
+) -> [(L, L); MAX_DRIVE_ROWS] {
+    let zero = L::splat(0.0);
+    let steps = (L::splat(scale.inv_h), L::splat(scale.inv_h2));
+    let mut limited = zero.gt(zero);
+    for &lanes in &held.lanes[..limits] {
+        limited = limited | lanes;
+    }
+    let mut out = [(zero, zero); MAX_DRIVE_ROWS];
+    for (r, o) in (limits..K).enumerate() {
+        if !held.any[o] {
+            continue;
+        }
+        let at = r * DRIVE_RECORD;
+        let record = &mut block.scratch[n].drive[at..at + DRIVE_RECORD];
+        let [c, w, _] = load::<L, DRIVE_RECORD>(record, start);
+        let drive = &block.joints[index].drive;
+        let (d, b, target) = drive.row(r, (c, w, limited), start, steps);
+        target.store(&mut record[2][start..]);
+        out[r] = (held.keep(E, E + o, d), held.keep(E, E + o, b));
+    }
+    out
 }
 
 // ---------------------------------------------------------------------------
@@ -815,7 +907,7 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
             continue;
         };
         let limits = kind.first_limit();
-        if limits == kind.count() {
+        if limits == kind.first_drive() {
             continue;
         }
         let dlambda = load::<L, MAX>(&block.scratch[n].x, start);
@@ -823,7 +915,7 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
         let turn_b = turn_of(block, b, start);
         let joint = &block.joints[index as usize];
         let soft = joint.soft_lanes::<L>(start);
-        for (l, k) in (limits..kind.count()).enumerate() {
+        for (l, k) in (limits..kind.first_drive()).enumerate() {
             let scratch = &block.scratch[n];
             let record = load::<L, RECORD>(&scratch.limits[l * RECORD..(l + 1) * RECORD], start);
             let ja = Vec3::new(record[1], record[2], record[3]);
@@ -861,10 +953,16 @@ fn turn_of<L: Lane>(block: &TreeBlock, n: u32, start: usize) -> Vec3<L> {
 /// Adds each held limit row's multiplier to its joint's substep total
 /// (a soft limit's spring force; zero for a row not held), in the lanes
 /// whose limits are soft (a hard row's is never read: so what shares its
-/// block changes nothing).
+/// block changes nothing); and each drive's rows' multipliers and
+/// requested moves to its sums, capping it (`super::drive`).
 #[inline(always)]
-pub(super) fn accumulate<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
-    if !block.soft {
+pub(super) fn accumulate<L: Lane>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    start: usize,
+    scale: SubstepScale,
+) {
+    if !block.soft && !block.driven {
         return;
     }
     for (n, node) in topology.nodes.iter().enumerate() {
@@ -876,10 +974,25 @@ pub(super) fn accumulate<L: Lane>(block: &mut TreeBlock, topology: &Topology, st
         };
         let dlambda = load::<L, MAX>(&block.scratch[n].x, start);
         let joint = &mut block.joints[index as usize];
-        let soft = joint.soft_lanes::<L>(start);
-        for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
-            let lambda = L::load(&joint.limit_lambda[l][start..]);
-            L::select(soft, lambda + dlambda[k], lambda).store(&mut joint.limit_lambda[l][start..]);
+        if block.soft {
+            let soft = joint.soft_lanes::<L>(start);
+            for (l, k) in (kind.first_limit()..kind.first_drive()).enumerate() {
+                let lambda = L::load(&joint.limit_lambda[l][start..]);
+                L::select(soft, lambda + dlambda[k], lambda)
+                    .store(&mut joint.limit_lambda[l][start..]);
+            }
+        }
+        let rows = kind.count() - kind.first_drive();
+        if block.driven && rows > 0 {
+            let zero = L::splat(0.0);
+            let mut records = [[zero; DRIVE_RECORD]; MAX_DRIVE_ROWS];
+            for (r, record) in records.iter_mut().enumerate().take(rows) {
+                let at = r * DRIVE_RECORD;
+                *record = load::<L, DRIVE_RECORD>(&block.scratch[n].drive[at..], start);
+            }
+            let first = kind.first_drive();
+            let steps = &dlambda[first..first + rows];
+            (joint.drive).accumulate(steps, &records[..rows], start, scale.inv_h2);
         }
     }
 }
@@ -892,6 +1005,7 @@ pub(super) fn start_limits<L: Lane>(
     topology: &Topology,
     rows: &BodyRows,
     start: usize,
+    h: f32,
 ) {
     let scale = SubstepScale {
         inv_h: 0.0,
@@ -906,10 +1020,14 @@ pub(super) fn start_limits<L: Lane>(
         };
         let joint = &mut block.joints[index as usize];
         let (a, b) = joint.bodies.gather::<L>(rows, start);
-        let measured = Rows::measure_limits(kind, &a, &b, &joint.geometry(start, scale));
-        for (l, k) in (kind.first_limit()..kind.count()).enumerate() {
+        let geometry = joint.geometry(start, scale);
+        let measured = Rows::measure_limits(kind, &a, &b, &geometry);
+        for (l, k) in (kind.first_limit()..kind.first_drive()).enumerate() {
             let violation = measured.c[k].max(L::splat(0.0));
             violation.store(&mut joint.limit_start[l][start..]);
+        }
+        if block.driven && kind.first_drive() < kind.count() {
+            joint.drive.start(kind, (&a, &b), &geometry, start, h);
         }
     }
 }
@@ -959,13 +1077,18 @@ pub(super) fn apply<L: Lane>(
     }
 }
 
-/// Every joint's rows count is 5 or 6, its equality rows 3, 5 or 6 (the
-/// sizes `by_rows!` names).
+/// Every joint's rows and equality rows are the sizes `by_rows!` names
+/// (`E`, and `K` = `count - E`).
 const _: () = {
     use super::rows::SwingRows::{Cone, Ellipse, Pyramid};
-    assert!(JointRows::Socket(Cone).count() == 5 && JointRows::Socket(Ellipse).count() == 5);
-    assert!(JointRows::Rod.count() == 5 && JointRows::Socket(Pyramid).count() == 6);
-    assert!(JointRows::Hinge.count() == 6 && JointRows::Fixed.count() == 6);
+    assert!(JointRows::Socket(Cone).count() == 8 && JointRows::Socket(Ellipse).count() == 8);
+    assert!(JointRows::Rod.count() == 5 && JointRows::Socket(Pyramid).count() == 9);
+    assert!(JointRows::Hinge.count() == 7 && JointRows::Fixed.count() == 6);
     assert!(JointRows::Socket(Cone).first_limit() == 3 && JointRows::Rod.first_limit() == 3);
     assert!(JointRows::Hinge.first_limit() == 5 && JointRows::Fixed.first_limit() == 6);
+    assert!(JointRows::Socket(Pyramid).limit_count() <= super::rows::MAX_LIMITS);
+    assert!(
+        JointRows::Socket(Pyramid).count() - JointRows::Socket(Pyramid).first_limit()
+            <= MAX_OPTIONAL
+    );
 };

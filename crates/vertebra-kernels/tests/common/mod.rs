@@ -5,6 +5,7 @@ use glam::{Mat3, Quat, Vec3};
 use rand::RngExt;
 use rand::rngs::StdRng;
 use vertebra_kernels::body::{BodyRows, PairLane, StartLane};
+use vertebra_kernels::driven::DriveLane;
 use vertebra_kernels::limited::LimitLane;
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::check::same_bits;
@@ -254,4 +255,39 @@ pub fn moved(
 ) -> vertebra_kernels::body::BodyLanes<f32> {
     b.p = (Vec3::from(b.p) + v).into();
     b
+}
+
+/// A drive of either strength (compliance, or `1 / omega^2` with
+/// compliance 0), moving or still, with or without a torque limit.
+pub fn random_drive(r: &mut StdRng, compliance: f32) -> DriveLane {
+    let spring = r.random_bool(0.5);
+    let omega = match r.random_range(0..3) {
+        0 => 1e-2,
+        1 => 1e4,
+        _ => r.random_range(1.0..200.0),
+    };
+    DriveLane {
+        target: unit_quat(r),
+        velocity: if r.random_bool(0.5) {
+            glam::Vec3::new(
+                r.random_range(-20.0..20.0),
+                r.random_range(-20.0..20.0),
+                r.random_range(-20.0..20.0),
+            )
+        } else {
+            glam::Vec3::ZERO
+        },
+        compliance: if spring { 0.0 } else { compliance },
+        period2: if spring { 1.0 / (omega * omega) } else { 0.0 },
+        damping_time: match r.random_range(0..3) {
+            0 => 0.0,
+            1 => 1e6,
+            _ => r.random_range(0.0..1.0),
+        },
+        max_torque: match r.random_range(0..4) {
+            0 => 0.0,
+            1 => r.random_range(0.0..50.0),
+            _ => f32::INFINITY,
+        },
+    }
 }

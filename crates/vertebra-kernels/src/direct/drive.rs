@@ -1,0 +1,256 @@
+//! A joint's drive as rows of the direct solve, so that its frequency and
+//! damping ratio hold for the limb it moves, children included.
+//!
+//! **Why rows of the tree.** Iterated as a part (`parts::drive`), a drive
+//! given by frequency is a spring scaled by its own pair's effective
+//! inertia `W^-1`: it moves its child body at the stated frequency, but
+//! the bodies hanging below pull it back through their joints, so a limb
+//! with children answers slower, and a damping ratio of 1 rings. Solved
+//! with the tree's other rows, the drive's rows see the whole tree.
+//!
+//! **Frequency and ratio: each joint its own oscillator.** The drive
+//! part's spring form leaves the error `C` of its row, after one
+//! iteration from `C~`, at `C_1 (1 + g + s) = C~ + g C_0` with `s = (omega
+//! h)^2` and `g = 2 zeta omega h`: the implicit Euler step of `C'' =
+//! -omega^2 C - 2 zeta omega C'`, with no mass in it. The tree solve
+//! reaches any target error exactly (to the linearisation), whatever the
+//! masses that move with the joint: so each drive row is held as a hard
+//! row at the target `T = (C~ + g C_0) / (1 + g + s)`, and every driven
+//! joint's error follows its own oscillator at the stated frequency and
+//! ratio, whatever it carries (as a computed-torque drive does in joint
+//! space: its stiffness is the tree's joint-space mass times `omega^2`).
+//! `C~` is the error without what the drive did this substep: the error
+//! measured now less `delta`, the drive's own requested moves summed over
+//! the substep's solves (`delta += T - C`, kept in `moved`). So a contact
+//! or another part that moves the joint between solves moves it as a
+//! spring lets it: the target follows by `1 / (1 + g + s)` of the push,
+//! as the part's `alpha lambda` term makes it. In the stored numbers
+//! (`period2 = 1 / omega^2`, `damping_time = 2 zeta / omega`):
+//!
+//! `T = (period2 (C - delta) + damping_time h C_0) / (period2 + damping_time h + h^2)`
+//!
+//! which is 0 for a rigid drive (both zero), with no division by zero.
+//!
+//! **Compliance and damping** (N m per radian: a spring of its own, not
+//! scaled by any mass) make the row soft as a soft limit's
+//! (`docs/direct.md`): `alpha~ = c / h^2`, `gamma = damping_time / h`,
+//! `-alpha~ / (1 + gamma)` on the diagonal and `(C + alpha~ lambda +
+//! gamma (C - C_0)) / (1 + gamma)` on the right.
+//!
+//! **Torque cap.** The rows' multipliers, summed over the substep's
+//! solves (`lambda`, along a's axes), are the drive's angular impulse
+//! times `h`: the torque is `lambda / h^2`. After a solve that takes
+//! `|lambda|` past `max_torque h^2`, the drive is capped for the rest of
+//! the substep at `cap = lambda max_torque h^2 / |lambda|`: each later
+//! solve prescribes its rows' step `cap - lambda` (a row of compliance
+//! [`CAPPED_COMPLIANCE`] times its own inverse mass `w`, its right-hand
+//! side `-CAPPED_COMPLIANCE w (cap - lambda)`: the row's motion changes its
+//! step by a millionth), which takes back the excess and then holds the
+//! capped torque. A hit beyond the cap turns the joint away, and the
+//! drive brings it back afterwards.
+//!
+//! **Against a limit.** A drive pulling past a hard limit would ask of
+//! its hard rows what the limit's row refuses (rows that repeat each
+//! other, with other targets). So in a lane where a limit of the joint is
+//! held, the drive's rows are soft instead: the part's own spring on its
+//! pair's inverse mass `w`, `alpha~ = w period2 / h^2` (at least `w`: a
+//! rigid drive as stiff as one step makes it) with its damping, as a soft
+//! limit's rows are. The limit holds, and the drive pulls against it or
+//! away from it with a spring's force; the limit lets go when the drive
+//! pulls it inside. A soft limit is a spring the hard target rows
+//! overrule.
+
+use bytemuck::{Pod, Zeroable};
+use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::{Lane, Mask};
+
+use super::rows::{Geometry, JointRows, MAX_DRIVE_ROWS, drive_axes};
+use crate::body::BodyLanes;
+use crate::driven::DriveLane;
+use crate::parts::drive;
+
+/// The compliance of a capped drive's row, in units of its own inverse
+/// mass: large enough that the row's own motion moves its prescribed
+/// step by a millionth, small enough that its pivot stays a number.
+pub const CAPPED_COMPLIANCE: f32 = 1.0e6;
+
+/// The largest `alpha~` (per kg m^2) a soft drive row carries: a row
+/// that soft pulls by less than 1e-30 of its error, and an infinite one
+/// (a compliance near `f32::MAX`) would make `alpha~ lambda` a NaN.
+pub const MAX_ALPHA: f32 = 1.0e30;
+
+/// Values the solve records of each drive row (a node scratch's `drive`):
+/// its error `c`, its generalised inverse mass `w` and its target `T`.
+pub const DRIVE_RECORD: usize = 3;
+
+/// A tree joint's drive in each lane: its settings, copied as the joint
+/// is laid out, and the substep's state.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C, align(32))]
+pub struct DriveNode {
+    /// This substep's target: b's joint frame relative to a's (advanced
+    /// by [`super::StartPass`] every substep, as the joint block's own
+    /// copy is, bit for bit).
+    pub target: QuatBlock,
+    /// The target's angular velocity (rad/s, a's joint frame).
+    pub velocity: Vec3Block,
+    /// Compliance (rad / (N m)): a soft row where positive.
+    pub compliance: [f32; BLOCK_LANES],
+    /// `1 / omega^2` (s^2).
+    pub period2: [f32; BLOCK_LANES],
+    /// `gamma h` (s): compliance times damping, or `2 zeta / omega`.
+    pub damping_time: [f32; BLOCK_LANES],
+    /// The largest torque (N m), infinity for none.
+    pub max_torque: [f32; BLOCK_LANES],
+    /// 1 where the lane has a drive (its rows held), 0 where not.
+    pub enabled: [f32; BLOCK_LANES],
+    /// Each row's error at the substep's start, `C_0` (rad).
+    pub start: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
+    /// Each row's multiplier summed over the substep's solves.
+    pub lambda: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
+    /// Each row's requested moves summed over the substep's solves,
+    /// `delta` (rad).
+    pub moved: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
+    /// The capped multiplier the rows hold once capped.
+    pub cap: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
+    /// 1 where the drive reached its cap this substep.
+    pub capped: [f32; BLOCK_LANES],
+}
+
+impl DriveNode {
+    /// Writes one joint's drive (or none) into `lane`.
+    pub fn set(&mut self, lane: usize, drive: Option<&DriveLane>) {
+        let d = drive.copied().unwrap_or(DriveLane::OFF);
+        self.target.set(lane, d.target);
+        self.velocity.set(lane, d.velocity);
+        self.compliance[lane] = d.compliance;
+        self.period2[lane] = d.period2;
+        self.damping_time[lane] = d.damping_time;
+        self.max_torque[lane] = d.max_torque;
+        self.enabled[lane] = if drive.is_some() { 1.0 } else { 0.0 };
+        for row in 0..MAX_DRIVE_ROWS {
+            self.start[row][lane] = 0.0;
+            self.lambda[row][lane] = 0.0;
+            self.moved[row][lane] = 0.0;
+            self.cap[row][lane] = 0.0;
+        }
+        self.capped[lane] = 0.0;
+    }
+
+    /// The drive's substep start for the lanes from `start`, before the
+    /// bodies are predicted: each row's error against the last substep's
+    /// target (`+0` where off, whatever else shares the block), the target
+    /// advanced by `h` at its velocity, the sums reset.
+    #[inline(always)]
+    pub(super) fn start<L: Lane>(
+        &mut self,
+        kind: JointRows,
+        (a, b): (&BodyLanes<L>, &BodyLanes<L>),
+        g: &Geometry<L>,
+        start: usize,
+        h: f32,
+    ) {
+        let zero = L::splat(0.0);
+        let target = self.target.load::<L>(start);
+        let enabled = L::load(&self.enabled[start..]).gt(zero);
+        let (c, _) = drive::measure_in_a(a, b, g.frame_a, g.frame_b, target);
+        for (row, e) in drive_axes(kind, g.frame_a).into_iter().enumerate() {
+            L::select(enabled, c.dot(e), zero).store(&mut self.start[row][start..]);
+            zero.store(&mut self.lambda[row][start..]);
+            zero.store(&mut self.moved[row][start..]);
+            zero.store(&mut self.cap[row][start..]);
+        }
+        zero.store(&mut self.capped[start..]);
+        let velocity = self.velocity.load(start);
+        self.target
+            .store(start, drive::advance(target, velocity, L::splat(h)));
+    }
+
+    /// Row `row`'s diagonal entry and right-hand side for the lanes from
+    /// `start` (see the module documentation), from its record `[c, w]`
+    /// and the lanes where a limit of the joint is held; returns them and
+    /// the target `T` to record (`C` where the row is soft: no move).
+    #[inline(always)]
+    pub(super) fn row<L: Lane>(
+        &self,
+        row: usize,
+        (c, w, limited): (L, L, L::Mask),
+        start: usize,
+        (inv_h, inv_h2): (L, L),
+    ) -> (L, L, L) {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let h = one / inv_h;
+        let h2 = one / inv_h2;
+        let compliance = L::load(&self.compliance[start..]);
+        let period2 = L::load(&self.period2[start..]);
+        let damping_time = L::load(&self.damping_time[start..]);
+        let c0 = L::load(&self.start[row][start..]);
+        let lambda = L::load(&self.lambda[row][start..]);
+        let moved = L::load(&self.moved[row][start..]);
+        // The oscillator's target, a hard row's right-hand side `C - T`.
+        let spring = damping_time * h;
+        let target = (period2 * (c - moved) + spring * c0) / (period2 + spring + h2);
+        // A soft row: a compliant drive's, or a drive's against a held
+        // limit, on its own pair's inverse mass (at most a substep's
+        // period: a rigid drive's as stiff as one step can make it).
+        let compliant = compliance.gt(zero);
+        let paired = w * (period2 * inv_h2).max(one);
+        let alpha = L::select(compliant, compliance * inv_h2, paired).min(L::splat(MAX_ALPHA));
+        let gamma = damping_time * inv_h;
+        let inv = one / (one + gamma);
+        let soft_b = (c + alpha * lambda + gamma * (c - c0)) * inv;
+        let soft = compliant | limited;
+        let (mut d, mut b) = (
+            L::select(soft, -(alpha * inv), zero),
+            L::select(soft, soft_b, c - target),
+        );
+        let target = L::select(soft, c, target);
+        // A capped drive's prescribed step.
+        let capped = L::load(&self.capped[start..]).gt(zero);
+        let big = L::splat(CAPPED_COMPLIANCE) * w;
+        let cap = L::load(&self.cap[row][start..]);
+        d = L::select(capped, -big, d);
+        b = L::select(capped, -(big * (cap - lambda)), b);
+        (d, b, target)
+    }
+
+    /// After a solve, for the lanes from `start`: each row's multiplier
+    /// step `dlambda` and, for the oscillator, its requested move `T - C`
+    /// (`records`: each row's `[c, w, T]`) added to the substep's sums;
+    /// and a drive whose summed torque passed `max_torque` capped there
+    /// for the rest of the substep.
+    #[inline(always)]
+    pub(super) fn accumulate<L: Lane>(
+        &mut self,
+        dlambda: &[L],
+        records: &[[L; DRIVE_RECORD]],
+        start: usize,
+        inv_h2: f32,
+    ) {
+        let zero = L::splat(0.0);
+        let enabled = L::load(&self.enabled[start..]).gt(zero);
+        let mut lambda = [zero; MAX_DRIVE_ROWS];
+        let mut squared = zero;
+        for (row, &[c, _, target]) in records.iter().enumerate() {
+            let sum = L::load(&self.lambda[row][start..]) + dlambda[row];
+            let moved = L::load(&self.moved[row][start..]) + (target - c);
+            L::select(enabled, sum, zero).store(&mut self.lambda[row][start..]);
+            L::select(enabled, moved, zero).store(&mut self.moved[row][start..]);
+            lambda[row] = L::select(enabled, sum, zero);
+            squared += lambda[row] * lambda[row];
+        }
+        let limit = L::load(&self.max_torque[start..]) / L::splat(inv_h2);
+        let was = L::load(&self.capped[start..]).gt(zero);
+        let caps = squared.gt(limit * limit).and_not(was);
+        let scale = limit / L::select(caps, squared.sqrt(), L::splat(1.0));
+        for (row, &lambda) in lambda.iter().enumerate().take(records.len()) {
+            // An overflowing sum (`squared` infinite) caps at zero, not at
+            // `inf * 0`.
+            let capped = lambda * scale;
+            let capped = L::select(capped.eq(capped), capped, zero);
+            let cap = L::load(&self.cap[row][start..]);
+            L::select(caps, capped, cap).store(&mut self.cap[row][start..]);
+        }
+        L::select(caps | was, L::splat(1.0), zero).store(&mut self.capped[start..]);
+    }
+}
