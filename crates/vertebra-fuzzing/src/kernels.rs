@@ -301,10 +301,12 @@ fn pad(input: &mut Input, blocks: &mut Blocks) {
 /// random.
 fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
     let kinds = [
-        JointRows::Socket(SwingRows::Cone),
-        JointRows::Socket(SwingRows::Ellipse),
-        JointRows::Socket(SwingRows::Pyramid),
-        JointRows::Hinge,
+        JointRows::Socket(SwingRows::Cone, false),
+        JointRows::Socket(SwingRows::Ellipse, true),
+        JointRows::Socket(SwingRows::Pyramid, false),
+        JointRows::Socket(SwingRows::Pyramid, true),
+        JointRows::Hinge(false),
+        JointRows::Hinge(true),
         JointRows::Fixed,
         JointRows::Rod,
     ];
@@ -333,7 +335,7 @@ fn tree_block(input: &mut Input) -> (Topology, TreeBlock) {
         let sides = [(own(0), own(1)), (fixed, own(0))];
         for ((joint, &(a, b)), &(kind, ..)) in block.joints.iter_mut().zip(&sides).zip(&shape) {
             let twist = sorted_range(input);
-            let drivable = matches!(kind, JointRows::Socket(_) | JointRows::Hinge);
+            let drivable = kind.count() > kind.first_drive();
             let drive = (drivable && input.flag()).then(|| drive_lane(input));
             joint.set(
                 lane,

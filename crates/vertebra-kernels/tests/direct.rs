@@ -510,8 +510,8 @@ fn turn(r: &mut StdRng, angle: f32) -> GQuat {
 fn point_rows_are_exact_gradients_everywhere() {
     let mut r = StdRng::seed_from_u64(10);
     for kind in [
-        JointRows::Socket(SwingRows::Cone),
-        JointRows::Hinge,
+        JointRows::Socket(SwingRows::Cone, false),
+        JointRows::Hinge(false),
         JointRows::Fixed,
     ] {
         for _ in 0..200 {
@@ -574,13 +574,13 @@ fn hinge_axis_lock_curve_and_drive_rows_are_gradients_at_zero_error_and_first_or
                 r.random_range(0.1..2.5)
             };
             let misalignment = turn(&mut r, angle);
-            let mut hinge = joint(&mut r, JointRows::Hinge, misalignment);
+            let mut hinge = joint(&mut r, JointRows::Hinge(true), misalignment);
             hinge.driven = true;
             let fixed = joint(&mut r, JointRows::Fixed, misalignment);
             // The socket's drive rows on the hinge's bodies and frames: the
             // hinge's one drive row is their component along its axis.
             let socket = Measured {
-                kind: JointRows::Socket(SwingRows::Cone),
+                kind: JointRows::Socket(SwingRows::Cone, true),
                 ..hinge
             };
             let d = r.random_range(0.2..1.0);
@@ -896,10 +896,10 @@ fn hanging_chain(r: &mut StdRng, kinds: &[JointRows]) -> Tree {
 /// bodies (0.01 to 10 kg), each chain's joints every kind in turn.
 fn star(r: &mut StdRng) -> Tree {
     const KINDS: [JointRows; 4] = [
-        JointRows::Hinge,
+        JointRows::Hinge(false),
         JointRows::Fixed,
         JointRows::Rod,
-        JointRows::Socket(SwingRows::Cone),
+        JointRows::Socket(SwingRows::Cone, false),
     ];
     let mut tree = Tree::new();
     tree.bodies.push(body_at(r, DVec3::ZERO, 10.0));
@@ -1094,10 +1094,13 @@ fn errors(tree: &Tree, offsets: &Offsets, passes: usize) -> Vec<f64> {
     errors
 }
 
-use JointRows::{Fixed, Hinge, Rod};
+use JointRows::{Fixed, Rod};
+
+/// An undriven hinge's rows.
+const HINGE: JointRows = JointRows::Hinge(false);
 
 /// A socket with a circular cone.
-const POINT: JointRows = JointRows::Socket(SwingRows::Cone);
+const POINT: JointRows = JointRows::Socket(SwingRows::Cone, false);
 
 /// The trees of the first-order tests, by name: sockets hanging from a
 /// static anchor, every kind mixed (straight rods) likewise and with the
@@ -1105,9 +1108,9 @@ const POINT: JointRows = JointRows::Socket(SwingRows::Cone);
 fn named_tree(r: &mut StdRng, name: &str) -> Tree {
     match name {
         "sockets" => hanging_chain(r, &[POINT]),
-        "mixed" => hanging_chain(r, &[Hinge, Fixed, Rod, POINT, Hinge, Rod]),
+        "mixed" => hanging_chain(r, &[HINGE, Fixed, Rod, POINT, HINGE, Rod]),
         "mixed, each joint's sides swapped" => {
-            let mut tree = hanging_chain(r, &[Fixed, Rod, Hinge, POINT, Rod, Hinge]);
+            let mut tree = hanging_chain(r, &[Fixed, Rod, HINGE, POINT, Rod, HINGE]);
             swap_sides(&mut tree);
             tree
         }
@@ -1374,11 +1377,15 @@ struct Trees {
     topology: Topology,
 }
 
-const KINDS: [JointRows; 6] = [
+/// Every kind of rows, driven (some lane has a drive) and not.
+const KINDS: [JointRows; 9] = [
     POINT,
-    JointRows::Socket(SwingRows::Ellipse),
-    JointRows::Socket(SwingRows::Pyramid),
-    Hinge,
+    JointRows::Socket(SwingRows::Cone, true),
+    JointRows::Socket(SwingRows::Ellipse, false),
+    JointRows::Socket(SwingRows::Pyramid, false),
+    JointRows::Socket(SwingRows::Pyramid, true),
+    HINGE,
+    JointRows::Hinge(true),
     Fixed,
     Rod,
 ];
@@ -1532,11 +1539,10 @@ fn random_lane(
                 let compliance = log_uniform(r, -6.0, -1.0);
                 common::limit_softness(r, compliance)
             },
-            drive: (matches!(kind, JointRows::Socket(_) | JointRows::Hinge) && r.random_bool(0.5))
-                .then(|| {
-                    let compliance = log_uniform(r, -6.0, -1.0);
-                    common::random_drive(r, compliance)
-                }),
+            drive: (kind.count() > kind.first_drive() && r.random_bool(0.5)).then(|| {
+                let compliance = log_uniform(r, -6.0, -1.0);
+                common::random_drive(r, compliance)
+            }),
         };
         node.set(lane, &joint);
         node.bodies.set_start(lane, &start);
@@ -1947,7 +1953,7 @@ fn topology_refuses_loops_disconnected_sets_and_bad_joints() {
             3,
             vec![
                 (POINT, Some(0), Some(1)),
-                (Hinge, Some(1), Some(2)),
+                (HINGE, Some(1), Some(2)),
                 (Rod, Some(2), Some(0)),
             ],
             Loop,
@@ -1961,7 +1967,7 @@ fn topology_refuses_loops_disconnected_sets_and_bad_joints() {
         (
             "a body joined to itself",
             2,
-            vec![(POINT, Some(0), Some(1)), (Hinge, Some(1), Some(1))],
+            vec![(POINT, Some(0), Some(1)), (HINGE, Some(1), Some(1))],
             Loop,
         ),
         (
@@ -2125,9 +2131,9 @@ fn twist_and_hinge_range_rows_are_the_twist_past_the_nearer_end_and_its_gradient
     let mut r = StdRng::seed_from_u64(41);
     let kinds = [
         (POINT, 4),
-        (JointRows::Socket(SwingRows::Ellipse), 4),
-        (JointRows::Socket(SwingRows::Pyramid), 5),
-        (Hinge, 5),
+        (JointRows::Socket(SwingRows::Ellipse, false), 4),
+        (JointRows::Socket(SwingRows::Pyramid, false), 5),
+        (HINGE, 5),
     ];
     for (kind, k) in kinds {
         let mut checked = 0;
@@ -2202,7 +2208,7 @@ fn hinge_range_row_is_a_gradient_to_first_order_in_the_axis_error() {
             twist: [lo, hi],
             ..NO_LIMITS
         };
-        let m = posed(&mut r, Hinge, local, &limits);
+        let m = posed(&mut r, HINGE, local, &limits);
         check_limit_row("hinge range, tilted", &m, 5, e as f64, tilt as f64);
     }
 }
@@ -2246,7 +2252,7 @@ fn ellipse_row_is_the_distance_past_the_ellipse_and_its_gradient_to_first_order_
         ellipse: SEMI_AXES,
         ..NO_LIMITS
     };
-    let kind = JointRows::Socket(SwingRows::Ellipse);
+    let kind = JointRows::Socket(SwingRows::Ellipse, false);
     for _ in 0..600 {
         let (q, n) = ellipse_point(r.random_range(-3.1..3.1));
         let outside = r.random_bool(0.5);
@@ -2300,7 +2306,7 @@ fn ellipse_row_is_the_distance_past_the_ellipse_and_its_gradient_to_first_order_
 #[test]
 fn pyramid_rows_are_each_angle_past_its_range_and_their_gradients() {
     let mut r = StdRng::seed_from_u64(44);
-    let kind = JointRows::Socket(SwingRows::Pyramid);
+    let kind = JointRows::Socket(SwingRows::Pyramid, false);
     'poses: for _ in 0..400 {
         // Ranges about Y and Z, and each angle past or inside the nearer
         // end by 0.1 to 0.5 rad (the other end at least as far).
@@ -2454,13 +2460,13 @@ fn past_limit(
     e: f32,
     centred: Option<f32>,
 ) -> (Tree, Offsets, usize) {
-    let ellipse = JointRows::Socket(SwingRows::Ellipse);
-    let pyramid = JointRows::Socket(SwingRows::Pyramid);
+    let ellipse = JointRows::Socket(SwingRows::Ellipse, false);
+    let pyramid = JointRows::Socket(SwingRows::Pyramid, false);
     let (kind, bend) = match case {
         "cone" | "twist" => (POINT, 0.0),
         "ellipse" => (ellipse, 0.0),
         "pyramid y" | "pyramid z" => (pyramid, 0.0),
-        "hinge range" => (Hinge, 0.0),
+        "hinge range" => (HINGE, 0.0),
         "rod bend" => (Rod, 0.4),
         _ => (Rod, 0.0),
     };

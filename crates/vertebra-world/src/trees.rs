@@ -377,14 +377,18 @@ fn rod_lane(d: &RodDesc) -> JointLane {
     }
 }
 
-fn rows_of(kind: &JointKind) -> JointRows {
-    match kind {
-        JointKind::Socket(limits) => JointRows::Socket(match limits.swing {
-            Swing::Free | Swing::Cone(_) => SwingRows::Cone,
-            Swing::Ellipse { .. } => SwingRows::Ellipse,
-            Swing::Pyramid { .. } => SwingRows::Pyramid,
-        }),
-        JointKind::Hinge { .. } => JointRows::Hinge,
+fn rows_of(d: &JointDesc) -> JointRows {
+    let driven = d.drive.is_some();
+    match &d.kind {
+        JointKind::Socket(limits) => JointRows::Socket(
+            match limits.swing {
+                Swing::Free | Swing::Cone(_) => SwingRows::Cone,
+                Swing::Ellipse { .. } => SwingRows::Ellipse,
+                Swing::Pyramid { .. } => SwingRows::Pyramid,
+            },
+            driven,
+        ),
+        JointKind::Hinge { .. } => JointRows::Hinge(driven),
         JointKind::Fixed => JointRows::Fixed,
     }
 }
@@ -393,7 +397,7 @@ fn rows_of(kind: &JointKind) -> JointRows {
 /// edge.
 fn find(joints: &[Option<JointDesc>], rods: &[Option<RodDesc>], bodies: &BodyStore) -> Vec<Found> {
     let edges = (joints.iter().enumerate())
-        .filter_map(|(s, d)| d.map(|d| (Edge::Joint(s), rows_of(&d.kind), d.body_a, d.body_b)))
+        .filter_map(|(s, d)| d.map(|d| (Edge::Joint(s), rows_of(&d), d.body_a, d.body_b)))
         .chain(
             (rods.iter().enumerate())
                 .filter_map(|(s, d)| d.map(|d| (Edge::Rod(s), JointRows::Rod, d.body_a, d.body_b))),

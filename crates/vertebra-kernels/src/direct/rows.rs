@@ -53,10 +53,12 @@ pub enum SwingRows {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum JointRows {
     /// A socket: the point, the swing limit (one row, two for a pyramid),
-    /// the twist range and the drive (8 or 9 rows).
-    Socket(SwingRows),
-    /// A hinge: the point, the axis, the range and the drive (7 rows).
-    Hinge,
+    /// the twist range (5 or 6 rows), and where `true` (some lane has a
+    /// drive) the drive's 3.
+    Socket(SwingRows, bool),
+    /// A hinge: the point, the axis and the range (6 rows), and where
+    /// `true` the drive's 1.
+    Hinge(bool),
     /// A fixed joint: the point and the lock (6 rows).
     Fixed,
     /// A rod: the curve, the length and the bend and twist limits (5 rows).
@@ -67,11 +69,9 @@ impl JointRows {
     /// How many rows.
     pub const fn count(self) -> usize {
         match self {
-            JointRows::Socket(SwingRows::Pyramid) => 9,
-            JointRows::Socket(_) => 8,
-            JointRows::Hinge => 7,
-            JointRows::Fixed => 6,
-            JointRows::Rod => 5,
+            JointRows::Socket(_, true) => self.first_drive() + 3,
+            JointRows::Hinge(true) => 7,
+            _ => self.first_drive(),
         }
     }
 
@@ -80,8 +80,8 @@ impl JointRows {
     /// iterated).
     pub const fn first_drive(self) -> usize {
         match self {
-            JointRows::Socket(SwingRows::Pyramid) | JointRows::Hinge | JointRows::Fixed => 6,
-            JointRows::Socket(_) | JointRows::Rod => 5,
+            JointRows::Socket(SwingRows::Pyramid, _) | JointRows::Hinge(_) | JointRows::Fixed => 6,
+            JointRows::Socket(..) | JointRows::Rod => 5,
         }
     }
 
@@ -94,8 +94,8 @@ impl JointRows {
     /// (`first_drive()` for none: a fixed joint).
     pub const fn first_limit(self) -> usize {
         match self {
-            JointRows::Socket(_) | JointRows::Rod => 3,
-            JointRows::Hinge => 5,
+            JointRows::Socket(..) | JointRows::Rod => 3,
+            JointRows::Hinge(_) => 5,
             JointRows::Fixed => 6,
         }
     }
@@ -109,7 +109,7 @@ impl JointRows {
     /// row, whose error is in swing sines (half a radian per radian for
     /// small swings: `parts::ellipse`), else one.
     pub const fn is_sine_row(self, k: usize) -> bool {
-        matches!(self, JointRows::Socket(SwingRows::Ellipse)) && k == 3
+        matches!(self, JointRows::Socket(SwingRows::Ellipse, _)) && k == 3
     }
 }
 
@@ -232,8 +232,8 @@ impl<L: Lane> Rows<L> {
     #[inline(always)]
     fn equalities(&mut self, kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         match kind {
-            JointRows::Socket(_) => self.point(0, a, b, g),
-            JointRows::Hinge => {
+            JointRows::Socket(..) => self.point(0, a, b, g),
+            JointRows::Hinge(_) => {
                 self.point(0, a, b, g);
                 self.axis(3, a, b, g);
             }
@@ -252,19 +252,19 @@ impl<L: Lane> Rows<L> {
     #[inline(always)]
     fn limits(&mut self, kind: JointRows, a: &BodyLanes<L>, b: &BodyLanes<L>, g: &Geometry<L>) {
         match kind {
-            JointRows::Socket(SwingRows::Cone) => {
+            JointRows::Socket(SwingRows::Cone, _) => {
                 self.swing(3, a, b, g);
                 self.twist(4, a, b, g);
             }
-            JointRows::Socket(SwingRows::Ellipse) => {
+            JointRows::Socket(SwingRows::Ellipse, _) => {
                 self.ellipse(3, a, b, g);
                 self.twist(4, a, b, g);
             }
-            JointRows::Socket(SwingRows::Pyramid) => {
+            JointRows::Socket(SwingRows::Pyramid, _) => {
                 self.pyramid(3, a, b, g);
                 self.twist(5, a, b, g);
             }
-            JointRows::Hinge => self.twist(5, a, b, g),
+            JointRows::Hinge(_) => self.twist(5, a, b, g),
             JointRows::Fixed => {}
             JointRows::Rod => self.rod_limits(3, a, b, g),
         }
@@ -428,7 +428,7 @@ impl<L: Lane> Rows<L> {
 #[inline(always)]
 pub fn drive_axes<L: Lane>(kind: JointRows, frame_a: Quat<L>) -> [Vec3<L>; MAX_DRIVE_ROWS] {
     match kind {
-        JointRows::Hinge => {
+        JointRows::Hinge(_) => {
             let zero = Vec3::zero();
             [axis_x(frame_a), zero, zero]
         }

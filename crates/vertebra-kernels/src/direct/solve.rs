@@ -45,10 +45,12 @@ use crate::parts::limit::Softness;
 macro_rules! by_rows {
     ($kind:expr, $f:ident::<$L:ty>($($arg:expr),* $(,)?)) => {
         match $kind {
-            JointRows::Socket(SwingRows::Pyramid) => $f::<$L, 3, 6>($($arg),*),
-            JointRows::Socket(_) => $f::<$L, 3, 5>($($arg),*),
-            JointRows::Rod => $f::<$L, 3, 2>($($arg),*),
-            JointRows::Hinge => $f::<$L, 5, 2>($($arg),*),
+            JointRows::Socket(SwingRows::Pyramid, true) => $f::<$L, 3, 6>($($arg),*),
+            JointRows::Socket(SwingRows::Pyramid, false) => $f::<$L, 3, 3>($($arg),*),
+            JointRows::Socket(_, true) => $f::<$L, 3, 5>($($arg),*),
+            JointRows::Socket(_, false) | JointRows::Rod => $f::<$L, 3, 2>($($arg),*),
+            JointRows::Hinge(true) => $f::<$L, 5, 2>($($arg),*),
+            JointRows::Hinge(false) => $f::<$L, 5, 1>($($arg),*),
             JointRows::Fixed => $f::<$L, 6, 0>($($arg),*),
         }
     };
@@ -63,6 +65,26 @@ pub(super) fn load<L: Lane, const N: usize>(src: &[[f32; BLOCK_LANES]], start: u
     }
     out
 }
+
+/// Loads the first `count` (at most `N`) lane values from scratch arrays,
+/// the rest zero: a block's entries where the scratch is sized for the
+/// largest (a body's 6 x 6 in a scratch sized for a driven pyramid's
+/// 9 x 9).
+#[inline(always)]
+fn load_first<L: Lane, const N: usize>(
+    src: &[[f32; BLOCK_LANES]],
+    start: usize,
+    count: usize,
+) -> [L; N] {
+    let mut out = [L::splat(0.0); N];
+    for (o, s) in out.iter_mut().zip(&src[..count]) {
+        *o = L::load(&s[start..]);
+    }
+    out
+}
+
+/// A body's block: the packed entries of a 6 x 6 lower triangle.
+const BODY_PACKED: usize = at(6, 0);
 
 /// Stores lane values into scratch arrays.
 #[inline(always)]
@@ -509,8 +531,8 @@ fn body_block<L: Lane>(
                 (&port.minus, &port.minus_b)
             }
         };
-        let minus = load::<L, PACKED>(minus, start);
-        let minus_b = load::<L, MAX>(minus_b, start);
+        let minus = load_first::<L, PACKED>(minus, start, BODY_PACKED);
+        let minus_b = load_first::<L, MAX>(minus_b, start, 6);
         for (d, m) in d.iter_mut().zip(minus) {
             *d += m;
         }
@@ -520,8 +542,8 @@ fn body_block<L: Lane>(
     }
     ldl::factor::<L, 6>(&mut d);
     let scratch = &mut block.scratch[n];
-    store(&d, &mut scratch.factors, start);
-    store(&b, &mut scratch.b, start);
+    store(&d[..BODY_PACKED], &mut scratch.factors, start);
+    store(&b[..6], &mut scratch.b, start);
     d
 }
 
@@ -543,8 +565,8 @@ fn body_out<L: Lane, const E: usize, const K: usize>(
     let zero = L::splat(0.0);
     let held = held::<L, E, K>(block, p, start);
     let scratch = &block.scratch[n];
-    let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
-    let mut z = load::<L, MAX>(&scratch.b, start);
+    let coupling = load_first::<L, { MAX * 6 }>(&scratch.coupling, start, (E + K) * 6);
+    let mut z = load_first::<L, MAX>(&scratch.b, start, 6);
     ldl::forward::<L, 6>(factors, &mut z);
     let mut w = [[zero; MAX]; MAX];
     let mut scaled = [[zero; MAX]; MAX];
@@ -657,7 +679,7 @@ fn joint_node<L: Lane, const E: usize, const K: usize>(
     let scratch = &mut block.scratch[n];
     store(&d[..at(E + K, 0)], &mut scratch.factors, start);
     store(&b[..E + K], &mut scratch.b, start);
-    let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
+    let coupling = load_first::<L, { MAX * 6 }>(&scratch.coupling, start, (E + K) * 6);
     ldl::forward_held::<L, E, K>(&d, &mut b, &held);
     let mut scaled = [[zero; MAX]; 6];
     let mut w = [[zero; MAX]; 6];
@@ -810,12 +832,12 @@ fn body_unknowns<L: Lane, const E: usize, const K: usize>(
     start: usize,
 ) {
     let scratch = &block.scratch[n];
-    let factors = load::<L, PACKED>(&scratch.factors, start);
-    let mut y = load::<L, MAX>(&scratch.b, start);
+    let factors = load_first::<L, PACKED>(&scratch.factors, start, BODY_PACKED);
+    let mut y = load_first::<L, MAX>(&scratch.b, start, 6);
     if let Some(p) = parent {
         let held = held::<L, E, K>(block, p, start);
-        let xp = load::<L, MAX>(&block.scratch[p].x, start);
-        let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
+        let xp = load_first::<L, MAX>(&block.scratch[p].x, start, E + K);
+        let coupling = load_first::<L, { MAX * 6 }>(&scratch.coupling, start, (E + K) * 6);
         for i in 0..E {
             for c in 0..6 {
                 y[c] += coupling[i * 6 + c] * xp[i];
@@ -832,7 +854,7 @@ fn body_unknowns<L: Lane, const E: usize, const K: usize>(
         }
     }
     ldl::solve::<L, 6>(&factors, &mut y);
-    store(&y, &mut block.scratch[n].x, start);
+    store(&y[..6], &mut block.scratch[n].x, start);
 }
 
 /// Joint node `n`'s multipliers, from its parent body's unknowns (the
@@ -851,9 +873,9 @@ fn joint_unknowns<L: Lane, const E: usize, const K: usize>(
         load::<L, 6>(&block.scratch[parent as usize].x, start)
     };
     let scratch = &block.scratch[n];
-    let factors = load::<L, PACKED>(&scratch.factors, start);
-    let mut y = load::<L, MAX>(&scratch.b, start);
-    let coupling = load::<L, { MAX * 6 }>(&scratch.coupling, start);
+    let factors = load_first::<L, PACKED>(&scratch.factors, start, at(E + K, 0));
+    let mut y = load_first::<L, MAX>(&scratch.b, start, E + K);
+    let coupling = load_first::<L, { MAX * 6 }>(&scratch.coupling, start, (E + K) * 6);
     for i in 0..E + K {
         if held.computed(E, i) {
             for c in 0..6 {
@@ -1051,7 +1073,7 @@ pub(super) fn apply<L: Lane>(
         };
         let body = &block.bodies[index as usize];
         let mut lanes = BodyLanes::<L>::gather(rows, &body.row[start..]);
-        let x = load::<L, MAX>(&block.scratch[n].x, start);
+        let x = load_first::<L, MAX>(&block.scratch[n].x, start, 6);
         // A trust region: the rows are linear in the turn, so a turn of
         // more than a radian (a tree of near-dependent rows across a
         // million-to-one inertia ratio) is not a step the linearisation
@@ -1081,14 +1103,20 @@ pub(super) fn apply<L: Lane>(
 /// (`E`, and `K` = `count - E`).
 const _: () = {
     use super::rows::SwingRows::{Cone, Ellipse, Pyramid};
-    assert!(JointRows::Socket(Cone).count() == 8 && JointRows::Socket(Ellipse).count() == 8);
-    assert!(JointRows::Rod.count() == 5 && JointRows::Socket(Pyramid).count() == 9);
-    assert!(JointRows::Hinge.count() == 7 && JointRows::Fixed.count() == 6);
-    assert!(JointRows::Socket(Cone).first_limit() == 3 && JointRows::Rod.first_limit() == 3);
-    assert!(JointRows::Hinge.first_limit() == 5 && JointRows::Fixed.first_limit() == 6);
-    assert!(JointRows::Socket(Pyramid).limit_count() <= super::rows::MAX_LIMITS);
-    assert!(
-        JointRows::Socket(Pyramid).count() - JointRows::Socket(Pyramid).first_limit()
-            <= MAX_OPTIONAL
+    let (cone, ellipse, pyramid) = (
+        JointRows::Socket(Cone, false),
+        JointRows::Socket(Ellipse, false),
+        JointRows::Socket(Pyramid, false),
     );
+    assert!(cone.count() == 5 && ellipse.count() == 5 && pyramid.count() == 6);
+    assert!(
+        JointRows::Socket(Cone, true).count() == 8 && JointRows::Socket(Pyramid, true).count() == 9
+    );
+    assert!(JointRows::Rod.count() == 5 && JointRows::Fixed.count() == 6);
+    assert!(JointRows::Hinge(false).count() == 6 && JointRows::Hinge(true).count() == 7);
+    assert!(cone.first_limit() == 3 && JointRows::Rod.first_limit() == 3);
+    assert!(JointRows::Hinge(true).first_limit() == 5 && JointRows::Fixed.first_limit() == 6);
+    assert!(pyramid.limit_count() <= super::rows::MAX_LIMITS);
+    let driven = JointRows::Socket(Pyramid, true);
+    assert!(driven.count() - driven.first_limit() <= MAX_OPTIONAL);
 };
