@@ -135,8 +135,8 @@ const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0xb36d_d5f6_47c9_e263;
 
 // The paper's scenes, passive bending and the 30-ragdoll drop, each
 // spine, solved directly.
-const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x2636_906e_671c_b1e1;
-const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x7bb4_b6ec_3042_0e2d;
+const GOLDEN_BENDING_SOCKETS_DIRECT: u64 = 0x412e_010b_667f_27f3;
+const GOLDEN_BENDING_ROD_DIRECT: u64 = 0x5943_886e_d66d_2748;
 const GOLDEN_DROP_SOCKETS_DIRECT: u64 = 0x3070_1f12_587a_75ea;
 const GOLDEN_DROP_ROD_DIRECT: u64 = 0x8072_15bf_128f_98ab;
 
