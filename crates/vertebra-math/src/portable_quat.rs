@@ -63,6 +63,12 @@ pub trait PortableQuat: Sized {
     /// half sine and cosine rather than glam's `acos` of a per-target dot
     /// product (and exact for small turns, where `acos` is not).
     fn angle_between_portable(self, rhs: Self) -> f32;
+    /// `self` turned at angular velocity `w` (rad/s, world) for `t`
+    /// seconds exactly: `exp(w t / 2) self`, renormalised, through the
+    /// lane math's polynomials. The first-order `q + t/2 (w, 0) q` turns by
+    /// `2 atan(|w| t / 2)` instead, and together with deriving `w` from the
+    /// quaternion difference it bleeds spin at `(|w| t)^2 / 8` per step.
+    fn turned_portable(self, w: Vec3, t: f32) -> Self;
 }
 
 impl PortableQuat for Quat {
@@ -158,5 +164,12 @@ impl PortableQuat for Quat {
     fn angle_between_portable(self, rhs: Quat) -> f32 {
         let turn = self.conjugate().mul_portable(rhs);
         2.0 * crate::trig::atan2(turn.xyz().length(), turn.w.abs())
+    }
+
+    #[inline]
+    fn turned_portable(self, w: Vec3, t: f32) -> Quat {
+        let (axis, speed) = crate::Vec3::<f32>::from(w).normalize_or_zero();
+        let turn = crate::Quat::<f32>::from_axis_angle(axis, speed * t);
+        Quat::from(turn * self.into()).normalize_portable()
     }
 }

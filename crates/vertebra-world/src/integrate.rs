@@ -6,8 +6,10 @@
 
 use glam::{Quat, Vec3};
 use vertebra_kernels::body::BodyRows;
+use vertebra_math::PortableQuat;
 use vertebra_store::{BodyKind, BodyStore};
 
+use crate::body_drive::{BodyDrives, Clock, Driven};
 use crate::islands::Islands;
 
 /// One chunk of bodies (slots `start..`): what the body passes write.
@@ -32,6 +34,8 @@ pub(crate) struct BodyRead<'a> {
     pub torque: &'a [Vec3],
     pub linear_damping: &'a [f32],
     pub angular_damping: &'a [f32],
+    /// The bodies' drives by slot (empty when no body has one).
+    pub drives: &'a [BodyDrives],
     pub gravity: Vec3,
     pub max_linear_speed: f32,
     pub max_angular_speed: f32,
@@ -47,10 +51,12 @@ pub(crate) fn mark_moving(b: &BodyStore, islands: &Islands, moving: &mut Vec<boo
 }
 
 /// Integration of velocities (gravity, forces, the implicit gyroscopic
-/// term in the body frame) and of the rows' displacements and
-/// orientations, for one chunk of bodies; the previous ones are kept for
-/// deriving velocities afterwards.
-pub(crate) fn predict(c: &mut BodyChunk, b: &BodyRead, rows: &BodyRows, h: f32) {
+/// term in the body frame, then the body's drives, `body_drive.rs`) and of
+/// the rows' displacements and orientations, for one chunk of bodies in
+/// substep `clock`; the previous ones are kept for deriving velocities
+/// afterwards.
+pub(crate) fn predict(c: &mut BodyChunk, b: &BodyRead, rows: &BodyRows, clock: Clock) {
+    let h = clock.h;
     let (max_linear, max_angular) = (b.max_linear_speed, b.max_angular_speed);
     for j in 0..c.linear_velocity.len() {
         let i = c.start + j;
@@ -69,6 +75,20 @@ pub(crate) fn predict(c: &mut BodyChunk, b: &BodyRead, rows: &BodyRows, h: f32) 
             let torque_body = q.inverse() * b.torque[i];
             let w_body = limit(w_body + b.inverse_inertia[i] * torque_body * h, max_angular);
             c.angular_velocity[j] = q * w_body;
+            if let Some(drives) = b.drives.get(i).filter(|d| d.any()) {
+                let (displacement, orientation) = pose(rows, i);
+                let body = Driven {
+                    position: b.position[i],
+                    displacement,
+                    orientation,
+                    inverse_mass: b.inverse_mass[i],
+                    inertia: b.inertia[i],
+                    inverse_inertia: b.inverse_inertia[i],
+                };
+                let (v, w) = drives.pull(&body, clock, c.linear_velocity[j], c.angular_velocity[j]);
+                c.linear_velocity[j] = limit(v, max_linear);
+                c.angular_velocity[j] = limit(w, max_angular);
+            }
         } else {
             c.linear_velocity[j] = limit(c.linear_velocity[j], max_linear);
             c.angular_velocity[j] = w;
@@ -78,7 +98,7 @@ pub(crate) fn predict(c: &mut BodyChunk, b: &BodyRead, rows: &BodyRows, h: f32) 
         rows.pose[i + 1].set(BodyRows::pose_row(
             displacement + c.linear_velocity[j] * h,
             b.inverse_mass[i],
-            integrate(orientation, c.angular_velocity[j], h),
+            orientation.turned_portable(c.angular_velocity[j], h),
         ));
     }
 }
@@ -217,19 +237,9 @@ fn gyroscopic(w: Vec3, inertia: glam::Mat3, h: f32) -> Vec3 {
     }
 }
 
-/// Turns `q` at angular velocity `w` for `h` seconds exactly:
-/// `exp(w h / 2) q`. The first-order `q + h/2 (w, 0) q` turns by
-/// `2 atan(|w| h / 2)` instead, and together with deriving `w` from the
-/// quaternion difference it bleeds spin at `(|w| h)^2 / 8` per substep.
-/// Through the math layer's polynomials, so every platform agrees.
-fn integrate(q: Quat, w: Vec3, h: f32) -> Quat {
-    let (axis, speed) = vertebra_math::Vec3::<f32>::from(w).normalize_or_zero();
-    let turn = vertebra_math::Quat::<f32>::from_axis_angle(axis, speed * h);
-    vertebra_math::PortableQuat::normalize_portable(glam::Quat::from(turn * q.into()))
-}
-
 /// The angular velocity that turns `q0` into `q` in `h` seconds, exactly
-/// (the inverse of [`integrate`]): `log(q q0*) / h`, shortest arc.
+/// (the inverse of `PortableQuat::turned_portable`): `log(q q0*) / h`,
+/// shortest arc.
 pub(crate) fn angular_velocity(q: Quat, q0: Quat, h: f32) -> Vec3 {
     let turn = vertebra_math::Quat::<f32>::from(vertebra_math::PortableQuat::mul_portable(
         q,

@@ -23,6 +23,7 @@
 //! ```
 
 mod bins;
+mod body_drive;
 mod checks;
 mod config;
 mod contact;
@@ -61,6 +62,7 @@ use vertebra_math::{Backend, DefaultFloatMode};
 use vertebra_scheduler::Colouring;
 use vertebra_store::Slots;
 
+pub use body_drive::{UprightDrive, WorldDrive};
 pub use config::{
     JointSolver, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS,
     SleepSettings, SolverConfig,
@@ -106,6 +108,9 @@ pub struct World {
     joints: Vec<Option<joint::JointDesc>>,
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
+    /// The bodies' drives by slot, no longer than the last driven body's
+    /// slot (`body_drive.rs`).
+    body_drives: Vec<body_drive::BodyDrives>,
     colouring: Colouring,
     islands: islands::Islands,
     /// Scratch of the step: this step's solve bins (`bins.rs`).
@@ -177,6 +182,7 @@ impl World {
             joints: Vec::new(),
             rod_slots: Slots::new(lineage),
             rods: Vec::new(),
+            body_drives: Vec::new(),
             colouring: Colouring::new(),
             islands: islands::Islands::default(),
             bins: bins::Bins::default(),
@@ -258,6 +264,7 @@ impl World {
         }
         self.layout_dirty |= self.islands.take_out(i);
         self.bodies.remove(handle)?;
+        self.clear_body_drives(i);
         self.pose_version += 1;
         self.contacts
             .retain(|c| c.body_a != handle && c.body_b != handle);
@@ -781,7 +788,8 @@ impl World {
         forces::read(self, h, dt);
         forces::break_joints(self);
         if let Some(settings) = &self.config.sleep {
-            let links = islands::links(&self.joints, &self.rods);
+            let links = islands::links(&self.joints, &self.rods)
+                .chain(body_drive::moving_links(&self.body_drives));
             self.layout_dirty |=
                 self.islands
                     .settle(settings, dt, &mut self.bodies, links, &self.contacts);

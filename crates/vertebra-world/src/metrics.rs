@@ -171,6 +171,11 @@ struct Hashed<'a> {
     islands: &'a crate::islands::Islands,
     /// The contacts set for the next step.
     contacts: &'a [Contact],
+    /// The bodies' drives, when any body has one: a world without them
+    /// hashes no list, so its hash does not depend on a feature it does
+    /// not use (as [`HashedRod`]).
+    #[serde(skip_serializing_if = "<[_]>::is_empty")]
+    body_drives: &'a [crate::body_drive::BodyDrives],
 }
 
 /// A rod slot as the state hash encodes it: `Free` (no rod), `Still` (a
@@ -243,6 +248,7 @@ pub(crate) fn state_hash(world: &World) -> u64 {
         colouring: &world.colouring,
         islands: &world.islands,
         contacts: &world.contacts,
+        body_drives: &world.body_drives,
     };
     // Which world issued the handles, and their generations, change no
     // step: equal worlds hash alike whoever built them.

@@ -60,6 +60,7 @@ use serde::{Deserialize, Serialize};
 use vertebra_scheduler::Colouring;
 use vertebra_store::{BodyHandle, BodyStore, Error, Slots};
 
+use crate::body_drive::{self, BodyDrives, moving_links};
 use crate::islands::{Islands, links};
 use crate::{Contact, JointDesc, RodDesc, World, checks, layout::ROD_KEY};
 
@@ -149,6 +150,7 @@ struct State {
     joints: Vec<Option<JointDesc>>,
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
+    body_drives: Vec<BodyDrives>,
     colouring: Colouring,
     islands: Islands,
     contacts: Vec<Contact>,
@@ -240,9 +242,9 @@ impl State {
         self.colouring
             .validate(&edges, bodies.capacity())
             .map_err(|why| corrupt(format!("colouring: {why}")))?;
-        self.islands
-            .validate(bodies, links(&self.joints, &self.rods))
-            .map_err(corrupt)?;
+        body_drive::validate_all(&self.body_drives, bodies).map_err(corrupt)?;
+        let links = links(&self.joints, &self.rods).chain(moving_links(&self.body_drives));
+        self.islands.validate(bodies, links).map_err(corrupt)?;
         // A pending contact, too, may have lost its dynamic body to a kind
         // change since it was set.
         for (k, c) in self.contacts.iter().enumerate() {
@@ -304,6 +306,7 @@ impl World {
             joints: self.joints.clone(),
             rod_slots: self.rod_slots.clone(),
             rods: self.rods.clone(),
+            body_drives: self.body_drives.clone(),
             colouring: self.colouring.clone(),
             islands: self.islands.clone(),
             contacts: self.contacts.clone(),
@@ -337,6 +340,7 @@ impl World {
         self.joints = state.joints;
         self.rod_slots = state.rod_slots;
         self.rods = state.rods;
+        self.body_drives = state.body_drives;
         self.colouring = state.colouring;
         self.islands = state.islands;
         self.islands.derive();
@@ -368,7 +372,7 @@ mod tests {
     use crate::islands::{Island, NO_ISLAND};
     use crate::{
         AngularDrive, BodyDesc, BodyKind, JointKind, LimitSoftness, RodStiffness, Shape,
-        SolverConfig, Spring, Swing, SwingTwist,
+        SolverConfig, Spring, Swing, SwingTwist, UprightDrive, WorldDrive,
     };
 
     #[test]
@@ -446,6 +450,10 @@ mod tests {
         world.add_rod(rod).unwrap();
         world.add_joint(driven).unwrap();
         world.set_body_velocity(links[2], Vec3::X, Vec3::Z).unwrap();
+        let pose = WorldDrive::new(Vec3::Y, Quat::IDENTITY, Spring::RIGID).with_caps(30.0, 5.0);
+        world.set_world_drive(links[1], Some(pose)).unwrap();
+        let upright = UprightDrive::new(Vec3::Y, Vec3::Y, Spring::RIGID).with_max_torque(2.0);
+        world.set_upright_drive(links[2], Some(upright)).unwrap();
         for _ in 0..5 {
             world.step(1.0 / 60.0).unwrap();
         }
@@ -590,6 +598,25 @@ mod tests {
             (
                 Box::new(|s| s.joints_at[1] -= 1),
                 "body 1: counted in 1 joints, used by 2",
+            ),
+            (
+                Box::new(|s| s.body_drives.push(BodyDrives::default())),
+                "body drives: the list ends in an undriven slot",
+            ),
+            (
+                Box::new(|s| s.body_drives[2].world.as_mut().unwrap().max_force = -1.0),
+                "body 2: world drive max force must be positive",
+            ),
+            (
+                Box::new(|s| s.body_drives[3].upright.as_mut().unwrap().axis = Vec3::X * 2.0),
+                "body 3: upright drive axis is not normalised",
+            ),
+            (
+                Box::new(|s| {
+                    s.body_drives.resize(5, BodyDrives::default());
+                    s.body_drives[4] = s.body_drives[3];
+                }),
+                "body 4: drives on no live body",
             ),
             (
                 Box::new(|s| s.joints_at.push(0)),
@@ -764,7 +791,7 @@ mod tests {
         let ball = |x: f32| BodyDesc::dynamic(mass).with_position(Vec3::new(x, -0.5, 0.0));
         let a = world.add_body(ball(0.0)).unwrap();
         let b = world.add_body(ball(2.0)).unwrap();
-        world.add_body(ball(5.0)).unwrap();
+        let free = world.add_body(ball(5.0)).unwrap();
         let bodies = world.bodies();
         let drive = AngularDrive::spring(Quat::IDENTITY, 4.0, 0.7);
         let driven =
@@ -781,6 +808,8 @@ mod tests {
         .unwrap();
         world.add_joint(driven).unwrap();
         world.add_joint(held).unwrap();
+        let still = WorldDrive::new(Vec3::new(5.0, -0.5, 0.0), Quat::IDENTITY, Spring::RIGID);
+        world.set_world_drive(free, Some(still)).unwrap();
         for _ in 0..40 {
             world.step(1.0 / 60.0).unwrap();
         }
@@ -822,6 +851,10 @@ mod tests {
                     drive.target_velocity = Vec3::new(0.0, 0.5, 0.0);
                 }),
                 "body 2: asleep, held by a moving drive or rod rest (to body 0)".into(),
+            ),
+            (
+                Box::new(|s| s.body_drives[4].world.as_mut().unwrap().linear_velocity = Vec3::X),
+                "body 4: asleep, held by a moving drive or rod rest (to body 4)".into(),
             ),
             (
                 Box::new(|s| s.bodies.linear_velocity[1] = Vec3::X),

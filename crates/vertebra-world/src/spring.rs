@@ -65,6 +65,13 @@ pub enum SpringField {
     Drive,
     /// A limit's softness: `limit compliance`, `limit damping ratio`, ...
     Limit,
+    /// A world drive's position part: `world drive position frequency`, ...
+    WorldPosition,
+    /// A world drive's orientation part: `world drive orientation
+    /// frequency`, ...
+    WorldOrientation,
+    /// An upright drive's strength: `upright drive frequency`, ...
+    Upright,
 }
 
 /// The names a check gives a spring's numbers and ranges.
@@ -99,6 +106,9 @@ impl SpringField {
         match self {
             Self::Drive => names!("drive"),
             Self::Limit => names!("limit"),
+            Self::WorldPosition => names!("world drive position"),
+            Self::WorldOrientation => names!("world drive orientation"),
+            Self::Upright => names!("upright drive"),
         }
     }
 }

@@ -16,6 +16,7 @@ use vertebra_math::Backend;
 use vertebra_store::{BodyKind, BodyStore};
 
 use crate::World;
+use crate::body_drive::Clock;
 use crate::integrate::{mark_moving, pose};
 use crate::joint::JointKind;
 use crate::kinds::{BlockKind, JointBlock, Vector};
@@ -100,10 +101,15 @@ pub(crate) fn solve(world: &mut World, dt: f32, workers: usize) {
             .blocks
             .iter_mut()
             .for_each(|b| b.start_substep(remaining));
-        world.repaired += solve_substep(world, h, workers);
+        let clock = Clock { k: substep, h };
+        world.repaired += solve_substep(world, clock, workers);
     }
     commit(world);
     keep_drive_targets(world);
+    let elapsed = substeps as f32 * h;
+    for d in &mut world.body_drives {
+        d.advance(elapsed);
+    }
     keep_rod_rests(world);
     let bodies = &mut world.bodies;
     bodies.force.iter_mut().for_each(|f| *f = Vec3::ZERO);

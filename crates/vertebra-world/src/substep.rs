@@ -21,6 +21,7 @@ use vertebra_math::Backend;
 
 use crate::World;
 use crate::bins::Bins;
+use crate::body_drive::Clock;
 use crate::contact_layout::{ContactBin, ContactLayout};
 use crate::integrate::{
     BodyChunk, BodyRead, damp, derive_velocities, predict, read_velocities, repair,
@@ -62,6 +63,8 @@ struct Substep<'a> {
     min_blocks: usize,
     iterations: u32,
     h: f32,
+    /// Which substep of the step this is (from 0).
+    k: u32,
     /// Relax passes after the velocity pass ([`RELAX_PASSES`] or none).
     relax_passes: u32,
     bodies: BodyRead<'a>,
@@ -87,7 +90,8 @@ struct Substep<'a> {
 /// iterations, derive velocities, the velocity pass, damp and repair, as
 /// one launch of the task system's workers walking the stages
 /// ([`Substep::walk`]). Returns how many bodies were repaired.
-pub(crate) fn solve_substep(world: &mut World, h: f32, workers: usize) -> u64 {
+pub(crate) fn solve_substep(world: &mut World, clock: Clock, workers: usize) -> u64 {
+    let Clock { k, h } = clock;
     let config = &world.config;
     let b = &mut world.bodies;
     let n = b.capacity();
@@ -127,6 +131,7 @@ pub(crate) fn solve_substep(world: &mut World, h: f32, workers: usize) -> u64 {
         min_blocks: config.parallel_min_blocks,
         iterations: config.iterations,
         h,
+        k,
         relax_passes: if config.relax_contacts {
             RELAX_PASSES
         } else {
@@ -143,6 +148,7 @@ pub(crate) fn solve_substep(world: &mut World, h: f32, workers: usize) -> u64 {
             torque: &b.torque,
             linear_damping: &b.linear_damping,
             angular_damping: &b.angular_damping,
+            drives: &world.body_drives,
             gravity: config.gravity,
             max_linear_speed: config.max_linear_speed,
             max_angular_speed: config.max_angular_speed,
@@ -178,9 +184,9 @@ pub(crate) fn solve_substep(world: &mut World, h: f32, workers: usize) -> u64 {
 impl<'a> Substep<'a> {
     /// The substep's stages, in order.
     fn walk(&self, cursor: &mut Cursor) {
-        let h = self.h;
+        let (h, k) = (self.h, self.k);
         let bodies = &self.bodies;
-        self.body_pass(cursor, |c, rows| predict(c, bodies, rows, h));
+        self.body_pass(cursor, |c, rows| predict(c, bodies, rows, Clock { k, h }));
         // An iteration's tree solve factors each tree once; the closing
         // solves settle the limits' active set (docs/direct.md, "The
         // limits").

@@ -11,7 +11,9 @@
 //! pose to a turn about +Z (the chain stays in the XY plane): targets of
 //! opposite signs, so that each joint's motion pulls on its neighbours.
 
-use core::f32::consts::{PI, TAU};
+mod common;
+
+use core::f32::consts::TAU;
 
 use glam::{Quat, Vec3};
 use vertebra_world::{
@@ -100,42 +102,6 @@ impl Chain {
     }
 }
 
-/// `x(t)` of `x'' = -omega^2 (x - s) - 2 zeta omega x'` from rest at 0.
-fn underdamped(t: f32, omega: f32, zeta: f32, s: f32) -> f32 {
-    let wd = omega * (1.0 - zeta * zeta).sqrt();
-    let decay = (-zeta * omega * t).exp();
-    s - s * decay * ((wd * t).cos() + zeta / (1.0 - zeta * zeta).sqrt() * (wd * t).sin())
-}
-
-/// The frequency (Hz) and damping ratio of a step response toward `s`
-/// sampled every `DT`: the damped frequency from the spacing of its first
-/// two crossings of `s` (linearly interpolated), the ratio from its first
-/// two extremes' logarithmic decrement (each extreme a parabola through
-/// three samples).
-fn frequency_and_ratio(x: &[f32], s: f32) -> (f32, f32) {
-    let e: Vec<f32> = x.iter().map(|x| x - s).collect();
-    let mut crossings = Vec::new();
-    for k in 1..e.len() {
-        if e[k - 1].signum() != e[k].signum() && e[k - 1] != 0.0 {
-            crossings.push((k as f32 + e[k - 1] / (e[k - 1] - e[k])) * DT);
-        }
-    }
-    let mut extremes = Vec::new();
-    for k in 1..e.len() - 1 {
-        let (a, b, c) = (e[k - 1].abs(), e[k].abs(), e[k + 1].abs());
-        if b > a && b >= c && e[k - 1].signum() == e[k + 1].signum() {
-            let curvature = a - 2.0 * b + c;
-            extremes.push(b - (a - c) * (a - c) / (8.0 * curvature));
-        }
-    }
-    assert!(crossings.len() >= 2 && extremes.len() >= 2, "{e:?}");
-    let damped = PI / (crossings[1] - crossings[0]);
-    let decrement = (extremes[0] / extremes[1]).ln();
-    let zeta = decrement / (PI * PI + decrement * decrement).sqrt();
-    let omega = damped / (1.0 - zeta * zeta).sqrt();
-    (omega / TAU, zeta)
-}
-
 /// Every joint of `links` against its own oscillator at `HZ`, `ZETA`:
 /// the frequency and ratio measured within 5%, the whole response within
 /// 5% of its step.
@@ -144,9 +110,9 @@ fn each_joint_is_its_own_oscillator(links: &[(f32, f32, f32)]) {
     let frames = chain.run(120);
     for (j, &(_, _, s)) in links.iter().enumerate() {
         let x: Vec<f32> = frames.iter().map(|f| f[j]).collect();
-        let (hz, zeta) = frequency_and_ratio(&x, s);
+        let (hz, zeta) = common::frequency_and_ratio(&x, s, DT);
         let worst = (x.iter().enumerate())
-            .map(|(k, x)| (x - underdamped((k + 1) as f32 * DT, TAU * HZ, ZETA, s)).abs())
+            .map(|(k, x)| (x - common::underdamped((k + 1) as f32 * DT, TAU * HZ, ZETA, s)).abs())
             .fold(0.0, f32::max);
         eprintln!(
             "joint {j}: {hz:.3} Hz, ratio {zeta:.3}; largest difference from the closed form \
@@ -181,7 +147,7 @@ fn iterated_pair_drives_do_not_hold_for_a_limb_with_children() {
     let mut chain = Chain::new(JointSolver::Iterative, &links, f32::INFINITY);
     let frames = chain.run(120);
     let x: Vec<f32> = frames.iter().map(|f| f[0]).collect();
-    let (hz, _) = frequency_and_ratio(&x, links[0].2);
+    let (hz, _) = common::frequency_and_ratio(&x, links[0].2, DT);
     eprintln!("iterated shoulder: {hz:.3} Hz of {HZ}");
     assert!((hz / HZ - 1.0).abs() > 0.2, "{hz} Hz");
 }

@@ -1,6 +1,8 @@
 //! Builders shared by the world's tests.
 #![allow(dead_code)]
 
+use core::f32::consts::{PI, TAU};
+
 use glam::{Quat, Vec3};
 use vertebra_world::{
     BodyDesc, BodyHandle, JointDesc, JointHandle, JointSolver, Shape, SolverConfig, World,
@@ -70,4 +72,40 @@ pub fn world_with(substeps: u32, iterations: u32, joints: JointSolver) -> World 
 pub fn angle_between(a: Quat, b: Quat) -> f32 {
     let r = a * b.conjugate();
     2.0 * Vec3::new(r.x, r.y, r.z).length().atan2(r.w.abs())
+}
+
+/// `x(t)` of `x'' = -omega^2 (x - s) - 2 zeta omega x'` from rest at 0.
+pub fn underdamped(t: f32, omega: f32, zeta: f32, s: f32) -> f32 {
+    let wd = omega * (1.0 - zeta * zeta).sqrt();
+    let decay = (-zeta * omega * t).exp();
+    s - s * decay * ((wd * t).cos() + zeta / (1.0 - zeta * zeta).sqrt() * (wd * t).sin())
+}
+
+/// The frequency (Hz) and damping ratio of a step response toward `s`
+/// sampled every `dt` (s): the damped frequency from the spacing of its first
+/// two crossings of `s` (linearly interpolated), the ratio from its first
+/// two extremes' logarithmic decrement (each extreme a parabola through
+/// three samples).
+pub fn frequency_and_ratio(x: &[f32], s: f32, dt: f32) -> (f32, f32) {
+    let e: Vec<f32> = x.iter().map(|x| x - s).collect();
+    let mut crossings = Vec::new();
+    for k in 1..e.len() {
+        if e[k - 1].signum() != e[k].signum() && e[k - 1] != 0.0 {
+            crossings.push((k as f32 + e[k - 1] / (e[k - 1] - e[k])) * dt);
+        }
+    }
+    let mut extremes = Vec::new();
+    for k in 1..e.len() - 1 {
+        let (a, b, c) = (e[k - 1].abs(), e[k].abs(), e[k + 1].abs());
+        if b > a && b >= c && e[k - 1].signum() == e[k + 1].signum() {
+            let curvature = a - 2.0 * b + c;
+            extremes.push(b - (a - c) * (a - c) / (8.0 * curvature));
+        }
+    }
+    assert!(crossings.len() >= 2 && extremes.len() >= 2, "{e:?}");
+    let damped = PI / (crossings[1] - crossings[0]);
+    let decrement = (extremes[0] / extremes[1]).ln();
+    let zeta = decrement / (PI * PI + decrement * decrement).sqrt();
+    let omega = damped / (1.0 - zeta * zeta).sqrt();
+    (omega / TAU, zeta)
 }
