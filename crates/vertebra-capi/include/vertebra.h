@@ -1005,6 +1005,48 @@ typedef struct VtTaskSystem {
   void *context;
 } VtTaskSystem;
 
+// A body pulled toward a pose in the world: its centre of mass toward
+// `position`, its orientation toward `orientation`, each part a damped
+// spring with a cap.
+typedef struct VtWorldDrive {
+  // The target for the centre of mass (m, world) as the next step
+  // begins.
+  struct VtVec3 position;
+  // The target orientation (unit, world).
+  struct VtQuat orientation;
+  // The target's velocity (m/s, world).
+  struct VtVec3 linear_velocity;
+  // The target's angular velocity (rad/s, world).
+  struct VtVec3 angular_velocity;
+  // Non-zero: the position part acts, at `linear`.
+  uint32_t has_linear;
+  // The position part's strength (`VT_SOFTNESS_KIND_COMPLIANCE`, 0:
+  // rigid, or `VT_SOFTNESS_KIND_SPRING`).
+  struct VtSoftness linear;
+  // Non-zero: the orientation part acts, at `angular`.
+  uint32_t has_angular;
+  // The orientation part's strength.
+  struct VtSoftness angular;
+  // The largest force the position part exerts (N; infinity:
+  // unlimited).
+  float max_force;
+  // The largest torque the orientation part exerts (N m; infinity:
+  // unlimited).
+  float max_torque;
+} VtWorldDrive;
+
+// One axis of a body held near a world direction.
+typedef struct VtUprightDrive {
+  // The body's axis (unit, body frame).
+  struct VtVec3 axis;
+  // The world direction (unit, world).
+  struct VtVec3 up;
+  // Its strength (compliance, 0: rigid, or a spring).
+  struct VtSoftness strength;
+  // The largest torque (N m; infinity: unlimited).
+  float max_torque;
+} VtUprightDrive;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -2289,6 +2331,45 @@ enum VtResult vt_world_measure_residuals(struct VtWorld *world, struct VtResidua
 // `world` is a live world; `tasks` is readable and follows
 // `VtTaskSystem`'s contract.
 enum VtResult vt_world_set_tasks(struct VtWorld *world, const struct VtTaskSystem *tasks);
+
+// Sets a dynamic body's world drive, or clears it (`drive` null). Refused
+// (nothing changed) for a body that is not dynamic or a field out of
+// range; the message names it.
+//
+// # Safety
+// `world` is a live world; `drive` is null or readable.
+enum VtResult vt_world_set_world_drive(struct VtWorld *world,
+                                       struct VtBody body,
+                                       const struct VtWorldDrive *drive);
+
+// Writes 1 into `has` and the body's world drive into `drive` (its target
+// as the next step begins), or 0 into `has` if it has none.
+//
+// # Safety
+// `world` is a live world; `has` and `drive` are writable.
+enum VtResult vt_world_world_drive(struct VtWorld *world,
+                                   struct VtBody body,
+                                   uint32_t *has,
+                                   struct VtWorldDrive *drive);
+
+// Sets a dynamic body's upright drive, or clears it (`drive` null), as
+// `vt_world_set_world_drive`.
+//
+// # Safety
+// `world` is a live world; `drive` is null or readable.
+enum VtResult vt_world_set_upright_drive(struct VtWorld *world,
+                                         struct VtBody body,
+                                         const struct VtUprightDrive *drive);
+
+// Writes 1 into `has` and the body's upright drive into `drive`, or 0
+// into `has` if it has none.
+//
+// # Safety
+// `world` is a live world; `has` and `drive` are writable.
+enum VtResult vt_world_upright_drive(struct VtWorld *world,
+                                     struct VtBody body,
+                                     uint32_t *has,
+                                     struct VtUprightDrive *drive);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -193,15 +193,24 @@ impl From<LimitSoftness> for VtSoftness {
     }
 }
 
+/// A drive's strength: compliance (0: rigid) or a spring, never hard; the
+/// refusal names `field`.
+pub(crate) fn drive_spring(s: VtSoftness, field: &str) -> Result<Spring, Failure> {
+    match LimitSoftness::try_from(s)? {
+        LimitSoftness::Soft(spring) => Ok(spring),
+        LimitSoftness::Hard => Err(Failure::new(
+            VtResult::InvalidEnum,
+            format!(
+                "{field}.kind is VT_SOFTNESS_KIND_HARD; a drive is compliant (0: rigid) or a spring"
+            ),
+        )),
+    }
+}
+
 impl TryFrom<VtDrive> for AngularDrive {
     type Error = Failure;
     fn try_from(d: VtDrive) -> Result<Self, Failure> {
-        let LimitSoftness::Soft(strength) = LimitSoftness::try_from(d.strength)? else {
-            return Err(Failure::new(
-                VtResult::InvalidEnum,
-                "drive.strength.kind is VT_SOFTNESS_KIND_HARD; a drive is compliant (0: rigid) or a spring",
-            ));
-        };
+        let strength = drive_spring(d.strength, "drive.strength")?;
         Ok(AngularDrive {
             target: d.target.into(),
             target_velocity: d.target_velocity.into(),

@@ -50,6 +50,7 @@ mod tasks;
 mod transition;
 mod types;
 mod world;
+mod world_drive;
 
 pub use blend::*;
 pub use body::*;
@@ -68,3 +69,4 @@ pub use tasks::{VtParallelFor, VtTaskFn, VtTaskSystem};
 pub use transition::*;
 pub use types::{VtBody, VtJoint, VtQuat, VtRod, VtTransform, VtVec3};
 pub use world::*;
+pub use world_drive::*;

@@ -349,6 +349,8 @@ fn a_null_world_is_refused_by_every_world_call() {
             ("remove_joint", vt_world_remove_joint(w, joint)),
             ("joint", vt_world_joint(w, joint, &mut jdesc)),
             ("drive", vt_world_set_joint_drive(w, joint, null())),
+            ("world_drive", vt_world_set_world_drive(w, a, null())),
+            ("upright_drive", vt_world_set_upright_drive(w, a, null())),
             (
                 "rod_from_pose",
                 vt_rod_from_pose(w, a, b, null(), 0, &mut rdesc),
@@ -3253,4 +3255,113 @@ fn a_rod_spine_of_a_description_without_a_spine_is_refused_through_c() {
     };
     refused(made, VtResult::Ragdoll, &[expected]);
     assert!(mapper.is_null());
+}
+
+fn spring(frequency: f32, damping_ratio: f32) -> VtSoftness {
+    VtSoftness {
+        kind: VtSoftnessKind::Spring as u32,
+        a: frequency,
+        b: damping_ratio,
+    }
+}
+
+#[test]
+fn world_and_upright_drives_round_trip_pull_and_refuse_by_name() {
+    let s = Scene::new();
+    let target = v(0.5, 1.8, 0.1);
+    let drive = VtWorldDrive {
+        position: target,
+        orientation: IDENTITY,
+        linear_velocity: v(0.0, 0.0, 0.0),
+        angular_velocity: v(0.0, 0.0, 0.0),
+        has_linear: 1,
+        linear: spring(4.0, 1.0),
+        has_angular: 0,
+        angular: spring(1.0, 1.0),
+        max_force: 200.0,
+        max_torque: f32::INFINITY,
+    };
+    let upright = VtUprightDrive {
+        axis: v(0.0, 1.0, 0.0),
+        up: v(0.0, 1.0, 0.0),
+        strength: spring(2.0, 1.0),
+        max_torque: 30.0,
+    };
+    // Refusals name the field and change nothing.
+    let hard = VtWorldDrive {
+        linear: VtSoftness {
+            kind: VtSoftnessKind::Hard as u32,
+            ..drive.linear
+        },
+        ..drive
+    };
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    s.refuses(VtResult::InvalidEnum, &["drive.linear.kind"], || unsafe {
+        vt_world_set_world_drive(s.w(), s.c, &hard)
+    });
+    let nan = VtWorldDrive {
+        max_force: f32::NAN,
+        ..drive
+    };
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    s.refuses(VtResult::NonFinite, &["world drive max force"], || unsafe {
+        vt_world_set_world_drive(s.w(), s.c, &nan)
+    });
+    let tilted = VtUprightDrive {
+        axis: v(0.0, 2.0, 0.0),
+        ..upright
+    };
+    s.refuses(
+        VtResult::NotNormalized,
+        &["upright drive axis"],
+        // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+        || unsafe { vt_world_set_upright_drive(s.w(), s.c, &tilted) },
+    );
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    s.refuses(VtResult::NotDynamic, &["driven body"], || unsafe {
+        vt_world_set_world_drive(s.w(), s.ground, &drive)
+    });
+    let mut has = 7u32;
+    let mut read = drive;
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    s.refuses(VtResult::NullPointer, &["has"], || unsafe {
+        vt_world_world_drive(s.w(), s.c, null_mut(), &mut read)
+    });
+    assert_eq!(has, 7, "a refused call wrote its output");
+    // Set, read back, pull.
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_set_world_drive(s.w(), s.c, &drive) });
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_set_upright_drive(s.w(), s.c, &upright) });
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_world_drive(s.w(), s.c, &mut has, &mut read) });
+    assert_eq!(has, 1);
+    assert_eq!((read.position.x, read.max_force), (0.5, 200.0));
+    assert_eq!((read.has_linear, read.has_angular), (1, 0));
+    let mut up = upright;
+    up.max_torque = 0.0;
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_upright_drive(s.w(), s.c, &mut has, &mut up) });
+    assert_eq!((has, up.max_torque), (1, 30.0));
+    let mut before = std::mem::MaybeUninit::<VtBodyState>::uninit();
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_body_state(s.w(), s.c, before.as_mut_ptr()) });
+    // SAFETY: written by the call above.
+    let before = unsafe { before.assume_init() }.position.x;
+    s.world.step(60);
+    let mut after = std::mem::MaybeUninit::<VtBodyState>::uninit();
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_body_state(s.w(), s.c, after.as_mut_ptr()) });
+    // SAFETY: written by the call above.
+    let after = unsafe { after.assume_init() }.position.x;
+    assert!(
+        (after - 0.5).abs() < (before - 0.5).abs(),
+        "{before} -> {after}"
+    );
+    // Cleared by null.
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_set_world_drive(s.w(), s.c, null()) });
+    // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
+    ok(unsafe { vt_world_world_drive(s.w(), s.c, &mut has, &mut read) });
+    assert_eq!(has, 0);
 }
