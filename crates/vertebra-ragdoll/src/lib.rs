@@ -148,6 +148,7 @@ mod skeleton_file;
 mod spec;
 mod text;
 mod transition;
+mod world_drive;
 mod write;
 
 pub use blend_back::{Blend, BlendBack};
@@ -170,3 +171,4 @@ pub use skeleton_file::REFERENCE_SKELETON;
 pub use spec::{BodyShape, BodySpec, SpineSpec};
 pub use text::{MAX_FILE_BYTES, read_text};
 pub use transition::Transition;
+pub use world_drive::{PhysicalAnimation, Upright, WorldDriveSettings};

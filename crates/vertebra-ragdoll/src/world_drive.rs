@@ -1,0 +1,237 @@
+//! A ragdoll held in the world by its animation: every dynamic body pulled
+//! toward its bone's pose by a world drive, some bodies kept upright, and
+//! the joints driven too, one call a frame (`Ragdoll::follow`). The world
+//! drives' caps are per kilogram, so a cap under gravity's acceleration
+//! keeps the ragdoll's own weight on its feet: it stands because it
+//! balances, not because the drives carry it.
+
+use glam::Vec3;
+use vertebra_math::DefaultFloatMode;
+use vertebra_store::BodyKind;
+use vertebra_world::{Spring, SpringField, UprightDrive, World, WorldDrive};
+
+use crate::drive::DriveSettings;
+use crate::error::{RagdollError, check_spring, range};
+use crate::pose::Pose;
+use crate::ragdoll::Ragdoll;
+
+/// One body kept upright: the axis that points up in the animation's pose
+/// is held near world up (+Y).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Upright {
+    /// The described body (its index in the description).
+    pub body: usize,
+    /// Stiffness and damping across the axis.
+    pub strength: Spring,
+    /// The largest torque (N m; infinity is unlimited).
+    pub max_torque: f32,
+}
+
+/// How hard every body is pulled toward its bone's pose in the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldDriveSettings {
+    /// The position part's strength (`None`: positions free).
+    pub linear: Option<Spring>,
+    /// The orientation part's strength (`None`: orientations free).
+    pub angular: Option<Spring>,
+    /// Each body's force cap per kilogram of its mass (N/kg, i.e. m/s^2;
+    /// infinity is unlimited): the drives together never push harder than
+    /// the ragdoll's mass times this, so below gravity's 9.81 they cannot
+    /// hold the ragdoll up alone.
+    pub max_acceleration: f32,
+    /// Each body's torque cap (N m; infinity is unlimited).
+    pub max_torque: f32,
+    /// Bodies kept upright, each at most once.
+    pub uprights: Vec<Upright>,
+}
+
+/// Everything that drives a ragdoll along its animation: its joints and
+/// its bodies in the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhysicalAnimation {
+    /// The joints' drives (`Ragdoll::drive_following`).
+    pub joints: DriveSettings,
+    /// The bodies' world drives (`Ragdoll::world_drive_following`).
+    pub world: WorldDriveSettings,
+}
+
+impl WorldDriveSettings {
+    /// Checks the settings for a ragdoll of `bodies` bodies; errors name
+    /// `world drive` and the field, or the upright by its index.
+    fn validate(&self, bodies: usize) -> Result<(), RagdollError> {
+        let context = "world drive";
+        if let Some(s) = self.linear {
+            check_spring(context, "linear", s, SpringField::WorldPosition)?;
+        }
+        if let Some(s) = self.angular {
+            check_spring(context, "angular", s, SpringField::WorldOrientation)?;
+        }
+        let cap = |x: f32| !(x.is_nan() || x < 0.0);
+        let reason = "must be a number, not negative";
+        range(
+            context,
+            "max_acceleration",
+            cap(self.max_acceleration),
+            reason,
+        )?;
+        range(context, "max_torque", cap(self.max_torque), reason)?;
+        for (k, u) in self.uprights.iter().enumerate() {
+            let context = format!("world drive upright {k}");
+            let once = !self.uprights[..k].iter().any(|v| v.body == u.body);
+            range(
+                &context,
+                "body",
+                u.body < bodies,
+                &format!("must be below {bodies}"),
+            )?;
+            range(
+                &context,
+                "body",
+                once,
+                "names a body an earlier upright names",
+            )?;
+            check_spring(&context, "strength", u.strength, SpringField::Upright)?;
+            range(&context, "max_torque", cap(u.max_torque), reason)?;
+        }
+        Ok(())
+    }
+}
+
+impl Ragdoll {
+    /// Pulls every dynamic body toward its bone's pose in `pose`, held
+    /// still, and keeps the settings' bodies upright as `pose` has them
+    /// (see [`Ragdoll::world_drive_following`]).
+    pub fn world_drive_to(
+        &self,
+        world: &mut World,
+        pose: &Pose,
+        settings: &WorldDriveSettings,
+    ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
+        self.world_drive(world, pose, None, settings)
+    }
+
+    /// Pulls every dynamic body along the animation: its world drive's
+    /// target starts at its bone's pose in `prev` and moves to `pose`'s as
+    /// the step of `dt` ends (`WorldDrive::following`); each upright body's
+    /// axis that is up in `pose` is held near world up. Kinematic bodies
+    /// (a partial ragdoll's) are left to the animation. Refused, nothing
+    /// changed, for settings or poses out of range (the error names them);
+    /// call it every frame with the animation's last two poses.
+    pub fn world_drive_following(
+        &self,
+        world: &mut World,
+        prev: &Pose,
+        pose: &Pose,
+        dt: f32,
+        settings: &WorldDriveSettings,
+    ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
+        self.world_drive(world, pose, Some((prev, dt)), settings)
+    }
+
+    /// The joints' and the bodies' drives along the animation, one call a
+    /// frame: [`Ragdoll::drive_following`] and
+    /// [`Ragdoll::world_drive_following`], both checked before either
+    /// changes anything.
+    pub fn follow(
+        &self,
+        world: &mut World,
+        (prev, pose): (&Pose, &Pose),
+        dt: f32,
+        animation: &PhysicalAnimation,
+    ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
+        self.check_world_drive(pose, Some((prev, dt)), &animation.world)?;
+        self.drive_following(world, prev, pose, dt, &animation.joints)?;
+        self.world_drive(world, pose, Some((prev, dt)), &animation.world)
+    }
+
+    /// Clears every body's world and upright drive.
+    pub fn release_world_drives(&self, world: &mut World) -> Result<(), RagdollError> {
+        self.check_not_removed()?;
+        for &body in self.bodies.iter().flatten() {
+            let clear = |w: &mut World| {
+                w.set_world_drive(body, None)?;
+                w.set_upright_drive(body, None)
+            };
+            if world.bodies().kind[body.index()] == BodyKind::Dynamic {
+                clear(world).map_err(|e| RagdollError::world("world drive", e))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Everything [`Ragdoll::world_drive`] checks before it changes
+    /// anything.
+    fn check_world_drive(
+        &self,
+        pose: &Pose,
+        from: Option<(&Pose, f32)>,
+        settings: &WorldDriveSettings,
+    ) -> Result<(), RagdollError> {
+        self.check_not_removed()?;
+        pose.validate(&self.desc)?;
+        settings.validate(self.desc.bodies.len())?;
+        if let Some((prev, dt)) = from {
+            prev.validate(&self.desc)?;
+            range(
+                "world drive",
+                "dt",
+                dt.is_finite() && dt >= vertebra_world::MIN_TIME_STEP,
+                "must be a time step of at least 1e-6 s",
+            )?;
+        }
+        Ok(())
+    }
+
+    fn world_drive(
+        &self,
+        world: &mut World,
+        pose: &Pose,
+        from: Option<(&Pose, f32)>,
+        settings: &WorldDriveSettings,
+    ) -> Result<(), RagdollError> {
+        self.check_world_drive(pose, from, settings)?;
+        // Every drive made and checked before any is set: a refused call
+        // changes nothing.
+        let mut drives = Vec::with_capacity(self.bodies.len());
+        for (k, body) in self.bodies.iter().enumerate() {
+            let Some(body) = *body else { continue };
+            let i = body.index();
+            if world.bodies().kind[i] != BodyKind::Dynamic {
+                continue;
+            }
+            let world_error = |e| {
+                let name = format!("body `{}`", self.desc.bodies[k].name);
+                RagdollError::world(&name, e)
+            };
+            let (position, orientation) = pose.bones[k];
+            let mut drive = WorldDrive::new(position, orientation, Spring::RIGID)
+                .with_strengths(settings.linear, settings.angular)
+                .with_caps(
+                    world.bodies().mass[i] * settings.max_acceleration,
+                    settings.max_torque,
+                );
+            if let Some((prev, dt)) = from {
+                drive = drive
+                    .following(prev.bones[k], pose.bones[k], dt)
+                    .map_err(world_error)?;
+            }
+            drive.validate().map_err(world_error)?;
+            let upright = settings.uprights.iter().find(|u| u.body == k).map(|u| {
+                let axis = (orientation.conjugate() * Vec3::Y).normalize();
+                UprightDrive::new(axis, Vec3::Y, u.strength).with_max_torque(u.max_torque)
+            });
+            drives.push((body, drive, upright));
+        }
+        for (body, drive, upright) in drives {
+            let set = |w: &mut World| {
+                w.set_world_drive(body, Some(drive))?;
+                w.set_upright_drive(body, upright)
+            };
+            set(world).map_err(|e| RagdollError::world("world drive", e))?;
+        }
+        Ok(())
+    }
+}
