@@ -797,6 +797,40 @@ typedef struct VtJointResidual {
   float limit_rad;
 } VtJointResidual;
 
+// One body kept upright: the body axis that is up in the animation held
+// near world +Y.
+typedef struct VtUpright {
+  // The described body (`vt_ragdoll_desc_body_index`).
+  uint32_t body;
+  // Its strength (compliance, 0: rigid, or a spring).
+  struct VtSoftness strength;
+  // The largest torque (N m; infinity: unlimited).
+  float max_torque;
+} VtUpright;
+
+// How hard every body of a ragdoll is pulled toward its pose in the
+// world.
+typedef struct VtWorldDriveSettings {
+  // Non-zero: the position part acts, at `linear`.
+  uint32_t has_linear;
+  // The position part's strength.
+  struct VtSoftness linear;
+  // Non-zero: the orientation part acts, at `angular`.
+  uint32_t has_angular;
+  // The orientation part's strength.
+  struct VtSoftness angular;
+  // Each body's force cap per kilogram (N/kg; below 9.81 the drives
+  // cannot carry the ragdoll's weight; infinity: unlimited).
+  float max_acceleration;
+  // Each body's torque cap (N m; infinity: unlimited).
+  float max_torque;
+  // `upright_count` bodies kept upright (any pointer when the count is
+  // 0).
+  const struct VtUpright *uprights;
+  // How many `uprights`.
+  size_t upright_count;
+} VtWorldDriveSettings;
+
 // Which colliders a query sees. Start from `vt_query_filter_default`
 // (sees everything); zeroed memory sees nothing (no group, no kind).
 typedef struct VtQueryFilter {
@@ -1585,6 +1619,43 @@ enum VtResult vt_world_island(struct VtWorld *world,
                               struct VtBody body,
                               uint32_t *island,
                               uint32_t *present);
+
+// Gives every dynamic body a world drive along the animation, from
+// `previous` to `pose` over `dt` seconds (both `count` world transforms,
+// one per described body), and keeps `settings`' bodies upright. Refused,
+// nothing changed, for settings or poses out of range.
+//
+// # Safety
+// `ragdoll` and `world` are live; `previous` and `pose` point to `count`
+// readable transforms; `settings` is readable, its `uprights` as it says.
+enum VtResult vt_ragdoll_world_drive_following(struct VtRagdoll *ragdoll,
+                                               struct VtWorld *world,
+                                               const struct VtTransform *previous,
+                                               const struct VtTransform *pose,
+                                               size_t count,
+                                               float dt,
+                                               const struct VtWorldDriveSettings *settings);
+
+// The joints' drives (`vt_ragdoll_drive_following`) and the bodies'
+// world drives (`vt_ragdoll_world_drive_following`) along the animation
+// in one call a frame, both checked before either changes anything.
+//
+// # Safety
+// As `vt_ragdoll_world_drive_following`; `joints` is readable.
+enum VtResult vt_ragdoll_follow(struct VtRagdoll *ragdoll,
+                                struct VtWorld *world,
+                                const struct VtTransform *previous,
+                                const struct VtTransform *pose,
+                                size_t count,
+                                float dt,
+                                const struct VtDriveSettings *joints,
+                                const struct VtWorldDriveSettings *settings);
+
+// Clears every body's world and upright drive.
+//
+// # Safety
+// `ragdoll` and `world` are live.
+enum VtResult vt_ragdoll_release_world_drives(struct VtRagdoll *ragdoll, struct VtWorld *world);
 
 // Writes into `desc` a joint of `kind` (a `VtJointKind`) between two
 // bodies at their current poses, exactly satisfied now, without limits or

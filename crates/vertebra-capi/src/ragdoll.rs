@@ -484,7 +484,7 @@ pub unsafe extern "C" fn vt_ragdoll_remove(
 ///
 /// # Safety
 /// `ragdoll` and `world` are null or live, used by no other call at once.
-unsafe fn with_ragdoll(
+pub(crate) unsafe fn with_ragdoll(
     ragdoll: *mut VtRagdoll,
     world: *mut VtWorld,
     body: impl FnOnce(&Ragdoll, &mut vertebra_world::World) -> Result<(), Failure>,

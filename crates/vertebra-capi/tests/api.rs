@@ -3070,6 +3070,7 @@ fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
         damping: 0.0,
         max_torque: INF,
     };
+    let world_settings = world_drive_settings(&[]);
     let name = CString::new("chest").expect("a name");
     let (r, w, l) = (c.ragdoll, c.world.0, c.layer.0);
     let (mut body, mut present, mut again) = (bits_body(), 7u32, null_mut());
@@ -3136,6 +3137,35 @@ fn a_removed_ragdoll_is_refused_by_every_call_naming_it() {
                 ),
             ),
             ("vt_ragdoll_release_drives", vt_ragdoll_release_drives(r, w)),
+            (
+                "vt_ragdoll_world_drive_following",
+                vt_ragdoll_world_drive_following(
+                    r,
+                    w,
+                    pose.as_ptr(),
+                    pose.as_ptr(),
+                    pose.len(),
+                    DT,
+                    &world_settings,
+                ),
+            ),
+            (
+                "vt_ragdoll_follow",
+                vt_ragdoll_follow(
+                    r,
+                    w,
+                    pose.as_ptr(),
+                    pose.as_ptr(),
+                    pose.len(),
+                    DT,
+                    &settings,
+                    &world_settings,
+                ),
+            ),
+            (
+                "vt_ragdoll_release_world_drives",
+                vt_ragdoll_release_world_drives(r, w),
+            ),
             (
                 "vt_ragdoll_apply_impulse",
                 vt_ragdoll_apply_impulse(r, w, name.as_ptr(), v(1.0, 0.0, 0.0), null()),
@@ -3364,4 +3394,115 @@ fn world_and_upright_drives_round_trip_pull_and_refuse_by_name() {
     // SAFETY: a live world; readable inputs, writable outputs (or the null tested).
     ok(unsafe { vt_world_world_drive(s.w(), s.c, &mut has, &mut read) });
     assert_eq!(has, 0);
+}
+
+/// Every body's world drive at 2 Hz, ratio 1, capped at half its weight
+/// and 20 N m, with `uprights`.
+fn world_drive_settings(uprights: &[VtUpright]) -> VtWorldDriveSettings {
+    VtWorldDriveSettings {
+        has_linear: 1,
+        linear: spring(2.0, 1.0),
+        has_angular: 1,
+        angular: spring(2.0, 1.0),
+        max_acceleration: 4.9,
+        max_torque: 20.0,
+        uprights: uprights.as_ptr(),
+        upright_count: uprights.len(),
+    }
+}
+
+#[test]
+fn a_ragdoll_follows_its_animation_in_the_world_from_c() {
+    let c = Drop_::new(VtSpineMode::Sockets);
+    let pose = lifted_bind(&c.desc, 0.3);
+    let joints = VtDriveSettings {
+        strength: VtStrength {
+            kind: 2,
+            a: 8.0,
+            b: 1.0,
+        },
+        damping: 0.0,
+        max_torque: 300.0,
+    };
+    let (r, w) = (c.ragdoll, c.world.0);
+    let (name, mut index) = (CString::new("chest").expect("a name"), 0usize);
+    // SAFETY: a live description; a NUL-terminated name; writable.
+    ok(unsafe { vt_ragdoll_desc_body_index(c.desc.0, name.as_ptr(), &mut index) });
+    let chest = VtUpright {
+        body: index as u32,
+        strength: spring(2.0, 1.0),
+        max_torque: 100.0,
+    };
+    let hard = VtUpright {
+        strength: VtSoftness {
+            kind: VtSoftnessKind::Hard as u32,
+            a: 0.0,
+            b: 0.0,
+        },
+        ..chest
+    };
+    let follow = |settings: &VtWorldDriveSettings| {
+        // SAFETY: live objects; `count` readable transforms; readable
+        // settings whose uprights are as they say.
+        unsafe {
+            vt_ragdoll_follow(
+                r,
+                w,
+                pose.as_ptr(),
+                pose.as_ptr(),
+                pose.len(),
+                DT,
+                &joints,
+                settings,
+            )
+        }
+    };
+    let before = c.world.bytes();
+    let mut nulled = world_drive_settings(&[chest]);
+    nulled.uprights = null();
+    refused(
+        follow(&nulled),
+        VtResult::NullPointer,
+        &["settings.uprights"],
+    );
+    refused(
+        follow(&world_drive_settings(&[hard])),
+        VtResult::InvalidEnum,
+        &["settings.uprights[0].strength.kind"],
+    );
+    let too_far = VtUpright { body: 99, ..chest };
+    refused(
+        follow(&world_drive_settings(&[too_far])),
+        VtResult::Ragdoll,
+        &["world drive upright 0", "body"],
+    );
+    assert!(
+        before == c.world.bytes(),
+        "a refused call changed the world"
+    );
+    ok(follow(&world_drive_settings(&[chest])));
+    let mut count = 0;
+    // SAFETY: a live description; writable.
+    ok(unsafe { vt_ragdoll_desc_body_count(c.desc.0, &mut count) });
+    let mut uprights = 0;
+    for k in 0..count {
+        let (mut body, mut present) = (bits_body(), 0u32);
+        // SAFETY: live objects; writable.
+        ok(unsafe { vt_ragdoll_body(r, k, &mut body, &mut present) });
+        assert_eq!(present, 1, "body {k}");
+        let (mut has, mut drive) = (0u32, std::mem::MaybeUninit::<VtWorldDrive>::uninit());
+        // SAFETY: a live world; writable outputs.
+        ok(unsafe { vt_world_world_drive(w, body, &mut has, drive.as_mut_ptr()) });
+        assert_eq!(has, 1, "body {k}");
+        // SAFETY: written by the call above.
+        let drive = unsafe { drive.assume_init() };
+        assert_eq!((drive.has_linear, drive.max_torque), (1, 20.0));
+        let mut up = std::mem::MaybeUninit::<VtUprightDrive>::uninit();
+        // SAFETY: a live world; writable outputs.
+        ok(unsafe { vt_world_upright_drive(w, body, &mut has, up.as_mut_ptr()) });
+        uprights += has;
+    }
+    assert_eq!(uprights, 1);
+    // SAFETY: live objects.
+    ok(unsafe { vt_ragdoll_release_world_drives(r, w) });
 }
