@@ -9,11 +9,11 @@ use serde::{Deserialize, Serialize};
 use vertebra_world::{
     AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, JointDesc, JointHandle, JointKind,
     LimitSoftness, RodDesc, RodHandle, RodStiffness, Shape, Snapshot, SolverConfig, Spring, Swing,
-    SwingTwist, World,
+    SwingTwist, UprightDrive, World, WorldDrive,
 };
 
 use crate::input::Input;
-use crate::world::{Seen, add_body, add_joint, add_rod, set_contacts};
+use crate::world::{Seen, add_body, add_joint, add_rod, body_drive, set_contacts};
 
 // The payload's layout as the fuzzer sees it: `vertebra_world`'s private
 // `State` field for field (postcard is not self-describing). Every valid
@@ -87,9 +87,16 @@ struct State {
     joints: Vec<Option<JointDesc>>,
     rod_slots: Slots,
     rods: Vec<Option<RodDesc>>,
+    body_drives: Vec<BodyDrives>,
     colouring: Colouring,
     islands: Islands,
     contacts: Vec<Contact>,
+}
+
+#[derive(Clone, Copy, Default, Serialize, Deserialize)]
+struct BodyDrives {
+    world: Option<WorldDrive>,
+    upright: Option<UprightDrive>,
 }
 
 const HEADER: usize = 24;
@@ -438,7 +445,8 @@ fn islands(input: &mut Input, islands: &mut Islands) {
 
 /// One change to the state, chosen by the input.
 fn change(input: &mut Input, state: &mut State) {
-    match input.pick(8) {
+    match input.pick(9) {
+        8 => body_drives(input, state),
         7 => islands(input, &mut state.islands),
         0 | 1 => body(input, &mut state.bodies),
         2 => socket(input, state),
@@ -451,6 +459,40 @@ fn change(input: &mut Input, state: &mut State) {
                 0 => state.joints_at.push(1),
                 _ => state.joints_at[input.pick(n)] = input.pick(4) as u32,
             }
+        }
+    }
+}
+
+/// A body's drives changed: a field to any value, a drive on any slot,
+/// or an undriven slot at the end.
+fn body_drives(input: &mut Input, state: &mut State) {
+    let n = state.body_drives.len();
+    if n == 0 || input.flag() {
+        let mut d = BodyDrives::default();
+        if input.flag() {
+            d.upright = Some(UprightDrive::new(Vec3::Y, Vec3::Y, Spring::RIGID));
+        }
+        let at = input.pick(n + 2);
+        state
+            .body_drives
+            .resize(state.body_drives.len().max(at + 1), BodyDrives::default());
+        state.body_drives[at] = d;
+        return;
+    }
+    let d = &mut state.body_drives[input.pick(n)];
+    if let Some(w) = d.world.as_mut() {
+        match input.pick(5) {
+            0 => vec3(input, &mut w.position),
+            1 => quat(input, &mut w.orientation),
+            2 => vec3(input, &mut w.linear_velocity),
+            3 => w.max_force = value(input),
+            _ => w.linear = Some(spring(input)),
+        }
+    } else if let Some(u) = d.upright.as_mut() {
+        match input.pick(3) {
+            0 => vec3(input, &mut u.axis),
+            1 => u.max_torque = value(input),
+            _ => u.strength = spring(input),
         }
     }
 }
@@ -495,6 +537,13 @@ fn build(input: &mut Input) -> World {
     let _ = set_contacts(&mut world, &seen, input);
     if input.flag() {
         world = asleep(&world, &seen);
+    }
+    // Last, so that the sleep seeds still reach their sleep state.
+    for _ in 0..input.pick(3) {
+        if !seen.bodies.is_empty() {
+            let body = seen.bodies[input.pick(seen.bodies.len())];
+            let _ = body_drive(&mut world, body, input);
+        }
     }
     world
 }

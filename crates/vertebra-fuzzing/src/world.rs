@@ -4,7 +4,8 @@ use glam::Vec3;
 use vertebra_world::{
     AngularDrive, BodyDesc, BodyHandle, BodyKind, Contact, Error, JointDesc, JointHandle,
     JointKind, JointSolver, LimitSoftness, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT,
-    RodDesc, RodHandle, RodStiffness, Shape, SolverConfig, Spring, Swing, SwingTwist, World,
+    RodDesc, RodHandle, RodStiffness, Shape, SolverConfig, Spring, Swing, SwingTwist, UprightDrive,
+    World, WorldDrive,
 };
 
 use crate::input::Input;
@@ -147,6 +148,57 @@ fn drive(input: &mut Input) -> AngularDrive {
     }
 }
 
+/// A spring of either kind.
+fn spring(input: &mut Input) -> Spring {
+    if input.flag() {
+        Spring::Compliance {
+            compliance: input.float(1.0),
+            damping: input.float(10.0),
+        }
+    } else {
+        Spring::Frequency {
+            frequency: input.float(50.0),
+            damping_ratio: input.float(2.0),
+        }
+    }
+}
+
+/// A world drive (each part on or off, moving or not, capped or not), an
+/// upright drive, or either cleared.
+pub(crate) fn body_drive(
+    world: &mut World,
+    body: BodyHandle,
+    input: &mut Input,
+) -> Result<(), Error> {
+    let cap = |input: &mut Input| match input.flag() {
+        true => input.float(1000.0),
+        false => f32::INFINITY,
+    };
+    match input.pick(4) {
+        0 => {
+            let mut drive = WorldDrive::new(input.vec3(5.0), input.quat(), spring(input));
+            drive.linear_velocity = input.vec3(20.0);
+            drive.angular_velocity = input.vec3(20.0);
+            let (linear, angular) = (
+                input.flag().then(|| spring(input)),
+                input.flag().then(|| spring(input)),
+            );
+            let drive = drive
+                .with_strengths(linear, angular)
+                .with_caps(cap(input), cap(input));
+            world.set_world_drive(body, Some(drive))
+        }
+        1 => {
+            let axis = input.vec3(1.0).normalize_or(Vec3::Y);
+            let drive =
+                UprightDrive::new(axis, input.vec3(1.0).normalize_or(Vec3::Y), spring(input));
+            world.set_upright_drive(body, Some(drive.with_max_torque(cap(input))))
+        }
+        2 => world.set_world_drive(body, None),
+        _ => world.set_upright_drive(body, None),
+    }
+}
+
 pub(crate) fn add_rod(
     world: &mut World,
     seen: &Seen,
@@ -249,7 +301,7 @@ fn kinematic(world: &mut World, body: BodyHandle, input: &mut Input) -> Result<(
 
 /// One call chosen by the input; `Err` is a refusal.
 fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Error> {
-    match input.pick(13) {
+    match input.pick(14) {
         0 => add_body(world, input).map(|h| seen.bodies.push(h)),
         1 => match seen.body(input) {
             Some(h) => world.remove_body(h),
@@ -282,6 +334,10 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
             Some(h) => kinematic(world, h, input),
             None => Ok(()),
         },
+        12 => match seen.body(input) {
+            Some(h) => body_drive(world, h, input),
+            None => Ok(()),
+        },
         _ => world.step(if input.flag() {
             1.0 / 60.0
         } else {
@@ -292,6 +348,7 @@ fn call(world: &mut World, seen: &mut Seen, input: &mut Input) -> Result<(), Err
 
 /// Up to 64 arbitrary calls (bodies, sockets, rods and contacts added and
 /// removed, contacts copied in or swapped in without a copy, poses, velocities, forces and impulses set, kinds switched,
+/// world and upright drives set and cleared,
 /// kinematic bodies moved, steps) with arbitrary floats
 /// one time in eight: no panic; every refused call leaves the world as it
 /// was; every body stays finite; no pending contact names a removed body;
