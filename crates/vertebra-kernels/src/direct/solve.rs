@@ -318,7 +318,7 @@ pub(super) fn hold(block: &mut TreeBlock, topology: &Topology, first_pass: bool)
                 if o >= limits {
                     // A drive's rows: held where the lane has a drive.
                     scratch.active[o][lane] = if block.driven {
-                        drive.enabled[lane]
+                        drive.settings.enabled[lane]
                     } else {
                         0.0
                     };
