@@ -14,12 +14,16 @@ use crate::body::{BodyLanes, BodyPairs, BodyRows};
 use crate::parts::drive;
 use crate::pass::BlockKernel;
 
-/// Eight drives, field by field.
+/// Eight drives' settings, field by field: what a drive asks, held alike
+/// by the iterated drive ([`DriveBlock`]) and by a tree joint's drive
+/// rows in the direct solve (`direct::drive`), each beside its own
+/// substep state.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 #[repr(C, align(32))]
-pub struct DriveBlock {
+pub struct DriveSettings {
     /// Target of the current substep: b's joint frame relative to a's
-    /// (advanced by [`Starts`] every substep).
+    /// (advanced every substep by the drive's start: [`Starts`], or the
+    /// direct solve's start pass).
     pub target: QuatBlock,
     /// Target angular velocity (rad/s, a's joint frame).
     pub velocity: Vec3Block,
@@ -34,6 +38,28 @@ pub struct DriveBlock {
     pub max_torque: [f32; BLOCK_LANES],
     /// 1 where the drive is on, 0 where off.
     pub enabled: [f32; BLOCK_LANES],
+}
+
+impl DriveSettings {
+    /// Writes one joint's drive (or none) into `lane`.
+    pub fn set(&mut self, lane: usize, drive: Option<&DriveLane>) {
+        let d = drive.copied().unwrap_or(DriveLane::OFF);
+        self.target.set(lane, d.target);
+        self.velocity.set(lane, d.velocity);
+        self.compliance[lane] = d.compliance;
+        self.period2[lane] = d.period2;
+        self.damping_time[lane] = d.damping_time;
+        self.max_torque[lane] = d.max_torque;
+        self.enabled[lane] = if drive.is_some() { 1.0 } else { 0.0 };
+    }
+}
+
+/// Eight iterated drives: their settings and their XPBD state.
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C, align(32))]
+pub struct DriveBlock {
+    /// What the drives ask.
+    pub settings: DriveSettings,
     /// The accumulated XPBD multiplier (world vector), reset every substep.
     pub lambda: Vec3Block,
     /// The error at the substep's start (rad, world), measured by
@@ -73,14 +99,7 @@ impl DriveLane {
 impl DriveBlock {
     /// Writes one joint's drive (or none) into `lane`.
     pub fn set(&mut self, lane: usize, drive: Option<&DriveLane>) {
-        let d = drive.copied().unwrap_or(DriveLane::OFF);
-        self.target.set(lane, d.target);
-        self.velocity.set(lane, d.velocity);
-        self.compliance[lane] = d.compliance;
-        self.period2[lane] = d.period2;
-        self.damping_time[lane] = d.damping_time;
-        self.max_torque[lane] = d.max_torque;
-        self.enabled[lane] = if drive.is_some() { 1.0 } else { 0.0 };
+        self.settings.set(lane, drive);
         self.lambda.set(lane, GVec3::ZERO);
         self.start.set(lane, GVec3::ZERO);
     }
@@ -88,13 +107,14 @@ impl DriveBlock {
     /// The lanes from `start` as the drive part reads them.
     #[inline(always)]
     fn lanes<L: Lane>(&self, start: usize) -> drive::Drive<L> {
+        let s = &self.settings;
         drive::Drive {
-            target: self.target.load(start),
-            compliance: L::load(&self.compliance[start..]),
-            period2: L::load(&self.period2[start..]),
-            damping_time: L::load(&self.damping_time[start..]),
-            max_torque: L::load(&self.max_torque[start..]),
-            enabled: L::load(&self.enabled[start..]),
+            target: s.target.load(start),
+            compliance: L::load(&s.compliance[start..]),
+            period2: L::load(&s.period2[start..]),
+            damping_time: L::load(&s.damping_time[start..]),
+            max_torque: L::load(&s.max_torque[start..]),
+            enabled: L::load(&s.enabled[start..]),
             start: self.start.load(start),
         }
     }
@@ -150,12 +170,13 @@ impl<B: Driven> BlockKernel for Starts<B> {
         let (a, b) = block.bodies().gather::<L>(rows, start);
         let (frame_a, frame_b) = block.frames::<L>(start);
         let d = block.drive_mut();
-        let target = d.target.load::<L>(start);
-        let enabled = L::load(&d.enabled[start..]);
+        let target = d.settings.target.load::<L>(start);
+        let enabled = L::load(&d.settings.enabled[start..]);
         let error = drive::start(&a, &b, frame_a, frame_b, target, enabled);
         d.start.store(start, error);
-        let velocity = d.velocity.load(start);
-        d.target
+        let velocity = d.settings.velocity.load(start);
+        d.settings
+            .target
             .store(start, drive::advance(target, velocity, L::splat(h)));
     }
 }

@@ -1816,7 +1816,7 @@ fn drive_state(joint: &JointNode, lane: usize) -> Vec<f32> {
     let d = &joint.drive;
     let sums = (d.start.iter().chain(&d.lambda).chain(&d.moved)).chain(&d.cap);
     let mut out: Vec<f32> = sums.map(|v| v[lane]).collect();
-    out.extend(d.target.get(lane).to_array());
+    out.extend(d.settings.target.get(lane).to_array());
     out.push(d.capped[lane]);
     out
 }

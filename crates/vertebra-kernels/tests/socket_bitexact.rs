@@ -168,7 +168,7 @@ fn run(backend: Backend, raw: &RawRows, blocks: &[SocketBlock]) -> Vec<f32> {
             out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(v)));
         }
         out.extend(bytemuck::cast_slice::<_, f32>(core::slice::from_ref(
-            &b.drive.target,
+            &b.drive.settings.target,
         )));
         out.extend(b.limit_lambda.iter().flatten());
         out.extend(b.limit_start.iter().flatten());

@@ -200,11 +200,11 @@ fn keep_drive_targets(world: &mut World) {
         drive.target = match desc.kind {
             JointKind::Socket(_) => {
                 let (block, lane) = layout.sockets.place[slot];
-                layout.sockets.blocks[block].drive.target.get(lane)
+                layout.sockets.blocks[block].drive.settings.target.get(lane)
             }
             JointKind::Hinge { .. } => {
                 let (block, lane) = layout.hinges.place[slot];
-                layout.hinges.blocks[block].drive.target.get(lane)
+                layout.hinges.blocks[block].drive.settings.target.get(lane)
             }
             JointKind::Fixed => continue,
         };

@@ -61,12 +61,12 @@
 //! overrule.
 
 use bytemuck::{Pod, Zeroable};
-use vertebra_math::block::{BLOCK_LANES, QuatBlock, Vec3Block};
+use vertebra_math::block::BLOCK_LANES;
 use vertebra_math::{Lane, Mask};
 
 use super::rows::{Geometry, JointRows, MAX_DRIVE_ROWS, drive_axes};
 use crate::body::BodyLanes;
-use crate::driven::DriveLane;
+use crate::driven::{DriveLane, DriveSettings};
 use crate::parts::drive;
 
 /// The compliance of a capped drive's row, in units of its own inverse
@@ -84,26 +84,15 @@ pub const MAX_ALPHA: f32 = 1.0e30;
 pub const DRIVE_RECORD: usize = 3;
 
 /// A tree joint's drive in each lane: its settings, copied as the joint
-/// is laid out, and the substep's state.
+/// is laid out (the same piece the iterated drive holds), and the
+/// substep's state of its rows.
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 #[repr(C, align(32))]
 pub struct DriveNode {
-    /// This substep's target: b's joint frame relative to a's (advanced
-    /// by [`super::StartPass`] every substep, as the joint block's own
-    /// copy is, bit for bit).
-    pub target: QuatBlock,
-    /// The target's angular velocity (rad/s, a's joint frame).
-    pub velocity: Vec3Block,
-    /// Compliance (rad / (N m)): a soft row where positive.
-    pub compliance: [f32; BLOCK_LANES],
-    /// `1 / omega^2` (s^2).
-    pub period2: [f32; BLOCK_LANES],
-    /// `gamma h` (s): compliance times damping, or `2 zeta / omega`.
-    pub damping_time: [f32; BLOCK_LANES],
-    /// The largest torque (N m), infinity for none.
-    pub max_torque: [f32; BLOCK_LANES],
-    /// 1 where the lane has a drive (its rows held), 0 where not.
-    pub enabled: [f32; BLOCK_LANES],
+    /// What the drive asks. Its target is this substep's (advanced by
+    /// [`super::StartPass`] every substep, as the joint block's own copy
+    /// is, bit for bit).
+    pub settings: DriveSettings,
     /// Each row's error at the substep's start, `C_0` (rad).
     pub start: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
     /// Each row's multiplier summed over the substep's solves.
@@ -120,14 +109,7 @@ pub struct DriveNode {
 impl DriveNode {
     /// Writes one joint's drive (or none) into `lane`.
     pub fn set(&mut self, lane: usize, drive: Option<&DriveLane>) {
-        let d = drive.copied().unwrap_or(DriveLane::OFF);
-        self.target.set(lane, d.target);
-        self.velocity.set(lane, d.velocity);
-        self.compliance[lane] = d.compliance;
-        self.period2[lane] = d.period2;
-        self.damping_time[lane] = d.damping_time;
-        self.max_torque[lane] = d.max_torque;
-        self.enabled[lane] = if drive.is_some() { 1.0 } else { 0.0 };
+        self.settings.set(lane, drive);
         for row in 0..MAX_DRIVE_ROWS {
             self.start[row][lane] = 0.0;
             self.lambda[row][lane] = 0.0;
@@ -151,8 +133,8 @@ impl DriveNode {
         h: f32,
     ) {
         let zero = L::splat(0.0);
-        let target = self.target.load::<L>(start);
-        let enabled = L::load(&self.enabled[start..]).gt(zero);
+        let target = self.settings.target.load::<L>(start);
+        let enabled = L::load(&self.settings.enabled[start..]).gt(zero);
         let (c, _) = drive::measure_in_a(a, b, g.frame_a, g.frame_b, target);
         for (row, e) in drive_axes(kind, g.frame_a).into_iter().enumerate() {
             L::select(enabled, c.dot(e), zero).store(&mut self.start[row][start..]);
@@ -161,8 +143,9 @@ impl DriveNode {
             zero.store(&mut self.cap[row][start..]);
         }
         zero.store(&mut self.capped[start..]);
-        let velocity = self.velocity.load(start);
-        self.target
+        let velocity = self.settings.velocity.load(start);
+        self.settings
+            .target
             .store(start, drive::advance(target, velocity, L::splat(h)));
     }
 
@@ -181,9 +164,9 @@ impl DriveNode {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         let h = one / inv_h;
         let h2 = one / inv_h2;
-        let compliance = L::load(&self.compliance[start..]);
-        let period2 = L::load(&self.period2[start..]);
-        let damping_time = L::load(&self.damping_time[start..]);
+        let compliance = L::load(&self.settings.compliance[start..]);
+        let period2 = L::load(&self.settings.period2[start..]);
+        let damping_time = L::load(&self.settings.damping_time[start..]);
         let c0 = L::load(&self.start[row][start..]);
         let lambda = L::load(&self.lambda[row][start..]);
         let moved = L::load(&self.moved[row][start..]);
@@ -228,7 +211,7 @@ impl DriveNode {
         inv_h2: f32,
     ) {
         let zero = L::splat(0.0);
-        let enabled = L::load(&self.enabled[start..]).gt(zero);
+        let enabled = L::load(&self.settings.enabled[start..]).gt(zero);
         let mut lambda = [zero; MAX_DRIVE_ROWS];
         let mut squared = zero;
         for (row, &[c, _, target]) in records.iter().enumerate() {
@@ -239,7 +222,7 @@ impl DriveNode {
             lambda[row] = L::select(enabled, sum, zero);
             squared += lambda[row] * lambda[row];
         }
-        let limit = L::load(&self.max_torque[start..]) / L::splat(inv_h2);
+        let limit = L::load(&self.settings.max_torque[start..]) / L::splat(inv_h2);
         let was = L::load(&self.capped[start..]).gt(zero);
         let caps = squared.gt(limit * limit).and_not(was);
         let scale = limit / L::select(caps, squared.sqrt(), L::splat(1.0));

@@ -554,7 +554,7 @@ impl JointNode {
             softness: self
                 .softness
                 .lanes(start, L::splat(scale.inv_h), L::splat(scale.inv_h2)),
-            drive_target: self.drive.target.load(start),
+            drive_target: self.drive.settings.target.load(start),
             start: self.bodies.start(start),
         }
     }

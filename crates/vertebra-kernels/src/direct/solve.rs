@@ -318,7 +318,7 @@ pub(super) fn hold(block: &mut TreeBlock, topology: &Topology, first_pass: bool)
                 if o >= limits {
                     // A drive's rows: held where the lane has a drive.
                     scratch.active[o][lane] = if block.driven {
-                        drive.enabled[lane]
+                        drive.settings.enabled[lane]
                     } else {
                         0.0
                     };
@@ -531,13 +531,15 @@ fn body_block<L: Lane>(
                 (&port.minus, &port.minus_b)
             }
         };
-        let minus = load_first::<L, PACKED>(minus, start, BODY_PACKED);
-        let minus_b = load_first::<L, MAX>(minus_b, start, 6);
-        for (d, m) in d.iter_mut().zip(minus) {
-            *d += m;
+        // A body's entries only, not the largest block's (the rest
+        // stay zero).
+        let minus = load::<L, BODY_PACKED>(minus, start);
+        let minus_b = load::<L, 6>(minus_b, start);
+        for (d, m) in d.iter_mut().zip(&minus) {
+            *d += *m;
         }
-        for (b, m) in b.iter_mut().zip(minus_b) {
-            *b -= m;
+        for (b, m) in b.iter_mut().zip(&minus_b) {
+            *b -= *m;
         }
     }
     ldl::factor::<L, 6>(&mut d);
@@ -568,16 +570,20 @@ fn body_out<L: Lane, const E: usize, const K: usize>(
     let coupling = load_first::<L, { MAX * 6 }>(&scratch.coupling, start, (E + K) * 6);
     let mut z = load_first::<L, MAX>(&scratch.b, start, 6);
     ldl::forward::<L, 6>(factors, &mut z);
-    let mut w = [[zero; MAX]; MAX];
-    let mut scaled = [[zero; MAX]; MAX];
+    // Each row's six entries on the body only: arrays sized for the
+    // largest block (9 x 9) would be zeroed whole at every call.
+    let mut w = [[zero; 6]; MAX];
+    let mut scaled = [[zero; 6]; MAX];
     for i in 0..E + K {
         if !held.computed(E, i) {
             continue;
         }
-        w[i][..6].copy_from_slice(&coupling[i * 6..i * 6 + 6]);
-        ldl::forward::<L, 6>(factors, &mut w[i]);
+        let mut row = [zero; MAX];
+        row[..6].copy_from_slice(&coupling[i * 6..i * 6 + 6]);
+        ldl::forward::<L, 6>(factors, &mut row);
         for k in 0..6 {
-            scaled[i][k] = w[i][k] * factors[at(k, k)];
+            w[i][k] = row[k];
+            scaled[i][k] = row[k] * factors[at(k, k)];
         }
     }
     let scratch = &mut block.scratch[n];
@@ -679,13 +685,12 @@ fn joint_node<L: Lane, const E: usize, const K: usize>(
     let scratch = &mut block.scratch[n];
     store(&d[..at(E + K, 0)], &mut scratch.factors, start);
     store(&b[..E + K], &mut scratch.b, start);
-    let coupling = load_first::<L, { MAX * 6 }>(&scratch.coupling, start, (E + K) * 6);
     ldl::forward_held::<L, E, K>(&d, &mut b, &held);
     let mut scaled = [[zero; MAX]; 6];
     let mut w = [[zero; MAX]; 6];
     for c in 0..6 {
         for i in 0..E + K {
-            w[c][i] = coupling[i * 6 + c];
+            w[c][i] = L::load(&scratch.coupling[i * 6 + c][start..]);
         }
         ldl::forward_held::<L, E, K>(&d, &mut w[c], &held);
         for i in 0..E + K {
