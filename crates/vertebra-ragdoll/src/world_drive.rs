@@ -8,7 +8,7 @@
 use glam::Vec3;
 use vertebra_math::DefaultFloatMode;
 use vertebra_store::BodyKind;
-use vertebra_world::{Spring, SpringField, UprightDrive, World, WorldDrive};
+use vertebra_world::{BodyHandle, Spring, SpringField, UprightDrive, World, WorldDrive};
 
 use crate::drive::DriveSettings;
 use crate::error::{RagdollError, check_spring, range};
@@ -142,9 +142,9 @@ impl Ragdoll {
         animation: &PhysicalAnimation,
     ) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
-        self.check_world_drive(pose, Some((prev, dt)), &animation.world)?;
+        let drives = self.world_drives(world, pose, Some((prev, dt)), &animation.world)?;
         self.drive_following(world, prev, pose, dt, &animation.joints)?;
-        self.world_drive(world, pose, Some((prev, dt)), &animation.world)
+        set_world_drives(world, drives)
     }
 
     /// Clears every body's world and upright drive.
@@ -192,9 +192,20 @@ impl Ragdoll {
         from: Option<(&Pose, f32)>,
         settings: &WorldDriveSettings,
     ) -> Result<(), RagdollError> {
+        let drives = self.world_drives(world, pose, from, settings)?;
+        set_world_drives(world, drives)
+    }
+
+    /// Every dynamic body's world and upright drive, each made and checked
+    /// (nothing set yet: a refused call changes nothing).
+    fn world_drives(
+        &self,
+        world: &World,
+        pose: &Pose,
+        from: Option<(&Pose, f32)>,
+        settings: &WorldDriveSettings,
+    ) -> Result<Vec<BodyDrive>, RagdollError> {
         self.check_world_drive(pose, from, settings)?;
-        // Every drive made and checked before any is set: a refused call
-        // changes nothing.
         let mut drives = Vec::with_capacity(self.bodies.len());
         for (k, body) in self.bodies.iter().enumerate() {
             let Some(body) = *body else { continue };
@@ -225,13 +236,21 @@ impl Ragdoll {
             });
             drives.push((body, drive, upright));
         }
-        for (body, drive, upright) in drives {
-            let set = |w: &mut World| {
-                w.set_world_drive(body, Some(drive))?;
-                w.set_upright_drive(body, upright)
-            };
-            set(world).map_err(|e| RagdollError::world("world drive", e))?;
-        }
-        Ok(())
+        Ok(drives)
     }
+}
+
+/// A body with its world drive and upright drive (or none).
+type BodyDrive = (BodyHandle, WorldDrive, Option<UprightDrive>);
+
+/// Sets drives [`Ragdoll::world_drives`] made and checked.
+fn set_world_drives(world: &mut World, drives: Vec<BodyDrive>) -> Result<(), RagdollError> {
+    for (body, drive, upright) in drives {
+        let set = |w: &mut World| {
+            w.set_world_drive(body, Some(drive))?;
+            w.set_upright_drive(body, upright)
+        };
+        set(world).map_err(|e| RagdollError::world("world drive", e))?;
+    }
+    Ok(())
 }

@@ -166,6 +166,18 @@ fn refused_world_drives_name_the_field_and_change_nothing() {
         "{refused:?}"
     );
     assert_eq!(world.state_hash(), hash);
+    // `follow` makes and checks the bodies' drives before it drives the
+    // joints: the same refusal leaves the joints' drives as they were.
+    let animation = PhysicalAnimation {
+        joints: DriveSettings::uniform(Spring::RIGID),
+        world: good.clone(),
+    };
+    let refused = ragdoll.follow(&mut world, (&pose, &far), 1e-6, &animation);
+    assert!(
+        matches!(refused, Err(RagdollError::World { .. })),
+        "{refused:?}"
+    );
+    assert_eq!(world.state_hash(), hash);
     let zero_dt = ragdoll.world_drive_following(&mut world, &pose, &pose, 0.0, &good);
     assert!(matches!(
         zero_dt,
