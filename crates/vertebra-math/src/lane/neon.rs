@@ -290,6 +290,14 @@ fn opaque_masks(mut masks: uint32x4_t) -> uint32x4_t {
     masks
 }
 
+/// `masks` unchanged, held as `wide` holds them, through [`opaque_masks`]:
+/// the portable backend's `min`/`max` select by them on AArch64, for the
+/// same reason.
+#[inline(always)]
+pub(super) fn opaque_wide_masks(masks: wide::f32x4) -> wide::f32x4 {
+    bytemuck::cast(opaque_masks(bytemuck::cast(masks)))
+}
+
 /// `mask` unchanged, through an empty `asm!` block: the scalar reference's
 /// `min`/`max` select by it on AArch64, for the reason [`opaque_masks`]
 /// gives.

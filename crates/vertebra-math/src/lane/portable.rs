@@ -26,6 +26,18 @@ pub(crate) struct F32x4Portable(f32x4);
 #[repr(transparent)]
 pub(crate) struct M32x4Portable(f32x4);
 
+/// The comparison `min`/`max` select by. On AArch64 it passes through
+/// [`super::neon::opaque_wide_masks`]: LLVM there may turn the select into
+/// `FMIN`, which gives `-0.0` for `min(-0.0, 0.0)` where the contract gives
+/// `0.0` (whether it does depends on how the crate is split into codegen
+/// units).
+#[inline(always)]
+fn opaque(masks: M32x4Portable) -> M32x4Portable {
+    #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+    let masks = M32x4Portable(super::neon::opaque_wide_masks(masks.0));
+    masks
+}
+
 /// 2^23: from here on every `f32` is an integer.
 const ROUND_LIMIT: f32 = 8_388_608.0;
 
@@ -149,11 +161,11 @@ impl Lane for F32x4Portable {
     }
     #[inline(always)]
     fn min(self, other: Self) -> Self {
-        Self::select(self.lt(other), self, other)
+        Self::select(opaque(self.lt(other)), self, other)
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
-        Self::select(self.gt(other), self, other)
+        Self::select(opaque(self.gt(other)), self, other)
     }
     #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
