@@ -13,6 +13,7 @@ use crate::drive::DriveSettings;
 use crate::error::{Problems, RagdollError, finite, first, range};
 use crate::joint_def::{JointDef, JointSpec, check_joint, half_turn, resolve};
 use crate::model::{BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef};
+use crate::profile_def::ProfileSource;
 use crate::skeleton::{Skeleton, Transform};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
 use crate::text::item;
@@ -63,6 +64,8 @@ pub(crate) struct Document {
     pub(crate) joints: Vec<Item<JointSpec>>,
     pub(crate) spine: Option<Item<SpineSpec>>,
     pub(crate) drive: Option<Item<DriveSettings>>,
+    /// `[[profile]]` tables, resolved once the joint tree stands.
+    pub(crate) profiles: Vec<Item<ProfileSource>>,
 }
 
 /// The lines where a description's items are defined, to name them in
@@ -73,6 +76,7 @@ struct At {
     joints: Vec<Option<usize>>,
     spine: Option<usize>,
     drive: Option<usize>,
+    profiles: Vec<Option<usize>>,
 }
 
 impl At {
@@ -127,6 +131,7 @@ pub(crate) fn assemble_all(
         joints: doc.joints.iter().map(|j| j.line).collect(),
         spine: doc.spine.as_ref().and_then(|s| s.line),
         drive: doc.drive.as_ref().and_then(|d| d.line),
+        profiles: doc.profiles.iter().map(|p| p.line).collect(),
     };
     let index = names(
         doc.bodies.iter().map(|b| (b.value.name.as_str(), b.line)),
@@ -193,7 +198,7 @@ pub(crate) fn assemble_all(
             .done()
             .expect_err("a part of the description failed"));
     };
-    let desc = RagdollDesc {
+    let mut desc = RagdollDesc {
         name: doc.name,
         bodies,
         joints,
@@ -201,8 +206,17 @@ pub(crate) fn assemble_all(
         root,
         parent_joint,
         drive,
+        profiles: Vec::new(),
         skeleton: doc.skeleton,
     };
+    for p in &doc.profiles {
+        let context = item(p.line, &format!("profile `{}`", p.value.name()));
+        let resolved = problems.note(p.line, p.value.resolve(&desc, &context));
+        desc.profiles.extend(resolved);
+    }
+    if !problems.is_empty() {
+        return Err(problems.done().expect_err("a profile failed"));
+    }
     check(&desc, &at, &mut problems);
     problems.done()?;
     Ok(desc)
@@ -409,6 +423,24 @@ fn check(desc: &RagdollDesc, at: &At, problems: &mut Problems) {
         |k| at.joint(k, &desc.joints[k].name),
     );
     problems.note(at.drive, drive);
+    if stands {
+        check_profiles(desc, at, problems);
+    }
+}
+
+/// Every profile checked for the description (its joint tree standing),
+/// names unique.
+fn check_profiles(desc: &RagdollDesc, at: &At, problems: &mut Problems) {
+    let line = |k: usize| at.profiles.get(k).copied().flatten();
+    names(
+        (desc.profiles.iter().enumerate()).map(|(k, p)| (p.name.as_str(), line(k))),
+        "profile",
+        problems,
+    );
+    for (k, p) in desc.profiles.iter().enumerate() {
+        let context = item(line(k), &format!("profile `{}`", p.name));
+        problems.note(line(k), p.check(desc, &context));
+    }
 }
 
 /// Indexes `(name, line)` pairs by name; a name used twice is a problem

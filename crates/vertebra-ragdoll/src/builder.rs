@@ -6,6 +6,8 @@ use crate::drive::DriveSettings;
 use crate::error::RagdollError;
 use crate::joint_def::JointSpec;
 use crate::model::RagdollDesc;
+use crate::profile::Profile;
+use crate::profile_def::ProfileSource;
 use crate::skeleton::Skeleton;
 use crate::spec::{BodySpec, SpineSpec};
 use vertebra_math::DefaultFloatMode;
@@ -39,6 +41,7 @@ pub struct RagdollBuilder {
     joints: Vec<JointSpec>,
     spine: Option<SpineSpec>,
     drive: Option<DriveSettings>,
+    profiles: Vec<Profile>,
 }
 
 impl RagdollDesc {
@@ -52,6 +55,7 @@ impl RagdollDesc {
             joints: Vec::new(),
             spine: None,
             drive: None,
+            profiles: Vec::new(),
         }
     }
 }
@@ -83,6 +87,13 @@ impl RagdollBuilder {
         self
     }
 
+    /// With a physical-animation profile: one entry per joint and per
+    /// body, in the order they are added (the file's `[[profile]]`).
+    pub fn profile(mut self, profile: Profile) -> Self {
+        self.profiles.push(profile);
+        self
+    }
+
     /// With the skeleton the bodies follow (its model frame the world at
     /// bind pose).
     pub fn skeleton(mut self, skeleton: Skeleton) -> Self {
@@ -108,6 +119,9 @@ impl RagdollBuilder {
             joints: unlined(self.joints),
             spine: self.spine.map(Item::unlined),
             drive: self.drive.map(Item::unlined),
+            profiles: (self.profiles.into_iter())
+                .map(|p| Item::unlined(ProfileSource::Built(p)))
+                .collect(),
         })
     }
 }

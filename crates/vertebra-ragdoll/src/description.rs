@@ -2,8 +2,8 @@
 //! capsules (given by a segment, or from one bone of the skeleton to
 //! another), joints (sockets with swing and twist limits, hinges, fixed
 //! joints: `joint_def.rs`), an optional `[spine]` chain that the simplified
-//! ragdoll replaces by a rod, an optional `[drive]`, and an optional
-//! skeleton (`[[bone]]` tables, or a skeleton file) the bodies follow.
+//! ragdoll replaces by a rod, an optional `[drive]`, named
+//! `[[profile]]` tables (`profile_def.rs`), and an optional skeleton (`[[bone]]` tables, or a skeleton file) the bodies follow.
 //! Units in the file: metres, kilograms, degrees; here: metres, kilograms,
 //! radians.
 //!
@@ -22,6 +22,7 @@ use crate::drive_def::{RawDrive, drive_settings};
 use crate::error::{Problems, RagdollError, first};
 use crate::joint_def::{RawJoint, joint_spec};
 use crate::model::RagdollDesc;
+use crate::profile_def::{ProfileSource, RawProfile};
 use crate::skeleton::{Skeleton, Transform};
 use crate::skeleton_file::{RawBone, bones_all, syntax_naming};
 use crate::spec::{BodyShape, BodySpec, SpineSpec};
@@ -50,6 +51,8 @@ struct RawFile {
     joint: Vec<Spanned<RawJoint>>,
     spine: Option<Spanned<RawSpine>>,
     drive: Option<Spanned<RawDrive>>,
+    #[serde(default)]
+    profile: Vec<Spanned<RawProfile>>,
 }
 
 #[derive(Deserialize)]
@@ -231,6 +234,12 @@ impl RagdollDesc {
             joints,
             spine,
             drive,
+            profiles: (raw.profile.into_iter())
+                .map(|p| {
+                    let line = at(p.span());
+                    Item::at(ProfileSource::File(p.into_inner()), line)
+                })
+                .collect(),
         };
         assemble_all(doc, problems)
     }

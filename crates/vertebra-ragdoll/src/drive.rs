@@ -3,10 +3,10 @@
 //! strength a world [`Spring`]. Driving a built ragdoll with them:
 //! `pose_drive.rs`.
 
-use glam::Quat;
-use vertebra_world::{AngularDrive, Spring, SpringField};
+use vertebra_world::{Spring, SpringField};
 
 use crate::error::{RagdollError, check_spring, range};
+use crate::profile::JointDriveSetting;
 
 /// Drive settings for a whole ragdoll, with optional per-joint overrides.
 /// A strength is the world's [`Spring`]: [`Spring::RIGID`] (zero
@@ -43,9 +43,15 @@ impl DriveSettings {
         self
     }
 
-    /// The drive `strength` gives a socket aimed at `target`.
-    pub(crate) fn socket_drive(&self, strength: Spring, target: Quat) -> AngularDrive {
-        AngularDrive::new(target, strength).with_max_torque(self.max_torque)
+    /// One entry per joint of a ragdoll of `joints` joints: each joint's
+    /// strength, the shared torque limit.
+    pub(crate) fn joint_settings(&self, joints: usize) -> Vec<JointDriveSetting> {
+        (0..joints)
+            .map(|k| JointDriveSetting {
+                strength: Some(self.strength(k)),
+                max_torque: self.max_torque,
+            })
+            .collect()
     }
 
     /// Checks the settings for a ragdoll of `joints` joints: every strength

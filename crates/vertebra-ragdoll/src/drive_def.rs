@@ -14,17 +14,17 @@ use crate::error::{RagdollError, finite, range};
 #[derive(Clone, Copy, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawStrength {
-    strength: Option<RawInfinite>,
-    frequency: Option<f32>,
-    damping_ratio: Option<f32>,
-    compliance: Option<f32>,
-    damping: Option<f32>,
+    pub(crate) strength: Option<RawInfinite>,
+    pub(crate) frequency: Option<f32>,
+    pub(crate) damping_ratio: Option<f32>,
+    pub(crate) compliance: Option<f32>,
+    pub(crate) damping: Option<f32>,
 }
 
 /// The one word `strength` takes.
 #[derive(Clone, Copy, Deserialize)]
 #[serde(rename_all = "lowercase")]
-enum RawInfinite {
+pub(crate) enum RawInfinite {
     Infinite,
 }
 
@@ -34,11 +34,11 @@ enum RawInfinite {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawDrive {
-    strength: Option<RawInfinite>,
-    frequency: Option<f32>,
-    damping_ratio: Option<f32>,
-    compliance: Option<f32>,
-    damping: Option<f32>,
+    pub(crate) strength: Option<RawInfinite>,
+    pub(crate) frequency: Option<f32>,
+    pub(crate) damping_ratio: Option<f32>,
+    pub(crate) compliance: Option<f32>,
+    pub(crate) damping: Option<f32>,
     max_torque: Option<f32>,
 }
 
@@ -100,6 +100,33 @@ impl RawDrive {
     pub(crate) fn damping(&self) -> f32 {
         self.damping.unwrap_or(0.0)
     }
+
+    /// The table's strength fields.
+    pub(crate) fn strength_fields(&self) -> RawStrength {
+        RawStrength {
+            strength: self.strength,
+            frequency: self.frequency,
+            damping_ratio: self.damping_ratio,
+            compliance: self.compliance,
+            damping: self.damping,
+        }
+    }
+
+    /// The torque limit (N m), if the table gives one.
+    pub(crate) fn max_torque(&self) -> Option<f32> {
+        self.max_torque
+    }
+}
+
+impl RawStrength {
+    /// Whether any strength field is given.
+    pub(crate) fn is_given(&self) -> bool {
+        self.strength.is_some()
+            || self.frequency.is_some()
+            || self.damping_ratio.is_some()
+            || self.compliance.is_some()
+            || self.damping.is_some()
+    }
 }
 
 /// The `[drive]` table as drive settings without per-joint strengths (the
@@ -107,14 +134,7 @@ impl RawDrive {
 /// compliance) and a torque limit. Its values are checked with the whole
 /// description (`check_drive`).
 pub(crate) fn drive_settings(raw: &RawDrive, context: &str) -> Result<DriveSettings, RagdollError> {
-    let strength = RawStrength {
-        strength: raw.strength,
-        frequency: raw.frequency,
-        damping_ratio: raw.damping_ratio,
-        compliance: raw.compliance,
-        damping: raw.damping,
-    }
-    .read(context, 0.0)?;
+    let strength = raw.strength_fields().read(context, 0.0)?;
     let mut settings = DriveSettings::uniform(strength);
     if let Some(t) = raw.max_torque {
         settings = settings.with_max_torque(t);

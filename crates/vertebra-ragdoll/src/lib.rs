@@ -141,6 +141,8 @@ mod motion;
 mod partial;
 mod pose;
 mod pose_drive;
+mod profile;
+mod profile_def;
 mod ragdoll;
 mod read_back;
 mod skeleton;
@@ -163,6 +165,7 @@ pub use mapper::{BoneRole, SkeletonMapper};
 pub use mapping::SpineMapping;
 pub use model::{BodyDef, BoneBinding, MAX_BODIES, MAX_JOINTS, RagdollDesc, SpineDef, SpineMode};
 pub use pose::Pose;
+pub use profile::{BodyDriveSetting, JointDriveSetting, Profile, ProfileBlend, UprightSetting};
 #[cfg(feature = "harness")]
 pub use ragdoll::body_masses;
 pub use ragdoll::{BuildOptions, JointAnchors, Ragdoll, RodRest};

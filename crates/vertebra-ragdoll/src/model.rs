@@ -8,6 +8,7 @@ use vertebra_world::Shape;
 
 use crate::drive::DriveSettings;
 use crate::joint_def::JointDef;
+use crate::profile::Profile;
 use crate::skeleton::{Skeleton, Transform};
 use vertebra_math::DefaultFloatMode;
 
@@ -114,6 +115,9 @@ pub struct RagdollDesc {
     /// How the ragdoll is driven toward an animation pose (the file's
     /// `[drive]` table, with each joint's own strength), if the file says.
     pub drive: Option<DriveSettings>,
+    /// Named physical-animation profiles (the file's `[[profile]]`
+    /// tables), names unique.
+    pub profiles: Vec<Profile>,
     /// The animation skeleton the bodies follow ([`BodyDef::bone`]), its
     /// model frame the description's world frame at bind pose; if the
     /// description has one.
@@ -137,6 +141,11 @@ impl RagdollDesc {
         self.bodies
             .iter()
             .position(|b| b.bone.is_some_and(|binding| binding.bone == bone))
+    }
+
+    /// The profile named `name`, if the description has one.
+    pub fn profile(&self, name: &str) -> Option<&Profile> {
+        self.profiles.iter().find(|p| p.name == name)
     }
 
     /// Total mass (kg): the sum of the bodies' masses (a file's

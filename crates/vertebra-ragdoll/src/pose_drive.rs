@@ -10,12 +10,13 @@
 
 use glam::Vec3;
 use vertebra_math::{DefaultFloatMode, PortableQuat};
-use vertebra_world::{JointKind, RodDesc, RodStiffness, Spring, World};
+use vertebra_world::{AngularDrive, JointHandle, JointKind, RodDesc, RodStiffness, Spring, World};
 
 use crate::drive::DriveSettings;
 use crate::error::RagdollError;
 use crate::model::rod_name;
 use crate::pose::Pose;
+use crate::profile::JointDriveSetting;
 use crate::ragdoll::Ragdoll;
 
 /// The rod's bending and twisting for a drive strength, when it replaces
@@ -50,6 +51,13 @@ fn rod_stiffness(strength: Spring, rest_length: f32, joints: usize) -> RodStiffn
             damping_ratio,
         },
     }
+}
+
+/// Every joint's drive (`None`: not driven) and the rod's shape, made and
+/// checked, not yet set.
+pub(crate) struct JointDrives {
+    sockets: Vec<(JointHandle, Option<AngularDrive>)>,
+    rod: Option<(vertebra_world::RodHandle, RodDesc)>,
 }
 
 impl Ragdoll {
@@ -110,75 +118,136 @@ impl Ragdoll {
         settings: &DriveSettings,
     ) -> Result<(), RagdollError> {
         self.check_not_removed()?;
-        target.validate(&self.desc)?;
         let joints = &self.desc.joints;
         settings.validate("drive", joints.len(), |k| {
             format!("joint `{}`", joints[k].name)
         })?;
+        let settings = settings.joint_settings(joints.len());
+        let drives = self.joint_drives(target, from, &settings)?;
+        self.set_joint_drives(world, drives)
+    }
+
+    /// Every joint's drive and the rod's shape toward `target` (from
+    /// `from`, following), each made and checked; nothing set yet, so a
+    /// refused call changes nothing. `settings` holds one entry per
+    /// described joint (the caller checked them); the rod takes the spine's
+    /// first joint's.
+    pub(crate) fn joint_drives(
+        &self,
+        target: &Pose,
+        from: Option<(&Pose, f32)>,
+        settings: &[JointDriveSetting],
+    ) -> Result<JointDrives, RagdollError> {
+        self.check_not_removed()?;
+        target.validate(&self.desc)?;
+        if let Some((prev, _)) = from {
+            prev.validate(&self.desc)?;
+        }
         let relative = |pose: &Pose, j: &crate::JointDef| {
             let frame = j.frame;
             (pose.bones[j.parent].1.mul_portable(frame).inverse())
                 .mul_portable(pose.bones[j.child].1.mul_portable(frame))
                 .normalize_portable()
         };
-        for (k, (j, joint)) in self.desc.joints.iter().zip(&self.joints).enumerate() {
+        let mut sockets = Vec::with_capacity(self.joints.len());
+        for ((j, joint), setting) in self.desc.joints.iter().zip(&self.joints).zip(settings) {
             // A fixed joint has no rotation to drive.
             let (Some(joint), false) = (joint, j.kind == JointKind::Fixed) else {
                 continue;
             };
-            let end = relative(target, j);
             let world_error = |e| RagdollError::world(&format!("joint `{}`", j.name), e);
-            let mut drive = settings.socket_drive(settings.strength(k), end);
+            let Some(strength) = setting.strength else {
+                sockets.push((*joint, None));
+                continue;
+            };
+            let end = relative(target, j);
+            let mut drive = AngularDrive::new(end, strength).with_max_torque(setting.max_torque);
             if let Some((prev, dt)) = from {
                 drive = drive
                     .following(relative(prev, j), end, dt)
                     .map_err(world_error)?;
             }
-            world
-                .set_joint_drive(*joint, Some(drive))
-                .map_err(world_error)?;
+            drive.validate().map_err(world_error)?;
+            sockets.push((*joint, Some(drive)));
         }
-        if let (Some(rod), Some(rest), Some(spine)) = (self.rod, self.rod_rest, &self.desc.spine) {
-            // A pose's rod shape: `t_b` in a's material frame, and the
-            // twist.
-            let shape = |pose: &Pose| {
-                let (base, top) = (
-                    pose.bones[spine.bodies[0]].1,
-                    pose.bones[*spine.bodies.last().expect("a chain")].1,
-                );
-                let (f0, f1) = (
-                    base.mul_portable(rest.frame_a),
-                    top.mul_portable(rest.frame_b),
-                );
-                let tb = f1 * Vec3::X;
-                (
-                    (f0.inverse() * tb).normalize(),
-                    vertebra_world::rod_twist(f0, f1),
-                )
-            };
-            let stiffness = rod_stiffness(
-                settings.strength(spine.joints[0]),
-                rest.rest_length,
-                spine.joints.len(),
+        let rod = match (self.rod, self.rod_rest, &self.desc.spine) {
+            (Some(rod), Some(rest), Some(spine)) => {
+                let setting = settings[spine.joints[0]];
+                let shape = setting
+                    .strength
+                    .map(|strength| {
+                        self.driven_rod(rest, spine, strength, setting.max_torque, target, from)
+                    })
+                    .transpose()?
+                    .unwrap_or(rest);
+                Some((rod, shape))
+            }
+            _ => None,
+        };
+        Ok(JointDrives { sockets, rod })
+    }
+
+    /// The rod's shape driven toward `target` at `strength`.
+    fn driven_rod(
+        &self,
+        rest: RodDesc,
+        spine: &crate::SpineDef,
+        strength: Spring,
+        max_torque: f32,
+        target: &Pose,
+        from: Option<(&Pose, f32)>,
+    ) -> Result<RodDesc, RagdollError> {
+        // A pose's rod shape: `t_b` in a's material frame, and the twist.
+        let shape = |pose: &Pose| {
+            let (base, top) = (
+                pose.bones[spine.bodies[0]].1,
+                pose.bones[*spine.bodies.last().expect("a chain")].1,
             );
-            let driven = rest
-                .with_stiffness(stiffness, stiffness)
-                .with_max_torque(settings.max_torque);
-            let world_error = |e| RagdollError::world(&rod_name(&self.desc), e);
-            let driven = match from {
-                Some((prev, dt)) => driven
-                    .following(shape(prev), shape(target), dt)
-                    .map_err(world_error)?,
-                None => {
-                    let (bend_rest, twist_rest) = shape(target);
-                    RodDesc {
-                        bend_rest,
-                        twist_rest,
-                        ..driven.with_rest_velocity(Vec3::ZERO, 0.0)
-                    }
+            let (f0, f1) = (
+                base.mul_portable(rest.frame_a),
+                top.mul_portable(rest.frame_b),
+            );
+            let tb = f1 * Vec3::X;
+            (
+                (f0.inverse() * tb).normalize(),
+                vertebra_world::rod_twist(f0, f1),
+            )
+        };
+        let stiffness = rod_stiffness(strength, rest.rest_length, spine.joints.len());
+        let driven = rest
+            .with_stiffness(stiffness, stiffness)
+            .with_max_torque(max_torque);
+        let world_error = |e| RagdollError::world(&rod_name(&self.desc), e);
+        let driven = match from {
+            Some((prev, dt)) => driven
+                .following(shape(prev), shape(target), dt)
+                .map_err(world_error)?,
+            None => {
+                let (bend_rest, twist_rest) = shape(target);
+                RodDesc {
+                    bend_rest,
+                    twist_rest,
+                    ..driven.with_rest_velocity(Vec3::ZERO, 0.0)
                 }
-            };
-            world.set_rod(rod, driven).map_err(world_error)?;
+            }
+        };
+        driven.validate().map_err(world_error)?;
+        Ok(driven)
+    }
+
+    /// Sets drives [`Ragdoll::joint_drives`] made and checked.
+    pub(crate) fn set_joint_drives(
+        &self,
+        world: &mut World,
+        drives: JointDrives,
+    ) -> Result<(), RagdollError> {
+        for (joint, drive) in drives.sockets {
+            (world.set_joint_drive(joint, drive))
+                .map_err(|e| RagdollError::world("joint drive", e))?;
+        }
+        if let Some((rod, shape)) = drives.rod {
+            (world.set_rod(rod, shape))
+                .map_err(|e| RagdollError::world(&rod_name(&self.desc), e))?;
         }
         Ok(())
     }

@@ -13,6 +13,7 @@ use vertebra_world::{BodyHandle, Spring, SpringField, UprightDrive, World, World
 use crate::drive::DriveSettings;
 use crate::error::{RagdollError, check_spring, range};
 use crate::pose::Pose;
+use crate::profile::{BodyDriveSetting, Profile};
 use crate::ragdoll::Ragdoll;
 
 /// One body kept upright: the axis that points up in the animation's pose
@@ -137,14 +138,52 @@ impl Ragdoll {
     pub fn follow(
         &self,
         world: &mut World,
-        (prev, pose): (&Pose, &Pose),
+        poses: (&Pose, &Pose),
         dt: f32,
         animation: &PhysicalAnimation,
     ) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
-        let drives = self.world_drives(world, pose, Some((prev, dt)), &animation.world)?;
-        self.drive_following(world, prev, pose, dt, &animation.joints)?;
-        set_world_drives(world, drives)
+        self.check_world_drive(poses.1, Some((poses.0, dt)), &animation.world)?;
+        let joints = &self.desc.joints;
+        (animation.joints).validate("drive", joints.len(), |k| {
+            format!("joint `{}`", joints[k].name)
+        })?;
+        let profile = Profile::from_animation("", &self.desc, animation);
+        self.follow_checked(world, poses, dt, &profile)
+    }
+
+    /// Every joint and body driven along the animation by `profile` (as
+    /// [`Ragdoll::follow`] does; a [`crate::ProfileBlend`]'s current profile
+    /// each frame, for one that blends), one call a frame: joints whose
+    /// entry has no strength and bodies without drives are released.
+    /// Refused, nothing changed, for a profile not made for this ragdoll
+    /// (the error names its entry) or poses out of range.
+    pub fn follow_profile(
+        &self,
+        world: &mut World,
+        poses: (&Pose, &Pose),
+        dt: f32,
+        profile: &Profile,
+    ) -> Result<(), RagdollError> {
+        let _mode = DefaultFloatMode::enter();
+        self.check_not_removed()?;
+        profile.validate(&self.desc)?;
+        self.follow_checked(world, poses, dt, profile)
+    }
+
+    fn follow_checked(
+        &self,
+        world: &mut World,
+        (prev, pose): (&Pose, &Pose),
+        dt: f32,
+        profile: &Profile,
+    ) -> Result<(), RagdollError> {
+        self.check_poses(pose, Some((prev, dt)))?;
+        let from = Some((prev, dt));
+        let bodies = self.world_drives(world, pose, from, &profile.bodies)?;
+        let joints = self.joint_drives(pose, from, &profile.joints)?;
+        self.set_joint_drives(world, joints)?;
+        set_world_drives(world, bodies)
     }
 
     /// Clears every body's world and upright drive.
@@ -171,8 +210,13 @@ impl Ragdoll {
         settings: &WorldDriveSettings,
     ) -> Result<(), RagdollError> {
         self.check_not_removed()?;
-        pose.validate(&self.desc)?;
         settings.validate(self.desc.bodies.len())?;
+        self.check_poses(pose, from)
+    }
+
+    /// The poses (and the time step) a drive follows, checked.
+    fn check_poses(&self, pose: &Pose, from: Option<(&Pose, f32)>) -> Result<(), RagdollError> {
+        pose.validate(&self.desc)?;
         if let Some((prev, dt)) = from {
             prev.validate(&self.desc)?;
             range(
@@ -192,22 +236,29 @@ impl Ragdoll {
         from: Option<(&Pose, f32)>,
         settings: &WorldDriveSettings,
     ) -> Result<(), RagdollError> {
-        let drives = self.world_drives(world, pose, from, settings)?;
+        self.check_world_drive(pose, from, settings)?;
+        let animation = PhysicalAnimation {
+            joints: DriveSettings::uniform(Spring::RIGID),
+            world: settings.clone(),
+        };
+        let profile = Profile::from_animation("", &self.desc, &animation);
+        let drives = self.world_drives(world, pose, from, &profile.bodies)?;
         set_world_drives(world, drives)
     }
 
-    /// Every dynamic body's world and upright drive, each made and checked
-    /// (nothing set yet: a refused call changes nothing).
+    /// Every dynamic body's world and upright drive (`None`: released),
+    /// each made and checked (nothing set yet: a refused call changes
+    /// nothing). `settings` holds one entry per described body (the caller
+    /// checked them and the poses).
     fn world_drives(
         &self,
         world: &World,
         pose: &Pose,
         from: Option<(&Pose, f32)>,
-        settings: &WorldDriveSettings,
+        settings: &[BodyDriveSetting],
     ) -> Result<Vec<BodyDrive>, RagdollError> {
-        self.check_world_drive(pose, from, settings)?;
         let mut drives = Vec::with_capacity(self.bodies.len());
-        for (k, body) in self.bodies.iter().enumerate() {
+        for ((k, body), setting) in self.bodies.iter().enumerate().zip(settings) {
             let Some(body) = *body else { continue };
             let i = body.index();
             if world.bodies().kind[i] != BodyKind::Dynamic {
@@ -218,36 +269,44 @@ impl Ragdoll {
                 RagdollError::world(&name, e)
             };
             let (position, orientation) = pose.bones[k];
-            let mut drive = WorldDrive::new(position, orientation, Spring::RIGID)
-                .with_strengths(settings.linear, settings.angular)
-                .with_caps(
-                    world.bodies().mass[i] * settings.max_acceleration,
-                    settings.max_torque,
-                );
-            if let Some((prev, dt)) = from {
-                drive = drive
-                    .following(prev.bones[k], pose.bones[k], dt)
-                    .map_err(world_error)?;
-            }
-            drive.validate().map_err(world_error)?;
-            let upright = settings.uprights.iter().find(|u| u.body == k).map(|u| {
+            let drive = if setting.linear.is_some() || setting.angular.is_some() {
+                let mut drive = WorldDrive::new(position, orientation, Spring::RIGID)
+                    .with_strengths(setting.linear, setting.angular)
+                    .with_caps(
+                        world.bodies().mass[i] * setting.max_acceleration,
+                        setting.max_torque,
+                    );
+                if let Some((prev, dt)) = from {
+                    drive = drive
+                        .following(prev.bones[k], pose.bones[k], dt)
+                        .map_err(world_error)?;
+                }
+                drive.validate().map_err(world_error)?;
+                Some(drive)
+            } else {
+                None
+            };
+            let upright = setting.upright.map(|u| {
                 let axis = (orientation.conjugate() * Vec3::Y).normalize();
                 UprightDrive::new(axis, Vec3::Y, u.strength).with_max_torque(u.max_torque)
             });
+            if let Some(u) = &upright {
+                u.validate().map_err(world_error)?;
+            }
             drives.push((body, drive, upright));
         }
         Ok(drives)
     }
 }
 
-/// A body with its world drive and upright drive (or none).
-type BodyDrive = (BodyHandle, WorldDrive, Option<UprightDrive>);
+/// A body with its world drive and upright drive (each `None`: released).
+type BodyDrive = (BodyHandle, Option<WorldDrive>, Option<UprightDrive>);
 
 /// Sets drives [`Ragdoll::world_drives`] made and checked.
 fn set_world_drives(world: &mut World, drives: Vec<BodyDrive>) -> Result<(), RagdollError> {
     for (body, drive, upright) in drives {
         let set = |w: &mut World| {
-            w.set_world_drive(body, Some(drive))?;
+            w.set_world_drive(body, drive)?;
             w.set_upright_drive(body, upright)
         };
         set(world).map_err(|e| RagdollError::world("world drive", e))?;

@@ -10,6 +10,7 @@ use vertebra_world::{JointKind, LimitSoftness, Spring, Swing};
 use crate::drive::DriveSettings;
 use crate::joint_def::{JointDef, frame, kind_name};
 use crate::model::{BodyDef, RagdollDesc};
+use crate::profile::Profile;
 use crate::skeleton::{Skeleton, Transform};
 use crate::skeleton_file::write_bones;
 use crate::text::{float, floats, same_bits, string};
@@ -66,6 +67,9 @@ impl RagdollDesc {
         }
         if let Some(d) = &self.drive {
             write_drive(&mut out, d);
+        }
+        for p in &self.profiles {
+            write_profile(&mut out, p, self);
         }
         if let Some(skeleton) = &self.skeleton {
             write_bones(skeleton, &mut out);
@@ -245,6 +249,61 @@ fn write_drive(out: &mut String, d: &DriveSettings) {
         out.push_str(&format!("max_torque = {}\n", float(d.max_torque)));
     }
     out.push('\n');
+}
+
+/// A `[[profile]]` table: its uprights, then a `[[profile.bone]]` table for
+/// every body whose joint above it or whose world drive has a setting, so
+/// that each entry reads back exactly (a profile has no shared base).
+fn write_profile(out: &mut String, p: &Profile, desc: &RagdollDesc) {
+    out.push_str(&format!("[[profile]]\nname = {}\n", string(&p.name)));
+    let uprights: Vec<String> = (desc.bodies.iter().zip(&p.bodies))
+        .filter_map(|(b, s)| {
+            let u = s.upright?;
+            let mut fields = vec![format!("body = {}", string(&b.name))];
+            fields.extend(strength(u.strength, 0.0));
+            fields.extend(cap("max_torque", u.max_torque));
+            Some(format!("    {{ {} }},\n", fields.join(", ")))
+        })
+        .collect();
+    if !uprights.is_empty() {
+        out.push_str(&format!("upright = [\n{}]\n", uprights.concat()));
+    }
+    out.push('\n');
+    for (b, (body, s)) in desc.bodies.iter().zip(&p.bodies).enumerate() {
+        let joint = desc.parent_joint[b].map(|k| p.joints[k]);
+        let joints: Vec<String> = joint.map_or(Vec::new(), |j| {
+            let mut fields = j.strength.map_or(Vec::new(), |s| strength(s, 0.0));
+            fields.extend(cap("max_torque", j.max_torque));
+            fields
+        });
+        let mut world: Vec<String> = Vec::new();
+        for (name, part) in [("linear", s.linear), ("angular", s.angular)] {
+            if let Some(part) = part {
+                world.push(format!("{name} = {{ {} }}", strength(part, 0.0).join(", ")));
+            }
+        }
+        world.extend(cap("max_acceleration", s.max_acceleration));
+        world.extend(cap("max_torque", s.max_torque));
+        if joints.is_empty() && world.is_empty() {
+            continue;
+        }
+        out.push_str(&format!(
+            "[[profile.bone]]\nbody = {}\n",
+            string(&body.name)
+        ));
+        if !joints.is_empty() {
+            out.push_str(&format!("joints = {{ {} }}\n", joints.join(", ")));
+        }
+        if !world.is_empty() {
+            out.push_str(&format!("world = {{ {} }}\n", world.join(", ")));
+        }
+        out.push('\n');
+    }
+}
+
+/// `name = cap`, unless the cap is unlimited (no field).
+fn cap(name: &str, cap: f32) -> Option<String> {
+    (cap != f32::INFINITY).then(|| format!("{name} = {}", float(cap)))
 }
 
 /// How a joint's frame is written.

@@ -343,6 +343,9 @@ fn built() -> RagdollDesc {
             ..file.drive.clone().unwrap()
         })
         .skeleton(Skeleton::reference());
+    for p in &file.profiles {
+        builder = builder.profile(p.clone());
+    }
     for b in &file.bodies {
         builder = builder.body(BodySpec::capsule(&b.name, b.segment, b.radius, b.mass));
     }

@@ -1,0 +1,518 @@
+//! Physical-animation profiles: a named set of drive settings for a whole
+//! ragdoll, every joint's drive and every body's world and upright drive
+//! given one by one (a description's `[[profile]]` tables resolve to one:
+//! `profile_def.rs`), scaled per body by a 0..1 strength multiplier and
+//! blended from one profile to another over time ([`ProfileBlend`]).
+//!
+//! A multiplier `s` scales a drive's force: its stiffness and damping and
+//! its caps, all by `s` (a spring given by frequency `f` and ratio `z`
+//! becomes `f sqrt(s)`, `z sqrt(s)`; a compliance `c` with damping `d`
+//! becomes `c / s`, `d s`). A blend at `a` in 0..1 interpolates the
+//! stiffnesses, the dampings and the caps linearly, so the force a blended
+//! drive exerts is the interpolation of the two profiles' forces (below the
+//! caps). `docs/ragdolls.md`, "Profiles", says what blends smoothly and
+//! what does not (a rigid strength, an unlimited cap, two kinds of
+//! strength).
+
+use vertebra_world::{Spring, SpringField};
+
+use crate::error::{RagdollError, check_spring, range};
+use crate::model::RagdollDesc;
+use crate::world_drive::PhysicalAnimation;
+
+/// One joint's drive in a profile.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointDriveSetting {
+    /// The drive's strength (`None`: the joint is not driven).
+    pub strength: Option<Spring>,
+    /// The largest torque (N m; infinity is unlimited).
+    pub max_torque: f32,
+}
+
+/// One body's upright drive in a profile: the axis up in the animation's
+/// pose held near world up.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UprightSetting {
+    /// Stiffness and damping across the axis.
+    pub strength: Spring,
+    /// The largest torque (N m; infinity is unlimited).
+    pub max_torque: f32,
+}
+
+/// One body's drives in the world in a profile.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyDriveSetting {
+    /// The position part's strength (`None`: position free).
+    pub linear: Option<Spring>,
+    /// The orientation part's strength (`None`: orientation free).
+    pub angular: Option<Spring>,
+    /// The force cap per kilogram of the body's mass (N/kg; infinity is
+    /// unlimited).
+    pub max_acceleration: f32,
+    /// The torque cap (N m; infinity is unlimited).
+    pub max_torque: f32,
+    /// The upright drive, if the body has one.
+    pub upright: Option<UprightSetting>,
+}
+
+/// A named set of drive settings: one entry per described joint and one
+/// per described body. A simplified ragdoll's rod takes the entry of the
+/// spine's first joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Profile {
+    /// The profile's name, unique in its description.
+    pub name: String,
+    /// Per described joint, its drive.
+    pub joints: Vec<JointDriveSetting>,
+    /// Per described body, its world and upright drives.
+    pub bodies: Vec<BodyDriveSetting>,
+}
+
+impl JointDriveSetting {
+    /// Not driven.
+    pub const NONE: Self = Self {
+        strength: None,
+        max_torque: f32::INFINITY,
+    };
+
+    fn scaled(self, s: f32) -> Self {
+        Self::blended(Self::NONE, self, s)
+    }
+
+    fn blended(x: Self, y: Self, a: f32) -> Self {
+        Self {
+            strength: blended(x.strength, y.strength, a),
+            max_torque: caps(x.max_torque, x.strength, y.max_torque, y.strength, a),
+        }
+    }
+}
+
+impl BodyDriveSetting {
+    /// No drive in the world.
+    pub const NONE: Self = Self {
+        linear: None,
+        angular: None,
+        max_acceleration: f32::INFINITY,
+        max_torque: f32::INFINITY,
+        upright: None,
+    };
+
+    /// Whether the body has any drive.
+    pub fn is_driven(&self) -> bool {
+        self.linear.is_some() || self.angular.is_some() || self.upright.is_some()
+    }
+
+    fn scaled(self, s: f32) -> Self {
+        Self::blended(Self::NONE, self, s)
+    }
+
+    fn blended(x: Self, y: Self, a: f32) -> Self {
+        let upright = |u: Option<UprightSetting>| JointDriveSetting {
+            strength: u.map(|u| u.strength),
+            max_torque: u.map_or(f32::INFINITY, |u| u.max_torque),
+        };
+        let up = JointDriveSetting::blended(upright(x.upright), upright(y.upright), a);
+        // The force cap belongs to the position part, the torque cap to
+        // the orientation part: each fades with its own part.
+        Self {
+            linear: blended(x.linear, y.linear, a),
+            angular: blended(x.angular, y.angular, a),
+            max_acceleration: caps(
+                x.max_acceleration,
+                x.linear,
+                y.max_acceleration,
+                y.linear,
+                a,
+            ),
+            max_torque: caps(x.max_torque, x.angular, y.max_torque, y.angular, a),
+            upright: up.strength.map(|strength| UprightSetting {
+                strength,
+                max_torque: up.max_torque,
+            }),
+        }
+    }
+}
+
+impl Profile {
+    /// The profile `animation` gives `desc`: every joint the joint drive
+    /// settings' (their per-joint strengths included), every body the
+    /// world drive settings', the uprights on their bodies.
+    pub fn from_animation(name: &str, desc: &RagdollDesc, animation: &PhysicalAnimation) -> Self {
+        let (joints, world) = (&animation.joints, &animation.world);
+        let body = BodyDriveSetting {
+            linear: world.linear,
+            angular: world.angular,
+            max_acceleration: world.max_acceleration,
+            max_torque: world.max_torque,
+            upright: None,
+        };
+        let mut bodies = vec![body; desc.bodies.len()];
+        for u in &world.uprights {
+            if let Some(b) = bodies.get_mut(u.body) {
+                b.upright = Some(UprightSetting {
+                    strength: u.strength,
+                    max_torque: u.max_torque,
+                });
+            }
+        }
+        Self {
+            name: name.to_owned(),
+            joints: (0..desc.joints.len())
+                .map(|k| JointDriveSetting {
+                    strength: Some(joints.strength(k)),
+                    max_torque: joints.max_torque,
+                })
+                .collect(),
+            bodies,
+        }
+    }
+
+    /// Nothing driven: the ragdoll limp.
+    pub fn limp(name: &str, desc: &RagdollDesc) -> Self {
+        Self {
+            name: name.to_owned(),
+            joints: vec![JointDriveSetting::NONE; desc.joints.len()],
+            bodies: vec![BodyDriveSetting::NONE; desc.bodies.len()],
+        }
+    }
+
+    /// The profile with the drives of `body` (its world and upright drives
+    /// and the drive of the joint above it) and, if `below`, of every body
+    /// below it in the joint tree, scaled by `multiplier` (0..1: 0 turns
+    /// them off, 1 leaves them). Refused, naming the field, for a body out
+    /// of range or a multiplier outside 0..1.
+    pub fn scaled(
+        &self,
+        desc: &RagdollDesc,
+        body: usize,
+        below: bool,
+        multiplier: f32,
+    ) -> Result<Self, RagdollError> {
+        let context = format!("profile `{}`", self.name);
+        self.validate_counts(desc, &context)?;
+        check_multiplier(&context, multiplier)?;
+        let n = desc.bodies.len();
+        range(&context, "body", body < n, &format!("must be below {n}"))?;
+        let mut out = self.clone();
+        for b in covered(desc, body, below) {
+            out.bodies[b] = out.bodies[b].scaled(multiplier);
+            if let Some(k) = desc.parent_joint[b] {
+                out.joints[k] = out.joints[k].scaled(multiplier);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The profile between `self` (at `a = 0`) and `to` (at `a = 1`):
+    /// every stiffness, damping and cap interpolated (module
+    /// documentation). Named as `to`.
+    pub fn blended(&self, to: &Profile, a: f32) -> Result<Self, RagdollError> {
+        let context = format!("profile `{}`", to.name);
+        let same = self.joints.len() == to.joints.len() && self.bodies.len() == to.bodies.len();
+        range(
+            &context,
+            "joints",
+            same,
+            "must have as many joints and bodies as the profile it blends from",
+        )?;
+        range(
+            &context,
+            "blend",
+            (0.0..=1.0).contains(&a),
+            "must be in 0..1",
+        )?;
+        let pair = |x: &[JointDriveSetting], y: &[JointDriveSetting]| {
+            (x.iter().zip(y))
+                .map(|(&x, &y)| JointDriveSetting::blended(x, y, a))
+                .collect()
+        };
+        Ok(Self {
+            name: to.name.clone(),
+            joints: pair(&self.joints, &to.joints),
+            bodies: (self.bodies.iter().zip(&to.bodies))
+                .map(|(&x, &y)| BodyDriveSetting::blended(x, y, a))
+                .collect(),
+        })
+    }
+
+    /// Checks the profile for `desc`: one entry per joint and per body,
+    /// every strength one the world takes, every cap a number not
+    /// negative. Errors name the profile and the joint or body.
+    pub fn validate(&self, desc: &RagdollDesc) -> Result<(), RagdollError> {
+        self.check(desc, &format!("profile `{}`", self.name))
+    }
+
+    /// [`Profile::validate`], errors naming `context` (the profile, with
+    /// the line of its table in a file).
+    pub(crate) fn check(&self, desc: &RagdollDesc, context: &str) -> Result<(), RagdollError> {
+        self.validate_counts(desc, context)?;
+        for (j, s) in desc.joints.iter().zip(&self.joints) {
+            let context = format!("{context} joint `{}`", j.name);
+            if let Some(strength) = s.strength {
+                check_spring(&context, "drive", strength, SpringField::Drive)?;
+            }
+            check_cap(&context, "max_torque", s.max_torque)?;
+        }
+        for (b, s) in desc.bodies.iter().zip(&self.bodies) {
+            let context = format!("{context} body `{}`", b.name);
+            if let Some(strength) = s.linear {
+                check_spring(&context, "linear", strength, SpringField::WorldPosition)?;
+            }
+            if let Some(strength) = s.angular {
+                check_spring(&context, "angular", strength, SpringField::WorldOrientation)?;
+            }
+            check_cap(&context, "max_acceleration", s.max_acceleration)?;
+            check_cap(&context, "max_torque", s.max_torque)?;
+            if let Some(u) = s.upright {
+                check_spring(&context, "upright", u.strength, SpringField::Upright)?;
+                check_cap(&context, "upright max_torque", u.max_torque)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_counts(&self, desc: &RagdollDesc, context: &str) -> Result<(), RagdollError> {
+        let (joints, bodies) = (desc.joints.len(), desc.bodies.len());
+        range(
+            context,
+            "joints",
+            self.joints.len() == joints,
+            &format!("needs {joints} entries, one per joint"),
+        )?;
+        range(
+            context,
+            "bodies",
+            self.bodies.len() == bodies,
+            &format!("needs {bodies} entries, one per body"),
+        )
+    }
+}
+
+/// A profile blended into another over time: what a game holds per
+/// ragdoll and hands to [`crate::Ragdoll::follow_profile`] each frame.
+/// [`ProfileBlend::switch_to`] starts a blend from wherever the last one
+/// stands, so a hit may fade the drives out before a recovery has faded
+/// them back in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProfileBlend {
+    from: Profile,
+    to: Profile,
+    /// The blend's length (s); zero: switched.
+    duration: f32,
+    /// Time since the blend began (s).
+    elapsed: f32,
+}
+
+impl ProfileBlend {
+    /// At `profile`, not blending.
+    pub fn new(profile: Profile) -> Self {
+        Self {
+            from: profile.clone(),
+            to: profile,
+            duration: 0.0,
+            elapsed: 0.0,
+        }
+    }
+
+    /// Starts a blend of `duration` seconds (zero: at once) from the
+    /// profile as it stands now to `to`. Refused, unchanged, for a
+    /// duration that is negative or not finite, or a profile of another
+    /// shape.
+    pub fn switch_to(&mut self, to: Profile, duration: f32) -> Result<(), RagdollError> {
+        range(
+            &format!("profile `{}`", to.name),
+            "duration",
+            duration.is_finite() && duration >= 0.0,
+            "must be a time (s), not negative",
+        )?;
+        let from = self.current()?.blended(&to, 0.0)?;
+        *self = Self {
+            from,
+            to,
+            duration,
+            elapsed: 0.0,
+        };
+        Ok(())
+    }
+
+    /// Moves the blend on by `dt` seconds (a step's time).
+    pub fn advance(&mut self, dt: f32) {
+        if dt.is_finite() && dt > 0.0 {
+            self.elapsed = (self.elapsed + dt).min(self.duration);
+        }
+    }
+
+    /// How far the blend is, 0..1 (1: at the target).
+    pub fn progress(&self) -> f32 {
+        if self.elapsed >= self.duration {
+            1.0
+        } else {
+            self.elapsed / self.duration
+        }
+    }
+
+    /// The profile the blend is heading for.
+    pub fn target(&self) -> &Profile {
+        &self.to
+    }
+
+    /// The profile as the blend stands now.
+    pub fn current(&self) -> Result<Profile, RagdollError> {
+        self.from.blended(&self.to, self.progress())
+    }
+}
+
+/// The bodies `body` covers: itself and, if `below`, every body whose
+/// chain of joints toward the root passes it.
+pub(crate) fn covered(desc: &RagdollDesc, body: usize, below: bool) -> Vec<usize> {
+    (0..desc.bodies.len())
+        .filter(|&b| b == body || (below && is_below(desc, b, body)))
+        .collect()
+}
+
+/// Whether `b` lies below `above` in the joint tree.
+fn is_below(desc: &RagdollDesc, mut b: usize, above: usize) -> bool {
+    // A tree: at most one joint per body toward the root.
+    for _ in 0..desc.bodies.len() {
+        let Some(k) = desc.parent_joint.get(b).copied().flatten() else {
+            return false;
+        };
+        b = desc.joints[k].parent;
+        if b == above {
+            return true;
+        }
+    }
+    false
+}
+
+pub(crate) fn check_multiplier(context: &str, multiplier: f32) -> Result<(), RagdollError> {
+    range(
+        context,
+        "strength_multiplier",
+        (0.0..=1.0).contains(&multiplier),
+        "must be in 0..1",
+    )
+}
+
+fn check_cap(context: &str, field: &'static str, cap: f32) -> Result<(), RagdollError> {
+    range(
+        context,
+        field,
+        !(cap.is_nan() || cap < 0.0),
+        "must be a number, not negative",
+    )
+}
+
+/// A spring's stiffness and damping as a force law: for a frequency, per
+/// unit of the inertia it acts on (`(2 pi f)^2`, `2 z (2 pi f)`); for a
+/// compliance, `1 / c` and its damping.
+fn force_law(s: Spring) -> (f32, f32) {
+    match s {
+        Spring::Frequency {
+            frequency,
+            damping_ratio,
+        } => {
+            let omega = core::f32::consts::TAU * frequency;
+            (omega * omega, 2.0 * damping_ratio * omega)
+        }
+        Spring::Compliance {
+            compliance,
+            damping,
+        } => (1.0 / compliance, damping),
+    }
+}
+
+/// The spring of `law` in the kind of `like`; `None` if it is too weak to
+/// act (a frequency below the world's least).
+fn spring_of((stiffness, damping): (f32, f32), like: Spring) -> Option<Spring> {
+    match like {
+        Spring::Frequency { .. } => {
+            let omega = stiffness.sqrt();
+            let frequency = omega / core::f32::consts::TAU;
+            (frequency >= vertebra_world::MIN_DRIVE_FREQUENCY).then(|| Spring::Frequency {
+                frequency,
+                damping_ratio: damping / (2.0 * omega),
+            })
+        }
+        Spring::Compliance { .. } => (stiffness > 0.0).then(|| Spring::Compliance {
+            compliance: 1.0 / stiffness,
+            damping,
+        }),
+    }
+}
+
+fn lerp(x: f32, y: f32, a: f32) -> f32 {
+    if x == y { x } else { x + (y - x) * a }
+}
+
+/// A strength between `x` (at `a = 0`) and `y` (at `a = 1`): the force
+/// laws interpolated when both are of one kind (a rigid one stays rigid
+/// while it has any weight), one scaled by its weight when the other is
+/// none, and when their kinds differ, `x` faded out over the first half
+/// and `y` in over the second.
+fn blended(x: Option<Spring>, y: Option<Spring>, a: f32) -> Option<Spring> {
+    let scaled = |s: Spring, w: f32| {
+        let (k, d) = force_law(s);
+        if w >= 1.0 {
+            Some(s)
+        } else if w <= 0.0 {
+            None
+        } else {
+            spring_of((k * w, d * w), s)
+        }
+    };
+    match (x, y) {
+        (None, None) => None,
+        (Some(x), None) => scaled(x, 1.0 - a),
+        (None, Some(y)) => scaled(y, a),
+        (Some(x), Some(_)) if a <= 0.0 => Some(x),
+        (Some(_), Some(y)) if a >= 1.0 => Some(y),
+        (Some(x), Some(y)) if core::mem::discriminant(&x) == core::mem::discriminant(&y) => {
+            let ((kx, dx), (ky, dy)) = (force_law(x), force_law(y));
+            if kx.is_infinite() || ky.is_infinite() {
+                return Some(Spring::Compliance {
+                    compliance: 0.0,
+                    damping: lerp(dx, dy, a),
+                });
+            }
+            spring_of((lerp(kx, ky, a), lerp(dx, dy, a)), y)
+        }
+        (Some(x), Some(y)) => {
+            if a < 0.5 {
+                scaled(x, 1.0 - 2.0 * a)
+            } else {
+                scaled(y, 2.0 * a - 1.0)
+            }
+        }
+    }
+}
+
+/// A cap between `x` and `y` as their strengths blend: a part that is
+/// absent on one side takes the other side's cap scaled by its weight,
+/// so a drive fading in starts from no force at all.
+fn caps(x: f32, sx: Option<Spring>, y: f32, sy: Option<Spring>, a: f32) -> f32 {
+    if a <= 0.0 {
+        return x;
+    }
+    if a >= 1.0 {
+        return y;
+    }
+    match (sx, sy) {
+        (None, None) => f32::INFINITY,
+        (Some(_), None) => scale_cap(x, 1.0 - a),
+        (None, Some(_)) => scale_cap(y, a),
+        (Some(_), Some(_)) => lerp(x, y, a),
+    }
+}
+
+/// A cap scaled by a weight; an unlimited one stays unlimited while the
+/// weight is above zero.
+fn scale_cap(cap: f32, w: f32) -> f32 {
+    if w >= 1.0 {
+        cap
+    } else if cap.is_infinite() {
+        if w > 0.0 { cap } else { 0.0 }
+    } else {
+        cap * w.max(0.0)
+    }
+}
