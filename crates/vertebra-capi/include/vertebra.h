@@ -399,6 +399,10 @@ typedef struct VtBytes VtBytes;
 // `vt_collisions_destroy`).
 typedef struct VtCollisions VtCollisions;
 
+// A profile blend under way for one ragdoll (opaque;
+// `vt_profile_blend_create`; free it with `vt_profile_blend_destroy`).
+typedef struct VtProfileBlend VtProfileBlend;
+
 // A ragdoll living in a world: its bodies', joints' and rod's handles
 // (opaque; `vt_ragdoll_build`; free it with `vt_ragdoll_destroy`, which
 // leaves its bodies in the world: `vt_ragdoll_remove` takes them out).
@@ -1702,6 +1706,77 @@ enum VtResult vt_world_joint(struct VtWorld *world, struct VtJoint joint, struct
 enum VtResult vt_world_set_joint_drive(struct VtWorld *world,
                                        struct VtJoint joint,
                                        const struct VtDrive *drive);
+
+// Starts at `desc`'s profile `name` (not blending), written into `blend`
+// (free it with `vt_profile_blend_destroy`). The blend keeps its own copy
+// of `desc`. Refused for a name the description has no profile of.
+//
+// # Safety
+// `desc` is live; `name` is a NUL-terminated string; `blend` is writable.
+enum VtResult vt_profile_blend_create(const struct VtRagdollDesc *desc,
+                                      const char *name,
+                                      struct VtProfileBlend **blend);
+
+// Frees a profile blend (null does nothing).
+//
+// # Safety
+// `blend` is null or live, and not used afterwards.
+void vt_profile_blend_destroy(struct VtProfileBlend *blend);
+
+// Blends to the description's profile `name` over `duration` seconds
+// (0: at once), from wherever the blend stands now. Refused, unchanged,
+// for an unknown name or a duration negative or not finite.
+//
+// # Safety
+// `blend` is live; `name` is a NUL-terminated string.
+enum VtResult vt_profile_blend_switch(struct VtProfileBlend *blend,
+                                      const char *name,
+                                      float duration);
+
+// Blends over `duration` seconds to the profile the blend is heading for
+// with described body `body`'s drives (and, if `below` is non-zero,
+// every body's below it) scaled by `multiplier` (0..1): a limb fading
+// out as a hit lands. Refused, unchanged, for a body out of range or a
+// multiplier or duration out of range.
+//
+// # Safety
+// `blend` is live.
+enum VtResult vt_profile_blend_scale(struct VtProfileBlend *blend,
+                                     size_t body,
+                                     uint32_t below,
+                                     float multiplier,
+                                     float duration);
+
+// Moves the blend on by `dt` seconds (a frame's time; anything not
+// finite or not positive leaves it).
+//
+// # Safety
+// `blend` is live.
+enum VtResult vt_profile_blend_advance(struct VtProfileBlend *blend, float dt);
+
+// Writes how far the blend is into `progress` (0..1; 1 at its target).
+//
+// # Safety
+// `blend` is live; `progress` is writable.
+enum VtResult vt_profile_blend_progress(struct VtProfileBlend *blend, float *progress);
+
+// Drives every joint and body of the ragdoll along the animation, from
+// `previous` to `pose` over `dt` seconds (both `count` world transforms,
+// one per described body), with the profile as `blend` stands now. Call
+// it every frame, after `vt_profile_blend_advance`. Refused, nothing
+// changed, for poses out of range or a blend made for another ragdoll's
+// description (one of other counts).
+//
+// # Safety
+// `ragdoll`, `world` and `blend` are live; `previous` and `pose` point
+// to `count` readable transforms.
+enum VtResult vt_ragdoll_follow_profile(struct VtRagdoll *ragdoll,
+                                        struct VtWorld *world,
+                                        const struct VtTransform *previous,
+                                        const struct VtTransform *pose,
+                                        size_t count,
+                                        float dt,
+                                        struct VtProfileBlend *blend);
 
 // Writes a filter that sees every collider into `filter`.
 //

@@ -16,6 +16,7 @@
 //!   later call on it but its destroy returns `VT_RESULT_POISONED`).
 //! - Objects (`VtWorld`, `VtCollisions`, `VtRagdollDesc`, `VtRagdoll`,
 //!   `VtSkeleton`, `VtSkeletonMapper`, `VtTransition`, `VtBlendBack`,
+//!   `VtProfileBlend`,
 //!   `VtBytes`) are opaque. The caller owns every object a function writes to a `T**` and frees it with that
 //!   type's `_destroy` (null does nothing), exactly once. vertebra never
 //!   keeps a caller's pointer beyond the call (but the job system's
@@ -42,6 +43,7 @@ mod events;
 mod ffi;
 mod follow;
 mod joint;
+mod profile;
 mod query;
 mod ragdoll;
 mod rod;
@@ -62,6 +64,7 @@ pub use error::{VtResult, vt_last_error_message, vt_result_name};
 pub use events::*;
 pub use follow::*;
 pub use joint::*;
+pub use profile::*;
 pub use query::*;
 pub use ragdoll::*;
 pub use rod::*;
