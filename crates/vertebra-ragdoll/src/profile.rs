@@ -14,11 +14,9 @@
 //! what does not (a rigid strength, an unlimited cap, two kinds of
 //! strength).
 
-use vertebra_world::{Spring, SpringField};
+use vertebra_world::Spring;
 
-use crate::error::{RagdollError, check_spring, range};
-use crate::model::RagdollDesc;
-use crate::world_drive::PhysicalAnimation;
+use crate::error::{RagdollError, range};
 
 /// One joint's drive in a profile.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,7 +73,7 @@ impl JointDriveSetting {
         max_torque: f32::INFINITY,
     };
 
-    fn scaled(self, s: f32) -> Self {
+    pub(crate) fn scaled(self, s: f32) -> Self {
         Self::blended(Self::NONE, self, s)
     }
 
@@ -102,7 +100,7 @@ impl BodyDriveSetting {
         self.linear.is_some() || self.angular.is_some() || self.upright.is_some()
     }
 
-    fn scaled(self, s: f32) -> Self {
+    pub(crate) fn scaled(self, s: f32) -> Self {
         Self::blended(Self::NONE, self, s)
     }
 
@@ -134,75 +132,6 @@ impl BodyDriveSetting {
 }
 
 impl Profile {
-    /// The profile `animation` gives `desc`: every joint the joint drive
-    /// settings' (their per-joint strengths included), every body the
-    /// world drive settings', the uprights on their bodies.
-    pub fn from_animation(name: &str, desc: &RagdollDesc, animation: &PhysicalAnimation) -> Self {
-        let (joints, world) = (&animation.joints, &animation.world);
-        let body = BodyDriveSetting {
-            linear: world.linear,
-            angular: world.angular,
-            max_acceleration: world.max_acceleration,
-            max_torque: world.max_torque,
-            upright: None,
-        };
-        let mut bodies = vec![body; desc.bodies.len()];
-        for u in &world.uprights {
-            if let Some(b) = bodies.get_mut(u.body) {
-                b.upright = Some(UprightSetting {
-                    strength: u.strength,
-                    max_torque: u.max_torque,
-                });
-            }
-        }
-        Self {
-            name: name.to_owned(),
-            joints: (0..desc.joints.len())
-                .map(|k| JointDriveSetting {
-                    strength: Some(joints.strength(k)),
-                    max_torque: joints.max_torque,
-                })
-                .collect(),
-            bodies,
-        }
-    }
-
-    /// Nothing driven: the ragdoll limp.
-    pub fn limp(name: &str, desc: &RagdollDesc) -> Self {
-        Self {
-            name: name.to_owned(),
-            joints: vec![JointDriveSetting::NONE; desc.joints.len()],
-            bodies: vec![BodyDriveSetting::NONE; desc.bodies.len()],
-        }
-    }
-
-    /// The profile with the drives of `body` (its world and upright drives
-    /// and the drive of the joint above it) and, if `below`, of every body
-    /// below it in the joint tree, scaled by `multiplier` (0..1: 0 turns
-    /// them off, 1 leaves them). Refused, naming the field, for a body out
-    /// of range or a multiplier outside 0..1.
-    pub fn scaled(
-        &self,
-        desc: &RagdollDesc,
-        body: usize,
-        below: bool,
-        multiplier: f32,
-    ) -> Result<Self, RagdollError> {
-        let context = format!("profile `{}`", self.name);
-        self.validate_counts(desc, &context)?;
-        check_multiplier(&context, multiplier)?;
-        let n = desc.bodies.len();
-        range(&context, "body", body < n, &format!("must be below {n}"))?;
-        let mut out = self.clone();
-        for b in covered(desc, body, below) {
-            out.bodies[b] = out.bodies[b].scaled(multiplier);
-            if let Some(k) = desc.parent_joint[b] {
-                out.joints[k] = out.joints[k].scaled(multiplier);
-            }
-        }
-        Ok(out)
-    }
-
     /// The profile between `self` (at `a = 0`) and `to` (at `a = 1`):
     /// every stiffness, damping and cap interpolated (module
     /// documentation). Named as `to`.
@@ -233,58 +162,6 @@ impl Profile {
                 .map(|(&x, &y)| BodyDriveSetting::blended(x, y, a))
                 .collect(),
         })
-    }
-
-    /// Checks the profile for `desc`: one entry per joint and per body,
-    /// every strength one the world takes, every cap a number not
-    /// negative. Errors name the profile and the joint or body.
-    pub fn validate(&self, desc: &RagdollDesc) -> Result<(), RagdollError> {
-        self.check(desc, &format!("profile `{}`", self.name))
-    }
-
-    /// [`Profile::validate`], errors naming `context` (the profile, with
-    /// the line of its table in a file).
-    pub(crate) fn check(&self, desc: &RagdollDesc, context: &str) -> Result<(), RagdollError> {
-        self.validate_counts(desc, context)?;
-        for (j, s) in desc.joints.iter().zip(&self.joints) {
-            let context = format!("{context} joint `{}`", j.name);
-            if let Some(strength) = s.strength {
-                check_spring(&context, "drive", strength, SpringField::Drive)?;
-            }
-            check_cap(&context, "max_torque", s.max_torque)?;
-        }
-        for (b, s) in desc.bodies.iter().zip(&self.bodies) {
-            let context = format!("{context} body `{}`", b.name);
-            if let Some(strength) = s.linear {
-                check_spring(&context, "linear", strength, SpringField::WorldPosition)?;
-            }
-            if let Some(strength) = s.angular {
-                check_spring(&context, "angular", strength, SpringField::WorldOrientation)?;
-            }
-            check_cap(&context, "max_acceleration", s.max_acceleration)?;
-            check_cap(&context, "max_torque", s.max_torque)?;
-            if let Some(u) = s.upright {
-                check_spring(&context, "upright", u.strength, SpringField::Upright)?;
-                check_cap(&context, "upright max_torque", u.max_torque)?;
-            }
-        }
-        Ok(())
-    }
-
-    fn validate_counts(&self, desc: &RagdollDesc, context: &str) -> Result<(), RagdollError> {
-        let (joints, bodies) = (desc.joints.len(), desc.bodies.len());
-        range(
-            context,
-            "joints",
-            self.joints.len() == joints,
-            &format!("needs {joints} entries, one per joint"),
-        )?;
-        range(
-            context,
-            "bodies",
-            self.bodies.len() == bodies,
-            &format!("needs {bodies} entries, one per body"),
-        )
     }
 }
 
@@ -362,44 +239,12 @@ impl ProfileBlend {
     }
 }
 
-/// The bodies `body` covers: itself and, if `below`, every body whose
-/// chain of joints toward the root passes it.
-pub(crate) fn covered(desc: &RagdollDesc, body: usize, below: bool) -> Vec<usize> {
-    (0..desc.bodies.len())
-        .filter(|&b| b == body || (below && is_below(desc, b, body)))
-        .collect()
-}
-
-/// Whether `b` lies below `above` in the joint tree.
-fn is_below(desc: &RagdollDesc, mut b: usize, above: usize) -> bool {
-    // A tree: at most one joint per body toward the root.
-    for _ in 0..desc.bodies.len() {
-        let Some(k) = desc.parent_joint.get(b).copied().flatten() else {
-            return false;
-        };
-        b = desc.joints[k].parent;
-        if b == above {
-            return true;
-        }
-    }
-    false
-}
-
 pub(crate) fn check_multiplier(context: &str, multiplier: f32) -> Result<(), RagdollError> {
     range(
         context,
         "strength_multiplier",
         (0.0..=1.0).contains(&multiplier),
         "must be in 0..1",
-    )
-}
-
-fn check_cap(context: &str, field: &'static str, cap: f32) -> Result<(), RagdollError> {
-    range(
-        context,
-        field,
-        !(cap.is_nan() || cap < 0.0),
-        "must be a number, not negative",
     )
 }
 

@@ -2,16 +2,17 @@
 //! joints' drive, the bodies' world drive, uprights, and `[[profile.bone]]`
 //! tables that change a body (and, with `below = true`, every body below
 //! it) in file order, resolved into a [`Profile`] once the joint tree
-//! stands; see `docs/ragdolls.md`, "Profiles".
+//! stands; and profiles fitted to a description (made limp, scaled per
+//! subtree, checked); see `docs/ragdolls.md`, "Profiles".
 
 use serde::Deserialize;
-use vertebra_world::Spring;
+use vertebra_world::{Spring, SpringField};
 
 use crate::drive_def::{RawDrive, RawInfinite, RawStrength};
-use crate::error::{RagdollError, finite, range};
+use crate::error::{RagdollError, check_spring, finite, range};
 use crate::model::RagdollDesc;
 use crate::profile::{
-    BodyDriveSetting, JointDriveSetting, Profile, UprightSetting, check_multiplier, covered,
+    BodyDriveSetting, JointDriveSetting, Profile, UprightSetting, check_multiplier,
 };
 
 /// A profile as a description gives it: a file's table, resolved once the
@@ -217,4 +218,126 @@ fn finite_or_unlimited(context: &str, field: &'static str, cap: f32) -> Result<(
     }
     finite(context, field, &[cap])?;
     range(context, field, cap >= 0.0, "must not be negative")
+}
+
+impl Profile {
+    /// Nothing driven: the ragdoll limp.
+    pub fn limp(name: &str, desc: &RagdollDesc) -> Self {
+        Self {
+            name: name.to_owned(),
+            joints: vec![JointDriveSetting::NONE; desc.joints.len()],
+            bodies: vec![BodyDriveSetting::NONE; desc.bodies.len()],
+        }
+    }
+
+    /// The profile with the drives of `body` (its world and upright drives
+    /// and the drive of the joint above it) and, if `below`, of every body
+    /// below it in the joint tree, scaled by `multiplier` (0..1: 0 turns
+    /// them off, 1 leaves them). Refused, naming the field, for a body out
+    /// of range or a multiplier outside 0..1.
+    pub fn scaled(
+        &self,
+        desc: &RagdollDesc,
+        body: usize,
+        below: bool,
+        multiplier: f32,
+    ) -> Result<Self, RagdollError> {
+        let context = format!("profile `{}`", self.name);
+        self.validate_counts(desc, &context)?;
+        check_multiplier(&context, multiplier)?;
+        let n = desc.bodies.len();
+        range(&context, "body", body < n, &format!("must be below {n}"))?;
+        let mut out = self.clone();
+        for b in covered(desc, body, below) {
+            out.bodies[b] = out.bodies[b].scaled(multiplier);
+            if let Some(k) = desc.parent_joint[b] {
+                out.joints[k] = out.joints[k].scaled(multiplier);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Checks the profile for `desc`: one entry per joint and per body,
+    /// every strength one the world takes, every cap a number not
+    /// negative. Errors name the profile and the joint or body.
+    pub fn validate(&self, desc: &RagdollDesc) -> Result<(), RagdollError> {
+        self.check(desc, &format!("profile `{}`", self.name))
+    }
+
+    /// [`Profile::validate`], errors naming `context` (the profile, with
+    /// the line of its table in a file).
+    pub(crate) fn check(&self, desc: &RagdollDesc, context: &str) -> Result<(), RagdollError> {
+        self.validate_counts(desc, context)?;
+        for (j, s) in desc.joints.iter().zip(&self.joints) {
+            let context = format!("{context} joint `{}`", j.name);
+            if let Some(strength) = s.strength {
+                check_spring(&context, "drive", strength, SpringField::Drive)?;
+            }
+            check_cap(&context, "max_torque", s.max_torque)?;
+        }
+        for (b, s) in desc.bodies.iter().zip(&self.bodies) {
+            let context = format!("{context} body `{}`", b.name);
+            if let Some(strength) = s.linear {
+                check_spring(&context, "linear", strength, SpringField::WorldPosition)?;
+            }
+            if let Some(strength) = s.angular {
+                check_spring(&context, "angular", strength, SpringField::WorldOrientation)?;
+            }
+            check_cap(&context, "max_acceleration", s.max_acceleration)?;
+            check_cap(&context, "max_torque", s.max_torque)?;
+            if let Some(u) = s.upright {
+                check_spring(&context, "upright", u.strength, SpringField::Upright)?;
+                check_cap(&context, "upright max_torque", u.max_torque)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_counts(&self, desc: &RagdollDesc, context: &str) -> Result<(), RagdollError> {
+        let (joints, bodies) = (desc.joints.len(), desc.bodies.len());
+        range(
+            context,
+            "joints",
+            self.joints.len() == joints,
+            &format!("needs {joints} entries, one per joint"),
+        )?;
+        range(
+            context,
+            "bodies",
+            self.bodies.len() == bodies,
+            &format!("needs {bodies} entries, one per body"),
+        )
+    }
+}
+
+/// The bodies `body` covers: itself and, if `below`, every body whose
+/// chain of joints toward the root passes it.
+fn covered(desc: &RagdollDesc, body: usize, below: bool) -> Vec<usize> {
+    (0..desc.bodies.len())
+        .filter(|&b| b == body || (below && is_below(desc, b, body)))
+        .collect()
+}
+
+/// Whether `b` lies below `above` in the joint tree.
+fn is_below(desc: &RagdollDesc, mut b: usize, above: usize) -> bool {
+    // A tree: at most one joint per body toward the root.
+    for _ in 0..desc.bodies.len() {
+        let Some(k) = desc.parent_joint.get(b).copied().flatten() else {
+            return false;
+        };
+        b = desc.joints[k].parent;
+        if b == above {
+            return true;
+        }
+    }
+    false
+}
+
+fn check_cap(context: &str, field: &'static str, cap: f32) -> Result<(), RagdollError> {
+    range(
+        context,
+        field,
+        !(cap.is_nan() || cap < 0.0),
+        "must be a number, not negative",
+    )
 }

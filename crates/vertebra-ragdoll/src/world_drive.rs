@@ -12,8 +12,9 @@ use vertebra_world::{BodyHandle, Spring, SpringField, UprightDrive, World, World
 
 use crate::drive::DriveSettings;
 use crate::error::{RagdollError, check_spring, range};
+use crate::model::RagdollDesc;
 use crate::pose::Pose;
-use crate::profile::{BodyDriveSetting, Profile};
+use crate::profile::{BodyDriveSetting, JointDriveSetting, Profile, UprightSetting};
 use crate::ragdoll::Ragdoll;
 
 /// One body kept upright: the axis that points up in the animation's pose
@@ -95,6 +96,41 @@ impl WorldDriveSettings {
             range(&context, "max_torque", cap(u.max_torque), reason)?;
         }
         Ok(())
+    }
+}
+
+impl Profile {
+    /// The profile `animation` gives `desc`: every joint the joint drive
+    /// settings' (their per-joint strengths included), every body the
+    /// world drive settings', the uprights on their bodies.
+    pub fn from_animation(name: &str, desc: &RagdollDesc, animation: &PhysicalAnimation) -> Self {
+        let (joints, world) = (&animation.joints, &animation.world);
+        let body = BodyDriveSetting {
+            linear: world.linear,
+            angular: world.angular,
+            max_acceleration: world.max_acceleration,
+            max_torque: world.max_torque,
+            upright: None,
+        };
+        let mut bodies = vec![body; desc.bodies.len()];
+        for u in &world.uprights {
+            if let Some(b) = bodies.get_mut(u.body) {
+                b.upright = Some(UprightSetting {
+                    strength: u.strength,
+                    max_torque: u.max_torque,
+                });
+            }
+        }
+        Self {
+            name: name.to_owned(),
+            joints: (0..desc.joints.len())
+                .map(|k| JointDriveSetting {
+                    strength: Some(joints.strength(k)),
+                    max_torque: joints.max_torque,
+                })
+                .collect(),
+            bodies,
+        }
     }
 }
 
