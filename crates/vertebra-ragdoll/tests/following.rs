@@ -262,3 +262,38 @@ fn bad_strengths_are_refused_naming_the_joint_and_change_nothing() {
         );
     }
 }
+
+/// An animation turning one joint too fast for the world to drive is
+/// refused naming that joint, and no joint's drive changes: the ones
+/// before it in the description included.
+#[test]
+fn a_joint_turning_too_fast_is_refused_and_no_drive_changes() {
+    let (desc, mut world, bind, ragdoll) = anatomical_at_bind();
+    let settings = DriveSettings::uniform(Spring::RIGID);
+    ragdoll.drive_to(&mut world, &bind, &settings).unwrap();
+    let drives = |world: &World| -> Vec<Option<vertebra_world::AngularDrive>> {
+        (ragdoll.joints.iter().flatten())
+            .map(|&j| world.joint(j).unwrap().drive)
+            .collect()
+    };
+    let before = drives(&world);
+    // The last joint in the description turns 2.5 rad in a microsecond.
+    let last = desc.joints.last().unwrap().name.clone();
+    let fast = pose(&desc, |j| {
+        if j.name == last {
+            Quat::from_axis_angle(j.axis(), 2.5)
+        } else {
+            Quat::IDENTITY
+        }
+    });
+    // Softer drives than the ones set: any joint set would show.
+    let softer = DriveSettings::uniform(Spring::Frequency {
+        frequency: 5.0,
+        damping_ratio: 1.0,
+    });
+    let e = ragdoll
+        .drive_following(&mut world, &bind, &fast, 1e-6, &softer)
+        .unwrap_err();
+    assert!(e.to_string().contains(&format!("joint `{last}`")), "{e}");
+    assert_eq!(drives(&world), before, "a refused call changed a drive");
+}
