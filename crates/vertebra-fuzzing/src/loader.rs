@@ -18,7 +18,7 @@ fn reference() -> &'static Skeleton {
 /// as itself and converts to model space. As a ragdoll file, alone and on
 /// the reference skeleton: an error, or a description that validates,
 /// reads back from its TOML as itself, builds both ways, is driven by its
-/// own drive settings, and steps to a finite state without the step's NaN
+/// own drive settings and profiles (and blends of them), and steps to a finite state without the step's NaN
 /// guard.
 pub fn ragdoll_loader(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
@@ -88,6 +88,20 @@ fn build(desc: &RagdollDesc) {
         }
         for _ in 0..4 {
             world.step(1.0 / 60.0).expect("a valid step");
+        }
+        // Profiles the loader accepted, and blends between them, drive it.
+        let bind = Pose::bind(desc);
+        for (k, profile) in desc.profiles.iter().enumerate() {
+            let next = &desc.profiles[(k + 1) % desc.profiles.len()];
+            let half = profile
+                .blended(next, 0.5)
+                .expect("a description's profiles blend");
+            for p in [profile, &half] {
+                ragdoll
+                    .follow_profile(&mut world, (&bind, &bind), 1.0 / 60.0, p)
+                    .expect("accepted profiles drive the ragdoll");
+                world.step(1.0 / 60.0).expect("a valid step");
+            }
         }
         let store = world.bodies();
         for i in (0..store.capacity()).filter(|&i| store.is_live(i)) {
