@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use vertebra_ragdoll::{RagdollDesc, RagdollError, RagdollGenerator, Skeleton, read_text};
+use vertebra_ragdoll::{Profile, RagdollDesc, RagdollError, RagdollGenerator, Skeleton, read_text};
 use vertebra_world::{JointKind, LimitSoftness, Spring, Swing};
 
 /// What the file at `path` holds, as text; or every problem found, one a
@@ -280,6 +280,18 @@ fn ragdoll(path: &Path, desc: &RagdollDesc) -> String {
             let _ = writeln!(out, "drive: none");
         }
     }
+    let profiles: Vec<String> = desc.profiles.iter().map(profile).collect();
+    match profiles.is_empty() {
+        true => {
+            let _ = writeln!(out, "profiles: none");
+        }
+        false => {
+            let _ = writeln!(out, "profiles:");
+            for p in profiles {
+                let _ = writeln!(out, "  {p}");
+            }
+        }
+    }
     match &desc.skeleton {
         Some(s) => {
             let bound = desc.bodies.iter().filter(|b| b.bone.is_some()).count();
@@ -294,6 +306,22 @@ fn ragdoll(path: &Path, desc: &RagdollDesc) -> String {
         }
     }
     out
+}
+
+/// A profile in a line: how many joints it drives, how many bodies it
+/// pulls in the world, how many it keeps upright.
+fn profile(p: &Profile) -> String {
+    let joints = p.joints.iter().filter(|j| j.strength.is_some()).count();
+    let world = (p.bodies.iter())
+        .filter(|b| b.linear.is_some() || b.angular.is_some())
+        .count();
+    let upright = p.bodies.iter().filter(|b| b.upright.is_some()).count();
+    format!(
+        "{}: {joints} of {} joints driven, {world} of {} bodies held in the world, {upright} upright",
+        p.name,
+        p.joints.len(),
+        p.bodies.len()
+    )
 }
 
 fn skeleton(path: &Path, s: &Skeleton) -> String {

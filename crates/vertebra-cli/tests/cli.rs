@@ -524,7 +524,7 @@ fn check_prints_what_a_ragdoll_file_holds() {
     assert_eq!(code, 0, "{stderr}");
     // The file's own numbers: 13 bodies and 12 joints, 69 kg, the hips
     // 11 kg, knees hinged 0 to 150 degrees, shoulders elliptical 90 by 70,
-    // the spine's rod limits, the [drive] table, no skeleton.
+    // the spine's rod limits, the [drive] table, the profiles, no skeleton.
     for expected in [
         "ragdoll `anatomical-humanoid`: 13 bodies, 12 joints, 69 kg",
         "hips ",
@@ -533,6 +533,8 @@ fn check_prints_what_a_ragdoll_file_holds() {
         "socket  chest -> upper_arm_l  swing ellipse y 90 z 70 deg, twist -60 .. 60 deg",
         "spine: hips, spine_lower, spine_upper, chest (one rod in the simplified ragdoll): bend 60 deg, twist -30 .. 30 deg, stiffness 2 / 2 N m^2",
         "drive: spring 4 Hz, damping ratio 1, max torque 400 N m",
+        "profiles:\n  standing: 12 of 12 joints driven, 13 of 13 bodies held in the world, 2 upright\n",
+        "  limp: 0 of 12 joints driven, 0 of 13 bodies held in the world, 0 upright\n",
         "skeleton: none",
     ] {
         assert!(stdout.contains(expected), "`{expected}` in\n{stdout}");
