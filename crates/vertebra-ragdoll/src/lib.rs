@@ -1,9 +1,10 @@
 //! Ragdolls for vertebra (paper section 6): load a description, build it as
 //! a standard ragdoll (a socket chain in the spine) or as the paper's
 //! simplified ragdoll (one rod), switch a character from animation to
-//! physics at any pose, drive it toward an animation pose, and write the
-//! result back onto an animation skeleton that has more bones than the
-//! ragdoll has bodies ([`SkeletonMapper`]; [`Transition`] switches from
+//! physics at any pose, drive it toward an animation pose (joints, and
+//! bodies in the world, with named [`Profile`]s blended over time by
+//! [`ProfileBlend`]), and write the result back onto an animation skeleton
+//! that has more bones than the ragdoll has bodies ([`SkeletonMapper`]; [`Transition`] switches from
 //! animation without a pop, an example on its page). The format, the
 //! mapper and the mapping modes are documented in `docs/ragdolls.md`.
 //!
