@@ -1,5 +1,6 @@
 //! The paper's scenes (figures 1, 2, 6, 7, 8), on the reference humanoid,
-//! two on the anatomical humanoid (a hit reaction, the drop), and a chain
+//! three on the anatomical humanoid (a hit reaction, the drop, the stagger:
+//! standing and walking on capped drives, hit on the chest), and a chain
 //! with a 1:1000 mass ratio across a joint, at 60 Hz
 //! with gravity (0, -9.81, 0), 1 substep and 20 iterations unless told
 //! otherwise, each with a rod spine (simplified) or a socket spine
@@ -8,6 +9,7 @@
 mod builder;
 mod config;
 mod controllability;
+mod following;
 mod frame;
 mod gait;
 mod heavy_chain;
@@ -25,10 +27,12 @@ mod seeds;
 mod setup;
 mod skeleton_out;
 mod spread;
+mod stagger;
 mod walk;
 
 pub use builder::build;
 pub use config::SceneConfig;
+pub use following::Following;
 pub use frame::Frame;
 pub use gait::{Foot, Gait};
 pub use heavy_chain::{HEAVY_MASS, LINK_MASS, LINKS, heavy_chain};
@@ -43,4 +47,5 @@ pub use scene_world::SceneWorld;
 pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};
 pub use skeleton_out::SkeletonOut;
 pub use spread::Spread;
+pub use stagger::{STAGGER_HIT, WALK_SPEED, WALK_START, stagger_animation, stagger_walk};
 pub use walk::Walk;
