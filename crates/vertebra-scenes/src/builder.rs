@@ -28,7 +28,7 @@ pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
 
 /// The ragdoll `config`'s scene builds: its own, the heavy chain, or the
 /// humanoid its scene is measured on.
-fn description(config: &SceneConfig) -> Result<RagdollDesc, RagdollError> {
+pub(crate) fn description(config: &SceneConfig) -> Result<RagdollDesc, RagdollError> {
     match (config.scene, &config.ragdoll) {
         (Scene::HeavyChain, None) => heavy_chain::heavy_chain(),
         (Scene::HeavyChain, Some(_)) => Err(RagdollError::OutOfRange {

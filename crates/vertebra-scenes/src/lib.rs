@@ -28,6 +28,8 @@ mod setup;
 mod skeleton_out;
 mod spread;
 mod stagger;
+mod stagger_hit;
+mod stagger_sweep;
 mod walk;
 
 pub use builder::build;
@@ -48,4 +50,9 @@ pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};
 pub use skeleton_out::SkeletonOut;
 pub use spread::Spread;
 pub use stagger::{STAGGER_HIT, WALK_SPEED, WALK_START, stagger_animation, stagger_walk};
+pub use stagger_hit::{Activity, Side, StaggerHit, Tracking, UPRIGHT_FRACTION};
+pub use stagger_sweep::{
+    STAGGER_IMPULSES, STANDING_HIT_FRAME, StaggerSweep, TRACKED_FRAMES, WALKING_HIT_FRAME,
+    WATCHED_FRAMES,
+};
 pub use walk::Walk;

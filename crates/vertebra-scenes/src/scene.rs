@@ -30,7 +30,7 @@ pub enum Scene {
     /// The anatomical humanoid standing on flat ground with nothing
     /// kinematic, following a standing and then a walking animation with
     /// capped drives ([`crate::stagger_animation`]), hit on the chest
-    /// ([`crate::STAGGER_HIT`]).
+    /// ([`crate::STAGGER_HIT`]; the sweep of hits: [`crate::StaggerSweep`]).
     Stagger,
 }
 

@@ -2,7 +2,8 @@
 //! nothing kinematic, following first a standing animation and then a
 //! walk with its joints' drives and capped world drives
 //! ([`stagger_animation`]); hit on the chest, it staggers and recovers, or
-//! falls. The scene's own run (`run`) walks and takes one hit.
+//! falls. [`crate::StaggerSweep`] hits it harder and harder from every
+//! side; the scene's own run (`run`) walks and takes one hit.
 
 use glam::Vec3;
 use vertebra_collide::{Collider, ColliderShape, Collisions};
