@@ -10,6 +10,7 @@ mod plots;
 mod render;
 mod reproduce;
 mod skeleton_csv;
+mod stagger;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -56,8 +57,12 @@ enum Command {
     /// Runs one scene.
     Scene {
         /// passive-bending, ragdoll-drop, controllability (the paper's),
-        /// hit-reaction, anatomical-drop (the anatomical humanoid), or
-        /// heavy-chain (1 kg links holding a 1000 kg body).
+        /// hit-reaction, anatomical-drop (the anatomical humanoid),
+        /// heavy-chain (1 kg links holding a 1000 kg body), or stagger (the
+        /// anatomical humanoid standing and walking with capped drives,
+        /// hit on the chest: a table of hits of 20 to 150 N s from four
+        /// sides over --seeds, 5 unless given; with --frames, --gltf or
+        /// --skeleton-out, its one run: standing, walking, one hit).
         name: String,
         /// rod (simplified) or sockets (standard).
         #[arg(long)]
@@ -106,7 +111,8 @@ enum Command {
         #[arg(long, default_value_t = f32::INFINITY, allow_negative_numbers = true)]
         max_torque: f32,
         /// Run from K seeds (--seed .. --seed + K - 1) and give every
-        /// figure's median and spread over them.
+        /// figure's median and spread over them (stagger: every hit from
+        /// each seed).
         #[arg(long)]
         seeds: Option<u64>,
         /// Let still islands sleep (the world's default: a body's mass
@@ -296,6 +302,11 @@ fn execute(command: Command) -> Result<(), String> {
             }
             if let (Some(_), Some(_)) = (seeds, &gltf) {
                 return Err("--gltf writes one run; not with --seeds".to_owned());
+            }
+            let one_run = frames.is_some() || skeleton_out.is_some() || gltf.is_some();
+            if scene == Scene::Stagger && !one_run {
+                let count = seeds.unwrap_or(stagger::DEFAULT_SEEDS);
+                return stagger::sweep(&config, count, json);
             }
             if let Some(count) = seeds {
                 let seeded = Seeded::run(&config, count, |_, _| {}).map_err(|e| e.to_string())?;

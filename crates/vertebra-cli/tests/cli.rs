@@ -510,6 +510,56 @@ fn the_new_scenes_run_by_name_and_report_their_figures() {
     assert!(stdout.contains("largest limit violation"), "{stdout}");
 }
 
+/// `scene stagger` sweeps chest hits over seeds and prints a row per hit
+/// and what every seed survived; JSON gives the same; with `--frames` it
+/// is one run like any scene's.
+#[test]
+fn the_stagger_prints_its_sweep_of_hits() {
+    let stagger = ["scene", "stagger", "--spine", "rod", "--seeds", "1"];
+    let (code, stdout, stderr) = vertebra(&stagger);
+    assert_eq!(code, 0, "{stderr}");
+    let rows = stdout
+        .lines()
+        .filter(|l| l.starts_with("standing ") || l.starts_with("walking  "));
+    assert_eq!(rows.count(), 2 * 4 * 7, "{stdout}");
+    assert!(
+        stdout.contains("stagger (rod, direct joints), seeds 0..0"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("largest impulse every seed survived"),
+        "{stdout}"
+    );
+    let mut json = stagger.to_vec();
+    json.push("--json");
+    let (code, stdout, stderr) = vertebra(&json);
+    assert_eq!(code, 0, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    assert_eq!(v["scene"], "stagger");
+    assert_eq!(v["hits"].as_array().unwrap().len(), 2 * 4 * 7);
+    let first = &v["hits"][0];
+    for field in [
+        "activity",
+        "from",
+        "impulse_ns",
+        "seed",
+        "stays_up",
+        "lowest_hips_m",
+        "peak_m",
+    ] {
+        assert!(first.get(field).is_some(), "missing `{field}`");
+    }
+    assert!(v["tracking"]["max_m"].as_f64().unwrap() < 0.05);
+    let front = &v["largest_survived"]["standing"]["front"];
+    assert!(front["impulse_ns"].as_f64().unwrap() >= 40.0, "{front}");
+    let (code, stdout, stderr) = vertebra(&["scene", "stagger", "--spine", "rod", "--frames", "5"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.starts_with("stagger (rod, direct joints):"),
+        "{stdout}"
+    );
+}
+
 /// A shipped model file.
 fn model(name: &str) -> String {
     format!(

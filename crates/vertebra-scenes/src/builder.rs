@@ -5,7 +5,7 @@ use vertebra_ragdoll::{RagdollDesc, RagdollError};
 
 use crate::{
     Scene, SceneConfig, SceneWorld, controllability, heavy_chain, hit_reaction, passive_bending,
-    ragdoll_drop,
+    ragdoll_drop, stagger,
 };
 use vertebra_math::DefaultFloatMode;
 
@@ -21,13 +21,14 @@ pub fn build(config: &SceneConfig) -> Result<SceneWorld, RagdollError> {
         Scene::RagdollDrop | Scene::AnatomicalDrop => ragdoll_drop::build(world, &desc, config),
         Scene::HitReaction => hit_reaction::build(world, &desc, config, &drive),
         Scene::HeavyChain => heavy_chain::build(world, &desc, config),
+        Scene::Stagger => stagger::build(world, &desc, config),
     };
     Ok(built?.watching(config.measure_residuals))
 }
 
 /// The ragdoll `config`'s scene builds: its own, the heavy chain, or the
 /// humanoid its scene is measured on.
-fn description(config: &SceneConfig) -> Result<RagdollDesc, RagdollError> {
+pub(crate) fn description(config: &SceneConfig) -> Result<RagdollDesc, RagdollError> {
     match (config.scene, &config.ragdoll) {
         (Scene::HeavyChain, None) => heavy_chain::heavy_chain(),
         (Scene::HeavyChain, Some(_)) => Err(RagdollError::OutOfRange {

@@ -5,7 +5,7 @@ use core::str::FromStr;
 
 use vertebra_ragdoll::SpineMode;
 
-/// A scene: the paper's three, two on the anatomical humanoid, and a
+/// A scene: the paper's three, three on the anatomical humanoid, and a
 /// chain with a large mass ratio.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Scene {
@@ -27,6 +27,11 @@ pub enum Scene {
     /// across a joint. No spine: built with sockets only (a rod spine is
     /// refused, naming the chain's description).
     HeavyChain,
+    /// The anatomical humanoid standing on flat ground with nothing
+    /// kinematic, following a standing and then a walking animation with
+    /// capped drives ([`crate::stagger_animation`]), hit on the chest
+    /// ([`crate::STAGGER_HIT`]; the sweep of hits: [`crate::StaggerSweep`]).
+    Stagger,
 }
 
 impl Scene {
@@ -38,13 +43,14 @@ impl Scene {
     ];
 
     /// Every simulated scene.
-    pub const ALL: [Scene; 6] = [
+    pub const ALL: [Scene; 7] = [
         Scene::PassiveBending,
         Scene::RagdollDrop,
         Scene::Controllability,
         Scene::HitReaction,
         Scene::AnatomicalDrop,
         Scene::HeavyChain,
+        Scene::Stagger,
     ];
 
     /// The name on the command line.
@@ -56,6 +62,7 @@ impl Scene {
             Scene::HitReaction => "hit-reaction",
             Scene::AnatomicalDrop => "anatomical-drop",
             Scene::HeavyChain => "heavy-chain",
+            Scene::Stagger => "stagger",
         }
     }
 
@@ -75,7 +82,8 @@ impl Scene {
         }
     }
 
-    /// Frames the paper's figure runs (the new scenes: 4 s, 10 s and 5 s).
+    /// Frames the paper's figure runs (the new scenes: 4 s, 10 s, 5 s and
+    /// 8 s).
     pub fn default_frames(self) -> usize {
         match self {
             Scene::PassiveBending => 300,
@@ -84,6 +92,7 @@ impl Scene {
             Scene::HitReaction => 240,
             Scene::AnatomicalDrop => 600,
             Scene::HeavyChain => 300,
+            Scene::Stagger => 480,
         }
     }
 }
@@ -98,7 +107,7 @@ impl FromStr for Scene {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         Scene::ALL.into_iter().find(|x| x.name() == s).ok_or_else(|| {
-            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability, hit-reaction, anatomical-drop or heavy-chain)")
+            format!("unknown scene `{s}` (expected passive-bending, ragdoll-drop, controllability, hit-reaction, anatomical-drop, heavy-chain or stagger)")
         })
     }
 }

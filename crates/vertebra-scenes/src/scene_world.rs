@@ -8,7 +8,7 @@ use vertebra_collide::Collisions;
 use vertebra_ragdoll::{Pose, Ragdoll, RagdollError};
 use vertebra_world::{BodyHandle, Contact, JointHandle, RodHandle, World};
 
-use crate::{Frame, Scene};
+use crate::{Following, Frame, Scene};
 use vertebra_math::{DefaultFloatMode, PortableQuat};
 
 /// A built scene: its world, collisions and ragdolls, and what is
@@ -29,6 +29,9 @@ pub struct SceneWorld {
     /// Impulses: (frame, body, impulse in N s through its centre of mass),
     /// applied before that frame's step (the hit reaction).
     pub hits: Vec<(usize, BodyHandle, Vec3)>,
+    /// The animation the first ragdoll follows before each step (the
+    /// stagger), or `None`.
+    pub following: Option<Following>,
     /// The joints the residual error counts: the ragdolls' own (not the
     /// pins holding hips in place) and any the scene adds
     /// ([`Self::with_joints`]).
@@ -60,6 +63,7 @@ impl SceneWorld {
             target,
             push,
             hits: Vec::new(),
+            following: None,
             joints,
             rods,
             contacts: Vec::new(),
@@ -83,6 +87,12 @@ impl SceneWorld {
     /// With `hits` ([`Self::hits`]).
     pub(crate) fn with_hits(mut self, hits: Vec<(usize, BodyHandle, Vec3)>) -> Self {
         self.hits = hits;
+        self
+    }
+
+    /// With the first ragdoll following `following` ([`Self::following`]).
+    pub(crate) fn with_following(mut self, following: Following) -> Self {
+        self.following = Some(following);
         self
     }
 
@@ -119,8 +129,9 @@ impl SceneWorld {
 
     /// Frame `frame` of the scene, `dt` seconds, and nothing that watches
     /// it: collision detection, the push of figure 7 (controllability,
-    /// frames 30 to 90), the hits due this frame, the step. What a game
-    /// pays for the frame ([`SceneRun::frame_ms`](crate::SceneRun::frame_ms)).
+    /// frames 30 to 90), the hits due this frame, the drives set to follow
+    /// the animation (the stagger), the step. What a game pays for the
+    /// frame ([`SceneRun::frame_ms`](crate::SceneRun::frame_ms)).
     pub fn frame(&mut self, scene: Scene, frame: usize, dt: f32) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
         self.detect(dt)?;
@@ -131,6 +142,9 @@ impl SceneWorld {
         }
         for &(_, body, impulse) in self.hits.iter().filter(|h| h.0 == frame) {
             self.world.apply_impulse(body, impulse)?;
+        }
+        if let (Some(following), Some(ragdoll)) = (&self.following, self.ragdolls.first()) {
+            following.follow(ragdoll, &mut self.world, frame, dt)?;
         }
         Ok(self.world.step(dt)?)
     }

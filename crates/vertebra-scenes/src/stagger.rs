@@ -1,0 +1,148 @@
+//! The stagger: the anatomical humanoid standing on flat ground with
+//! nothing kinematic, following first a standing animation and then a
+//! walk with its joints' drives and capped world drives
+//! ([`stagger_animation`]); hit on the chest, it staggers and recovers, or
+//! falls. [`crate::StaggerSweep`] hits it harder and harder from every
+//! side; the scene's own run (`run`) walks and takes one hit.
+
+use glam::Vec3;
+use vertebra_collide::{Collider, ColliderShape, Collisions};
+use vertebra_ragdoll::{
+    BuildOptions, DriveSettings, PhysicalAnimation, Ragdoll, RagdollDesc, RagdollError, Upright,
+    WorldDriveSettings,
+};
+use vertebra_world::{BodyDesc, Spring, World};
+
+use crate::setup::spine_top;
+use crate::{Following, Gait, SceneConfig, SceneWorld, Walk};
+
+/// The walk's speed once its ramp is over (m/s).
+pub const WALK_SPEED: f32 = 1.5;
+
+/// When the walk starts (s): standing before.
+pub const WALK_START: f32 = 1.0;
+
+/// The scene's own run: the frame whose step its one hit precedes (5 s:
+/// 2.5 s into full speed) and the hit (N s, world): from the front.
+pub const STAGGER_HIT: (usize, Vec3) = (300, Vec3::new(0.0, 0.0, -40.0));
+
+/// Gravity's pull (m/s^2), against which the world drives' force caps are
+/// set.
+const G: f32 = 9.81;
+
+fn critical(frequency: f32) -> Spring {
+    Spring::Frequency {
+        frequency,
+        damping_ratio: 1.0,
+    }
+}
+
+/// How the stagger's ragdoll follows its animation, standing and walking:
+/// every joint at 8 Hz, critically damped, its torque capped at 300 N m,
+/// but those that carry the weight (the legs' and the spine's: every joint
+/// not below the top of the spine) at 120 Hz, stiff enough under either
+/// joint solve that only their caps let a hit bend them; every body pulled
+/// toward its pose at 2 Hz with a force cap of half its weight (all caps
+/// together carry half the ragdoll: it stands and walks on its legs) and
+/// 20 N m; the hips and the chest (the top of the spine) kept upright at
+/// 2 Hz (100 N m).
+pub fn stagger_animation(desc: &RagdollDesc) -> PhysicalAnimation {
+    let top = spine_top(desc);
+    let upright = |body: usize| Upright {
+        body,
+        strength: critical(2.0),
+        max_torque: 100.0,
+    };
+    let carrying = (desc.joints.iter())
+        .map(|j| (!below(desc, j.child, top)).then_some(critical(120.0)))
+        .collect();
+    PhysicalAnimation {
+        joints: DriveSettings {
+            joints: carrying,
+            ..DriveSettings::uniform(critical(8.0)).with_max_torque(300.0)
+        },
+        world: WorldDriveSettings {
+            linear: Some(critical(2.0)),
+            angular: Some(critical(2.0)),
+            max_acceleration: 0.5 * G,
+            max_torque: 20.0,
+            uprights: vec![upright(desc.root), upright(top)],
+        },
+    }
+}
+
+/// Whether `body` hangs below `top` (not `top` itself).
+fn below(desc: &RagdollDesc, mut body: usize, top: usize) -> bool {
+    while let Some(j) = desc.parent_joint[body] {
+        body = desc.joints[j].parent;
+        if body == top {
+            return true;
+        }
+    }
+    false
+}
+
+/// The stagger's animation on `desc`: standing until `start` (s), then
+/// walking at [`WALK_SPEED`] (infinity: standing throughout), placed as
+/// the scene places its ragdoll for `seed`: its lowest point 1 mm above
+/// the ground, moved and turned by the seed's perturbation.
+pub fn stagger_walk(desc: &RagdollDesc, seed: u64, start: f32) -> Result<Walk, RagdollError> {
+    let low = (desc.bodies.iter())
+        .map(|b| b.segment[0].y.min(b.segment[1].y) - b.radius)
+        .fold(f32::MAX, f32::min);
+    let lift = Vec3::new(0.0, 0.001 - low, 0.0);
+    let (offset, turn) = crate::seed::perturbation(seed, 0);
+    Ok(Walk::new(desc, Gait::walk(WALK_SPEED), start)?.placed(turn, lift + offset))
+}
+
+/// The scene's world: a static ground plane at y = 0 and the ragdoll at
+/// its animation's first pose, following `walk` with `animation`'s
+/// drives.
+pub(crate) fn stagger_world(
+    mut world: World,
+    desc: &RagdollDesc,
+    config: &SceneConfig,
+    walk: Walk,
+    animation: PhysicalAnimation,
+) -> Result<SceneWorld, RagdollError> {
+    let mut collisions = Collisions::new();
+    let ground = world.add_body(BodyDesc::fixed())?;
+    collisions.add(Collider::new(ground, ColliderShape::Plane(Vec3::Y)))?;
+    let pose = walk.pose(desc, 0.0)?;
+    let ragdoll = Ragdoll::build(
+        &mut world,
+        desc,
+        BuildOptions::new(config.spine),
+        &pose,
+        None,
+    )?;
+    collisions.add_ragdoll(&ragdoll)?;
+    let following = Following {
+        desc: desc.clone(),
+        walk,
+        animation,
+    };
+    Ok(
+        SceneWorld::new(world, Some(collisions), vec![ragdoll], None, None)
+            .with_following(following),
+    )
+}
+
+/// The scene's own run: standing for [`WALK_START`], then walking; the
+/// chest hit by [`STAGGER_HIT`].
+pub(crate) fn build(
+    world: World,
+    desc: &RagdollDesc,
+    config: &SceneConfig,
+) -> Result<SceneWorld, RagdollError> {
+    let walk = stagger_walk(desc, config.seed, WALK_START)?;
+    let scene = stagger_world(world, desc, config, walk, stagger_animation(desc))?;
+    let chest =
+        scene.ragdolls[0].bodies[spine_top(desc)].ok_or_else(|| RagdollError::UnknownBody {
+            context: "scene stagger (the body hit)".to_owned(),
+            field: "body",
+            name: "chest".to_owned(),
+        })?;
+    let (frame, impulse) = STAGGER_HIT;
+    Ok(scene.with_hits(vec![(frame, chest, impulse)]))
+}
