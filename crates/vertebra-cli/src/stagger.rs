@@ -9,7 +9,7 @@ use std::time::Instant;
 use serde_json::{Value, json};
 use vertebra_ragdoll::RagdollDesc;
 use vertebra_scenes::{
-    Activity, STAGGER_IMPULSES, SceneConfig, Side, StaggerHit, StaggerSweep, stagger_animation,
+    Activity, STAGGER_IMPULSES, SceneConfig, Side, StaggerHit, StaggerSweep, stagger_profile,
 };
 
 use crate::output::{joints_name, spine_name};
@@ -27,7 +27,7 @@ pub fn sweep(config: &SceneConfig, count: u64, json: bool) -> Result<(), String>
         .ragdoll
         .clone()
         .unwrap_or_else(RagdollDesc::anatomical_humanoid);
-    let animation = stagger_animation(&desc);
+    let animation = stagger_profile(&desc).map_err(|e| e.to_string())?;
     let started = Instant::now();
     let sweep = StaggerSweep::run(config, &animation, config.seed..end, &STAGGER_IMPULSES)
         .map_err(|e| e.to_string())?;

@@ -1,5 +1,5 @@
-//! Profiles in a description file: `[[profile]]` tables, each a name, the
-//! joints' drive, the bodies' world drive, uprights, and `[[profile.bone]]`
+//! Profiles in a description file: `[[profile]]` tables, each a name, an
+//! optional `base` (an earlier profile it starts from), the joints' drive, the bodies' world drive, uprights, and `[[profile.bone]]`
 //! tables that change a body (and, with `below = true`, every body below
 //! it) in file order, resolved into a [`Profile`] once the joint tree
 //! stands; and profiles fitted to a description (made limp, scaled per
@@ -48,6 +48,7 @@ impl ProfileSource {
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawProfile {
     name: String,
+    base: Option<String>,
     joints: Option<RawDrive>,
     world: Option<RawWorld>,
     #[serde(default)]
@@ -94,19 +95,39 @@ struct RawProfileBone {
 /// The profile `raw` gives `desc` (its joint tree standing); errors name
 /// `context` (the profile), an upright or a bone table by its index.
 fn resolve(raw: &RawProfile, desc: &RagdollDesc, context: &str) -> Result<Profile, RagdollError> {
-    let joint = match &raw.joints {
-        Some(d) => joint_setting(d, JointDriveSetting::NONE, &format!("{context} joints"))?,
-        None => JointDriveSetting::NONE,
+    let mut profile = match &raw.base {
+        Some(base) => {
+            let found = desc.profile(base).ok_or_else(|| RagdollError::OutOfRange {
+                context: context.to_owned(),
+                field: "base",
+                reason: format!("names `{base}`, which is no profile above this one"),
+            })?;
+            Profile {
+                name: raw.name.clone(),
+                ..found.clone()
+            }
+        }
+        None => Profile {
+            name: raw.name.clone(),
+            joints: vec![JointDriveSetting::NONE; desc.joints.len()],
+            bodies: vec![BodyDriveSetting::NONE; desc.bodies.len()],
+        },
     };
-    let body = match &raw.world {
-        Some(w) => world_setting(w, BodyDriveSetting::NONE, &format!("{context} world"))?,
-        None => BodyDriveSetting::NONE,
-    };
-    let mut profile = Profile {
-        name: raw.name.clone(),
-        joints: vec![joint; desc.joints.len()],
-        bodies: vec![body; desc.bodies.len()],
-    };
+    if let Some(d) = &raw.joints {
+        let context = format!("{context} joints");
+        for j in &mut profile.joints {
+            *j = joint_setting(d, *j, &context)?;
+        }
+    }
+    if let Some(w) = &raw.world {
+        let context = format!("{context} world");
+        for b in &mut profile.bodies {
+            *b = world_setting(w, *b, &context)?;
+        }
+    }
+    // A based profile's uprights may be given again; one table gives a
+    // body at most one.
+    let named: Vec<&str> = raw.upright.iter().map(|u| u.body.as_str()).collect();
     let mut multipliers = vec![1.0_f32; desc.bodies.len()];
     for (k, bone) in raw.bone.iter().enumerate() {
         let context = format!("{context} bone {k}");
@@ -129,7 +150,7 @@ fn resolve(raw: &RawProfile, desc: &RagdollDesc, context: &str) -> Result<Profil
     for (k, u) in raw.upright.iter().enumerate() {
         let context = format!("{context} upright {k}");
         let b = body_named(desc, &u.body, &context)?;
-        let once = profile.bodies[b].upright.is_none();
+        let once = !named[..k].contains(&u.body.as_str());
         range(
             &context,
             "body",

@@ -47,12 +47,24 @@ fn a_bone_table_scales_its_subtree_by_its_multiplier() {
     let hit = desc.profile("hit").unwrap();
     let joint = |name: &str| desc.joint_index(name).unwrap();
     let body = |name: &str| desc.body_index(name).unwrap();
-    // Standing: every joint 8 Hz, 300 N m; every body 2 Hz, 4.905 N/kg.
-    assert!(standing.joints.iter().all(|j| *j
-        == JointDriveSetting {
-            strength: Some(frequency(8.0, 1.0)),
+    // Standing: the legs and spine at 120 Hz, the neck and the arms (the
+    // bone tables, one with the bodies below it) at 8 Hz, all 300 N m.
+    let arms = ["neck", "shoulder_l", "elbow_l", "shoulder_r", "elbow_r"];
+    for (j, setting) in desc.joints.iter().zip(&standing.joints) {
+        let f = if arms.contains(&j.name.as_str()) {
+            8.0
+        } else {
+            120.0
+        };
+        let want = JointDriveSetting {
+            strength: Some(frequency(f, 1.0)),
             max_torque: 300.0,
-        }));
+        };
+        assert_eq!(*setting, want, "{}", j.name);
+    }
+    // Hit is based on standing: its uprights are standing's, at half.
+    let upright = hit.bodies[body("chest")].upright.unwrap();
+    assert!(close(upright.max_torque, 50.0), "{upright:?}");
     // Hit: the arms and everything below them at 0.2 (later tables win
     // over the hips' 0.5 that covers the whole body), the head at 0.2, the
     // rest at 0.5. A multiplier scales stiffness, damping and caps.
@@ -238,10 +250,10 @@ fn refused_profiles_name_the_table_and_change_nothing() {
         assert_ne!(text, ANATOMICAL_HUMANOID, "{from}");
         RagdollDesc::from_toml(&text).unwrap_err().to_string()
     };
-    let hit = at("name = \"hit\"") - 1;
+    let standing = at("name = \"standing\"") - 1;
     let e = refused("body = \"upper_arm_l\"\nbelow", "body = \"wing\"\nbelow");
     assert!(
-        e.starts_with(&format!("line {hit}: profile `hit` bone 1")) && e.contains("wing"),
+        e.starts_with(&format!("line {standing}: profile `standing` bone 1")) && e.contains("wing"),
         "{e}"
     );
     let e = refused("strength_multiplier = 0.2", "strength_multiplier = 1.5");
@@ -249,11 +261,16 @@ fn refused_profiles_name_the_table_and_change_nothing() {
         e.contains("profile `hit` bone 1") && e.contains("strength_multiplier"),
         "{e}"
     );
+    let e = refused("base = \"standing\"", "base = \"running\"");
+    assert!(
+        e.contains("profile `hit`") && e.contains("base") && e.contains("running"),
+        "{e}"
+    );
     let e = refused("name = \"limp\"", "name = \"hit\"");
     assert!(e.contains("hit") && e.contains("profile"), "{e}");
     let e = refused(
-        "{ body = \"chest\", frequency = 2.0, damping_ratio = 1.0, max_torque = 100.0 },\n]\n\n# Hit",
-        "{ body = \"hips\", frequency = 2.0, damping_ratio = 1.0, max_torque = 100.0 },\n]\n\n# Hit",
+        "{ body = \"chest\", frequency = 2.0, damping_ratio = 1.0, max_torque = 100.0 },\n]",
+        "{ body = \"hips\", frequency = 2.0, damping_ratio = 1.0, max_torque = 100.0 },\n]",
     );
     assert!(
         e.contains("profile `standing` upright 1") && e.contains("body"),
@@ -265,7 +282,7 @@ fn refused_profiles_name_the_table_and_change_nothing() {
         "{e}"
     );
     let e = refused(
-        "joints = { frequency = 8.0, damping_ratio = 1.0, max_torque = 300.0 }",
+        "joints = { frequency = 120.0, damping_ratio = 1.0, max_torque = 300.0 }",
         "joints = { frequency = 0.0, damping_ratio = 1.0 }",
     );
     assert!(

@@ -1,9 +1,9 @@
 //! A ragdoll following an animation frame by frame with its joints' and
-//! world drives (`Ragdoll::follow`): what a scene with a powered ragdoll
+//! world drives (`Ragdoll::follow_profile`): what a scene with a powered ragdoll
 //! does before each step.
 
 use glam::Vec3;
-use vertebra_ragdoll::{PhysicalAnimation, Ragdoll, RagdollDesc, RagdollError};
+use vertebra_ragdoll::{Profile, Ragdoll, RagdollDesc, RagdollError};
 use vertebra_world::World;
 
 use crate::Walk;
@@ -16,7 +16,7 @@ pub struct Following {
     /// The animation: a walk, or (starting at infinity) standing.
     pub walk: Walk,
     /// The drives' settings.
-    pub animation: PhysicalAnimation,
+    pub animation: Profile,
 }
 
 impl Following {
@@ -33,7 +33,7 @@ impl Following {
     ) -> Result<(), RagdollError> {
         let prev = self.walk.pose(&self.desc, frame as f32 * dt)?;
         let pose = self.walk.pose(&self.desc, (frame + 1) as f32 * dt)?;
-        ragdoll.follow(world, (&prev, &pose), dt, &self.animation)
+        ragdoll.follow_profile(world, (&prev, &pose), dt, &self.animation)
     }
 
     /// Where the animation has the hips at the end of frame `frame` (m,

@@ -29,7 +29,7 @@ pub enum Scene {
     HeavyChain,
     /// The anatomical humanoid standing on flat ground with nothing
     /// kinematic, following a standing and then a walking animation with
-    /// capped drives ([`crate::stagger_animation`]), hit on the chest
+    /// capped drives ([`crate::stagger_profile`]), hit on the chest
     /// ([`crate::STAGGER_HIT`]; the sweep of hits: [`crate::StaggerSweep`]).
     Stagger,
 }

@@ -1,17 +1,14 @@
 //! The stagger: the anatomical humanoid standing on flat ground with
 //! nothing kinematic, following first a standing animation and then a
 //! walk with its joints' drives and capped world drives
-//! ([`stagger_animation`]); hit on the chest, it staggers and recovers, or
+//! ([`stagger_profile`]); hit on the chest, it staggers and recovers, or
 //! falls. [`crate::StaggerSweep`] hits it harder and harder from every
 //! side; the scene's own run (`run`) walks and takes one hit.
 
 use glam::Vec3;
 use vertebra_collide::{Collider, ColliderShape, Collisions};
-use vertebra_ragdoll::{
-    BuildOptions, DriveSettings, PhysicalAnimation, Ragdoll, RagdollDesc, RagdollError, Upright,
-    WorldDriveSettings,
-};
-use vertebra_world::{BodyDesc, Spring, World};
+use vertebra_ragdoll::{BuildOptions, Profile, Ragdoll, RagdollDesc, RagdollError};
+use vertebra_world::{BodyDesc, World};
 
 use crate::setup::spine_top;
 use crate::{Following, Gait, SceneConfig, SceneWorld, Walk};
@@ -26,60 +23,22 @@ pub const WALK_START: f32 = 1.0;
 /// 2.5 s into full speed) and the hit (N s, world): from the front.
 pub const STAGGER_HIT: (usize, Vec3) = (300, Vec3::new(0.0, 0.0, -40.0));
 
-/// Gravity's pull (m/s^2), against which the world drives' force caps are
-/// set.
-const G: f32 = 9.81;
-
-fn critical(frequency: f32) -> Spring {
-    Spring::Frequency {
-        frequency,
-        damping_ratio: 1.0,
-    }
-}
-
 /// How the stagger's ragdoll follows its animation, standing and walking:
-/// every joint at 8 Hz, critically damped, its torque capped at 300 N m,
-/// but those that carry the weight (the legs' and the spine's: every joint
-/// not below the top of the spine) at 120 Hz, stiff enough under either
-/// joint solve that only their caps let a hit bend them; every body pulled
-/// toward its pose at 2 Hz with a force cap of half its weight (all caps
-/// together carry half the ragdoll: it stands and walks on its legs) and
-/// 20 N m; the hips and the chest (the top of the spine) kept upright at
-/// 2 Hz (100 N m).
-pub fn stagger_animation(desc: &RagdollDesc) -> PhysicalAnimation {
-    let top = spine_top(desc);
-    let upright = |body: usize| Upright {
-        body,
-        strength: critical(2.0),
-        max_torque: 100.0,
-    };
-    let carrying = (desc.joints.iter())
-        .map(|j| (!below(desc, j.child, top)).then_some(critical(120.0)))
-        .collect();
-    PhysicalAnimation {
-        joints: DriveSettings {
-            joints: carrying,
-            ..DriveSettings::uniform(critical(8.0)).with_max_torque(300.0)
-        },
-        world: WorldDriveSettings {
-            linear: Some(critical(2.0)),
-            angular: Some(critical(2.0)),
-            max_acceleration: 0.5 * G,
-            max_torque: 20.0,
-            uprights: vec![upright(desc.root), upright(top)],
-        },
-    }
-}
-
-/// Whether `body` hangs below `top` (not `top` itself).
-fn below(desc: &RagdollDesc, mut body: usize, top: usize) -> bool {
-    while let Some(j) = desc.parent_joint[body] {
-        body = desc.joints[j].parent;
-        if body == top {
-            return true;
-        }
-    }
-    false
+/// the description's `standing` profile (the anatomical humanoid's: the
+/// legs and spine, which carry the weight, at 120 Hz, stiff enough under
+/// either joint solve that only their 300 N m caps let a hit bend them;
+/// the neck and arms at 8 Hz; every body pulled toward its pose at 2 Hz
+/// with a force cap of half its weight, so it stands and walks on its
+/// legs, and 20 N m; hips and chest kept upright at 2 Hz, 100 N m).
+/// Refused for a description without one.
+pub fn stagger_profile(desc: &RagdollDesc) -> Result<Profile, RagdollError> {
+    desc.profile("standing")
+        .cloned()
+        .ok_or_else(|| RagdollError::OutOfRange {
+            context: format!("ragdoll `{}`", desc.name),
+            field: "profile",
+            reason: "`standing` is missing; the stagger follows it".to_owned(),
+        })
 }
 
 /// The stagger's animation on `desc`: standing until `start` (s), then
@@ -103,7 +62,7 @@ pub(crate) fn stagger_world(
     desc: &RagdollDesc,
     config: &SceneConfig,
     walk: Walk,
-    animation: PhysicalAnimation,
+    animation: Profile,
 ) -> Result<SceneWorld, RagdollError> {
     let mut collisions = Collisions::new();
     let ground = world.add_body(BodyDesc::fixed())?;
@@ -136,7 +95,7 @@ pub(crate) fn build(
     config: &SceneConfig,
 ) -> Result<SceneWorld, RagdollError> {
     let walk = stagger_walk(desc, config.seed, WALK_START)?;
-    let scene = stagger_world(world, desc, config, walk, stagger_animation(desc))?;
+    let scene = stagger_world(world, desc, config, walk, stagger_profile(desc)?)?;
     let chest =
         scene.ragdolls[0].bodies[spine_top(desc)].ok_or_else(|| RagdollError::UnknownBody {
             context: "scene stagger (the body hit)".to_owned(),

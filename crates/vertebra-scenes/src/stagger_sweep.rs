@@ -10,7 +10,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 use vertebra_collide::CollisionSnapshot;
 use vertebra_math::DefaultFloatMode;
-use vertebra_ragdoll::{PhysicalAnimation, RagdollError};
+use vertebra_ragdoll::{Profile, RagdollError};
 use vertebra_world::Snapshot;
 
 use crate::setup::spine_top;
@@ -53,14 +53,14 @@ impl StaggerSweep {
     /// The sweep of `config` (its spine, solver, backend, threads and
     /// ragdoll; `config.scene` and `config.frames` are not read), the
     /// ragdoll following its animation with `animation`'s drives
-    /// ([`crate::stagger_animation`]), from `seeds` (1 to [`MAX_SEEDS`]),
+    /// ([`crate::stagger_profile`]), from `seeds` (1 to [`MAX_SEEDS`]),
     /// with `sizes` (N s, finite, not negative), seeds spread over rayon's
     /// global pool (each run is deterministic, so the result does not
     /// depend on how many run at once). Refused, naming the field, for
     /// seeds or sizes out of range and whatever [`crate::build`] refuses.
     pub fn run(
         config: &SceneConfig,
-        animation: &PhysicalAnimation,
+        animation: &Profile,
         seeds: Range<u64>,
         sizes: &[f32],
     ) -> Result<Self, RagdollError> {
@@ -133,7 +133,7 @@ impl StaggerSweep {
 /// One seed's hits, walk, and the hips' standing height.
 fn seeded(
     config: &SceneConfig,
-    animation: &PhysicalAnimation,
+    animation: &Profile,
     seed: u64,
     sizes: &[f32],
 ) -> Result<(Vec<StaggerHit>, Tracking, f32), RagdollError> {

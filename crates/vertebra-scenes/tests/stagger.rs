@@ -1,6 +1,7 @@
 //! The stagger: the anatomical humanoid on flat ground with nothing
 //! kinematic, following a standing and then a walking animation with its
-//! joints' drives and capped world drives (`stagger_animation`). The walk
+//! joints' drives and capped world drives (the description's
+//! `standing` profile: `stagger_profile`). The walk
 //! is a gait (its feet planted while down, its hips bobbing, its arms
 //! against its legs) that starts from standing without a jump; the
 //! ragdoll stands, walks at 1.5 m/s with its hips near the animation's,
@@ -11,7 +12,7 @@ use glam::Vec3;
 use vertebra_ragdoll::{Pose, RagdollDesc, SpineMode};
 use vertebra_scenes::{
     Activity, FRAME_DT, Scene, SceneConfig, Side, StaggerSweep, WALK_SPEED, WALK_START, Walk,
-    build, stagger_animation, stagger_walk,
+    build, stagger_profile, stagger_walk,
 };
 use vertebra_world::{JointSolver, SolverConfig};
 
@@ -159,8 +160,8 @@ fn the_walk_is_a_gait_at_its_speed() {
 #[test]
 fn the_world_drives_caps_stay_under_the_ragdolls_weight() {
     let desc = RagdollDesc::anatomical_humanoid();
-    let animation = stagger_animation(&desc);
-    assert!(animation.world.max_acceleration < G);
+    let profile = stagger_profile(&desc).unwrap();
+    assert!(profile.bodies.iter().all(|b| b.max_acceleration < G));
     let mut scene = build(&config(SpineMode::Sockets, JointSolver::Direct)).unwrap();
     scene.frame(Scene::Stagger, 0, FRAME_DT).unwrap();
     let bodies = scene.ragdolls[0].bodies.iter().flatten();
@@ -203,7 +204,7 @@ fn it_stands_for_a_minute_with_its_hips_within_2_cm() {
 #[test]
 fn it_walks_within_5_cm_and_recovers_from_a_40_n_s_hit_from_every_side() {
     let desc = RagdollDesc::anatomical_humanoid();
-    let animation = stagger_animation(&desc);
+    let animation = stagger_profile(&desc).unwrap();
     for spine in SPINES {
         for joints in SOLVES {
             let config = config(spine, joints);
