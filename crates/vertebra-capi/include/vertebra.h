@@ -1736,8 +1736,9 @@ enum VtResult vt_profile_blend_switch(struct VtProfileBlend *blend,
 // Blends over `duration` seconds to the profile the blend is heading for
 // with described body `body`'s drives (and, if `below` is non-zero,
 // every body's below it) scaled by `multiplier` (0..1): a limb fading
-// out as a hit lands. Refused, unchanged, for a body out of range or a
-// multiplier or duration out of range.
+// out as a hit lands (scaling the same body again compounds: 0.5 twice is
+// 0.25). Refused, unchanged, for a body out of range or a multiplier or
+// duration out of range.
 //
 // # Safety
 // `blend` is live.

@@ -123,17 +123,19 @@ impl Ragdoll {
             format!("joint `{}`", joints[k].name)
         })?;
         let settings = settings.joint_settings(joints.len());
-        let drives = self.joint_drives(target, from, &settings)?;
+        let drives = self.joint_drives(world, target, from, &settings)?;
         self.set_joint_drives(world, drives)
     }
 
     /// Every joint's drive and the rod's shape toward `target` (from
     /// `from`, following), each made and checked; nothing set yet, so a
-    /// refused call changes nothing. `settings` holds one entry per
+    /// refused call changes nothing (a joint or rod no longer in `world`
+    /// included). `settings` holds one entry per
     /// described joint (the caller checked them); the rod takes the spine's
     /// first joint's.
     pub(crate) fn joint_drives(
         &self,
+        world: &World,
         target: &Pose,
         from: Option<(&Pose, f32)>,
         settings: &[JointDriveSetting],
@@ -156,6 +158,7 @@ impl Ragdoll {
                 continue;
             };
             let world_error = |e| RagdollError::world(&format!("joint `{}`", j.name), e);
+            world.joint(*joint).map_err(world_error)?;
             let Some(strength) = setting.strength else {
                 sockets.push((*joint, None));
                 continue;
@@ -172,6 +175,8 @@ impl Ragdoll {
         }
         let rod = match (self.rod, self.rod_rest, &self.desc.spine) {
             (Some(rod), Some(rest), Some(spine)) => {
+                let rod_error = |e| RagdollError::world(&rod_name(&self.desc), e);
+                world.rod(rod).map_err(rod_error)?;
                 let setting = settings[spine.joints[0]];
                 let shape = setting
                     .strength

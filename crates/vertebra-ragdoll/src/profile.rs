@@ -248,79 +248,121 @@ pub(crate) fn check_multiplier(context: &str, multiplier: f32) -> Result<(), Rag
     )
 }
 
-/// A spring's stiffness and damping as a force law: for a frequency, per
-/// unit of the inertia it acts on (`(2 pi f)^2`, `2 z (2 pi f)`); for a
-/// compliance, `1 / c` and its damping.
-fn force_law(s: Spring) -> (f32, f32) {
+/// `s` with its force scaled by `w` in (0, 1): stiffness and damping both
+/// (`f sqrt(w)`, `z sqrt(w)` for a frequency, so nothing is squared and
+/// nothing overflows; `c / w`, `d w` for a compliance); `None` once too
+/// weak for the world (a frequency below its least, a compliance past
+/// `f32`).
+fn scaled(s: Spring, w: f32) -> Option<Spring> {
+    if w >= 1.0 {
+        return Some(s);
+    }
+    if w <= 0.0 {
+        return None;
+    }
     match s {
         Spring::Frequency {
             frequency,
             damping_ratio,
         } => {
-            let omega = core::f32::consts::TAU * frequency;
-            (omega * omega, 2.0 * damping_ratio * omega)
+            let root = w.sqrt();
+            let frequency = frequency * root;
+            (frequency >= vertebra_world::MIN_DRIVE_FREQUENCY).then_some(Spring::Frequency {
+                frequency,
+                damping_ratio: damping_ratio * root,
+            })
         }
         Spring::Compliance {
             compliance,
             damping,
-        } => (1.0 / compliance, damping),
-    }
-}
-
-/// The spring of `law` in the kind of `like`; `None` if it is too weak to
-/// act (a frequency below the world's least).
-fn spring_of((stiffness, damping): (f32, f32), like: Spring) -> Option<Spring> {
-    match like {
-        Spring::Frequency { .. } => {
-            let omega = stiffness.sqrt();
-            let frequency = omega / core::f32::consts::TAU;
-            (frequency >= vertebra_world::MIN_DRIVE_FREQUENCY).then(|| Spring::Frequency {
-                frequency,
-                damping_ratio: damping / (2.0 * omega),
+        } => {
+            let compliance = compliance / w;
+            compliance.is_finite().then_some(Spring::Compliance {
+                compliance,
+                damping: damping * w,
             })
         }
-        Spring::Compliance { .. } => (stiffness > 0.0).then(|| Spring::Compliance {
-            compliance: 1.0 / stiffness,
-            damping,
-        }),
     }
 }
 
-fn lerp(x: f32, y: f32, a: f32) -> f32 {
-    if x == y { x } else { x + (y - x) * a }
+/// Two springs of one kind between `x` (at `a = 0`) and `y` (at `a = 1`),
+/// `a` strictly between: their stiffnesses and dampings interpolated, in
+/// `f64` (a frequency's stiffness is its square). A rigid one (an infinite
+/// frequency, a zero compliance) stays rigid while it has any weight.
+fn interpolated(x: Spring, y: Spring, a: f32) -> Option<Spring> {
+    let a = f64::from(a);
+    let lerp = |p: f64, q: f64| p + (q - p) * a;
+    match (x, y) {
+        (
+            Spring::Frequency {
+                frequency: fx,
+                damping_ratio: zx,
+            },
+            Spring::Frequency {
+                frequency: fy,
+                damping_ratio: zy,
+            },
+        ) => {
+            if fx.is_infinite() || fy.is_infinite() {
+                let z = if fx.is_infinite() { zx } else { zy };
+                return Some(Spring::Frequency {
+                    frequency: f32::INFINITY,
+                    damping_ratio: z,
+                });
+            }
+            let (fx, fy) = (f64::from(fx), f64::from(fy));
+            let stiffness = lerp(fx * fx, fy * fy);
+            let damping = lerp(f64::from(zx) * fx, f64::from(zy) * fy);
+            let frequency = stiffness.sqrt();
+            Some(Spring::Frequency {
+                frequency: frequency as f32,
+                damping_ratio: (damping / frequency) as f32,
+            })
+        }
+        (
+            Spring::Compliance {
+                compliance: cx,
+                damping: dx,
+            },
+            Spring::Compliance {
+                compliance: cy,
+                damping: dy,
+            },
+        ) => {
+            let damping = lerp(f64::from(dx), f64::from(dy)) as f32;
+            if cx == 0.0 || cy == 0.0 {
+                return Some(Spring::Compliance {
+                    compliance: 0.0,
+                    damping,
+                });
+            }
+            let stiffness = lerp(1.0 / f64::from(cx), 1.0 / f64::from(cy));
+            Some(Spring::Compliance {
+                compliance: (1.0 / stiffness) as f32,
+                damping,
+            })
+        }
+        _ => None,
+    }
 }
 
 /// A strength between `x` (at `a = 0`) and `y` (at `a = 1`): the force
-/// laws interpolated when both are of one kind (a rigid one stays rigid
-/// while it has any weight), one scaled by its weight when the other is
-/// none, and when their kinds differ, `x` faded out over the first half
-/// and `y` in over the second.
+/// laws interpolated when both are of one kind, one scaled by its weight
+/// when the other is none, and when their kinds differ, `x` faded out
+/// over the first half and `y` in over the second.
 fn blended(x: Option<Spring>, y: Option<Spring>, a: f32) -> Option<Spring> {
-    let scaled = |s: Spring, w: f32| {
-        let (k, d) = force_law(s);
-        if w >= 1.0 {
-            Some(s)
-        } else if w <= 0.0 {
-            None
-        } else {
-            spring_of((k * w, d * w), s)
-        }
-    };
+    if a <= 0.0 {
+        return x;
+    }
+    if a >= 1.0 {
+        return y;
+    }
     match (x, y) {
         (None, None) => None,
         (Some(x), None) => scaled(x, 1.0 - a),
         (None, Some(y)) => scaled(y, a),
-        (Some(x), Some(_)) if a <= 0.0 => Some(x),
-        (Some(_), Some(y)) if a >= 1.0 => Some(y),
         (Some(x), Some(y)) if core::mem::discriminant(&x) == core::mem::discriminant(&y) => {
-            let ((kx, dx), (ky, dy)) = (force_law(x), force_law(y));
-            if kx.is_infinite() || ky.is_infinite() {
-                return Some(Spring::Compliance {
-                    compliance: 0.0,
-                    damping: lerp(dx, dy, a),
-                });
-            }
-            spring_of((lerp(kx, ky, a), lerp(dx, dy, a)), y)
+            interpolated(x, y, a)
         }
         (Some(x), Some(y)) => {
             if a < 0.5 {
@@ -346,7 +388,9 @@ fn caps(x: f32, sx: Option<Spring>, y: f32, sy: Option<Spring>, a: f32) -> f32 {
         (None, None) => f32::INFINITY,
         (Some(_), None) => scale_cap(x, 1.0 - a),
         (None, Some(_)) => scale_cap(y, a),
-        (Some(_), Some(_)) => lerp(x, y, a),
+        // An unlimited cap stays unlimited while it has any weight.
+        (Some(_), Some(_)) if x.is_infinite() || y.is_infinite() => f32::INFINITY,
+        (Some(_), Some(_)) => x + (y - x) * a,
     }
 }
 

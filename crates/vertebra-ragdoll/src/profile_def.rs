@@ -135,7 +135,15 @@ fn resolve(raw: &RawProfile, desc: &RagdollDesc, context: &str) -> Result<Profil
         if let Some(m) = bone.strength_multiplier {
             check_multiplier(&context, m)?;
         }
-        for c in covered(desc, b, bone.below.unwrap_or(false)) {
+        let below = bone.below.unwrap_or(false);
+        let no_joint = bone.joints.is_some() && !below && desc.parent_joint[b].is_none();
+        range(
+            &context,
+            "joints",
+            !no_joint,
+            "is for the joint above the body, and the root has none (below = true reaches the joints below it)",
+        )?;
+        for c in covered(desc, b, below) {
             if let (Some(d), Some(j)) = (&bone.joints, desc.parent_joint[c]) {
                 profile.joints[j] = joint_setting(d, profile.joints[j], &context)?;
             }
@@ -292,22 +300,22 @@ impl Profile {
         for (j, s) in desc.joints.iter().zip(&self.joints) {
             let context = format!("{context} joint `{}`", j.name);
             if let Some(strength) = s.strength {
-                check_spring(&context, "drive", strength, SpringField::Drive)?;
+                strength_in_range(&context, "drive", strength, SpringField::Drive)?;
             }
             check_cap(&context, "max_torque", s.max_torque)?;
         }
         for (b, s) in desc.bodies.iter().zip(&self.bodies) {
             let context = format!("{context} body `{}`", b.name);
             if let Some(strength) = s.linear {
-                check_spring(&context, "linear", strength, SpringField::WorldPosition)?;
+                strength_in_range(&context, "linear", strength, SpringField::WorldPosition)?;
             }
             if let Some(strength) = s.angular {
-                check_spring(&context, "angular", strength, SpringField::WorldOrientation)?;
+                strength_in_range(&context, "angular", strength, SpringField::WorldOrientation)?;
             }
             check_cap(&context, "max_acceleration", s.max_acceleration)?;
             check_cap(&context, "max_torque", s.max_torque)?;
             if let Some(u) = s.upright {
-                check_spring(&context, "upright", u.strength, SpringField::Upright)?;
+                strength_in_range(&context, "upright", u.strength, SpringField::Upright)?;
                 check_cap(&context, "upright max_torque", u.max_torque)?;
             }
         }
@@ -352,6 +360,28 @@ fn is_below(desc: &RagdollDesc, mut b: usize, above: usize) -> bool {
         }
     }
     false
+}
+
+/// A profile's strength as the world checks it, and finite: a rigid one is
+/// a zero compliance (`strength = "infinite"` in a file), which a file
+/// writes and reads back, where an infinite frequency does not.
+fn strength_in_range(
+    context: &str,
+    field: &'static str,
+    strength: Spring,
+    of: SpringField,
+) -> Result<(), RagdollError> {
+    check_spring(context, field, strength, of)?;
+    let finite = match strength {
+        Spring::Frequency { frequency, .. } => frequency.is_finite(),
+        Spring::Compliance { .. } => true,
+    };
+    range(
+        context,
+        field,
+        finite,
+        "has an infinite frequency; a rigid drive in a profile is a zero compliance",
+    )
 }
 
 fn check_cap(context: &str, field: &'static str, cap: f32) -> Result<(), RagdollError> {

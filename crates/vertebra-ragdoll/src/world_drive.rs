@@ -14,7 +14,7 @@ use crate::drive::DriveSettings;
 use crate::error::{RagdollError, check_spring, range};
 use crate::model::RagdollDesc;
 use crate::pose::Pose;
-use crate::profile::{BodyDriveSetting, JointDriveSetting, Profile, UprightSetting};
+use crate::profile::{BodyDriveSetting, Profile, UprightSetting};
 use crate::ragdoll::Ragdoll;
 
 /// One body kept upright: the axis that points up in the animation's pose
@@ -102,9 +102,18 @@ impl WorldDriveSettings {
 impl Profile {
     /// The profile `animation` gives `desc`: every joint the joint drive
     /// settings' (their per-joint strengths included), every body the
-    /// world drive settings', the uprights on their bodies.
-    pub fn from_animation(name: &str, desc: &RagdollDesc, animation: &PhysicalAnimation) -> Self {
+    /// world drive settings', the uprights on their bodies. Refused, naming
+    /// the field, for settings `Ragdoll::follow` refuses.
+    pub fn from_animation(
+        name: &str,
+        desc: &RagdollDesc,
+        animation: &PhysicalAnimation,
+    ) -> Result<Self, RagdollError> {
         let (joints, world) = (&animation.joints, &animation.world);
+        joints.validate("drive", desc.joints.len(), |k| {
+            format!("joint `{}`", desc.joints[k].name)
+        })?;
+        world.validate(desc.bodies.len())?;
         let body = BodyDriveSetting {
             linear: world.linear,
             angular: world.angular,
@@ -121,16 +130,11 @@ impl Profile {
                 });
             }
         }
-        Self {
+        Ok(Self {
             name: name.to_owned(),
-            joints: (0..desc.joints.len())
-                .map(|k| JointDriveSetting {
-                    strength: Some(joints.strength(k)),
-                    max_torque: joints.max_torque,
-                })
-                .collect(),
+            joints: joints.joint_settings(desc.joints.len()),
             bodies,
-        }
+        })
     }
 }
 
@@ -179,12 +183,8 @@ impl Ragdoll {
         animation: &PhysicalAnimation,
     ) -> Result<(), RagdollError> {
         let _mode = DefaultFloatMode::enter();
-        self.check_world_drive(poses.1, Some((poses.0, dt)), &animation.world)?;
-        let joints = &self.desc.joints;
-        (animation.joints).validate("drive", joints.len(), |k| {
-            format!("joint `{}`", joints[k].name)
-        })?;
-        let profile = Profile::from_animation("", &self.desc, animation);
+        self.check_not_removed()?;
+        let profile = Profile::from_animation("", &self.desc, animation)?;
         self.follow_checked(world, poses, dt, &profile)
     }
 
@@ -217,24 +217,43 @@ impl Ragdoll {
         self.check_poses(pose, Some((prev, dt)))?;
         let from = Some((prev, dt));
         let bodies = self.world_drives(world, pose, from, &profile.bodies)?;
-        let joints = self.joint_drives(pose, from, &profile.joints)?;
+        let joints = self.joint_drives(world, pose, from, &profile.joints)?;
         self.set_joint_drives(world, joints)?;
         set_world_drives(world, bodies)
     }
 
     /// Clears every body's world and upright drive.
+    /// Refused, nothing changed, for a body no longer in `world`.
     pub fn release_world_drives(&self, world: &mut World) -> Result<(), RagdollError> {
         self.check_not_removed()?;
-        for &body in self.bodies.iter().flatten() {
+        let mut dynamic = Vec::with_capacity(self.bodies.len());
+        for (k, body) in self.bodies.iter().enumerate() {
+            let Some(body) = *body else { continue };
+            if self.body_index_in(world, k, body)?.1 == BodyKind::Dynamic {
+                dynamic.push(body);
+            }
+        }
+        for body in dynamic {
             let clear = |w: &mut World| {
                 w.set_world_drive(body, None)?;
                 w.set_upright_drive(body, None)
             };
-            if world.bodies().kind[body.index()] == BodyKind::Dynamic {
-                clear(world).map_err(|e| RagdollError::world("world drive", e))?;
-            }
+            clear(world).map_err(|e| RagdollError::world("world drive", e))?;
         }
         Ok(())
+    }
+
+    /// Described body `k`'s `body` in `world`: its index and kind; refused,
+    /// naming the body, for a handle `world` did not issue or has removed.
+    fn body_index_in(
+        &self,
+        world: &World,
+        k: usize,
+        body: BodyHandle,
+    ) -> Result<(usize, BodyKind), RagdollError> {
+        let i = (world.bodies().index(body))
+            .map_err(|e| RagdollError::world(&format!("body `{}`", self.desc.bodies[k].name), e))?;
+        Ok((i, world.bodies().kind[i]))
     }
 
     /// Everything [`Ragdoll::world_drive`] checks before it changes
@@ -277,7 +296,7 @@ impl Ragdoll {
             joints: DriveSettings::uniform(Spring::RIGID),
             world: settings.clone(),
         };
-        let profile = Profile::from_animation("", &self.desc, &animation);
+        let profile = Profile::from_animation("", &self.desc, &animation)?;
         let drives = self.world_drives(world, pose, from, &profile.bodies)?;
         set_world_drives(world, drives)
     }
@@ -296,8 +315,8 @@ impl Ragdoll {
         let mut drives = Vec::with_capacity(self.bodies.len());
         for ((k, body), setting) in self.bodies.iter().enumerate().zip(settings) {
             let Some(body) = *body else { continue };
-            let i = body.index();
-            if world.bodies().kind[i] != BodyKind::Dynamic {
+            let (i, kind) = self.body_index_in(world, k, body)?;
+            if kind != BodyKind::Dynamic {
                 continue;
             }
             let world_error = |e| {

@@ -202,7 +202,7 @@ fn follow_profile_drives_as_follow_does() {
             }],
         },
     };
-    let profile = Profile::from_animation("walk", &desc, &animation);
+    let profile = Profile::from_animation("walk", &desc, &animation).unwrap();
     for spine in [SpineMode::Sockets, SpineMode::Rod] {
         let run = |by_profile: bool| {
             let mut world = World::new(SolverConfig::default()).unwrap();
@@ -313,4 +313,102 @@ fn refused_profiles_name_the_table_and_change_nothing() {
         assert!(e.to_string().contains(names), "{e}");
         assert_eq!(world.state_hash(), hash);
     }
+}
+
+/// The anatomical humanoid's file with `extra` tables after it.
+fn with(extra: &str) -> Result<RagdollDesc, String> {
+    RagdollDesc::from_toml(&format!("{ANATOMICAL_HUMANOID}\n{extra}")).map_err(|e| e.to_string())
+}
+
+#[test]
+fn an_unlimited_cap_blends_into_a_finite_one_without_a_nan() {
+    let desc = with(
+        "[[profile]]\nname = \"a\"\njoints = { frequency = 8.0, damping_ratio = 1.0 }\n\
+         world = { linear = { frequency = 2.0, damping_ratio = 1.0 } }\n\
+         [[profile]]\nname = \"b\"\n\
+         joints = { frequency = 8.0, damping_ratio = 1.0, max_torque = 300.0 }\n\
+         world = { linear = { frequency = 2.0, damping_ratio = 1.0 }, max_acceleration = 4.0 }\n",
+    )
+    .unwrap();
+    let (a, b) = (desc.profile("a").unwrap(), desc.profile("b").unwrap());
+    for k in 1..100 {
+        let t = k as f32 / 100.0;
+        for mid in [a.blended(b, t).unwrap(), b.blended(a, t).unwrap()] {
+            mid.validate(&desc).unwrap();
+            assert_eq!(mid.joints[0].max_torque, f32::INFINITY, "{t}");
+            assert_eq!(mid.bodies[0].max_acceleration, f32::INFINITY, "{t}");
+        }
+    }
+}
+
+#[test]
+fn strengths_far_out_scale_and_read_back() {
+    // A frequency whose square overflows f32, scaled by a multiplier.
+    let desc = with(
+        "[[profile]]\nname = \"x\"\njoints = { frequency = 1e20, damping_ratio = 1.0 }\n\
+         [[profile.bone]]\nbody = \"head\"\nstrength_multiplier = 0.5\n",
+    )
+    .unwrap();
+    let neck = desc.joint_index("neck").unwrap();
+    let strength = desc.profile("x").unwrap().joints[neck].strength;
+    let (f, z) = (1e20 * 0.5_f32.sqrt(), 0.5_f32.sqrt());
+    assert_eq!(strength, Some(frequency(f, z)));
+    assert_eq!(RagdollDesc::from_toml(&desc.to_toml()).unwrap(), desc);
+    // An infinite frequency (rigid to the world) is refused in a profile:
+    // a file could not write it back.
+    let mut inf = Profile::limp("inf", &desc);
+    inf.joints[neck].strength = Some(frequency(f32::INFINITY, 1.0));
+    let e = inf.validate(&desc).unwrap_err().to_string();
+    assert!(
+        e.contains("joint `neck`") && e.contains("infinite frequency"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_bone_table_driving_the_joint_above_the_root_is_refused() {
+    let e = with(
+        "[[profile]]\nname = \"x\"\n[[profile.bone]]\nbody = \"hips\"\n\
+         joints = { frequency = 8.0, damping_ratio = 1.0 }\n",
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("profile `x` bone 0") && e.contains("root"),
+        "{e}"
+    );
+    // With below = true it drives the joints below the root.
+    let desc = with(
+        "[[profile]]\nname = \"x\"\n[[profile.bone]]\nbody = \"hips\"\nbelow = true\n\
+         joints = { frequency = 8.0, damping_ratio = 1.0 }\n",
+    )
+    .unwrap();
+    let x = desc.profile("x").unwrap();
+    assert!(
+        x.joints
+            .iter()
+            .all(|j| j.strength == Some(frequency(8.0, 1.0)))
+    );
+}
+
+#[test]
+fn a_ragdoll_driven_in_a_world_not_its_own_is_refused_not_a_panic() {
+    let desc = RagdollDesc::anatomical_humanoid();
+    let pose = vertebra_ragdoll::Pose::bind(&desc);
+    let standing = desc.profile("standing").unwrap();
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let options = BuildOptions::new(SpineMode::Sockets);
+    let ragdoll = Ragdoll::build(&mut world, &desc, options, &pose, None).unwrap();
+    let mut other = World::new(SolverConfig::default()).unwrap();
+    let e = (ragdoll.follow_profile(&mut other, (&pose, &pose), DT, standing)).unwrap_err();
+    assert!(e.to_string().contains("body `hips`"), "{e}");
+    let e = ragdoll.release_world_drives(&mut other).unwrap_err();
+    assert!(e.to_string().contains("body `hips`"), "{e}");
+    // A joint removed behind the ragdoll's back: refused, naming it, and
+    // nothing set.
+    let last = *ragdoll.joints.iter().rev().flatten().next().unwrap();
+    world.remove_joint(last).unwrap();
+    let hash = world.state_hash();
+    let e = (ragdoll.follow_profile(&mut world, (&pose, &pose), DT, standing)).unwrap_err();
+    assert!(e.to_string().contains("joint `knee_r`"), "{e}");
+    assert_eq!(world.state_hash(), hash, "a refused call changed the world");
 }
