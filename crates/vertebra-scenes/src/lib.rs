@@ -49,7 +49,9 @@ pub use scene_world::SceneWorld;
 pub use seeds::{Comparison, MAX_SEEDED_FRAMES, MAX_SEEDS, Seeded, compare};
 pub use skeleton_out::SkeletonOut;
 pub use spread::Spread;
-pub use stagger::{STAGGER_HIT, WALK_SPEED, WALK_START, stagger_profile, stagger_walk};
+pub use stagger::{
+    STAGGER_HIT, WALK_SPEED, WALK_START, stagger_profile, stagger_walk, standing_lift,
+};
 pub use stagger_hit::{Activity, Side, StaggerHit, Tracking, UPRIGHT_FRACTION};
 pub use stagger_sweep::{
     STAGGER_IMPULSES, STANDING_HIT_FRAME, StaggerSweep, TRACKED_FRAMES, WALKING_HIT_FRAME,

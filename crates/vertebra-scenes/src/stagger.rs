@@ -41,15 +41,21 @@ pub fn stagger_profile(desc: &RagdollDesc) -> Result<Profile, RagdollError> {
         })
 }
 
+/// How far (m, up) `desc`'s bind pose is raised to stand with its lowest
+/// point 1 mm above a ground at y = 0.
+pub fn standing_lift(desc: &RagdollDesc) -> Vec3 {
+    let low = (desc.bodies.iter())
+        .map(|b| b.segment[0].y.min(b.segment[1].y) - b.radius)
+        .fold(f32::MAX, f32::min);
+    Vec3::new(0.0, 0.001 - low, 0.0)
+}
+
 /// The stagger's animation on `desc`: standing until `start` (s), then
 /// walking at [`WALK_SPEED`] (infinity: standing throughout), placed as
 /// the scene places its ragdoll for `seed`: its lowest point 1 mm above
 /// the ground, moved and turned by the seed's perturbation.
 pub fn stagger_walk(desc: &RagdollDesc, seed: u64, start: f32) -> Result<Walk, RagdollError> {
-    let low = (desc.bodies.iter())
-        .map(|b| b.segment[0].y.min(b.segment[1].y) - b.radius)
-        .fold(f32::MAX, f32::min);
-    let lift = Vec3::new(0.0, 0.001 - low, 0.0);
+    let lift = standing_lift(desc);
     let (offset, turn) = crate::seed::perturbation(seed, 0);
     Ok(Walk::new(desc, Gait::walk(WALK_SPEED), start)?.placed(turn, lift + offset))
 }

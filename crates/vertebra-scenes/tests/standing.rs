@@ -70,10 +70,7 @@ impl Stand {
         collisions
             .add(Collider::new(ground, ColliderShape::Plane(Vec3::Y)))
             .unwrap();
-        let low = (desc.bodies.iter())
-            .map(|b| b.segment[0].y.min(b.segment[1].y) - b.radius)
-            .fold(f32::MAX, f32::min);
-        let lift = Vec3::new(0.0, 0.001 - low, 0.0);
+        let lift = vertebra_scenes::standing_lift(&desc);
         let pose = Pose::bind(&desc).moved(Vec3::ZERO, Quat::IDENTITY, lift);
         let options = BuildOptions::new(spine);
         let ragdoll = Ragdoll::build(&mut world, &desc, options, &pose, None).unwrap();
