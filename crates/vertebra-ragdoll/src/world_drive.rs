@@ -103,7 +103,10 @@ impl Profile {
     /// The profile `animation` gives `desc`: every joint the joint drive
     /// settings' (their per-joint strengths included), every body the
     /// world drive settings', the uprights on their bodies. Refused, naming
-    /// the field, for settings `Ragdoll::follow` refuses.
+    /// the field, for settings `Ragdoll::follow` refuses. An infinite
+    /// frequency, rigid to the world, becomes the rigid zero compliance a
+    /// profile holds (and a file writes), so that the profile is one
+    /// `Ragdoll::follow_profile` and `ProfileBlend` take.
     pub fn from_animation(
         name: &str,
         desc: &RagdollDesc,
@@ -115,8 +118,8 @@ impl Profile {
         })?;
         world.validate(desc.bodies.len())?;
         let body = BodyDriveSetting {
-            linear: world.linear,
-            angular: world.angular,
+            linear: world.linear.map(rigid_as_compliance),
+            angular: world.angular.map(rigid_as_compliance),
             max_acceleration: world.max_acceleration,
             max_torque: world.max_torque,
             upright: None,
@@ -125,16 +128,29 @@ impl Profile {
         for u in &world.uprights {
             if let Some(b) = bodies.get_mut(u.body) {
                 b.upright = Some(UprightSetting {
-                    strength: u.strength,
+                    strength: rigid_as_compliance(u.strength),
                     max_torque: u.max_torque,
                 });
             }
         }
+        let mut joints = joints.joint_settings(desc.joints.len());
+        for j in &mut joints {
+            j.strength = j.strength.map(rigid_as_compliance);
+        }
         Ok(Self {
             name: name.to_owned(),
-            joints: joints.joint_settings(desc.joints.len()),
+            joints,
             bodies,
         })
+    }
+}
+
+/// `s`, with an infinite frequency (rigid) as the zero compliance
+/// [`Spring::RIGID`]: the world lays both out alike.
+fn rigid_as_compliance(s: Spring) -> Spring {
+    match s {
+        Spring::Frequency { frequency, .. } if frequency.is_infinite() => Spring::RIGID,
+        s => s,
     }
 }
 

@@ -365,6 +365,59 @@ fn strengths_far_out_scale_and_read_back() {
     );
 }
 
+/// Settings `follow` takes give a profile `follow_profile` and a blend
+/// take: an infinite frequency (rigid to the world) becomes a zero
+/// compliance, and follows as it does.
+#[test]
+fn a_profile_from_rigid_frequencies_is_one_a_blend_takes() {
+    let desc = RagdollDesc::anatomical_humanoid();
+    let rigid = frequency(f32::INFINITY, 1.0);
+    let animation = PhysicalAnimation {
+        joints: vertebra_ragdoll::DriveSettings::uniform(rigid),
+        world: vertebra_ragdoll::WorldDriveSettings {
+            linear: Some(rigid),
+            angular: Some(rigid),
+            max_acceleration: 4.0,
+            max_torque: 30.0,
+            uprights: vec![vertebra_ragdoll::Upright {
+                body: desc.body_index("chest").unwrap(),
+                strength: rigid,
+                max_torque: 80.0,
+            }],
+        },
+    };
+    let profile = Profile::from_animation("rigid", &desc, &animation).unwrap();
+    profile.validate(&desc).unwrap();
+    assert!(
+        profile
+            .joints
+            .iter()
+            .all(|j| j.strength == Some(Spring::RIGID))
+    );
+    let mut blend = ProfileBlend::new(Profile::limp("limp", &desc));
+    blend.switch_to(profile.clone(), 0.5).unwrap();
+    let pose = vertebra_ragdoll::Pose::bind(&desc);
+    let run = |follow: &dyn Fn(&Ragdoll, &mut World) -> Result<(), RagdollError>| {
+        let mut world = World::new(SolverConfig::default()).unwrap();
+        let ragdoll = Ragdoll::build(
+            &mut world,
+            &desc,
+            BuildOptions::new(SpineMode::Rod),
+            &pose,
+            None,
+        )
+        .unwrap();
+        for _ in 0..10 {
+            follow(&ragdoll, &mut world).unwrap();
+            world.step(DT).unwrap();
+        }
+        world.state_hash()
+    };
+    let followed = run(&|r, w| r.follow(w, (&pose, &pose), DT, &animation));
+    let profiled = run(&|r, w| r.follow_profile(w, (&pose, &pose), DT, &profile));
+    assert_eq!(followed, profiled);
+}
+
 #[test]
 fn a_bone_table_driving_the_joint_above_the_root_is_refused() {
     let e = with(
