@@ -204,35 +204,20 @@ fn follow_profile_drives_as_follow_does() {
     };
     let profile = Profile::from_animation("walk", &desc, &animation).unwrap();
     for spine in [SpineMode::Sockets, SpineMode::Rod] {
-        let run = |by_profile: bool| {
-            let mut world = World::new(SolverConfig::default()).unwrap();
-            let first = common::walking(&desc, 0.0);
-            let options = BuildOptions::new(spine);
-            let ragdoll = Ragdoll::build(&mut world, &desc, options, &first, None).unwrap();
-            let mut prev = first;
-            for k in 1..=30 {
-                let pose = common::walking(&desc, k as f32 * DT);
-                let poses = (&prev, &pose);
-                if by_profile {
-                    ragdoll.follow_profile(&mut world, poses, DT, &profile)
-                } else {
-                    ragdoll.follow(&mut world, poses, DT, &animation)
-                }
-                .unwrap();
-                world.step(DT).unwrap();
-                prev = pose;
-            }
+        let run = |by: Drive| {
+            let (world, ragdoll, last) = walk_driven(&desc, spine, 30, by);
             // Driven, the chest keeps to the walk's turn.
             let chest = desc.body_index("chest").unwrap();
             let turn = world
                 .body(ragdoll.bodies[chest].unwrap())
                 .unwrap()
                 .orientation;
-            let off = common::angle(turn, prev.bones[chest].1);
+            let off = common::angle(turn, last.bones[chest].1);
             assert!(off < 0.2, "{spine:?}: chest {off} rad off the walk");
             world.state_hash()
         };
-        assert_eq!(run(true), run(false), "{spine:?}");
+        let (by_profile, by_follow) = (Drive::Profile(&profile), Drive::Follow(&animation));
+        assert_eq!(run(by_profile), run(by_follow), "{spine:?}");
     }
 }
 
@@ -396,26 +381,45 @@ fn a_profile_from_rigid_frequencies_is_one_a_blend_takes() {
     );
     let mut blend = ProfileBlend::new(Profile::limp("limp", &desc));
     blend.switch_to(profile.clone(), 0.5).unwrap();
-    let pose = vertebra_ragdoll::Pose::bind(&desc);
-    let run = |follow: &dyn Fn(&Ragdoll, &mut World) -> Result<(), RagdollError>| {
-        let mut world = World::new(SolverConfig::default()).unwrap();
-        let ragdoll = Ragdoll::build(
-            &mut world,
-            &desc,
-            BuildOptions::new(SpineMode::Rod),
-            &pose,
-            None,
-        )
-        .unwrap();
-        for _ in 0..10 {
-            follow(&ragdoll, &mut world).unwrap();
-            world.step(DT).unwrap();
+    let run = |by: Drive| walk_driven(&desc, SpineMode::Rod, 10, by).0.state_hash();
+    let followed = run(Drive::Follow(&animation));
+    assert_eq!(followed, run(Drive::Profile(&profile)));
+}
+
+/// How [`walk_driven`] drives a ragdoll each frame.
+#[derive(Clone, Copy)]
+enum Drive<'a> {
+    /// `Ragdoll::follow` with these settings.
+    Follow(&'a PhysicalAnimation),
+    /// `Ragdoll::follow_profile` with this profile.
+    Profile(&'a Profile),
+}
+
+/// A ragdoll of `desc` built on the walk's first pose in a world of its
+/// own and driven along the walk for `frames` frames: the world, the
+/// ragdoll and the walk's last pose.
+fn walk_driven(
+    desc: &RagdollDesc,
+    spine: SpineMode,
+    frames: usize,
+    by: Drive,
+) -> (World, Ragdoll, vertebra_ragdoll::Pose) {
+    let mut world = World::new(SolverConfig::default()).unwrap();
+    let first = common::walking(desc, 0.0);
+    let ragdoll = Ragdoll::build(&mut world, desc, BuildOptions::new(spine), &first, None).unwrap();
+    let mut prev = first;
+    for k in 1..=frames {
+        let pose = common::walking(desc, k as f32 * DT);
+        let poses = (&prev, &pose);
+        match by {
+            Drive::Follow(animation) => ragdoll.follow(&mut world, poses, DT, animation),
+            Drive::Profile(profile) => ragdoll.follow_profile(&mut world, poses, DT, profile),
         }
-        world.state_hash()
-    };
-    let followed = run(&|r, w| r.follow(w, (&pose, &pose), DT, &animation));
-    let profiled = run(&|r, w| r.follow_profile(w, (&pose, &pose), DT, &profile));
-    assert_eq!(followed, profiled);
+        .unwrap();
+        world.step(DT).unwrap();
+        prev = pose;
+    }
+    (world, ragdoll, prev)
 }
 
 #[test]
