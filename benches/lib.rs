@@ -458,6 +458,7 @@ impl ContactWorkload {
                 approach: -1.0,
                 overlap: 0.0,
                 start: StartLane::default(),
+                pinned: false,
             };
             out[k / BLOCK_LANES].set(k % BLOCK_LANES, &lane);
         }

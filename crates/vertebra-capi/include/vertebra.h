@@ -1008,6 +1008,10 @@ typedef struct VtSolverConfig {
   // Non-zero: a touching contact takes back the separating speed its
   // own push-out gave (`SolverConfig::relax_contacts`).
   uint32_t relax_contacts;
+  // Non-zero: with the direct joint solve, a tree's contacts with static
+  // or kinematic bodies are solved in its solve
+  // (`SolverConfig::pin_contacts`).
+  uint32_t pin_contacts;
 } VtSolverConfig;
 
 // A world's residual joint error: the paper's figure 8 measure.

@@ -81,6 +81,10 @@ pub struct VtSolverConfig {
     /// Non-zero: a touching contact takes back the separating speed its
     /// own push-out gave (`SolverConfig::relax_contacts`).
     pub relax_contacts: u32,
+    /// Non-zero: with the direct joint solve, a tree's contacts with static
+    /// or kinematic bodies are solved in its solve
+    /// (`SolverConfig::pin_contacts`).
+    pub pin_contacts: u32,
 }
 
 /// A world's residual joint error: the paper's figure 8 measure.
@@ -159,6 +163,7 @@ impl From<&SolverConfig> for VtSolverConfig {
             sleep_speed: sleep.speed,
             sleep_time: sleep.time,
             relax_contacts: u32::from(c.relax_contacts),
+            pin_contacts: u32::from(c.pin_contacts),
         }
     }
 }
@@ -193,6 +198,7 @@ impl TryFrom<&VtSolverConfig> for SolverConfig {
             measure_residuals: flag(c.measure_residuals),
             sleep,
             joints,
+            pin_contacts: flag(c.pin_contacts),
         })
     }
 }

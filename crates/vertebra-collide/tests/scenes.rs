@@ -164,12 +164,18 @@ fn drop_world(backend: Backend, threads: usize) -> (World, Collisions, Vec<Ragdo
         parallel_min_blocks: 1,
         ..SolverConfig::default()
     };
+    drop_ragdolls(config, 3)
+}
+
+/// `count` humanoids (rod spine, sockets, rod, ...) lying face down, one
+/// above the other, turned, in a world of `config` with a floor.
+fn drop_ragdolls(config: SolverConfig, count: usize) -> (World, Collisions, Vec<Ragdoll>) {
     let mut w = World::new(config).unwrap();
     let mut c = Collisions::new();
     ground(&mut w, &mut c);
     let desc = RagdollDesc::reference_humanoid();
     let mut ragdolls = Vec::new();
-    for k in 0..3 {
+    for k in 0..count {
         let spine = if k % 2 == 0 {
             SpineMode::Rod
         } else {
@@ -258,4 +264,73 @@ fn a_colliding_world_is_bit_identical_across_backends_and_threads() {
             );
         }
     }
+}
+
+/// With pins (`SolverConfig::pin_contacts`), a limp humanoid dropped face
+/// down: it lands without going through the floor, and in its fourth
+/// second its whole weight rests on its pins (the contacts' normal impulse
+/// over a frame is `m g dt`, to 10%). Prints how still its bodies are, and
+/// the same drop with iterated contacts (`docs/direct.md`, "Contacts in
+/// the solve: pins").
+#[test]
+fn a_ragdoll_on_pins_lands_and_rests_its_weight_on_them() {
+    for pin_contacts in [true, false] {
+        let config = SolverConfig {
+            sleep: None,
+            pin_contacts,
+            ..SolverConfig::default()
+        };
+        let (lowest, weight, worst, fastest, spin) = lying_still(config);
+        eprintln!(
+            "a ragdoll dropped, {}: deepest {:.2} mm, its weight {weight:.3} N s a frame held \
+             within {worst:.3}; in its fourth second the fastest body {fastest:.3} m/s, the \
+             fastest turn {spin:.2} rad/s",
+            if pin_contacts { "pins" } else { "iterated" },
+            lowest * 1e3
+        );
+        if pin_contacts {
+            assert!(lowest > -0.02, "through the floor: {lowest} m");
+            assert!(
+                worst < 0.1 * weight,
+                "its weight is not on its pins: {worst}"
+            );
+        }
+    }
+}
+
+/// One humanoid dropped on the floor in a world of `config`, 4 s: its
+/// lowest point (m), its weight over a frame (N s), and over its fourth
+/// second the largest difference of the contacts' normal impulse from it,
+/// the fastest speed (m/s) and turn (rad/s) of its bodies.
+fn lying_still(config: SolverConfig) -> (f32, f32, f32, f32, f32) {
+    let (mut w, c, ragdolls) = drop_ragdolls(config, 1);
+    let (r, desc) = (&ragdolls[0], RagdollDesc::reference_humanoid());
+    let mass: f32 = desc.bodies.iter().map(|b| b.mass).sum();
+    let weight = mass * 9.81 * DT;
+    let (mut lowest, mut worst) = (f32::MAX, 0.0f32);
+    let (mut fastest, mut spin) = (0.0f32, 0.0f32);
+    for frame in 0..240 {
+        step(&mut w, &c);
+        for (i, b) in r.bodies.iter().enumerate() {
+            let (Some(b), def) = (b, &desc.bodies[i]) else {
+                continue;
+            };
+            let s = w.body(*b).unwrap();
+            let half = (def.segment[1] - def.segment[0]) * 0.5;
+            let ends = [
+                s.position + s.orientation * half,
+                s.position - s.orientation * half,
+            ];
+            lowest = lowest.min(ends[0].y.min(ends[1].y) - def.radius);
+            if frame >= 180 {
+                fastest = fastest.max(s.linear_velocity.length());
+                spin = spin.max(s.angular_velocity.length());
+            }
+        }
+        if frame >= 180 {
+            let normal: f32 = w.contact_impulses().iter().map(|i| i.normal).sum();
+            worst = worst.max((normal - weight).abs());
+        }
+    }
+    (lowest, weight, worst, fastest, spin)
 }

@@ -264,6 +264,7 @@ fn contact_block(input: &mut Input, rows: &RawRows) -> ContactBlock {
             approach: input.float(10.0),
             overlap: input.float(0.1).abs(),
             start: start(input),
+            pinned: input.flag(),
         };
         block.set(k, &lane);
         block.bodies.set_start(k, &start(input));

@@ -109,6 +109,12 @@ pub struct ContactBlock {
     /// The velocity pass's friction impulses on b of the step, summed (N s,
     /// world).
     pub kicked_t: Vec3Block,
+    /// Nonzero: a tree's direct solve takes the contact (a pin,
+    /// `direct::pin`): the position iterations and the velocity pass's
+    /// dynamic friction leave it out, and its multipliers are the pin's,
+    /// written in after the substep's solves (restitution and relax read
+    /// them as any contact's).
+    pub pinned: [f32; BLOCK_LANES],
 }
 
 /// One contact's solver data.
@@ -132,6 +138,8 @@ pub struct ContactLane {
     pub overlap: f32,
     /// The two points when the step began.
     pub start: StartLane,
+    /// Whether a tree's direct solve takes it ([`ContactBlock::pinned`]).
+    pub pinned: bool,
 }
 
 /// A padding lane: null rows, zero normal, so nothing acts, and no writes
@@ -150,6 +158,7 @@ impl LaneBlock for ContactBlock {
         approach: 0.0,
         overlap: 0.0,
         start: StartLane::ZERO,
+        pinned: false,
     };
 
     /// Writes one contact into `lane`.
@@ -170,6 +179,7 @@ impl LaneBlock for ContactBlock {
         self.pushed_t.set(lane, GVec3::ZERO);
         self.kicked_n[lane] = 0.0;
         self.kicked_t.set(lane, GVec3::ZERO);
+        self.pinned[lane] = if c.pinned { 1.0 } else { 0.0 };
     }
 }
 
@@ -289,7 +299,9 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
 
     let (ra, rb, d) = arms(block, start, &a, &b);
     let allowance = L::load(&block.allowance[start..]);
-    let c = (d.dot(n) + allowance).min(zero);
+    // A pinned lane's rows are its tree's: nothing here.
+    let free = L::load(&block.pinned[start..]).eq(zero);
+    let c = L::select(free, (d.dot(n) + allowance).min(zero), zero);
     let (resp_a, resp_b) = (a.positional_response(ra, n), b.positional_response(rb, n));
     let dlambda_n = safe_ratio(-c, resp_a.weight + resp_b.weight);
     b.push(n, &resp_b, dlambda_n);
@@ -307,7 +319,7 @@ fn solve_positions<L: Lane>(block: &mut ContactBlock, start: usize, rows: &BodyR
     let wanted = lambda_t + t.scale(safe_ratio(-slide, w));
     let (direction, size) = wanted.normalize_or_zero();
     let bound = L::load(&block.friction[start..]) * lambda_n;
-    let clamped = direction.scale(size.min(bound));
+    let clamped = Vec3::select(free, direction.scale(size.min(bound)), lambda_t);
     let impulse = clamped - lambda_t;
     push(&mut a, &mut b, ra, rb, impulse);
     block.lambda_t.store(start, clamped);
@@ -472,7 +484,9 @@ fn solve_velocities<L: Lane>(
     let used = block.lambda_t.load::<L>(start).length();
     let budget = ((L::load(&block.friction[start..]) * touch.lambda_n - used) / h).max(zero);
     let impulse = stop.min(budget);
-    let friction = t.scale(L::select(touching, -impulse, zero));
+    // A pin's friction is all in its tree's solve.
+    let free = L::load(&block.pinned[start..]).eq(zero);
+    let friction = t.scale(L::select(touching & free, -impulse, zero));
     touch.kick(friction);
     let kicked_t = block.kicked_t.load::<L>(start) + friction;
     block.kicked_t.store(start, kicked_t);

@@ -49,6 +49,7 @@ fn scene(seed: u64, blocks: usize, adversarial: bool) -> (RawRows, Vec<ContactBl
                     approach: r.random_range(-10.0..10.0),
                     overlap: r.random_range(0.0..0.1),
                     start: common::start(&mut r, adversarial),
+                    pinned: r.random_bool(0.2),
                 },
             );
         }

@@ -124,6 +124,15 @@ pub struct SolverConfig {
     pub sleep: Option<SleepSettings>,
     /// How the joints' equality parts are solved ([`JointSolver`]).
     pub joints: JointSolver,
+    /// With the direct joint solve: each contact between a body of a tree
+    /// and a static or kinematic body is solved in the tree's own solve
+    /// (a pin: `docs/direct.md`, "Contacts in the solve: pins"), so that a
+    /// light body under a heavy one (a foot under a ragdoll) holds and
+    /// rubs with its whole tree's mass, where an iterated contact keeps
+    /// its own share of each push. Off by default: a pile of ragdolls
+    /// still jitters with it (`docs/direct.md`). Needs
+    /// [`JointSolver::Direct`].
+    pub pin_contacts: bool,
 }
 
 /// The default: the direct joint solve at 1 substep of 8 iterations, with
@@ -166,6 +175,7 @@ impl SolverConfig {
             measure_residuals: false,
             sleep: Some(SleepSettings::default()),
             joints: JointSolver::Iterative,
+            pin_contacts: false,
         }
     }
 
@@ -216,6 +226,11 @@ impl SolverConfig {
         }
         if let Some(sleep) = &self.sleep {
             sleep.validate()?;
+        }
+        if self.pin_contacts && self.joints != JointSolver::Direct {
+            return Err(Error::InvalidConfig(
+                "pin_contacts needs the direct joint solve (joints: Direct)",
+            ));
         }
         check_finite("gravity", self.gravity)
     }

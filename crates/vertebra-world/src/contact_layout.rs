@@ -7,6 +7,8 @@ use core::ops::Range;
 use glam::Vec3;
 use vertebra_kernels::body::{BodyPairs, LaneBlock, StartLane};
 use vertebra_kernels::contact::{ContactBlock, ContactImpulse, ContactLane};
+use vertebra_kernels::direct::TreeBlock;
+use vertebra_kernels::direct::pin::{MAX_PINS, PIN_STIFFNESS, PinLane};
 use vertebra_math::block::BLOCK_LANES;
 use vertebra_scheduler::MAX_COLOURS;
 use vertebra_store::{BodyHandle, BodyKind, BodyStore};
@@ -14,6 +16,7 @@ use vertebra_store::{BodyHandle, BodyKind, BodyStore};
 use crate::bins::Bins;
 use crate::contact::Contact;
 use crate::layout::pair;
+use crate::trees::Trees;
 
 /// This step's contacts, coloured and in blocks. Kept by the world and
 /// laid out again every step into the same buffers: once they have grown
@@ -44,6 +47,49 @@ pub(crate) struct ContactLayout {
     reads: Vec<u32>,
     /// Scratch: per block, its contacts' range of `order`.
     block_keys: Vec<Range<u32>>,
+    /// This step's pins: the contacts its trees' solves take
+    /// ([`Self::pin`]).
+    pub pins: Vec<Pinned>,
+    /// Scratch: per contact, whether a tree's solve takes it.
+    pinned: Vec<bool>,
+    /// Scratch: per tree, its mass (kg; NaN until a pin asks).
+    tree_mass: Vec<f32>,
+    /// Scratch: per contact, its block and lane.
+    lane_of: Vec<(u32, u8)>,
+}
+
+/// A contact a tree's solve takes: where its lane is here, and where its
+/// pin is.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Pinned {
+    /// The contact's block here and its lane.
+    pub contact_block: u32,
+    pub contact_lane: u8,
+    /// The tree block, the body's index in it, the lane and the slot.
+    pub block: u32,
+    pub body: u32,
+    pub lane: u8,
+    pub slot: u8,
+}
+
+/// Writes each pin's multipliers over the substep's solves into its
+/// contact's lane (`lambda_n`, `lambda_t`), where the velocity pass, the
+/// relax passes and the step's impulses read them as any contact's.
+pub(crate) fn pins_to_contacts(
+    pins: &[Pinned],
+    trees: &[TreeBlock],
+    contacts: &mut [ContactBlock],
+) {
+    for p in pins {
+        let pin = &trees[p.block as usize].pins[p.body as usize];
+        let Some((normal, friction)) = pin.substep(p.lane as usize, p.slot as usize) else {
+            continue;
+        };
+        let block = &mut contacts[p.contact_block as usize];
+        let lane = p.contact_lane as usize;
+        block.lambda_n[lane] = normal;
+        block.lambda_t.set(lane, friction);
+    }
 }
 
 /// One solve bin's contacts.
@@ -93,6 +139,9 @@ impl ContactLayout {
     /// ranges of every colour and bin, and as many padding blocks as they
     /// hold, each to be filled from its contacts ([`Self::fill`]).
     pub fn plan(&mut self, contacts: &[Contact], bodies: &BodyStore, asleep: &[bool], bins: &Bins) {
+        self.pins.clear();
+        self.pinned.clear();
+        self.pinned.resize(contacts.len(), false);
         self.blocks.clear();
         self.colours.clear();
         self.bins.clear();
@@ -136,6 +185,87 @@ impl ContactLayout {
             .resize(self.block_keys.len(), ContactBlock::padding());
     }
 
+    /// Gives the trees' solves the contacts between one of their bodies and
+    /// a static or kinematic body (`vertebra_kernels::direct::pin`), in
+    /// the order given, up to [`MAX_PINS`] a body (its further contacts
+    /// stay iterated), each from its lane here (overlap capped at
+    /// `max_depth`, m), which is marked pinned ([`ContactBlock::pinned`]).
+    /// Every pin of the step before is cleared first. After
+    /// [`Self::plan`], before [`Self::fill`].
+    pub fn pin(
+        &mut self,
+        contacts: &[Contact],
+        bodies: &BodyStore,
+        trees: &mut Trees,
+        max_depth: f32,
+    ) {
+        for block in &mut trees.blocks {
+            for pins in &mut block.pins {
+                (0..BLOCK_LANES).for_each(|lane| pins.clear_lane(lane));
+            }
+        }
+        self.tree_mass.clear();
+        self.tree_mass.resize(trees.members.len(), f32::NAN);
+        self.lane_of.clear();
+        self.lane_of.resize(contacts.len(), (0, 0));
+        for (block, keys) in self.block_keys.iter().enumerate() {
+            let keys = &self.order[keys.start as usize..keys.end as usize];
+            for (lane, &key) in keys.iter().enumerate() {
+                self.lane_of[key as usize] = (block as u32, lane as u8);
+            }
+        }
+        for (key, contact) in contacts.iter().enumerate() {
+            if self.colour_of[key] == ASLEEP {
+                continue;
+            }
+            let (a, b) = (contact.body_a.index(), contact.body_b.index());
+            let fixed = |i: usize| bodies.kind[i] != BodyKind::Dynamic;
+            let place = |i: usize| trees.bodies.get(i).copied().flatten();
+            let (place, tree_is_b) = match (place(a), place(b)) {
+                (Some(p), _) if fixed(b) => (p, false),
+                (_, Some(p)) if fixed(a) => (p, true),
+                _ => continue,
+            };
+            let block = &mut trees.blocks[place.block];
+            if !block.pinned() {
+                block.take_pins();
+            }
+            let pins = &mut block.pins[place.body];
+            let Some(slot) = (0..MAX_PINS).find(|&k| pins.slots[k].side[place.lane] == 0.0) else {
+                continue;
+            };
+            let mass = &mut self.tree_mass[place.tree];
+            if mass.is_nan() {
+                *mass = trees.members[place.tree]
+                    .iter()
+                    .map(|&i| bodies.mass[i])
+                    .sum();
+            }
+            let lane = contact_lane(contact, bodies, max_depth);
+            let pin = PinLane {
+                pair: lane.pair,
+                point_a: lane.point_a,
+                point_b: lane.point_b,
+                normal: lane.normal,
+                friction: lane.friction,
+                overlap: lane.overlap,
+                start: lane.start,
+                tree_is_b,
+            };
+            pins.set(place.lane, slot, &pin, PIN_STIFFNESS * *mass);
+            self.pinned[key] = true;
+            let (contact_block, contact_lane) = self.lane_of[key];
+            self.pins.push(Pinned {
+                contact_block,
+                contact_lane,
+                block: place.block as u32,
+                body: place.body as u32,
+                lane: place.lane as u8,
+                slot: slot as u8,
+            });
+        }
+    }
+
     /// The planned blocks ([`Self::plan`]), to be filled by
     /// [`ContactFill::blocks`] in any chunks on any threads.
     pub fn fill<'a>(
@@ -147,6 +277,7 @@ impl ContactLayout {
         let fill = ContactFill {
             block_keys: &self.block_keys,
             order: &self.order,
+            pinned: &self.pinned,
             contacts,
             bodies,
             max_depth,
@@ -250,6 +381,7 @@ impl ContactLayout {
 pub(crate) struct ContactFill<'a> {
     block_keys: &'a [Range<u32>],
     order: &'a [u32],
+    pinned: &'a [bool],
     contacts: &'a [Contact],
     bodies: &'a BodyStore,
     max_depth: f32,
@@ -265,7 +397,11 @@ impl ContactFill<'_> {
                 .enumerate()
             {
                 let contact = &self.contacts[key as usize];
-                block.set(lane, &contact_lane(contact, self.bodies, self.max_depth));
+                let data = ContactLane {
+                    pinned: self.pinned[key as usize],
+                    ..contact_lane(contact, self.bodies, self.max_depth)
+                };
+                block.set(lane, &data);
             }
         }
     }
@@ -314,6 +450,7 @@ fn contact_lane(contact: &Contact, bodies: &BodyStore, max_depth: f32) -> Contac
         approach: (velocity(ib, contact.point) - velocity(ia, contact.point)).dot(n),
         overlap: depth.max(0.0),
         start,
+        pinned: false,
     }
 }
 

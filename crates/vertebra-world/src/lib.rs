@@ -775,6 +775,10 @@ impl World {
         let asleep = self.islands.asleep();
         self.contact_layout
             .plan(&self.contacts, &self.bodies, asleep, &self.bins);
+        if self.config.pin_contacts {
+            let trees = &mut self.layout.trees;
+            (self.contact_layout).pin(&self.contacts, &self.bodies, trees, max_depth);
+        }
         // The contacts' lanes and the joints' start of step, on the workers
         // when there are many (step::start_blocks_all).
         step::start_blocks_all(self, max_depth, workers);

@@ -292,6 +292,11 @@ impl<'a, B> SharedBlocks<'a, B> {
         }
     }
 
+    /// How many blocks are lent.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
     /// The blocks in `range`.
     ///
     /// # Safety

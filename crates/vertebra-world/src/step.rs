@@ -101,6 +101,12 @@ pub(crate) fn solve(world: &mut World, dt: f32, workers: usize) {
             .blocks
             .iter_mut()
             .for_each(|b| b.start_substep(remaining));
+        for block in &mut world.layout.trees.blocks {
+            block
+                .pins
+                .iter_mut()
+                .for_each(|p| p.start_substep(remaining));
+        }
         let clock = Clock { k: substep, h };
         world.repaired += solve_substep(world, clock, workers);
     }

@@ -22,7 +22,7 @@ use vertebra_math::Backend;
 use crate::World;
 use crate::bins::Bins;
 use crate::body_drive::Clock;
-use crate::contact_layout::{ContactBin, ContactLayout};
+use crate::contact_layout::{ContactBin, ContactLayout, Pinned, pins_to_contacts};
 use crate::integrate::{
     BodyChunk, BodyRead, damp, derive_velocities, predict, read_velocities, repair,
 };
@@ -82,6 +82,8 @@ struct Substep<'a> {
     /// The bins `1..` keep to their own rows (`bins_apart`): each may be
     /// solved by one worker while others solve the rest.
     bins_apart: bool,
+    /// The step's pins (`ContactLayout::pin`).
+    pins: &'a [Pinned],
     /// Bodies put back by [`repair`] this substep.
     repaired: AtomicU64,
 }
@@ -171,6 +173,7 @@ pub(crate) fn solve_substep(world: &mut World, clock: Clock, workers: usize) -> 
         contact_bins: &contacts.bins,
         contacts_disjoint: contacts.disjoint,
         bins_apart,
+        pins: &contacts.pins,
         repaired: AtomicU64::new(0),
     };
     world
@@ -217,6 +220,7 @@ impl<'a> Substep<'a> {
                 self.solve_bin(bin, &closing, false);
             }
         });
+        self.pins_stage(cursor);
         self.body_pass(cursor, |c, rows| derive_velocities(c, bodies, rows, h));
         let resting_speed = 2.0 * bodies.gravity.length() * h;
         let settings = VelocitySettings {
@@ -267,6 +271,27 @@ impl<'a> Substep<'a> {
             pass,
             backend,
         }
+    }
+
+    /// One stage of one chunk, after every tree's solves and before the
+    /// velocity pass: each pin's multipliers into its contact's lane
+    /// (`contact_layout::pins_to_contacts`). None without pins.
+    fn pins_stage(&self, cursor: &mut Cursor) {
+        if self.pins.is_empty() {
+            return;
+        }
+        cursor.stage(&[&Chunks(1, |_| {
+            let (trees, contacts) = (&self.blocks.trees, &self.blocks.contacts);
+            // SAFETY: the only part of its stage, of one chunk: nothing
+            // else reaches the trees or the contacts while it runs.
+            let (trees, contacts) = unsafe {
+                (
+                    trees.range(0..trees.len()),
+                    contacts.range(0..contacts.len()),
+                )
+            };
+            pins_to_contacts(self.pins, trees, contacts);
+        })]);
     }
 
     /// One stage of `pass` over every chunk of bodies.

@@ -42,6 +42,19 @@ pub(crate) struct Place {
     pub lane: usize,
 }
 
+/// A body of a tree: where its lane is, and which tree it is of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct BodyPlace {
+    /// The block.
+    pub block: usize,
+    /// The body's index in the block's bodies.
+    pub body: usize,
+    /// The lane.
+    pub lane: usize,
+    /// The tree (an index into `Trees::members`).
+    pub tree: usize,
+}
+
 /// Every tree of the layout.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Trees {
@@ -53,6 +66,10 @@ pub(crate) struct Trees {
     pub joints: Vec<Option<Place>>,
     /// For each rod slot in a tree, its place.
     pub rods: Vec<Option<Place>>,
+    /// For each body slot in a tree, its place.
+    pub bodies: Vec<Option<BodyPlace>>,
+    /// Each tree's bodies (slots), in the order its joints name them.
+    pub members: Vec<Vec<usize>>,
     /// No two lanes of any blocks write one row: blocks may run at once.
     pub disjoint: bool,
     /// Each shape's place in `topologies`.
@@ -75,6 +92,7 @@ enum Edge {
 struct Lane<'a> {
     block: usize,
     lane: usize,
+    tree: usize,
     bodies: &'a [u32],
     joints: &'a [u32],
 }
@@ -102,21 +120,27 @@ impl Trees {
         let first = self.blocks.len();
         let found = find(joints, rods, bodies);
         let wholes: Vec<usize> = found.iter().map(|f| self.whole(f)).collect();
+        let first_tree = self.members.len();
+        self.members.extend(found.iter().map(|f| f.bodies.clone()));
         let descs = (joints, rods, bodies);
         let Some(most) = plan(&self.topologies, &wholes, backend) else {
-            let mut by_shape: BTreeMap<usize, Vec<&Found>> = BTreeMap::new();
-            for (tree, &topology) in found.iter().zip(&wholes) {
-                by_shape.entry(topology).or_default().push(tree);
+            let mut by_shape: BTreeMap<usize, Vec<(usize, &Found)>> = BTreeMap::new();
+            for (t, (tree, &topology)) in found.iter().zip(&wholes).enumerate() {
+                by_shape
+                    .entry(topology)
+                    .or_default()
+                    .push((first_tree + t, tree));
             }
             for (topology, trees) in by_shape {
                 for chunk in trees.chunks(BLOCK_LANES) {
                     let shape = &self.topologies[topology];
                     let mut block = TreeBlock::padding(topology as u32, shape);
                     let index = self.blocks.len();
-                    for (lane, tree) in chunk.iter().enumerate() {
+                    for (lane, &(t, tree)) in chunk.iter().enumerate() {
                         let whole = Lane {
                             block: index,
                             lane,
+                            tree: t,
                             bodies: &(0..tree.bodies.len() as u32).collect::<Vec<_>>(),
                             joints: &(0..tree.edges.len() as u32).collect::<Vec<_>>(),
                         };
@@ -132,11 +156,12 @@ impl Trees {
             .collect();
         let trees: Vec<(&Topology, Vec<u32>)> = cut.iter().map(|(t, c)| (t, c.clone())).collect();
         let (mut blocks, placed) = split::lay_out(&trees, &mut self.topologies);
-        for (tree, pieces) in found.iter().zip(&placed) {
+        for (t, (tree, pieces)) in found.iter().zip(&placed).enumerate() {
             for p in pieces {
                 let lane = Lane {
                     block: first + p.block,
                     lane: p.lane,
+                    tree: first_tree + t,
                     bodies: &p.piece.bodies,
                     joints: &p.piece.joints,
                 };
@@ -182,9 +207,19 @@ impl Trees {
         block.padding &= !(1 << lane);
         for (k, &i) in at.bodies.iter().enumerate() {
             let node = &mut block.bodies[k];
-            let row = tree.bodies[i as usize] as u32 + 1;
-            node.set(lane, row, true, 1.0, glam::Mat3::IDENTITY);
+            let slot = tree.bodies[i as usize];
+            node.set(lane, slot as u32 + 1, true, 1.0, glam::Mat3::IDENTITY);
             set_mass(node, lane, bodies);
+            let place = BodyPlace {
+                block: at.block,
+                body: k,
+                lane,
+                tree: at.tree,
+            };
+            if self.bodies.len() <= slot {
+                self.bodies.resize(slot + 1, None);
+            }
+            self.bodies[slot] = Some(place);
         }
         for (k, &j) in at.joints.iter().enumerate() {
             let place = Some(Place {
@@ -474,6 +509,9 @@ impl crate::start::StartBlock for TreeBlock {
     fn start(&mut self, bodies: &BodyStore) {
         for node in &mut self.bodies {
             node.reset_moved();
+        }
+        for pins in &mut self.pins {
+            pins.start_step();
         }
         for lane in (0..BLOCK_LANES).filter(|l| self.padding & (1 << l) == 0) {
             for node in &mut self.bodies {

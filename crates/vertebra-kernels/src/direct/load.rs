@@ -141,6 +141,13 @@ impl Loads<'_> {
         let inertia = body.inertia_lanes::<L>(start);
         let mut linear = dp.scale(L::load(&body.mass[start..]));
         let mut angular = q.rotate(inertia.mul_vec(q.inverse_rotate(turn)));
+        // The pins moved the body too: their impulses are the ground's, not
+        // a joint's.
+        if let Some(pins) = block.pins.get(index) {
+            let [x, y, z, ax, ay, az] = load::<L, 6>(&pins.impulse, start);
+            linear -= Vec3::new(x, y, z);
+            angular -= Vec3::new(ax, ay, az);
+        }
         for &child in self.topology.children(n) {
             let below = match child {
                 Child::Node(c) => &block.momenta[c as usize],

@@ -32,6 +32,7 @@
 pub mod drive;
 pub mod ldl;
 pub mod load;
+pub mod pin;
 pub mod rows;
 mod solve;
 pub mod split;
@@ -716,6 +717,10 @@ pub struct TreeBlock {
     /// Per node, its subtree's momentum over the step, about a body's
     /// centre ([`load::LoadPass`]; never read by the solve).
     pub momenta: Vec<load::MomentumBlock>,
+    /// Per body (in the topology's body order), its pins: contacts with
+    /// static or kinematic bodies solved as rows of the tree's solve
+    /// ([`pin`]); empty for a block that takes none.
+    pub pins: Vec<pin::PinNode>,
 }
 
 impl TreeBlock {
@@ -737,7 +742,18 @@ impl TreeBlock {
             parent: [None; BLOCK_LANES],
             parent_x: [[0.0; BLOCK_LANES]; 6],
             momenta: vec![[Vec3Block::ZERO; 2]; shape.nodes.len()],
+            pins: Vec::new(),
         }
+    }
+
+    /// Gives every body of the block its (empty) pin slots.
+    pub fn take_pins(&mut self) {
+        self.pins = vec![pin::PinNode::empty(); self.bodies.len()];
+    }
+
+    /// Whether the block's bodies take pins.
+    pub fn pinned(&self) -> bool {
+        !self.pins.is_empty()
     }
 
     /// The lanes holding a tree (or a piece of one).
@@ -785,7 +801,14 @@ impl PositionPass<'_> {
             let live = block.live();
             block.dirty.fill(live);
         }
-        for pass in 1..=passes.max(1) {
+        // Pins take their own passes, lane by lane (`solve::LIMITS_SPENT`).
+        let pinned = blocks.iter().any(TreeBlock::pinned);
+        let most = if pinned {
+            passes.max(pin::PIN_PASSES)
+        } else {
+            passes.max(1)
+        };
+        for pass in 1..=most {
             for block in blocks.iter_mut() {
                 solve::hold(block, &topologies[block.topology as usize], pass == 1);
             }
@@ -802,7 +825,7 @@ impl PositionPass<'_> {
                 block.crossing = [0.0; BLOCK_LANES];
                 run_phase(on, block, Phase::Settle);
             }
-            if !solve::join_crossings(blocks) || pass >= passes {
+            if !solve::join_crossings(blocks, pass >= passes) || pass >= most {
                 break;
             }
             for block in blocks.iter_mut() {

@@ -33,6 +33,7 @@ use vertebra_math::{Lane, Mask, Vec3};
 use super::MAX_LIMIT_RETURN_SPEED;
 use super::drive::DRIVE_RECORD;
 use super::ldl::{self, Held, MAX, PACKED, at};
+use super::pin;
 use super::rows::{
     FREE, JointRows, LIMIT_RECORD as RECORD, MAX_DRIVE_ROWS, MAX_OPTIONAL, Rows, SwingRows,
 };
@@ -88,7 +89,7 @@ const BODY_PACKED: usize = at(6, 0);
 
 /// Stores lane values into scratch arrays.
 #[inline(always)]
-fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
+pub(super) fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
     for (v, d) in values.iter().zip(dst) {
         v.store(&mut d[start..]);
     }
@@ -215,6 +216,9 @@ pub(super) fn measure<L: Lane>(
             }
         }
         store(&measured, &mut block.scratch[n].measured, start);
+    }
+    for pins in block.pins.iter_mut() {
+        pin::measure::<L>(pins, rows, start);
     }
 }
 
@@ -367,6 +371,13 @@ pub(super) fn take_crossings(block: &mut TreeBlock, topology: &Topology) {
             }
         }
     }
+    if block.pinned() {
+        for (n, node) in topology.nodes.iter().enumerate() {
+            if let NodeKind::Body { index } = node.kind {
+                block.dirty[n] |= pin::take(&mut block.pins[index as usize], &crossing);
+            }
+        }
+    }
 }
 
 /// The set the last settle chose, releases included, as the next
@@ -377,19 +388,26 @@ pub(super) fn adopt(block: &mut TreeBlock) {
     }
 }
 
+/// A lane's crossing: a limit row's (another pass while the solve's bound
+/// allows), or a pin's (another pass up to [`pin::PIN_PASSES`]).
+const LIMIT_CROSSED: f32 = 1.0;
+/// See [`LIMIT_CROSSED`].
+const PIN_CROSSED: f32 = 2.0;
+
 /// Joins each tree's crossings across the blocks its pieces take: a trunk
 /// crosses where a piece hanging from it does, and every piece where its
-/// trunk does. Returns whether any tree crossed.
-pub(super) fn join_crossings(blocks: &mut [TreeBlock]) -> bool {
+/// trunk does (a pin's crossing over a limit's). Once `limits_spent` (the
+/// solve's passes for its limits are taken), only pins' crossings count.
+/// Returns whether any tree crossed.
+pub(super) fn join_crossings(blocks: &mut [TreeBlock], limits_spent: bool) -> bool {
     for k in 0..blocks.len() {
         let (before, rest) = blocks.split_at_mut(k);
         let block = &mut rest[0];
         for port in &block.ports {
             for (lane, source) in port.source.iter().enumerate() {
-                if let Some(s) = source
-                    && before[s.block as usize].crossing[s.lane as usize] != 0.0
-                {
-                    block.crossing[lane] = 1.0;
+                if let Some(s) = source {
+                    let theirs = before[s.block as usize].crossing[s.lane as usize];
+                    block.crossing[lane] = block.crossing[lane].max(theirs);
                 }
             }
         }
@@ -400,20 +418,21 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock]) -> bool {
         for (lane, source) in block.parent.iter().enumerate() {
             if let Some(s) = source {
                 let parent = &after[s.block as usize - k - 1];
-                if parent.crossing[s.lane as usize] != 0.0 {
-                    block.crossing[lane] = 1.0;
-                }
+                let theirs = parent.crossing[s.lane as usize];
+                block.crossing[lane] = block.crossing[lane].max(theirs);
             }
         }
     }
-    for block in blocks.iter() {
-        for &c in &block.crossing {
-            if c != 0.0 {
-                return true;
+    let mut any = false;
+    for block in blocks.iter_mut() {
+        for c in block.crossing.iter_mut() {
+            if limits_spent && *c < PIN_CROSSED {
+                *c = 0.0;
             }
+            any |= *c != 0.0;
         }
     }
-    false
+    any
 }
 
 /// Copies into block `k`'s ports their subtrees' complements (and which
@@ -541,6 +560,11 @@ fn body_block<L: Lane>(
         for (b, m) in b.iter_mut().zip(&minus_b) {
             *b -= *m;
         }
+    }
+    if let NodeKind::Body { index } = topology.nodes[n].kind
+        && let Some(pins) = block.pins.get(index as usize)
+    {
+        pin::add_to_block::<L>(pins, &mut d, &mut b, start);
     }
     ldl::factor::<L, 6>(&mut d);
     let scratch = &mut block.scratch[n];
@@ -957,7 +981,17 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
             L::select(now, one, zero).store(&mut block.scratch[n].next[l][start..]);
         }
     }
-    L::select(crossed, one, zero).store(&mut block.crossing[start..]);
+    let mut crossing = L::select(crossed, L::splat(LIMIT_CROSSED), zero);
+    for (n, node) in topology.nodes.iter().enumerate() {
+        if let NodeKind::Body { index } = node.kind
+            && let Some(pins) = block.pins.get_mut(index as usize)
+        {
+            let x = load::<L, 6>(&block.scratch[n].x, start);
+            let crossed = pin::settle::<L>(pins, &x, start);
+            crossing = L::select(crossed, L::splat(PIN_CROSSED), crossing);
+        }
+    }
+    crossing.store(&mut block.crossing[start..]);
 }
 
 /// Body node `n`'s turn from the solve (for none, the side of the root
@@ -1057,6 +1091,9 @@ pub(super) fn start_limits<L: Lane>(
             joint.drive.start(kind, (&a, &b), &geometry, start, h);
         }
     }
+    for pins in block.pins.iter_mut() {
+        pin::start_substep::<L>(pins, rows, start);
+    }
 }
 
 /// The largest turn one solve gives a body (rad).
@@ -1093,6 +1130,9 @@ pub(super) fn apply<L: Lane>(
         let turn = lanes.q.inverse_rotate(world_turn);
         lanes.q = lanes.q.integrate_local(turn, L::splat(1.0));
         lanes.scatter_pose(rows, &body.write[start..]);
+        if let Some(pins) = block.pins.get_mut(index as usize) {
+            pin::finish::<L>(pins, start);
+        }
         // What moved it, for the joints' forces (never read by the solve).
         let moved = &mut block.bodies[index as usize].moved;
         for (k, v) in [dp.x, dp.y, dp.z, world_turn.x, world_turn.y, world_turn.z]
