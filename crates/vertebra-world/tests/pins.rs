@@ -234,3 +234,42 @@ fn pulled_up_it_lifts_off_as_a_free_body() {
         "rose {risen}, not {expected}"
     );
 }
+
+#[test]
+fn spun_on_its_foot_it_stops_at_coulombs_torque() {
+    let mu = 0.2;
+    let spin = 6.0;
+    let mut stand = Stand::new(mu);
+    for body in [stand.foot, stand.trunk] {
+        let v = Vec3::ZERO;
+        stand
+            .world
+            .set_body_velocity(body, v, Vec3::new(0.0, spin, 0.0))
+            .unwrap();
+    }
+    // Every corner 0.424 m from the axis: the friction's torque is
+    // mu m g r, against both boxes' inertia about the vertical.
+    let r = Vec3::new(FOOT.x, 0.0, FOOT.z).length();
+    let inertia = |m: f32, h: Vec3| m * 4.0 * (h.x * h.x + h.z * h.z) / 12.0;
+    let decel = mu * TOTAL * G * r / (inertia(FOOT_MASS, FOOT) + inertia(TRUNK_MASS, TRUNK));
+    let mut spins = Vec::new();
+    for _ in 0..60 {
+        stand.step(Vec3::ZERO);
+        spins.push(stand.world.body(stand.trunk).unwrap().angular_velocity.y);
+    }
+    let expected = spin - 3.0 * decel * DT;
+    eprintln!(
+        "spun at {spin} rad/s: {:.3} rad/s after 3 frames ({expected:.3}), {:.5} after 1 s",
+        spins[2], spins[59]
+    );
+    assert!(
+        (spins[2] - expected).abs() < 0.02 * spin,
+        "{} against {expected}",
+        spins[2]
+    );
+    assert!(
+        spins[59].abs() < 1e-3,
+        "still turning at {} rad/s",
+        spins[59]
+    );
+}

@@ -38,12 +38,16 @@
 //! bound, as a wrench about their centre of pressure `o` (the normal
 //! multipliers' mean of the arms): with `F` the summed tangential
 //! multipliers, `tau` their moment about `o` along the normal and `s` the
-//! mean distance of the pins from `o`, the patch holds while
-//! `|F|^2 + (tau / s)^2 <= (sum mu lambda_n)^2` (an elliptic limit
-//! surface), each over the substep's solves so far and this one. A cone
-//! per pin lets a pushed box feel twice its `mu`: its load moves to the
-//! front corners, and the back ones' excess is clamped from their
-//! multipliers, not from the body.
+//! patch's size (the loaded pins' mean distance from their own centre),
+//! the patch holds while `|F|^2 + (tau / s)^2 <= (sum mu lambda_n)^2` (an
+//! elliptic limit surface), each over the substep's solves so far and
+//! this one. A cone per pin lets a pushed box feel twice its `mu`: its
+//! load moves to the front corners, and the back ones' excess is clamped
+//! from their multipliers, not from the body. The size is the patch's,
+//! not the load's spread about `o`: a capsule whose load sat on one end
+//! had a size near zero, so any twist its joints held slid it, and a limp
+//! ragdoll's limbs kept turning (6.48 rad/s in its fourth second, 0.35
+//! with the patch's size).
 //!
 //! A body's pins either **stick** (the tangent rows held with the
 //! normal's) or **slide**: no tangent rows, each held pin pushing
@@ -562,26 +566,31 @@ pub(super) fn settle<L: Lane>(pins: &mut PinNode, x: &[L; 6], start: usize) -> L
         force.store(&mut slot.next_force[start..]);
         slot.next_way.store(start, way);
     }
-    // The moment of the friction about the centre of pressure, and the
-    // pins' mean distance from it.
+    // The moment of the friction about the centre of pressure.
     let has_load = load.gt(zero);
     let centre = Vec3::select(
         has_load,
         moment.scale(one / load.max(L::splat(f32::MIN_POSITIVE))),
         Vec3::zero(),
     );
+    // The loaded pins' own centre and mean distance from it: the patch's
+    // size, whatever its load's spread.
+    let (mut count, mut middle) = (zero, Vec3::zero());
+    for k in 0..MAX_PINS {
+        let loaded = L::select(loads[k].gt(zero), one, zero);
+        count += loaded;
+        middle += arms[k].scale(loaded);
+    }
+    let middle = middle.scale(one / count.max(one));
     let mut spread = zero;
     for k in 0..MAX_PINS {
         let offset = arms[k] - centre;
         spin += offset.cross(frictions[k]).dot(normals[k]);
-        let across = offset - normals[k].scale(offset.dot(normals[k]));
-        spread += loads[k].max(zero) * across.length();
+        let from_middle = arms[k] - middle;
+        let across = from_middle - normals[k].scale(from_middle.dot(normals[k]));
+        spread += L::select(loads[k].gt(zero), across.length(), zero);
     }
-    let radius = L::select(
-        has_load,
-        spread / load.max(L::splat(f32::MIN_POSITIVE)),
-        zero,
-    );
+    let radius = L::select(has_load, spread / count.max(one), zero);
     let turning = L::select(
         radius.gt(L::splat(1.0e-4)),
         spin / radius.max(L::splat(1.0e-4)),
