@@ -801,7 +801,8 @@ impl PositionPass<'_> {
             let live = block.live();
             block.dirty.fill(live);
         }
-        // Pins take their own passes, lane by lane (`solve::LIMITS_SPENT`).
+        // Pins take their own passes, lane by lane, past the limits' bound
+        // (`solve::join_crossings`).
         let pinned = blocks.iter().any(TreeBlock::pinned);
         let most = if pinned {
             passes.max(pin::PIN_PASSES)

@@ -89,7 +89,7 @@ const BODY_PACKED: usize = at(6, 0);
 
 /// Stores lane values into scratch arrays.
 #[inline(always)]
-pub(super) fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
+fn store<L: Lane>(values: &[L], dst: &mut [[f32; BLOCK_LANES]], start: usize) {
     for (v, d) in values.iter().zip(dst) {
         v.store(&mut d[start..]);
     }
