@@ -113,9 +113,9 @@ pub const STUCK: f32 = 2.0;
 /// again and asked beyond its bound once more.
 pub const FREE: f32 = 3.0;
 
-/// How many times a solve may hold or let go one pin's normal: after that
-/// the pin keeps its last state (an active set over the contacts of a
-/// whole tree can cycle).
+/// How many times a solve may hold or let go one pin's normal before it
+/// may no longer be taken (an active set over the contacts of a whole
+/// tree can cycle); a pulling normal is let go whatever its count.
 const MAX_FLIPS: f32 = 2.0;
 
 /// Where a pin's record ([`PinSlot::record`]) keeps its three errors.
@@ -538,10 +538,13 @@ pub(super) fn settle<L: Lane>(pins: &mut PinNode, x: &[L; 6], start: usize) -> L
         lambda_n.store(&mut slot.lambda_n[start..]);
         slot.lambda_t.store(start, lambda_t);
         // The normal's next pass.
-        let live = live::<L>(slot, start) & L::load(&slot.flips[start..]).lt(L::splat(MAX_FLIPS));
+        // A pulling normal is always let go; one is taken only while its
+        // flips last, so the passes end.
+        let live = live::<L>(slot, start);
+        let takes = live & L::load(&slot.flips[start..]).lt(L::splat(MAX_FLIPS));
         let crossing = L::splat(PIN_CROSSING);
         let pulls = live & held & sn.gt(crossing);
-        let carried = live & !held & sn.lt(-crossing);
+        let carried = takes & !held & sn.lt(-crossing);
         let next = (held & !pulls) | carried;
         L::select(next, one, zero).store(&mut slot.next[start..]);
         crossed = crossed | pulls | carried;
