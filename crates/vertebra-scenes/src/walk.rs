@@ -1,8 +1,9 @@
 //! A walking animation for the anatomical humanoid: [`Gait`]'s timing
 //! turned into a pose at any time. The legs reach their feet by two-bone
 //! inverse kinematics (hip and knee), so a planted foot stays where it is
-//! while the hips pass over it; the arms swing against the legs, the
-//! shoulders turn against the hips, and the head keeps looking ahead.
+//! while the hips pass over it (on a leg with an ankle the foot is kept
+//! flat and ahead); the arms swing against the legs, the shoulders turn
+//! against the hips, and the head keeps looking ahead.
 
 use glam::{Quat, Vec3};
 use vertebra_math::{DefaultFloatMode, PortableQuat, trig};
@@ -24,8 +25,9 @@ pub struct Walk {
     joints: Joints,
     root_bind: Vec3,
     /// Per leg (left, right): the hip's anchor from the hips' centre, the
-    /// thigh's length (hip to knee), the shin's (knee to the end of its
-    /// capsule's segment, the centre of the round end it stands on).
+    /// foot (the ankle's pivot, or without ankles the end of the shin's
+    /// capsule segment, the centre of the round end it stands on), the
+    /// thigh's length (hip to knee), the shin's (knee to foot).
     legs: [Leg; 2],
     turn: Quat,
     offset: Vec3,
@@ -45,6 +47,8 @@ struct Joints {
     count: usize,
     hips: [usize; 2],
     knees: [usize; 2],
+    /// `ankle_l` and `ankle_r`, when the description has both.
+    ankles: Option<[usize; 2]>,
     shoulders: [usize; 2],
     elbows: [usize; 2],
     spine: Vec<usize>,
@@ -56,8 +60,11 @@ impl Walk {
     /// the origin with its hips at their bind place. Refused when `desc`
     /// lacks a joint the walk moves (the anatomical humanoid's `hip_l`,
     /// `knee_l`, `shoulder_l`, `elbow_l`, their right twins, `spine_1` to
-    /// `spine_3` and `neck`).
-    pub fn new(desc: &RagdollDesc, gait: Gait, start: f32) -> Result<Self, RagdollError> {
+    /// `spine_3` and `neck`). With `ankle_l` and `ankle_r` (feet below the
+    /// shins) the legs reach the ankles, the ankles keep the feet flat and
+    /// ahead, and a planted foot does not roll (`gait.foot_radius` is taken
+    /// as 0).
+    pub fn new(desc: &RagdollDesc, mut gait: Gait, start: f32) -> Result<Self, RagdollError> {
         let _mode = DefaultFloatMode::enter();
         let joint = |name: &str| {
             desc.joint_index(name).ok_or_else(|| {
@@ -74,6 +81,7 @@ impl Walk {
             count: desc.joints.len(),
             hips: pair("hip")?,
             knees: pair("knee")?,
+            ankles: pair("ankle").ok(),
             shoulders: pair("shoulder")?,
             elbows: pair("elbow")?,
             spine: ["spine_1", "spine_2", "spine_3"]
@@ -89,13 +97,17 @@ impl Walk {
                 &desc.joints[joints.knees[side]],
             );
             let shin = &desc.bodies[knee.child];
-            // The end of the shin's segment farther from the knee.
+            // The ankle, or the end of the shin's segment farther from the
+            // knee.
             let [a, b] = shin.segment;
-            let foot = if (a - knee.anchor).length() > (b - knee.anchor).length() {
+            let far = if (a - knee.anchor).length() > (b - knee.anchor).length() {
                 a
             } else {
                 b
             };
+            let foot = joints
+                .ankles
+                .map_or(far, |ankles| desc.joints[ankles[side]].anchor);
             Leg {
                 hip: hip.anchor - root_bind,
                 foot,
@@ -104,6 +116,9 @@ impl Walk {
             }
         };
         let legs = [leg(0), leg(1)];
+        if joints.ankles.is_some() {
+            gait.foot_radius = 0.0;
+        }
         Ok(Self {
             gait,
             start,
@@ -144,8 +159,13 @@ impl Walk {
             let at = leg.foot + Vec3::new(0.0, foot.lift, foot.forward);
             let hip = root + hips_turn * leg.hip;
             let (thigh, knee) = reach(hip, at, hips_turn * Vec3::X, leg.thigh, leg.shin);
+            let knee = Quat::from_rotation_x_portable(knee);
             rotations[self.joints.hips[side]] = hips_turn.conjugate().mul_portable(thigh);
-            rotations[self.joints.knees[side]] = Quat::from_rotation_x_portable(knee);
+            rotations[self.joints.knees[side]] = knee;
+            if let Some(ankles) = self.joints.ankles {
+                // The foot flat and ahead: the shin's turn undone.
+                rotations[ankles[side]] = thigh.mul_portable(knee).conjugate();
+            }
         }
         let grown = g.speed_fraction(t);
         let (_, _, turn) = g.hips(t);

@@ -8,10 +8,10 @@
 //! takes a 40 N s hit on the chest from every side and recovers, and a
 //! hit beyond what its capped drives can hold fells it.
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use vertebra_ragdoll::{Pose, RagdollDesc, SpineMode};
 use vertebra_scenes::{
-    Activity, FRAME_DT, Scene, SceneConfig, Side, StaggerSweep, WALK_SPEED, WALK_START, Walk,
+    Activity, FRAME_DT, Gait, Scene, SceneConfig, Side, StaggerSweep, WALK_SPEED, WALK_START, Walk,
     build, stagger_profile, stagger_walk,
 };
 use vertebra_world::{JointSolver, SolverConfig};
@@ -237,4 +237,74 @@ fn it_walks_within_5_cm_and_recovers_from_a_40_n_s_hit_from_every_side() {
             }
         }
     }
+}
+
+/// The anatomical humanoid with a 1 kg capsule foot below each shin, on a
+/// pyramid ankle at the shin's end (0.10 m up), flat on the ground.
+fn with_feet() -> RagdollDesc {
+    let mut text = vertebra_ragdoll::ANATOMICAL_HUMANOID.to_owned();
+    for (side, x) in [("l", 0.1), ("r", -0.1)] {
+        text.push_str(&format!(
+            "
+[[body]]
+name = \"foot_{side}\"
+segment = [[{x}, 0.035, -0.02], [{x}, 0.035, 0.10]]
+radius = 0.035
+mass = 1.0
+
+[[joint]]
+name = \"ankle_{side}\"
+parent = \"shin_{side}\"
+child = \"foot_{side}\"
+anchor = [{x}, 0.10, 0.0]
+axis = [0.0, -1.0, 0.0]
+normal = [1.0, 0.0, 0.0]
+swing = {{ y = [-40.0, 40.0], z = [-20.0, 20.0] }}
+twist = [-15.0, 15.0]
+"
+        ));
+    }
+    RagdollDesc::from_toml(&text).unwrap()
+}
+
+/// On legs with ankles, the walk reaches the ankles, keeps each foot flat
+/// and ahead throughout and a planted foot where it was planted (no roll),
+/// and still stands at the bind pose before it starts.
+#[test]
+fn on_feet_the_walk_keeps_them_flat_and_planted() {
+    let desc = with_feet();
+    let walk = Walk::new(&desc, Gait::walk(WALK_SPEED), WALK_START).unwrap();
+    let g = walk.gait;
+    assert_eq!(g.foot_radius, 0.0, "a foot on an ankle does not roll");
+    let bind = Pose::bind(&desc);
+    let still = walk.pose(&desc, 0.5 * WALK_START).unwrap();
+    for (k, (a, b)) in still.bones.iter().zip(&bind.bones).enumerate() {
+        assert!((a.0 - b.0).length() < 1e-5, "bone {k} off the bind pose");
+    }
+    let feet = ["foot_l", "foot_r"].map(|n| desc.body_index(n).unwrap());
+    let (mut tipped, mut drift, mut lift) = (0.0f32, 0.0f32, [0.0f32; 2]);
+    let full = WALK_START + g.ramp;
+    let mut before: Option<Pose> = None;
+    for f in 0..(2.0 / FRAME_DT) as usize {
+        let t = full + f as f32 * FRAME_DT;
+        let pose = walk.pose(&desc, t).unwrap();
+        for (side, &k) in feet.iter().enumerate() {
+            let (at, turn) = pose.bones[k];
+            tipped = tipped.max(turn.angle_between(Quat::IDENTITY));
+            lift[side] = lift[side].max(at.y - bind.bones[k].0.y);
+            let down = |t: f32| g.foot(side, t - WALK_START).down;
+            if let (Some(prev), true, true) = (&before, down(t), down(t - FRAME_DT)) {
+                drift = drift.max((at - prev.bones[k].0).length());
+            }
+        }
+        before = Some(pose);
+    }
+    eprintln!(
+        "feet on ankles: turned at most {tipped:.1e} rad, planted ones moved at most {:.4} mm a frame, lifted {:.3?} m",
+        drift * 1e3,
+        lift
+    );
+    assert!(tipped < 1e-3, "a foot turned {tipped} rad");
+    assert!(drift < 1e-4, "a planted foot moved {drift} m in a frame");
+    assert!(lift.iter().all(|&l| l > 0.05), "{lift:?}");
 }
