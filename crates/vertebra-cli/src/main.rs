@@ -125,6 +125,12 @@ enum Command {
         /// says.
         #[arg(long, num_args = 0..=1, default_missing_value = "true")]
         relax_contacts: Option<bool>,
+        /// Solve each ragdoll's contacts with the static world in its
+        /// direct joint solve (true or false; alone: true; only with
+        /// --joints direct). Unless given: on for the stagger under the
+        /// direct solve (its feet stand on them), off otherwise.
+        #[arg(long, num_args = 0..=1, default_missing_value = "true")]
+        pin_contacts: Option<bool>,
         /// One JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -247,6 +253,7 @@ fn execute(command: Command) -> Result<(), String> {
             seeds,
             sleep,
             relax_contacts,
+            pin_contacts,
             json,
             skeleton_out,
             gltf,
@@ -288,6 +295,8 @@ fn execute(command: Command) -> Result<(), String> {
             config.iterations = iterations.unwrap_or(solver.iterations);
             config.substeps = substeps.unwrap_or(solver.substeps);
             config.relax_contacts = relax_contacts.unwrap_or(solver.relax_contacts);
+            let direct = config.joints == JointSolver::Direct;
+            config.pin_contacts = pin_contacts.unwrap_or(scene == Scene::Stagger && direct);
             config.frames = frames;
             config.backend = backend;
             config.threads = threads;

@@ -70,6 +70,7 @@ fn setting_json(config: &SceneConfig, run: &SceneRun) -> serde_json::Map<String,
         "threads": config.threads,
         "sleep": config.sleep.is_some(),
         "relax_contacts": config.relax_contacts,
+        "pin_contacts": config.pin_contacts,
     }) else {
         unreachable!("a JSON object literal")
     };

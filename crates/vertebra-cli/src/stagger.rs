@@ -153,6 +153,7 @@ fn sweep_json(config: &SceneConfig, sweep: &StaggerSweep, backend: &str, seconds
         "threads": config.threads,
         "sleep": config.sleep.is_some(),
         "relax_contacts": config.relax_contacts,
+        "pin_contacts": config.pin_contacts,
         "seconds": seconds,
         "standing_hips_m": sweep.standing_height,
         "hits": sweep.hits.iter().map(hit_json).collect::<Vec<_>>(),

@@ -30,16 +30,20 @@ fn a_scene_runs_the_papers_settings_or_the_worlds_default_unless_told() {
             v["substeps"].as_u64().unwrap(),
             v["iterations"].as_u64().unwrap(),
             v["relax_contacts"].as_bool().unwrap(),
+            v["pin_contacts"].as_bool().unwrap(),
         )
     };
-    let paper = ("iterative".to_owned(), 1, 20, false);
-    let default = ("direct".to_owned(), 1, 8, true);
+    let paper = ("iterative".to_owned(), 1, 20, false, false);
+    let default = ("direct".to_owned(), 1, 8, true, false);
     assert_eq!(settings(&["passive-bending", "--spine", "rod"]), paper);
     assert_eq!(settings(&["heavy-chain", "--spine", "sockets"]), default);
     let iterated = ["heavy-chain", "--spine", "sockets", "--joints", "iterative"];
     assert_eq!(settings(&iterated), paper);
     let direct = ["ragdoll-drop", "--spine", "rod", "--joints", "direct"];
-    assert_eq!(settings(&direct), ("direct".to_owned(), 1, 20, false));
+    assert_eq!(
+        settings(&direct),
+        ("direct".to_owned(), 1, 20, false, false)
+    );
     let told = [
         "heavy-chain",
         "--spine",
@@ -51,9 +55,37 @@ fn a_scene_runs_the_papers_settings_or_the_worlds_default_unless_told() {
         "--relax-contacts",
         "false",
     ];
-    assert_eq!(settings(&told), ("direct".to_owned(), 2, 3, false));
+    assert_eq!(settings(&told), ("direct".to_owned(), 2, 3, false, false));
     let relaxed = ["passive-bending", "--spine", "rod", "--relax-contacts"];
-    assert_eq!(settings(&relaxed), ("iterative".to_owned(), 1, 20, true));
+    assert_eq!(
+        settings(&relaxed),
+        ("iterative".to_owned(), 1, 20, true, false)
+    );
+    // The stagger stands on pinned feet under the direct solve unless told.
+    let stagger = ["stagger", "--spine", "rod"];
+    assert_eq!(settings(&stagger), ("direct".to_owned(), 1, 8, true, true));
+    let unpinned = ["stagger", "--spine", "rod", "--pin-contacts", "false"];
+    assert_eq!(
+        settings(&unpinned),
+        ("direct".to_owned(), 1, 8, true, false)
+    );
+    let pinned = ["heavy-chain", "--spine", "sockets", "--pin-contacts"];
+    assert_eq!(settings(&pinned), ("direct".to_owned(), 1, 8, true, true));
+    // Pins need the direct solve: asked of the iterated one, refused.
+    let iterated = [
+        "scene",
+        "stagger",
+        "--spine",
+        "rod",
+        "--frames",
+        "2",
+        "--joints",
+        "iterative",
+        "--pin-contacts",
+    ];
+    let (code, _, stderr) = vertebra(&iterated);
+    assert_ne!(code, 0);
+    assert!(stderr.contains("pin_contacts"), "{stderr}");
 }
 
 #[test]
@@ -78,6 +110,7 @@ fn scene_json_has_every_field() {
         "threads",
         "sleep",
         "relax_contacts",
+        "pin_contacts",
         "seed",
         "frames",
         "summary",
@@ -572,19 +605,21 @@ fn model(name: &str) -> String {
 fn check_prints_what_a_ragdoll_file_holds() {
     let (code, stdout, stderr) = vertebra(&["check", &model("anatomical.toml")]);
     assert_eq!(code, 0, "{stderr}");
-    // The file's own numbers: 13 bodies and 12 joints, 69 kg, the hips
+    // The file's own numbers: 15 bodies and 14 joints, 69 kg, the hips
     // 11 kg, knees hinged 0 to 150 degrees, shoulders elliptical 90 by 70,
+    // ankles pyramids,
     // the spine's rod limits, the [drive] table, the profiles, no skeleton.
     for expected in [
-        "ragdoll `anatomical-humanoid`: 13 bodies, 12 joints, 69 kg",
+        "ragdoll `anatomical-humanoid`: 15 bodies, 14 joints, 69 kg",
         "hips ",
         "11 kg  radius 0.1 m\n",
         "hinge   thigh_l -> shin_l  range 0 .. 150 deg",
+        "socket  shin_l -> foot_l  swing pyramid y -40 .. 40 z -20 .. 20 deg, twist -15 .. 15 deg",
         "socket  chest -> upper_arm_l  swing ellipse y 90 z 70 deg, twist -60 .. 60 deg",
         "spine: hips, spine_lower, spine_upper, chest (one rod in the simplified ragdoll): bend 60 deg, twist -30 .. 30 deg, stiffness 2 / 2 N m^2",
         "drive: spring 4 Hz, damping ratio 1, max torque 400 N m",
-        "profiles:\n  standing: 12 of 12 joints driven, 13 of 13 bodies held in the world, 2 upright\n",
-        "  limp: 0 of 12 joints driven, 0 of 13 bodies held in the world, 0 upright\n",
+        "profiles:\n  standing: 14 of 14 joints driven, 15 of 15 bodies held in the world, 2 upright\n",
+        "  limp: 0 of 14 joints driven, 0 of 15 bodies held in the world, 0 upright\n",
         "skeleton: none",
     ] {
         assert!(stdout.contains(expected), "`{expected}` in\n{stdout}");

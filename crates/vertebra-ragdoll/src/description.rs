@@ -35,7 +35,8 @@ pub const REFERENCE_HUMANOID: &str = include_str!("../models/humanoid.toml");
 
 /// The anatomical humanoid, shipped with the crate: the reference
 /// humanoid's 13 bodies with hinged knees and elbows, elliptical shoulders,
-/// hips and spine joints, and a neck (`models/anatomical.toml`).
+/// hips and spine joints, and a neck, and two feet on pyramid ankles (15
+/// bodies, 14 joints; `models/anatomical.toml`).
 pub const ANATOMICAL_HUMANOID: &str = include_str!("../models/anatomical.toml");
 
 #[derive(Deserialize)]

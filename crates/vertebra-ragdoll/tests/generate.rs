@@ -36,7 +36,7 @@ fn bone(skeleton: &Skeleton, name: &str) -> usize {
 /// along its line of first children, or its first child for a limb's last
 /// body; the chest is ended at the neck's base and the head is given a
 /// length.
-const ENDS: [(&str, &str); 12] = [
+const ENDS: [(&str, &str); 14] = [
     ("hips", "spine_lower"),
     ("spine_lower", "spine_upper"),
     ("spine_upper", "chest"),
@@ -49,6 +49,8 @@ const ENDS: [(&str, &str); 12] = [
     ("shin_l", "foot_l"),
     ("thigh_r", "shin_r"),
     ("shin_r", "foot_r"),
+    ("foot_l", "toes_l"),
+    ("foot_r", "toes_r"),
 ];
 const HEAD_LENGTH: f32 = 0.12;
 

@@ -62,6 +62,10 @@ pub struct SceneConfig {
     /// (`SolverConfig::relax_contacts`): off in [`SceneConfig::new`], as
     /// in the paper; on in the world's default.
     pub relax_contacts: bool,
+    /// Whether a ragdoll's contacts with the static world are solved in
+    /// its direct joint solve (`SolverConfig::pin_contacts`; needs
+    /// [`JointSolver::Direct`]): off in [`SceneConfig::new`].
+    pub pin_contacts: bool,
 }
 
 impl SceneConfig {
@@ -85,6 +89,7 @@ impl SceneConfig {
             measure_residuals: true,
             sleep: None,
             relax_contacts: false,
+            pin_contacts: false,
         }
     }
 
@@ -130,6 +135,7 @@ impl SceneConfig {
             threads: self.threads,
             sleep: self.sleep,
             relax_contacts: self.relax_contacts,
+            pin_contacts: self.pin_contacts,
             ..SolverConfig::paper()
         };
         Ok(World::new(config)?)

@@ -31,10 +31,15 @@ struct Stand {
 
 impl Stand {
     /// The anatomical humanoid at its bind pose, its lowest point 1 mm
-    /// above the ground, following it with the `standing` profile.
+    /// above the ground, following it with the `standing` profile; its
+    /// contacts with the ground pinned (its 1 kg feet need them).
     fn new(spine: SpineMode) -> Self {
         let desc = RagdollDesc::anatomical_humanoid();
-        let mut world = World::new(SolverConfig::default()).unwrap();
+        let config = SolverConfig {
+            pin_contacts: true,
+            ..SolverConfig::default()
+        };
+        let mut world = World::new(config).unwrap();
         let mut collisions = Collisions::new();
         let ground = world.add_body(BodyDesc::fixed()).unwrap();
         collisions
@@ -140,19 +145,28 @@ fn a_hit_fades_the_drives_out_and_back_in_without_a_pop() {
     }
 }
 
+/// Fading to limp over half a second moves no body by more than 1 mm in a
+/// frame by the blend itself; neither does fading back in to standing
+/// from two thirds of the way out, before it has fallen. (Once it has
+/// fallen, a blend back to standing drives its stiff legs straight from
+/// a heap and throws it: getting up is a get-up clip's work,
+/// `docs/ragdolls.md`.)
 #[test]
-fn fading_to_limp_and_back_has_no_pop() {
+fn fading_to_limp_and_back_before_it_falls_has_no_pop() {
     for spine in [SpineMode::Sockets, SpineMode::Rod] {
         let mut stand = Stand::new(spine);
         stand.frames(30);
-        let limp = stand.profile("limp");
-        stand.blend.switch_to(limp, 0.5).unwrap();
+        stand.blend.switch_to(stand.profile("limp"), 0.5).unwrap();
         let out = stand.frames(45);
+        let mut stand = Stand::new(spine);
+        stand.frames(30);
+        stand.blend.switch_to(stand.profile("limp"), 0.5).unwrap();
+        stand.frames(20);
         let standing = stand.profile("standing");
-        stand.blend.switch_to(standing, 1.0).unwrap();
-        let back = stand.frames(90);
+        stand.blend.switch_to(standing, 0.5).unwrap();
+        let back = stand.frames(60);
         eprintln!(
-            "{spine:?}: fading to limp moved a body {:.3} mm, back {:.3} mm",
+            "{spine:?}: fading to limp moved a body {:.3} mm, back from two thirds out {:.3} mm",
             out * 1e3,
             back * 1e3
         );

@@ -61,10 +61,15 @@ struct Stand {
 
 impl Stand {
     /// The anatomical humanoid at its bind pose (standing, arms out), its
-    /// lowest point 1 mm above the ground, at the default solver settings.
+    /// lowest point 1 mm above the ground, at the default solver settings
+    /// with its contacts with the ground pinned (its 1 kg feet need them).
     fn new(spine: SpineMode) -> Self {
         let desc = RagdollDesc::anatomical_humanoid();
-        let mut world = World::new(SolverConfig::default()).unwrap();
+        let config = SolverConfig {
+            pin_contacts: true,
+            ..SolverConfig::default()
+        };
+        let mut world = World::new(config).unwrap();
         let mut collisions = Collisions::new();
         let ground = world.add_body(BodyDesc::fixed()).unwrap();
         collisions
