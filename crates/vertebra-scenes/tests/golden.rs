@@ -128,10 +128,10 @@ fn anatomical_drop_direct() {
 
 // The anatomical drop: its elliptical sockets, hinges and rod through
 // both solves.
-const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x8956_dae4_0c5d_c4bb;
-const GOLDEN_ANATOMICAL_ROD: u64 = 0xe17f_cac9_f0a4_ed67;
-const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x5fff_c5e6_5fb8_46f4;
-const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0xb36d_d5f6_47c9_e263;
+const GOLDEN_ANATOMICAL_SOCKETS: u64 = 0x3e10_c32f_ff19_9d3d;
+const GOLDEN_ANATOMICAL_ROD: u64 = 0x3d39_b9c2_d1c5_37eb;
+const GOLDEN_ANATOMICAL_SOCKETS_DIRECT: u64 = 0x7716_ebb1_2518_1336;
+const GOLDEN_ANATOMICAL_ROD_DIRECT: u64 = 0x513c_985b_4246_c33f;
 
 // The paper's scenes, passive bending and the 30-ragdoll drop, each
 // spine, solved directly.
