@@ -39,15 +39,27 @@
 //!
 //! **Torque cap.** The rows' multipliers, summed over the substep's
 //! solves (`lambda`, along a's axes), are the drive's angular impulse
-//! times `h`: the torque is `lambda / h^2`. After a solve that takes
-//! `|lambda|` past `max_torque h^2`, the drive is capped for the rest of
-//! the substep at `cap = lambda max_torque h^2 / |lambda|`: each later
-//! solve prescribes its rows' step `cap - lambda` (a row of compliance
-//! [`CAPPED_COMPLIANCE`] times its own inverse mass `w`, its right-hand
-//! side `-CAPPED_COMPLIANCE w (cap - lambda)`: the row's motion changes its
-//! step by a millionth), which takes back the excess and then holds the
-//! capped torque. A hit beyond the cap turns the joint away, and the
-//! drive brings it back afterwards.
+//! times `h`: the torque is `lambda / h^2`. A cap bounds the multiplier,
+//! and the bound is held as the limits' active set is: when a pass whose
+//! pins have settled would take `|lambda + dlambda|` past `max_torque
+//! h^2` ([`DriveNode::settle`]), its step is not taken; the drive is
+//! capped for the rest of the substep at `cap = (lambda + dlambda)
+//! max_torque h^2 / |lambda + dlambda|` and the tree is solved again (a
+//! pass of its own, as a pin's crossing takes). In that pass and each
+//! later solve the rows prescribe their step `cap - lambda` (a row of
+//! compliance [`CAPPED_COMPLIANCE`] times its own inverse mass `w`, its
+//! right-hand side `-CAPPED_COMPLIANCE w (cap - lambda)`: the row's
+//! motion changes its step by a millionth), and the drive exerts its
+//! capped torque. So an uncapped step, which may turn a limb into the
+//! ground the contacts then push it out of (the push kept as speed),
+//! never moves a body. A pass whose pins are still changing is no
+//! measure of the drive (a pin about to let go holds a foot the drive
+//! pushes against): it caps nothing, and the cap waits for the pins to
+//! settle or for their passes to run out, then takes one pass more. A
+//! cap found in that last pass is taken after it: its step moves the
+//! bodies, the drive is capped after it ([`DriveNode::accumulate`]), and
+//! the later solves take the excess back. A hit beyond the cap turns the
+//! joint away, and the drive brings it back afterwards.
 //!
 //! **Against a limit.** A drive pulling past a hard limit would ask of
 //! its hard rows what the limit's row refuses (rows that repeat each
@@ -104,6 +116,12 @@ pub struct DriveNode {
     pub cap: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
     /// 1 where the drive reached its cap this substep.
     pub capped: [f32; BLOCK_LANES],
+    /// Where the last settle found the drive past its cap (1), the cap
+    /// it would hold: taken if the tree is solved again
+    /// ([`Self::take`]).
+    pub capping: [f32; BLOCK_LANES],
+    /// See [`Self::capping`].
+    pub next_cap: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
 }
 
 impl DriveNode {
@@ -115,8 +133,10 @@ impl DriveNode {
             self.lambda[row][lane] = 0.0;
             self.moved[row][lane] = 0.0;
             self.cap[row][lane] = 0.0;
+            self.next_cap[row][lane] = 0.0;
         }
         self.capped[lane] = 0.0;
+        self.capping[lane] = 0.0;
     }
 
     /// The drive's substep start for the lanes from `start`, before the
@@ -143,6 +163,7 @@ impl DriveNode {
             zero.store(&mut self.cap[row][start..]);
         }
         zero.store(&mut self.capped[start..]);
+        zero.store(&mut self.capping[start..]);
         let velocity = self.settings.velocity.load(start);
         self.settings
             .target
@@ -197,11 +218,75 @@ impl DriveNode {
         (d, b, target)
     }
 
+    /// Where the summed multipliers `sum` (each row's) pass the cap
+    /// (`|sum| > max_torque h^2`) in a lane not yet capped, and the capped
+    /// multipliers there (`sum` scaled onto the cap).
+    #[inline(always)]
+    fn over_cap<L: Lane>(
+        &self,
+        sum: &[L],
+        start: usize,
+        inv_h2: f32,
+    ) -> (L::Mask, [L; MAX_DRIVE_ROWS]) {
+        let zero = L::splat(0.0);
+        let mut squared = zero;
+        for &x in sum {
+            squared += x * x;
+        }
+        let limit = L::load(&self.settings.max_torque[start..]) / L::splat(inv_h2);
+        let was = L::load(&self.capped[start..]).gt(zero);
+        let caps = squared.gt(limit * limit).and_not(was);
+        let scale = limit / L::select(caps, squared.sqrt(), L::splat(1.0));
+        let mut capped = [zero; MAX_DRIVE_ROWS];
+        for (out, &x) in capped.iter_mut().zip(sum) {
+            // An overflowing sum (`squared` infinite) caps at zero, not at
+            // `inf * 0`.
+            let c = x * scale;
+            *out = L::select(c.eq(c), c, zero);
+        }
+        (caps, capped)
+    }
+
+    /// After a pass, for the lanes from `start` not yet capped: whether
+    /// the pass's multiplier steps `dlambda` take the drive past its cap;
+    /// where they do, the cap it would hold is kept in `next_cap` and the
+    /// lane marked in `capping`, for [`Self::take`]. Returns the marked
+    /// lanes.
+    #[inline(always)]
+    pub(super) fn settle<L: Lane>(&mut self, dlambda: &[L], start: usize, inv_h2: f32) -> L::Mask {
+        let zero = L::splat(0.0);
+        let enabled = L::load(&self.settings.enabled[start..]).gt(zero);
+        let mut sum = [zero; MAX_DRIVE_ROWS];
+        for (row, &step) in dlambda.iter().enumerate() {
+            sum[row] = L::select(enabled, L::load(&self.lambda[row][start..]) + step, zero);
+        }
+        let (caps, capped) = self.over_cap(&sum[..dlambda.len()], start, inv_h2);
+        for (row, &c) in capped.iter().enumerate().take(dlambda.len()) {
+            L::select(caps, c, zero).store(&mut self.next_cap[row][start..]);
+        }
+        L::select(caps, L::splat(1.0), zero).store(&mut self.capping[start..]);
+        caps
+    }
+
+    /// Before the tree is solved again: the cap the last settle found in
+    /// `lane`, held from now on. Returns whether there was one.
+    pub(super) fn take(&mut self, lane: usize) -> bool {
+        if self.capping[lane] == 0.0 {
+            return false;
+        }
+        self.capped[lane] = 1.0;
+        for row in 0..MAX_DRIVE_ROWS {
+            self.cap[row][lane] = self.next_cap[row][lane];
+        }
+        true
+    }
+
     /// After a solve, for the lanes from `start`: each row's multiplier
     /// step `dlambda` and, for the oscillator, its requested move `T - C`
     /// (`records`: each row's `[c, w, T]`) added to the substep's sums;
-    /// and a drive whose summed torque passed `max_torque` capped there
-    /// for the rest of the substep.
+    /// and a drive whose summed torque passed `max_torque` (its solve's
+    /// passes spent before its cap was taken) capped there for the rest of
+    /// the substep.
     #[inline(always)]
     pub(super) fn accumulate<L: Lane>(
         &mut self,
@@ -213,27 +298,20 @@ impl DriveNode {
         let zero = L::splat(0.0);
         let enabled = L::load(&self.settings.enabled[start..]).gt(zero);
         let mut lambda = [zero; MAX_DRIVE_ROWS];
-        let mut squared = zero;
         for (row, &[c, _, target]) in records.iter().enumerate() {
             let sum = L::load(&self.lambda[row][start..]) + dlambda[row];
             let moved = L::load(&self.moved[row][start..]) + (target - c);
-            L::select(enabled, sum, zero).store(&mut self.lambda[row][start..]);
-            L::select(enabled, moved, zero).store(&mut self.moved[row][start..]);
             lambda[row] = L::select(enabled, sum, zero);
-            squared += lambda[row] * lambda[row];
+            lambda[row].store(&mut self.lambda[row][start..]);
+            L::select(enabled, moved, zero).store(&mut self.moved[row][start..]);
         }
-        let limit = L::load(&self.settings.max_torque[start..]) / L::splat(inv_h2);
-        let was = L::load(&self.capped[start..]).gt(zero);
-        let caps = squared.gt(limit * limit).and_not(was);
-        let scale = limit / L::select(caps, squared.sqrt(), L::splat(1.0));
-        for (row, &lambda) in lambda.iter().enumerate().take(records.len()) {
-            // An overflowing sum (`squared` infinite) caps at zero, not at
-            // `inf * 0`.
-            let capped = lambda * scale;
-            let capped = L::select(capped.eq(capped), capped, zero);
+        let rows = records.len();
+        let (caps, capped) = self.over_cap(&lambda[..rows], start, inv_h2);
+        for (row, &c) in capped.iter().enumerate().take(rows) {
             let cap = L::load(&self.cap[row][start..]);
-            L::select(caps, capped, cap).store(&mut self.cap[row][start..]);
+            L::select(caps, c, cap).store(&mut self.cap[row][start..]);
         }
+        let was = L::load(&self.capped[start..]).gt(zero);
         L::select(caps | was, L::splat(1.0), zero).store(&mut self.capped[start..]);
     }
 }

@@ -756,6 +756,12 @@ impl TreeBlock {
         !self.pins.is_empty()
     }
 
+    /// Whether the block's solves may take passes of their own: it takes
+    /// pins, or has drives (whose caps take a pass).
+    pub fn takes_passes(&self) -> bool {
+        self.pinned() || self.driven
+    }
+
     /// The lanes holding a tree (or a piece of one).
     pub fn live(&self) -> u8 {
         !(self.padding as u8)
@@ -801,15 +807,16 @@ impl PositionPass<'_> {
             let live = block.live();
             block.dirty.fill(live);
         }
-        // Pins take their own passes, lane by lane, past the limits' bound
-        // (`solve::join_crossings`).
-        let pinned = blocks.iter().any(TreeBlock::pinned);
-        let most = if pinned {
+        // Pins and drives reaching their caps take their own passes, lane
+        // by lane, past the limits' bound (`solve::join_crossings`).
+        let own = blocks.iter().any(TreeBlock::takes_passes);
+        let most = if own {
             passes.max(pin::PIN_PASSES)
         } else {
             passes.max(1)
         };
-        for pass in 1..=most {
+        // A drive's cap found as the pins' passes run out takes one more.
+        for pass in 1..=most + 1 {
             for block in blocks.iter_mut() {
                 solve::hold(block, &topologies[block.topology as usize], pass == 1);
             }
@@ -826,7 +833,8 @@ impl PositionPass<'_> {
                 block.crossing = [0.0; BLOCK_LANES];
                 run_phase(on, block, Phase::Settle);
             }
-            if !solve::join_crossings(blocks, pass >= passes) || pass >= most {
+            let spent = (pass >= passes, pass >= most);
+            if !solve::join_crossings(blocks, spent) || pass > most {
                 break;
             }
             for block in blocks.iter_mut() {
@@ -930,7 +938,7 @@ impl<const P: u8> LaneSlices for PhaseRun<'_, P> {
             MEASURE => solve::measure::<L>(self.block, topology, rows, start, scale),
             ELIMINATE => solve::eliminate::<L>(self.block, topology, start, scale),
             SUBSTITUTE => solve::substitute::<L>(self.block, topology, start),
-            SETTLE => solve::settle::<L>(self.block, topology, start),
+            SETTLE => solve::settle::<L>(self.block, topology, start, scale),
             _ => {
                 solve::accumulate::<L>(self.block, topology, start, scale);
                 solve::apply::<L>(self.block, topology, rows, start);

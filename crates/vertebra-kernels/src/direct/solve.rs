@@ -339,23 +339,32 @@ pub(super) fn hold(block: &mut TreeBlock, topology: &Topology, first_pass: bool)
 
 /// After a settle in which some tree crossed: every lane of such a tree
 /// takes the set the settle chose, and marks for factoring again each
-/// joint whose set changed and the body below it (their ancestors follow
-/// in the elimination).
+/// joint whose set changed or whose drive the settle capped, and the body
+/// below it (their ancestors follow in the elimination).
 pub(super) fn take_crossings(block: &mut TreeBlock, topology: &Topology) {
     let crossing = block.crossing;
     for (n, node) in topology.nodes.iter().enumerate() {
         let NodeKind::Joint {
-            rows: kind, a, b, ..
+            index,
+            rows: kind,
+            a,
+            b,
         } = node.kind
         else {
             continue;
         };
         let limits = kind.limit_count();
+        let drive = &mut block.joints[index as usize].drive;
         let scratch = &mut block.scratch[n];
         let mut changed = 0u8;
         for (lane, &crossed) in crossing.iter().enumerate() {
             if crossed == 0.0 {
                 continue;
+            }
+            // A drive's cap is taken once the tree's pins have settled (or
+            // their passes are spent: `join_crossings` clears their flag).
+            if block.driven && flags(crossed) & PIN_CROSSED == 0 && drive.take(lane) {
+                changed |= 1 << lane;
             }
             for o in 0..limits {
                 if scratch.next[o][lane] != scratch.active[o][lane] {
@@ -388,26 +397,49 @@ pub(super) fn adopt(block: &mut TreeBlock) {
     }
 }
 
-/// A lane's crossing: a limit row's (another pass while the solve's bound
-/// allows), or a pin's (another pass up to [`pin::PIN_PASSES`]).
-const LIMIT_CROSSED: f32 = 1.0;
+/// A lane's crossings, flags summed into one value per lane: a limit
+/// row's (another pass while the solve's bound allows), a drive's cap
+/// reached (taken once the tree's pins settle, or in one pass more when
+/// their passes are spent), a pin's (another pass up to
+/// [`pin::PIN_PASSES`]).
+const LIMIT_CROSSED: u8 = 1;
 /// See [`LIMIT_CROSSED`].
-const PIN_CROSSED: f32 = 2.0;
+const DRIVE_CAPPED: u8 = 2;
+/// See [`LIMIT_CROSSED`].
+const PIN_CROSSED: u8 = 4;
+
+/// A lane's crossing flags.
+fn flags(crossing: f32) -> u8 {
+    crossing as u8
+}
+
+/// Adds `theirs`'s crossing flags to `mine`.
+fn join(mine: &mut f32, theirs: f32) {
+    *mine = f32::from(flags(*mine) | flags(theirs));
+}
+
+/// `flag` in the lanes of `mask`, else 0.
+#[inline(always)]
+fn flag<L: Lane>(mask: L::Mask, flag: u8) -> L {
+    L::select(mask, L::splat(f32::from(flag)), L::splat(0.0))
+}
 
 /// Joins each tree's crossings across the blocks its pieces take: a trunk
 /// crosses where a piece hanging from it does, and every piece where its
-/// trunk does (a pin's crossing over a limit's). Once `limits_spent` (the
-/// solve's passes for its limits are taken), only pins' crossings count.
-/// Returns whether any tree crossed.
-pub(super) fn join_crossings(blocks: &mut [TreeBlock], limits_spent: bool) -> bool {
+/// trunk does. Once `spent.0` (the solve's passes for its limits are
+/// taken), limits' crossings no longer count; once `spent.1` (the pins'
+/// passes too), only drives' caps do. Returns whether any tree crossed.
+pub(super) fn join_crossings(blocks: &mut [TreeBlock], spent: (bool, bool)) -> bool {
     for k in 0..blocks.len() {
         let (before, rest) = blocks.split_at_mut(k);
         let block = &mut rest[0];
         for port in &block.ports {
             for (lane, source) in port.source.iter().enumerate() {
                 if let Some(s) = source {
-                    let theirs = before[s.block as usize].crossing[s.lane as usize];
-                    block.crossing[lane] = block.crossing[lane].max(theirs);
+                    join(
+                        &mut block.crossing[lane],
+                        before[s.block as usize].crossing[s.lane as usize],
+                    );
                 }
             }
         }
@@ -418,17 +450,21 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock], limits_spent: bool) -> bo
         for (lane, source) in block.parent.iter().enumerate() {
             if let Some(s) = source {
                 let parent = &after[s.block as usize - k - 1];
-                let theirs = parent.crossing[s.lane as usize];
-                block.crossing[lane] = block.crossing[lane].max(theirs);
+                join(&mut block.crossing[lane], parent.crossing[s.lane as usize]);
             }
         }
+    }
+    let mut kept = !0u8;
+    if spent.0 {
+        kept &= !LIMIT_CROSSED;
+    }
+    if spent.1 {
+        kept &= !PIN_CROSSED;
     }
     let mut any = false;
     for block in blocks.iter_mut() {
         for c in block.crossing.iter_mut() {
-            if limits_spent && *c < PIN_CROSSED {
-                *c = 0.0;
-            }
+            *c = f32::from(flags(*c) & kept);
             any |= *c != 0.0;
         }
     }
@@ -942,11 +978,27 @@ const CROSSING: f32 = 1.0e-4;
 /// its joint on the boundary until the next solve releases it. So a tree
 /// where some row crosses takes its new set for another pass
 /// ([`take_crossings`]), and every other keeps the set it had, which
-/// gives it the same bits again.
+/// gives it the same bits again. A drive whose step would pass its cap
+/// crosses too (`super::drive`), and so do the pins ([`pin::settle`]).
 #[inline(always)]
-pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start: usize) {
+pub(super) fn settle<L: Lane>(
+    block: &mut TreeBlock,
+    topology: &Topology,
+    start: usize,
+    scale: SubstepScale,
+) {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    let mut pins_crossed = zero.gt(zero);
+    for (n, node) in topology.nodes.iter().enumerate() {
+        if let NodeKind::Body { index } = node.kind
+            && let Some(pins) = block.pins.get_mut(index as usize)
+        {
+            let x = load::<L, 6>(&block.scratch[n].x, start);
+            pins_crossed = pins_crossed | pin::settle::<L>(pins, &x, start);
+        }
+    }
     let mut crossed = zero.gt(zero);
+    let mut capped = zero.gt(zero);
     for (n, node) in topology.nodes.iter().enumerate() {
         let NodeKind::Joint {
             index,
@@ -957,11 +1009,17 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
         else {
             continue;
         };
+        let dlambda = load::<L, MAX>(&block.scratch[n].x, start);
+        let (first, rows) = (kind.first_drive(), kind.count() - kind.first_drive());
+        if block.driven && rows > 0 {
+            let steps = &dlambda[first..first + rows];
+            let drive = &mut block.joints[index as usize].drive;
+            capped = capped | drive.settle(steps, start, scale.inv_h2);
+        }
         let limits = kind.first_limit();
-        if limits == kind.first_drive() {
+        if limits == first {
             continue;
         }
-        let dlambda = load::<L, MAX>(&block.scratch[n].x, start);
         let turn_a = turn_of(block, a, start);
         let turn_b = turn_of(block, b, start);
         let joint = &block.joints[index as usize];
@@ -981,17 +1039,25 @@ pub(super) fn settle<L: Lane>(block: &mut TreeBlock, topology: &Topology, start:
             L::select(now, one, zero).store(&mut block.scratch[n].next[l][start..]);
         }
     }
-    let mut crossing = L::select(crossed, L::splat(LIMIT_CROSSED), zero);
-    for (n, node) in topology.nodes.iter().enumerate() {
-        if let NodeKind::Body { index } = node.kind
-            && let Some(pins) = block.pins.get_mut(index as usize)
-        {
-            let x = load::<L, 6>(&block.scratch[n].x, start);
-            let crossed = pin::settle::<L>(pins, &x, start);
-            crossing = L::select(crossed, L::splat(PIN_CROSSED), crossing);
-        }
-    }
+    let crossing = flag::<L>(crossed, LIMIT_CROSSED)
+        + flag::<L>(capped, DRIVE_CAPPED)
+        + flag::<L>(pins_crossed, PIN_CROSSED);
     crossing.store(&mut block.crossing[start..]);
+}
+
+/// A joint node's first `rows` drive records.
+#[inline(always)]
+fn drive_records<L: Lane>(
+    scratch: &super::NodeScratch,
+    rows: usize,
+    start: usize,
+) -> [[L; DRIVE_RECORD]; MAX_DRIVE_ROWS] {
+    let mut records = [[L::splat(0.0); DRIVE_RECORD]; MAX_DRIVE_ROWS];
+    for (r, record) in records.iter_mut().enumerate().take(rows) {
+        let at = r * DRIVE_RECORD;
+        *record = load::<L, DRIVE_RECORD>(&scratch.drive[at..], start);
+    }
+    records
 }
 
 /// Body node `n`'s turn from the solve (for none, the side of the root
@@ -1045,12 +1111,7 @@ pub(super) fn accumulate<L: Lane>(
         }
         let rows = kind.count() - kind.first_drive();
         if block.driven && rows > 0 {
-            let zero = L::splat(0.0);
-            let mut records = [[zero; DRIVE_RECORD]; MAX_DRIVE_ROWS];
-            for (r, record) in records.iter_mut().enumerate().take(rows) {
-                let at = r * DRIVE_RECORD;
-                *record = load::<L, DRIVE_RECORD>(&block.scratch[n].drive[at..], start);
-            }
+            let records = drive_records::<L>(&block.scratch[n], rows, start);
             let first = kind.first_drive();
             let steps = &dlambda[first..first + rows];
             (joint.drive).accumulate(steps, &records[..rows], start, scale.inv_h2);
