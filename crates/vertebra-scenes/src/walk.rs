@@ -60,10 +60,12 @@ impl Walk {
     /// the origin with its hips at their bind place. Refused when `desc`
     /// lacks a joint the walk moves (the anatomical humanoid's `hip_l`,
     /// `knee_l`, `shoulder_l`, `elbow_l`, their right twins, `spine_1` to
-    /// `spine_3` and `neck`). With `ankle_l` and `ankle_r` (feet below the
-    /// shins) the legs reach the ankles, the ankles keep the feet flat and
-    /// ahead, and a planted foot does not roll (`gait.foot_radius` is taken
-    /// as 0).
+    /// `spine_3` and `neck`), or when a leg's joints are not one chain (a
+    /// knee's parent body must be its hip's child). With `ankle_l` and
+    /// `ankle_r` (feet below the shins: each ankle's parent is its knee's
+    /// child, or it is refused, as is one ankle without the other) the
+    /// legs reach the ankles, the ankles keep the feet flat and ahead, and
+    /// a planted foot does not roll (`gait.foot_radius` is taken as 0).
     pub fn new(desc: &RagdollDesc, mut gait: Gait, start: f32) -> Result<Self, RagdollError> {
         let _mode = DefaultFloatMode::enter();
         let joint = |name: &str| {
@@ -77,11 +79,21 @@ impl Walk {
         let pair = |stem: &str| -> Result<[usize; 2], RagdollError> {
             Ok([joint(&format!("{stem}_l"))?, joint(&format!("{stem}_r"))?])
         };
+        let ankles = match ["ankle_l", "ankle_r"].map(|name| desc.joint_index(name)) {
+            [Some(l), Some(r)] => Some([l, r]),
+            [None, None] => None,
+            _ => {
+                return Err(RagdollError::BadPose(format!(
+                    "the walk reaches both ankles (`ankle_l`, `ankle_r`) or neither; `{}` has one",
+                    desc.name
+                )));
+            }
+        };
         let joints = Joints {
             count: desc.joints.len(),
             hips: pair("hip")?,
             knees: pair("knee")?,
-            ankles: pair("ankle").ok(),
+            ankles,
             shoulders: pair("shoulder")?,
             elbows: pair("elbow")?,
             spine: ["spine_1", "spine_2", "spine_3"]
@@ -90,6 +102,12 @@ impl Walk {
                 .collect::<Result<_, _>>()?,
             neck: joint("neck")?,
         };
+        for side in 0..2 {
+            chained(desc, joints.hips[side], joints.knees[side])?;
+            if let Some(ankles) = joints.ankles {
+                chained(desc, joints.knees[side], ankles[side])?;
+            }
+        }
         let root_bind = desc.bodies[desc.root].centre();
         let leg = |side: usize| {
             let (hip, knee) = (
@@ -241,4 +259,21 @@ fn reach(hip: Vec3, foot: Vec3, lateral: Vec3, thigh: f32, shin: f32) -> (Quat, 
 fn acos(c: f32) -> f32 {
     let c = c.clamp(-1.0, 1.0);
     trig::atan2((1.0 - c * c).max(0.0).sqrt(), c)
+}
+
+/// Refuses, naming both joints, a leg whose joint `lower` does not hang
+/// from joint `upper`'s child body.
+fn chained(desc: &RagdollDesc, upper: usize, lower: usize) -> Result<(), RagdollError> {
+    let (upper, lower) = (&desc.joints[upper], &desc.joints[lower]);
+    if lower.parent == upper.child {
+        return Ok(());
+    }
+    Err(RagdollError::BadPose(format!(
+        "the walk bends joint `{}` below `{}`, but its parent body `{}` is not `{}`'s child `{}`",
+        lower.name,
+        upper.name,
+        desc.bodies[lower.parent].name,
+        upper.name,
+        desc.bodies[upper.child].name
+    )))
 }

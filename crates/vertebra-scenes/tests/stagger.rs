@@ -324,3 +324,37 @@ fn without_feet_a_planted_shin_rolls_on_its_round_end() {
     assert!(rolled > 1e-4 && rolled < 0.003, "{rolled} m");
     assert!(high - low < 1e-3, "{low} .. {high} m");
 }
+
+/// The walk refuses, naming the joint, legs it would bend wrongly: an
+/// ankle that does not hang from its leg's shin, a knee that does not hang
+/// from its thigh, one ankle without the other.
+#[test]
+fn the_walk_refuses_legs_that_are_not_one_chain() {
+    let refused = |desc: &RagdollDesc| {
+        Walk::new(desc, Gait::walk(WALK_SPEED), WALK_START)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
+    };
+    let shipped = RagdollDesc::anatomical_humanoid();
+    let index = |name: &str| shipped.joint_index(name).unwrap();
+    let mut desc = shipped.clone();
+    desc.joints[index("ankle_l")].parent = desc.body_index("thigh_l").unwrap();
+    let message = refused(&desc);
+    assert!(
+        message.contains("`ankle_l`") && message.contains("`shin_l`"),
+        "{message}"
+    );
+    let mut desc = shipped.clone();
+    desc.joints[index("knee_r")].parent = desc.body_index("hips").unwrap();
+    let message = refused(&desc);
+    assert!(
+        message.contains("`knee_r`") && message.contains("`thigh_r`"),
+        "{message}"
+    );
+    let mut desc = shipped.clone();
+    desc.joints[index("ankle_r")].name = "hock_r".into();
+    let message = refused(&desc);
+    assert!(message.contains("both ankles"), "{message}");
+    assert!(Walk::new(&shipped, Gait::walk(WALK_SPEED), WALK_START).is_ok());
+}
