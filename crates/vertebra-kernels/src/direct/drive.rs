@@ -42,7 +42,7 @@
 //! times `h`: the torque is `lambda / h^2`. A cap bounds the multiplier,
 //! and the bound is held as the limits' active set is: when a pass whose
 //! pins have settled would take `|lambda + dlambda|` past `max_torque
-//! h^2` ([`DriveNode::settle`]), its step is not taken; the drive is
+//! h^2` (`DriveNode::settle`), its step is not taken; the drive is
 //! capped for the rest of the substep at `cap = (lambda + dlambda)
 //! max_torque h^2 / |lambda + dlambda|` and the tree is solved again (a
 //! pass of its own, as a pin's crossing takes). In that pass and each
@@ -57,7 +57,7 @@
 //! pushes against): it caps nothing, and the cap waits for the pins to
 //! settle or for their passes to run out, then takes one pass more. A
 //! cap found in that last pass is taken after it: its step moves the
-//! bodies, the drive is capped after it ([`DriveNode::accumulate`]), and
+//! bodies, the drive is capped after it (`DriveNode::accumulate`), and
 //! the later solves take the excess back. A hit beyond the cap turns the
 //! joint away, and the drive brings it back afterwards.
 //!
@@ -118,7 +118,7 @@ pub struct DriveNode {
     pub capped: [f32; BLOCK_LANES],
     /// Where the last settle found the drive past its cap (1), the cap
     /// it would hold: taken if the tree is solved again
-    /// ([`Self::take`]).
+    /// (`DriveNode::take`).
     pub capping: [f32; BLOCK_LANES],
     /// See [`Self::capping`].
     pub next_cap: [[f32; BLOCK_LANES]; MAX_DRIVE_ROWS],
