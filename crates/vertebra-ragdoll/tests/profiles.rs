@@ -48,7 +48,7 @@ fn a_bone_table_scales_its_subtree_by_its_multiplier() {
     let joint = |name: &str| desc.joint_index(name).unwrap();
     let body = |name: &str| desc.body_index(name).unwrap();
     // Standing: the legs and spine at 120 Hz, the neck and the arms (the
-    // bone tables, one with the bodies below it) at 8 Hz, all 300 N m.
+    // bone tables, one with the bodies below it) at 8 Hz, all 450 N m.
     let arms = ["neck", "shoulder_l", "elbow_l", "shoulder_r", "elbow_r"];
     for (j, setting) in desc.joints.iter().zip(&standing.joints) {
         let f = if arms.contains(&j.name.as_str()) {
@@ -58,7 +58,7 @@ fn a_bone_table_scales_its_subtree_by_its_multiplier() {
         };
         let want = JointDriveSetting {
             strength: Some(frequency(f, 1.0)),
-            max_torque: 300.0,
+            max_torque: 450.0,
         };
         assert_eq!(*setting, want, "{}", j.name);
     }
@@ -79,7 +79,7 @@ fn a_bone_table_scales_its_subtree_by_its_multiplier() {
         let (k0, d0) = law(standing.joints[joint(j)].strength);
         let (k, d) = law(hit.joints[joint(j)].strength);
         assert!(close(k, s * k0) && close(d, s * d0), "{j}: {k} {d}");
-        assert!(close(hit.joints[joint(j)].max_torque, s * 300.0), "{j}");
+        assert!(close(hit.joints[joint(j)].max_torque, s * 450.0), "{j}");
         let (world0, world) = (standing.bodies[body(b)], hit.bodies[body(b)]);
         let (k0, d0) = law(world0.linear);
         let (k, d) = law(world.linear);
@@ -141,7 +141,7 @@ fn blends_interpolate_the_force_laws_and_end_on_the_target() {
         );
         assert!(close(m.0, x.0 + (y.0 - x.0) * a), "{a}: {m:?}");
         assert!(close(m.1, x.1 + (y.1 - x.1) * a), "{a}: {m:?}");
-        let cap = 300.0 + (60.0 - 300.0) * a;
+        let cap = 450.0 + (90.0 - 450.0) * a;
         assert!(close(mid.joints[elbow].max_torque, cap), "{a}");
     }
     // Fading into limp scales the forces and caps down to nothing.
@@ -149,7 +149,7 @@ fn blends_interpolate_the_force_laws_and_end_on_the_target() {
     let faded = standing.blended(limp, 0.75).unwrap();
     let (k0, _) = law(standing.joints[elbow].strength);
     let (k, _) = law(faded.joints[elbow].strength);
-    assert!(close(k, 0.25 * k0) && close(faded.joints[elbow].max_torque, 75.0));
+    assert!(close(k, 0.25 * k0) && close(faded.joints[elbow].max_torque, 112.5));
     assert_eq!(&standing.blended(limp, 1.0).unwrap(), limp);
 }
 
@@ -267,7 +267,7 @@ fn refused_profiles_name_the_table_and_change_nothing() {
         "{e}"
     );
     let e = refused(
-        "joints = { frequency = 120.0, damping_ratio = 1.0, max_torque = 300.0 }",
+        "joints = { frequency = 120.0, damping_ratio = 1.0, max_torque = 450.0 }",
         "joints = { frequency = 0.0, damping_ratio = 1.0 }",
     );
     assert!(

@@ -26,7 +26,7 @@ pub const STAGGER_HIT: (usize, Vec3) = (300, Vec3::new(0.0, 0.0, -40.0));
 /// How the stagger's ragdoll follows its animation, standing and walking:
 /// the description's `standing` profile (the anatomical humanoid's: the
 /// legs and spine, which carry the weight, at 120 Hz, stiff enough under
-/// either joint solve that only their 300 N m caps let a hit bend them;
+/// either joint solve that only their 450 N m caps let a hit bend them;
 /// the neck and arms at 8 Hz; every body pulled toward its pose at 2 Hz
 /// with a force cap of half its weight, so it stands and walks on its
 /// legs, and 20 N m; hips and chest kept upright at 2 Hz, 100 N m).

@@ -55,11 +55,14 @@
 //! never moves a body. A pass whose pins are still changing is no
 //! measure of the drive (a pin about to let go holds a foot the drive
 //! pushes against): it caps nothing, and the cap waits for the pins to
-//! settle or for their passes to run out, then takes one pass more. A
-//! cap found in that last pass is taken after it: its step moves the
-//! bodies, the drive is capped after it (`DriveNode::accumulate`), and
-//! the later solves take the excess back. A hit beyond the cap turns the
-//! joint away, and the drive brings it back afterwards.
+//! settle. Where their passes run out first, the cap is taken and the
+//! tree's pins and limits start the solve again (`solve::restart`), with
+//! as many passes again: the states the uncapped passes chose held what
+//! the uncapped drive pushed. A cap found in a solve's very last pass is
+//! taken after it: its step moves the bodies, the drive is capped after
+//! it (`DriveNode::accumulate`), and the later solves take the excess
+//! back. A hit beyond the cap turns the joint away, and the drive brings
+//! it back afterwards.
 //!
 //! **Against a limit.** A drive pulling past a hard limit would ask of
 //! its hard rows what the limit's row refuses (rows that repeat each

@@ -610,6 +610,8 @@ pub struct NodeScratch {
     /// The active set the last settle chose: a crossing lane's next
     /// pass, and the next solve's start.
     pub next: [[f32; BLOCK_LANES]; MAX_OPTIONAL],
+    /// The active set of the solve's first pass (a restart's).
+    pub first: [[f32; BLOCK_LANES]; MAX_OPTIONAL],
 }
 
 impl NodeScratch {
@@ -626,6 +628,7 @@ impl NodeScratch {
         drive: [[0.0; BLOCK_LANES]; MAX_DRIVE_ROWS * DRIVE_RECORD],
         active: [[0.0; BLOCK_LANES]; MAX_OPTIONAL],
         next: [[0.0; BLOCK_LANES]; MAX_OPTIONAL],
+        first: [[0.0; BLOCK_LANES]; MAX_OPTIONAL],
     };
 }
 
@@ -705,6 +708,9 @@ pub struct TreeBlock {
     pub held: Vec<[u8; MAX_OPTIONAL]>,
     /// The lanes whose active set crossed in the last settle.
     pub crossing: [f32; BLOCK_LANES],
+    /// The lanes whose solve started again this solve
+    /// (`solve::restart`).
+    pub restarted: u8,
     /// The topology's ports, each lane's subtree.
     pub ports: Vec<Port>,
     /// Where each lane's root joint's parent body is solved, for a piece
@@ -738,6 +744,7 @@ impl TreeBlock {
             dirty: vec![0; shape.nodes.len()],
             held: vec![[0; MAX_OPTIONAL]; shape.nodes.len()],
             crossing: [0.0; BLOCK_LANES],
+            restarted: 0,
             ports: vec![Port::empty(); shape.ports],
             parent: [None; BLOCK_LANES],
             parent_x: [[0.0; BLOCK_LANES]; 6],
@@ -810,13 +817,19 @@ impl PositionPass<'_> {
         // Pins and drives reaching their caps take their own passes, lane
         // by lane, past the limits' bound (`solve::join_crossings`).
         let own = blocks.iter().any(TreeBlock::takes_passes);
+        let pinned = blocks.iter().any(TreeBlock::pinned);
         let most = if own {
             passes.max(pin::PIN_PASSES)
         } else {
             passes.max(1)
         };
-        // A drive's cap found as the pins' passes run out takes one more.
-        for pass in 1..=most + 1 {
+        // A drive's cap found as the pins' passes run out takes one more,
+        // or (on pins) starts the solve's passes again (`solve::restart`).
+        let mut last = most + 1;
+        for block in blocks.iter_mut() {
+            block.restarted = 0;
+        }
+        for pass in 1.. {
             for block in blocks.iter_mut() {
                 solve::hold(block, &topologies[block.topology as usize], pass == 1);
             }
@@ -833,12 +846,16 @@ impl PositionPass<'_> {
                 block.crossing = [0.0; BLOCK_LANES];
                 run_phase(on, block, Phase::Settle);
             }
-            let spent = (pass >= passes, pass >= most);
-            if !solve::join_crossings(blocks, spent) || pass > most {
+            let bounds = solve::Bounds { pass, passes, most };
+            if !solve::join_crossings(blocks, bounds) || pass >= last {
                 break;
             }
             for block in blocks.iter_mut() {
-                solve::take_crossings(block, &topologies[block.topology as usize]);
+                let topology = &topologies[block.topology as usize];
+                solve::take_crossings(block, topology);
+                if pinned && pass == most && solve::restart(block, topology) != 0 {
+                    last = most + pin::PIN_PASSES + 1;
+                }
             }
         }
         for block in blocks.iter_mut() {

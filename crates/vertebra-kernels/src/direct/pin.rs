@@ -173,6 +173,11 @@ pub struct PinSlot {
     pub way: Vec3Block,
     /// The next pass's way.
     pub next_way: Vec3Block,
+    /// The normal row's and the way's state as the solve began
+    /// (`measure`), for `restart`.
+    pub first: [f32; BLOCK_LANES],
+    /// See [`Self::first`].
+    pub first_way: Vec3Block,
     /// The substep's solves before this one, summed: the normal
     /// multipliers (kg m).
     pub substep_n: [f32; BLOCK_LANES],
@@ -197,6 +202,8 @@ pub struct PinNode {
     pub mode: [f32; BLOCK_LANES],
     /// Its next pass's.
     pub next_mode: [f32; BLOCK_LANES],
+    /// Its mode as the solve began, for `restart`.
+    pub first_mode: [f32; BLOCK_LANES],
     /// The step's pin impulses on the body, summed: linear (kg m) and
     /// angular about its centre (kg m^2), world (never read by the solve:
     /// the joints' loads, `LoadPass`, leave them out).
@@ -429,9 +436,11 @@ pub(super) fn measure<L: Lane>(pins: &mut PinNode, rows: &BodyRows, start: usize
         let way = Vec3::select(fast, -direction, Vec3::zero());
         slot.way.store(start, way);
         slot.next_way.store(start, way);
+        slot.first_way.store(start, way);
         let held = L::select(live & values[C].lt(zero), one, zero);
         held.store(&mut slot.held[start..]);
         held.store(&mut slot.next[start..]);
+        held.store(&mut slot.first[start..]);
         zero.store(&mut slot.flips[start..]);
         zero.store(&mut slot.force[start..]);
         zero.store(&mut slot.next_force[start..]);
@@ -441,6 +450,7 @@ pub(super) fn measure<L: Lane>(pins: &mut PinNode, rows: &BodyRows, start: usize
     let mode = L::select(sliding, L::splat(SLIDE), L::splat(STICK));
     mode.store(&mut pins.mode[start..]);
     mode.store(&mut pins.next_mode[start..]);
+    mode.store(&mut pins.first_mode[start..]);
 }
 
 /// Adds a body's held pins to its block `d` (packed, 6 x 6) and right-hand
@@ -675,4 +685,22 @@ pub(super) fn take(pins: &mut PinNode, crossing: &[f32; BLOCK_LANES]) -> u8 {
         }
     }
     changed
+}
+
+/// Between passes (plain code): `lane`'s pins as the solve began (its
+/// [`measure`]): held, mode and ways as then, no flips, no sliding
+/// friction.
+pub(super) fn restart(pins: &mut PinNode, lane: usize) {
+    pins.mode[lane] = pins.first_mode[lane];
+    pins.next_mode[lane] = pins.first_mode[lane];
+    for slot in pins.slots.iter_mut() {
+        slot.held[lane] = slot.first[lane];
+        slot.next[lane] = slot.first[lane];
+        slot.flips[lane] = 0.0;
+        slot.force[lane] = 0.0;
+        slot.next_force[lane] = 0.0;
+        let way = slot.first_way.get(lane);
+        slot.way.set(lane, way);
+        slot.next_way.set(lane, way);
+    }
 }

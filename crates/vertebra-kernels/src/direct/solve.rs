@@ -330,6 +330,9 @@ pub(super) fn hold(block: &mut TreeBlock, topology: &Topology, first_pass: bool)
                     let c = scratch.limits[o * RECORD][lane];
                     scratch.active[o][lane] = if c > 0.0 { 1.0 } else { 0.0 };
                 }
+                if first_pass {
+                    scratch.first[o][lane] = scratch.active[o][lane];
+                }
                 *lane_bits |= u8::from(scratch.active[o][lane] > 0.0) << lane;
             }
         }
@@ -424,12 +427,25 @@ fn flag<L: Lane>(mask: L::Mask, flag: u8) -> L {
     L::select(mask, L::splat(f32::from(flag)), L::splat(0.0))
 }
 
+/// Where a solve's passes stand: this pass, the passes its limits may
+/// take, and the pins' (and the drives' caps').
+#[derive(Clone, Copy)]
+pub(super) struct Bounds {
+    /// This pass (from 1).
+    pub pass: usize,
+    /// The limits' passes.
+    pub passes: usize,
+    /// The pins' passes ([`restart`]ed lanes take as many again).
+    pub most: usize,
+}
+
 /// Joins each tree's crossings across the blocks its pieces take: a trunk
 /// crosses where a piece hanging from it does, and every piece where its
-/// trunk does. Once `spent.0` (the solve's passes for its limits are
-/// taken), limits' crossings no longer count; once `spent.1` (the pins'
-/// passes too), only drives' caps do. Returns whether any tree crossed.
-pub(super) fn join_crossings(blocks: &mut [TreeBlock], spent: (bool, bool)) -> bool {
+/// trunk does. Then, lane by lane: once the limits' passes are spent,
+/// their crossings no longer count; once the pins' are (`most`, or twice
+/// that and a pass in a restarted lane), only drives' caps do, for one
+/// pass more. Returns whether any tree crossed.
+pub(super) fn join_crossings(blocks: &mut [TreeBlock], bounds: Bounds) -> bool {
     for k in 0..blocks.len() {
         let (before, rest) = blocks.split_at_mut(k);
         let block = &mut rest[0];
@@ -454,21 +470,68 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock], spent: (bool, bool)) -> b
             }
         }
     }
-    let mut kept = !0u8;
-    if spent.0 {
-        kept &= !LIMIT_CROSSED;
-    }
-    if spent.1 {
-        kept &= !PIN_CROSSED;
-    }
+    let Bounds { pass, passes, most } = bounds;
     let mut any = false;
     for block in blocks.iter_mut() {
-        for c in block.crossing.iter_mut() {
+        for (lane, c) in block.crossing.iter_mut().enumerate() {
+            let restarted = block.restarted & (1 << lane) != 0;
+            let pins = if restarted {
+                most + pin::PIN_PASSES
+            } else {
+                most
+            };
+            let mut kept = !0u8;
+            if pass >= passes {
+                kept &= !LIMIT_CROSSED;
+            }
+            if pass >= pins {
+                kept &= !PIN_CROSSED;
+            }
+            if pass > pins {
+                kept = 0;
+            }
             *c = f32::from(flags(*c) & kept);
             any |= *c != 0.0;
         }
     }
     any
+}
+
+/// After the pass that spent the pins' passes (`most`) in a solve with
+/// pins, the lanes where a drive's cap was found (and taken): the drive was
+/// uncapped in every pass so far, and the pins' states those passes chose
+/// hold what an uncapped drive pushed (a heap a drive straightens chose
+/// them so, and kept the push as speed). Their pins and limits go back to
+/// the solve's start, and the lanes take the pins' passes again, with the
+/// drive capped. Returns the lanes restarted.
+pub(super) fn restart(block: &mut TreeBlock, topology: &Topology) -> u8 {
+    let mut lanes = 0u8;
+    for (lane, &c) in block.crossing.iter().enumerate() {
+        if flags(c) & DRIVE_CAPPED != 0 && block.restarted & (1 << lane) == 0 {
+            lanes |= 1 << lane;
+        }
+    }
+    if lanes == 0 {
+        return 0;
+    }
+    for lane in 0..BLOCK_LANES {
+        if lanes & (1 << lane) == 0 {
+            continue;
+        }
+        for pins in block.pins.iter_mut() {
+            pin::restart(pins, lane);
+        }
+        for scratch in block.scratch.iter_mut() {
+            for o in 0..MAX_OPTIONAL {
+                scratch.active[o][lane] = scratch.first[o][lane];
+            }
+        }
+    }
+    for (n, _) in topology.nodes.iter().enumerate() {
+        block.dirty[n] |= lanes;
+    }
+    block.restarted |= lanes;
+    lanes
 }
 
 /// Copies into block `k`'s ports their subtrees' complements (and which
