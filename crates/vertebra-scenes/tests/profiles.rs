@@ -229,18 +229,23 @@ fn a_drive_capped_at_zero_does_not_throw_a_fallen_ragdoll() {
         let apart = (runs[0].iter().flatten().zip(runs[1].iter().flatten()))
             .map(|(a, b)| (*a - *b).length())
             .fold(0.0, f32::max);
-        let fastest = (runs[1].iter().flatten())
-            .map(|v| v.length())
-            .fold(0.0, f32::max);
+        let [limp, fastest] = [&runs[0], &runs[1]].map(|run| {
+            (run.iter().flatten())
+                .map(|v| v.length())
+                .fold(0.0, f32::max)
+        });
         eprintln!(
-            "{spine:?}, pins {pins}: driven at a zero cap, fastest body {fastest:.3} m/s, \
-             {apart:.2e} m/s from the limp ragdoll's"
+            "{spine:?}, pins {pins}: driven at a zero cap, fastest body {fastest:.3} m/s \
+             (limp {limp:.3}), {apart:.2e} m/s from the limp ragdoll's"
         );
         // The capped rows change the solve's round-off and the passes its
-        // limits take, and a heap's contacts carry that on (the limp
-        // ragdoll's bodies settle at 0.05 to 0.25 m/s): a throw is metres a
-        // second.
-        assert!(fastest < 0.5, "{spine:?}, pins {pins}: {fastest} m/s");
+        // limits take, and a heap's contacts carry that on (a heap on pins
+        // may still be sliding off itself at 0.7 m/s): a throw is metres a
+        // second more than the limp ragdoll's.
+        assert!(
+            fastest < limp + 0.5,
+            "{spine:?}, pins {pins}: {fastest} m/s, limp {limp} m/s"
+        );
     }
 }
 

@@ -711,6 +711,12 @@ pub struct TreeBlock {
     /// The lanes whose solve started again this solve
     /// (`solve::restart`).
     pub restarted: u8,
+    /// The lanes whose pins had not settled when their passes ran out
+    /// (`end_unsettled`).
+    pub unsettled: u8,
+    /// Each lane's largest body step in the solve's first pass
+    /// (`step_sizes`; pinned blocks only).
+    pub first_step: [f32; BLOCK_LANES],
     /// The topology's ports, each lane's subtree.
     pub ports: Vec<Port>,
     /// Where each lane's root joint's parent body is solved, for a piece
@@ -745,6 +751,8 @@ impl TreeBlock {
             held: vec![[0; MAX_OPTIONAL]; shape.nodes.len()],
             crossing: [0.0; BLOCK_LANES],
             restarted: 0,
+            unsettled: 0,
+            first_step: [0.0; BLOCK_LANES],
             ports: vec![Port::empty(); shape.ports],
             parent: [None; BLOCK_LANES],
             parent_x: [[0.0; BLOCK_LANES]; 6],
@@ -828,23 +836,14 @@ impl PositionPass<'_> {
         let mut last = most + 1;
         for block in blocks.iter_mut() {
             block.restarted = 0;
+            block.unsettled = 0;
         }
         for pass in 1.. {
-            for block in blocks.iter_mut() {
-                solve::hold(block, &topologies[block.topology as usize], pass == 1);
-            }
-            for k in 0..blocks.len() {
-                solve::take_ports(blocks, k);
-                run_phase(on, &mut blocks[k], Phase::Eliminate);
-            }
-            for k in (0..blocks.len()).rev() {
-                solve::take_parent(blocks, k);
-                run_phase(on, &mut blocks[k], Phase::Substitute);
-            }
-            for block in blocks.iter_mut() {
-                block.dirty.fill(0);
-                block.crossing = [0.0; BLOCK_LANES];
-                run_phase(on, block, Phase::Settle);
+            solve_pass(on, blocks, pass == 1);
+            if pass == 1 && pinned {
+                for block in blocks.iter_mut() {
+                    block.first_step = step_sizes(block, topologies);
+                }
             }
             let bounds = solve::Bounds { pass, passes, most };
             if !solve::join_crossings(blocks, bounds) || pass >= last {
@@ -853,10 +852,13 @@ impl PositionPass<'_> {
             for block in blocks.iter_mut() {
                 let topology = &topologies[block.topology as usize];
                 solve::take_crossings(block, topology);
-                if pinned && pass == most && solve::restart(block, topology) != 0 {
+                if pinned && pass == most && solve::restart(block) != 0 {
                     last = most + pin::PIN_PASSES + 1;
                 }
             }
+        }
+        if pinned && end_unsettled(blocks, topologies) {
+            solve_pass(on, blocks, false);
         }
         for block in blocks.iter_mut() {
             solve::adopt(block);
@@ -865,6 +867,105 @@ impl PositionPass<'_> {
         }
     }
 }
+
+/// One pass of a [`PositionPass`] over every block: the active set held,
+/// the trees factored (leaves first, across the blocks' ports) and
+/// solved (roots first), and the next active set settled.
+fn solve_pass(on: PhaseOn<'_>, blocks: &mut [TreeBlock], first_pass: bool) {
+    let topologies = on.1;
+    for block in blocks.iter_mut() {
+        solve::hold(block, &topologies[block.topology as usize], first_pass);
+    }
+    for k in 0..blocks.len() {
+        solve::take_ports(blocks, k);
+        run_phase(on, &mut blocks[k], Phase::Eliminate);
+    }
+    for k in (0..blocks.len()).rev() {
+        solve::take_parent(blocks, k);
+        run_phase(on, &mut blocks[k], Phase::Substitute);
+    }
+    for block in blocks.iter_mut() {
+        block.dirty.fill(0);
+        block.crossing = [0.0; BLOCK_LANES];
+        run_phase(on, block, Phase::Settle);
+    }
+}
+
+/// Where a tree's pins had not settled when their passes ran out and its
+/// last pass moves it further than its first by more than [`WILD_STEP`]
+/// ([`step_sizes`], in any of its pieces), the tree starts again from its
+/// first pass's active set (`solve::start_again`) for one pass more, the
+/// solve's last. Returns whether any tree did.
+///
+/// The passes between are steps of a search that had not converged, and
+/// one can move a tree far more than the solve asks: a sliding pin pushes
+/// with `mu lambda_n` of the pass before, and a pass that pressed a 1 kg
+/// foot deep under a 70 kg tree gives the next a friction that turns the
+/// foot by radians (two limp ragdolls resting on each other on pins threw
+/// a forearm off at 17 m/s). The first pass's set is the pins as they
+/// stand, with no friction yet where they slide: ending there wherever
+/// the pins had not settled let a walking ragdoll's feet slip (its hips
+/// 5.8 cm off its animation), so a tree keeps a last pass that moves it
+/// about as far as its first.
+fn end_unsettled(blocks: &mut [TreeBlock], topologies: &[Topology]) -> bool {
+    for block in blocks.iter_mut() {
+        let last = step_sizes(block, topologies);
+        for (lane, &last) in last.iter().enumerate() {
+            let further = last > block.first_step[lane] + WILD_STEP;
+            block.crossing[lane] = f32::from(u8::from(further));
+        }
+    }
+    // A tree goes back where any of its pieces moved further.
+    solve::join_pieces(blocks);
+    let mut again = false;
+    for block in blocks.iter_mut() {
+        for (lane, c) in block.crossing.iter_mut().enumerate() {
+            if *c == 0.0 {
+                block.unsettled &= !(1 << lane);
+            }
+            *c = 0.0;
+        }
+        if block.unsettled != 0 {
+            solve::start_again(block, block.unsettled);
+            again = true;
+        }
+    }
+    again
+}
+
+/// Each lane's largest body step in the pass just solved: the larger of
+/// its turn (rad) and its move over [`STEP_LENGTH`].
+fn step_sizes(block: &TreeBlock, topologies: &[Topology]) -> [f32; BLOCK_LANES] {
+    let topology = &topologies[block.topology as usize];
+    let mut sizes = [0.0f32; BLOCK_LANES];
+    for (n, node) in topology.nodes.iter().enumerate() {
+        if let NodeKind::Body { .. } = node.kind {
+            let x = &block.scratch[n].x;
+            for (lane, size) in sizes.iter_mut().enumerate() {
+                let moved = length(x[0][lane], x[1][lane], x[2][lane]);
+                let turned = length(x[3][lane], x[4][lane], x[5][lane]);
+                *size = size.max(moved / STEP_LENGTH).max(turned);
+            }
+        }
+    }
+    sizes
+}
+
+/// The length of `(x, y, z)`.
+fn length(x: f32, y: f32, z: f32) -> f32 {
+    (x * x + y * y + z * z).sqrt()
+}
+
+/// How much further than its first pass a tree's last may move it
+/// ([`step_sizes`]) before an unsettled solve ends on its first pass's
+/// set: well above the differences between the passes of a tree at rest
+/// (gravity's step is 2.7 mm a substep at 60 Hz), well below the passes
+/// that threw bodies (tenths of a radian to radians).
+const WILD_STEP: f32 = 0.05;
+
+/// The length a body's move is measured against its turn by (m): a tenth
+/// of a metre counts as a radian.
+const STEP_LENGTH: f32 = 0.1;
 
 /// The fastest a hard limit found past its bound is brought back (rad/s,
 /// or swing sines per second for an ellipse): a substep removes at most
@@ -904,12 +1005,12 @@ const SUBSTITUTE: u8 = 2;
 const SETTLE: u8 = 3;
 const FINISH: u8 = 4;
 
+/// What a phase runs on: the backend, the topologies, the body rows and
+/// the substep's time scale.
+type PhaseOn<'a> = (Backend, &'a [Topology], &'a BodyRows, SubstepScale);
+
 /// Runs `phase` on every live slice of `block`, on `backend`.
-fn run_phase(
-    (backend, topologies, rows, scale): (Backend, &[Topology], &BodyRows, SubstepScale),
-    block: &mut TreeBlock,
-    phase: Phase,
-) {
+fn run_phase((backend, topologies, rows, scale): PhaseOn<'_>, block: &mut TreeBlock, phase: Phase) {
     let topology = &topologies[block.topology as usize];
     macro_rules! run {
         ($p:expr) => {

@@ -444,8 +444,44 @@ pub(super) struct Bounds {
 /// trunk does. Then, lane by lane: once the limits' passes are spent,
 /// their crossings no longer count; once the pins' are (`most`, or twice
 /// that and a pass in a restarted lane), only drives' caps do, for one
-/// pass more. Returns whether any tree crossed.
+/// pass more, and a lane whose pins still cross as their passes run out is
+/// marked [`TreeBlock::unsettled`]. Returns whether any tree crossed.
 pub(super) fn join_crossings(blocks: &mut [TreeBlock], bounds: Bounds) -> bool {
+    join_pieces(blocks);
+    let Bounds { pass, passes, most } = bounds;
+    let mut any = false;
+    for block in blocks.iter_mut() {
+        for (lane, c) in block.crossing.iter_mut().enumerate() {
+            let restarted = block.restarted & (1 << lane) != 0;
+            let pins = if restarted {
+                most + pin::PIN_PASSES
+            } else {
+                most
+            };
+            let mut kept = !0u8;
+            if pass >= passes {
+                kept &= !LIMIT_CROSSED;
+            }
+            if pass == pins && flags(*c) & PIN_CROSSED != 0 {
+                block.unsettled |= 1 << lane;
+            }
+            if pass >= pins {
+                kept &= !PIN_CROSSED;
+            }
+            if pass > pins {
+                kept = 0;
+            }
+            *c = f32::from(flags(*c) & kept);
+            any |= *c != 0.0;
+        }
+    }
+    any
+}
+
+/// Joins each tree's [`TreeBlock::crossing`] flags across the blocks its
+/// pieces take: a trunk gets those of every piece hanging from it, then
+/// every piece its trunk's.
+pub(super) fn join_pieces(blocks: &mut [TreeBlock]) {
     for k in 0..blocks.len() {
         let (before, rest) = blocks.split_at_mut(k);
         let block = &mut rest[0];
@@ -470,31 +506,6 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock], bounds: Bounds) -> bool {
             }
         }
     }
-    let Bounds { pass, passes, most } = bounds;
-    let mut any = false;
-    for block in blocks.iter_mut() {
-        for (lane, c) in block.crossing.iter_mut().enumerate() {
-            let restarted = block.restarted & (1 << lane) != 0;
-            let pins = if restarted {
-                most + pin::PIN_PASSES
-            } else {
-                most
-            };
-            let mut kept = !0u8;
-            if pass >= passes {
-                kept &= !LIMIT_CROSSED;
-            }
-            if pass >= pins {
-                kept &= !PIN_CROSSED;
-            }
-            if pass > pins {
-                kept = 0;
-            }
-            *c = f32::from(flags(*c) & kept);
-            any |= *c != 0.0;
-        }
-    }
-    any
 }
 
 /// After the pass that spent the pins' passes (`most`) in a solve with
@@ -504,7 +515,7 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock], bounds: Bounds) -> bool {
 /// them so, and kept the push as speed). Their pins and limits go back to
 /// the solve's start, and the lanes take the pins' passes again, with the
 /// drive capped. Returns the lanes restarted.
-pub(super) fn restart(block: &mut TreeBlock, topology: &Topology) -> u8 {
+pub(super) fn restart(block: &mut TreeBlock) -> u8 {
     let mut lanes = 0u8;
     for (lane, &c) in block.crossing.iter().enumerate() {
         if flags(c) & DRIVE_CAPPED != 0 && block.restarted & (1 << lane) == 0 {
@@ -514,6 +525,15 @@ pub(super) fn restart(block: &mut TreeBlock, topology: &Topology) -> u8 {
     if lanes == 0 {
         return 0;
     }
+    start_again(block, lanes);
+    block.restarted |= lanes;
+    block.unsettled &= !lanes;
+    lanes
+}
+
+/// The pins and limits of `lanes` as the solve began (`pin::restart`, the
+/// first pass's active set), every node of theirs marked for factoring.
+pub(super) fn start_again(block: &mut TreeBlock, lanes: u8) {
     for lane in 0..BLOCK_LANES {
         if lanes & (1 << lane) == 0 {
             continue;
@@ -527,11 +547,9 @@ pub(super) fn restart(block: &mut TreeBlock, topology: &Topology) -> u8 {
             }
         }
     }
-    for (n, _) in topology.nodes.iter().enumerate() {
-        block.dirty[n] |= lanes;
+    for dirty in block.dirty.iter_mut() {
+        *dirty |= lanes;
     }
-    block.restarted |= lanes;
-    lanes
 }
 
 /// Copies into block `k`'s ports their subtrees' complements (and which
