@@ -87,7 +87,7 @@ pub const PIN_STIFFNESS: f32 = 100.0;
 /// How many passes a solve may take where pins cross (their normals held
 /// or let go, their friction's mode changed) or drives reach their caps.
 /// A solve whose pins have not settled by then ends on its last pass, or
-/// (a passive tree that pass moved further than its first) on its first
+/// (where that pass moved the tree further than its first) on its first
 /// pass's set, solved once more (`PositionPass::run`).
 pub const PIN_PASSES: usize = 8;
 
