@@ -706,7 +706,8 @@ pub struct TreeBlock {
     pub dirty: Vec<u8>,
     /// Per joint node, the lanes holding each optional row this pass.
     pub held: Vec<[u8; MAX_OPTIONAL]>,
-    /// The lanes whose active set crossed in the last settle.
+    /// The lanes whose active set crossed in the last settle (after the
+    /// passes, `end_unsettled` joins its own flags across pieces here).
     pub crossing: [f32; BLOCK_LANES],
     /// The lanes whose solve started again this solve
     /// (`solve::restart`).
@@ -715,7 +716,7 @@ pub struct TreeBlock {
     /// (`end_unsettled`).
     pub unsettled: u8,
     /// Each lane's largest body step in the solve's first pass
-    /// (`step_sizes`; pinned blocks only).
+    /// (`step_sizes`; set in solves where some block takes pins).
     pub first_step: [f32; BLOCK_LANES],
     /// The topology's ports, each lane's subtree.
     pub ports: Vec<Port>,
