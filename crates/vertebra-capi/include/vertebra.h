@@ -131,6 +131,29 @@ typedef uint32_t VtJointSolver;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
+// Which trees' contacts with static and kinematic bodies are solved in
+// their direct joint solve (`PinContacts` in Rust).
+enum VtPinContacts
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  // None (the default, and the paper's).
+  VT_PIN_CONTACTS_NEVER = 0,
+  // Every tree's (needs the direct joint solve).
+  VT_PIN_CONTACTS_ALWAYS = 1,
+  // A tree's with a joint drive or a body's world-space or upright
+  // drive (a powered ragdoll standing on 1 kg feet needs it).
+  VT_PIN_CONTACTS_DRIVEN = 2,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum VtPinContacts VtPinContacts;
+#else
+typedef uint32_t VtPinContacts;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
 // How a body moves.
 enum VtBodyKind
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -1008,8 +1031,8 @@ typedef struct VtSolverConfig {
   // Non-zero: a touching contact takes back the separating speed its
   // own push-out gave (`SolverConfig::relax_contacts`).
   uint32_t relax_contacts;
-  // Non-zero: with the direct joint solve, a tree's contacts with static
-  // or kinematic bodies are solved in its solve
+  // A `VtPinContacts`: which trees' contacts with static or kinematic
+  // bodies are solved in their direct joint solve
   // (`SolverConfig::pin_contacts`).
   uint32_t pin_contacts;
 } VtSolverConfig;

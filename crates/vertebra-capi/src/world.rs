@@ -4,7 +4,9 @@
 use std::sync::Arc;
 
 use vertebra_math::Backend;
-use vertebra_world::{BackendChoice, JointSolver, SleepSettings, SolverConfig, TaskSystem, World};
+use vertebra_world::{
+    BackendChoice, JointSolver, PinContacts, SleepSettings, SolverConfig, TaskSystem, World,
+};
 
 use crate::error::{Failure, VtResult};
 use crate::ffi::{Object, call, enter, free, out, read};
@@ -42,6 +44,24 @@ pub enum VtJointSolver {
     /// Every tree of joints at once, each iteration (`docs/direct.md`).
     Direct = 1,
 }
+
+/// Which trees' contacts with static and kinematic bodies are solved in
+/// their direct joint solve (`PinContacts` in Rust).
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VtPinContacts {
+    /// None (the default, and the paper's).
+    Never = 0,
+    /// Every tree's (needs the direct joint solve).
+    Always = 1,
+    /// A tree's with a joint drive or a body's world-space or upright
+    /// drive (a powered ragdoll standing on 1 kg feet needs it).
+    Driven = 2,
+}
+
+/// The values of `VtPinContacts`, in order.
+const PIN_CONTACTS: [PinContacts; 3] =
+    [PinContacts::Never, PinContacts::Always, PinContacts::Driven];
 
 /// The solver's settings (`SolverConfig` in Rust; its docs give each
 /// field's range). `vt_solver_config_default` fills the defaults.
@@ -81,8 +101,8 @@ pub struct VtSolverConfig {
     /// Non-zero: a touching contact takes back the separating speed its
     /// own push-out gave (`SolverConfig::relax_contacts`).
     pub relax_contacts: u32,
-    /// Non-zero: with the direct joint solve, a tree's contacts with static
-    /// or kinematic bodies are solved in its solve
+    /// A `VtPinContacts`: which trees' contacts with static or kinematic
+    /// bodies are solved in their direct joint solve
     /// (`SolverConfig::pin_contacts`).
     pub pin_contacts: u32,
 }
@@ -163,7 +183,11 @@ impl From<&SolverConfig> for VtSolverConfig {
             sleep_speed: sleep.speed,
             sleep_time: sleep.time,
             relax_contacts: u32::from(c.relax_contacts),
-            pin_contacts: u32::from(c.pin_contacts),
+            pin_contacts: match c.pin_contacts {
+                PinContacts::Never => VtPinContacts::Never as u32,
+                PinContacts::Always => VtPinContacts::Always as u32,
+                PinContacts::Driven => VtPinContacts::Driven as u32,
+            },
         }
     }
 }
@@ -198,7 +222,7 @@ impl TryFrom<&VtSolverConfig> for SolverConfig {
             measure_residuals: flag(c.measure_residuals),
             sleep,
             joints,
-            pin_contacts: flag(c.pin_contacts),
+            pin_contacts: pick(c.pin_contacts, "config.pin_contacts", &PIN_CONTACTS)?,
         })
     }
 }

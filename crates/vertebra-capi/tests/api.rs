@@ -15,7 +15,7 @@ use vertebra_ragdoll::{
     SpineMapping, SpineMode, Transform,
 };
 use vertebra_world::{
-    AngularDrive, BodyDesc, JointDesc, JointKind, JointSolver, LimitSoftness, RodDesc,
+    AngularDrive, BodyDesc, JointDesc, JointKind, JointSolver, LimitSoftness, PinContacts, RodDesc,
     RodStiffness, Shape, SolverConfig, Spring, Swing, SwingTwist, World,
 };
 
@@ -581,6 +581,13 @@ fn the_presets_are_the_default_and_the_papers_settings() {
             )
         );
         assert_eq!(config.relax_contacts, u32::from(rust.relax_contacts));
+        let pins = [
+            (VtPinContacts::Never, PinContacts::Never),
+            (VtPinContacts::Always, PinContacts::Always),
+            (VtPinContacts::Driven, PinContacts::Driven),
+        ];
+        let pins = pins.iter().find(|(_, p)| *p == rust.pin_contacts);
+        assert_eq!(Some(config.pin_contacts), pins.map(|(c, _)| *c as u32));
     }
     assert_eq!(
         (
@@ -689,6 +696,13 @@ fn an_enum_out_of_range_is_refused_naming_the_field() {
             "config.joints",
             VtSolverConfig {
                 joints: 2,
+                ..config
+            },
+        ),
+        (
+            "config.pin_contacts",
+            VtSolverConfig {
+                pin_contacts: 3,
                 ..config
             },
         ),

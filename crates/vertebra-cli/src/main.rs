@@ -20,7 +20,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vertebra_math::BackendChoice;
 use vertebra_ragdoll::{RagdollDesc, RagdollError, SpineMode};
 use vertebra_scenes::{MAX_FRAMES, Scene, SceneConfig, SceneRun, Seeded};
-use vertebra_world::{JointSolver, SleepSettings, SolverConfig};
+use vertebra_world::{JointSolver, PinContacts, SleepSettings, SolverConfig};
 
 use gltf_out::GltfOut;
 use skeleton_csv::{Failed, SkeletonCsv};
@@ -125,12 +125,13 @@ enum Command {
         /// says.
         #[arg(long, num_args = 0..=1, default_missing_value = "true")]
         relax_contacts: Option<bool>,
-        /// Solve each ragdoll's contacts with the static world in its
-        /// direct joint solve (true or false; alone: true; only with
-        /// --joints direct). Unless given: on for the stagger under the
-        /// direct solve (its feet stand on them), off otherwise.
-        #[arg(long, num_args = 0..=1, default_missing_value = "true")]
-        pin_contacts: Option<bool>,
+        /// Which ragdolls' contacts with the static world are solved in
+        /// their direct joint solve: never, driven (a ragdoll with a
+        /// drive) or always (alone: always; always needs --joints
+        /// direct). Unless given: driven for the stagger under the direct
+        /// solve (its feet stand on them), never otherwise.
+        #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "always")]
+        pin_contacts: Option<Pins>,
         /// One JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -170,6 +171,23 @@ enum Spine {
 enum Joints {
     Iterative,
     Direct,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Pins {
+    Never,
+    Driven,
+    Always,
+}
+
+impl From<Pins> for PinContacts {
+    fn from(p: Pins) -> Self {
+        match p {
+            Pins::Never => PinContacts::Never,
+            Pins::Driven => PinContacts::Driven,
+            Pins::Always => PinContacts::Always,
+        }
+    }
 }
 
 impl From<Joints> for JointSolver {
@@ -296,7 +314,11 @@ fn execute(command: Command) -> Result<(), String> {
             config.substeps = substeps.unwrap_or(solver.substeps);
             config.relax_contacts = relax_contacts.unwrap_or(solver.relax_contacts);
             let direct = config.joints == JointSolver::Direct;
-            config.pin_contacts = pin_contacts.unwrap_or(scene == Scene::Stagger && direct);
+            let pins = match scene == Scene::Stagger && direct {
+                true => PinContacts::Driven,
+                false => PinContacts::Never,
+            };
+            config.pin_contacts = pin_contacts.map_or(pins, Into::into);
             config.frames = frames;
             config.backend = backend;
             config.threads = threads;

@@ -7,7 +7,7 @@ use std::path::Path;
 use serde_json::{Value, json};
 use vertebra_ragdoll::SpineMode;
 use vertebra_scenes::{Quantity, SceneConfig, SceneRun, Seeded, Spread};
-use vertebra_world::JointSolver;
+use vertebra_world::{JointSolver, PinContacts};
 
 /// `rod` or `sockets`.
 pub fn spine_name(spine: SpineMode) -> &'static str {
@@ -22,6 +22,14 @@ pub fn joints_name(joints: JointSolver) -> &'static str {
     match joints {
         JointSolver::Iterative => "iterative",
         JointSolver::Direct => "direct",
+    }
+}
+
+pub fn pins_name(pins: PinContacts) -> &'static str {
+    match pins {
+        PinContacts::Never => "never",
+        PinContacts::Driven => "driven",
+        PinContacts::Always => "always",
     }
 }
 
@@ -70,7 +78,7 @@ fn setting_json(config: &SceneConfig, run: &SceneRun) -> serde_json::Map<String,
         "threads": config.threads,
         "sleep": config.sleep.is_some(),
         "relax_contacts": config.relax_contacts,
-        "pin_contacts": config.pin_contacts,
+        "pin_contacts": pins_name(config.pin_contacts),
     }) else {
         unreachable!("a JSON object literal")
     };

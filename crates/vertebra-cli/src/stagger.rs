@@ -12,7 +12,7 @@ use vertebra_scenes::{
     Activity, STAGGER_IMPULSES, SceneConfig, Side, StaggerHit, StaggerSweep, stagger_profile,
 };
 
-use crate::output::{joints_name, spine_name};
+use crate::output::{joints_name, pins_name, spine_name};
 
 /// Seeds the sweep runs from unless told.
 pub const DEFAULT_SEEDS: u64 = 5;
@@ -153,7 +153,7 @@ fn sweep_json(config: &SceneConfig, sweep: &StaggerSweep, backend: &str, seconds
         "threads": config.threads,
         "sleep": config.sleep.is_some(),
         "relax_contacts": config.relax_contacts,
-        "pin_contacts": config.pin_contacts,
+        "pin_contacts": pins_name(config.pin_contacts),
         "seconds": seconds,
         "standing_hips_m": sweep.standing_height,
         "hits": sweep.hits.iter().map(hit_json).collect::<Vec<_>>(),

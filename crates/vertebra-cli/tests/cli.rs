@@ -30,11 +30,12 @@ fn a_scene_runs_the_papers_settings_or_the_worlds_default_unless_told() {
             v["substeps"].as_u64().unwrap(),
             v["iterations"].as_u64().unwrap(),
             v["relax_contacts"].as_bool().unwrap(),
-            v["pin_contacts"].as_bool().unwrap(),
+            v["pin_contacts"].as_str().unwrap().to_owned(),
         )
     };
-    let paper = ("iterative".to_owned(), 1, 20, false, false);
-    let default = ("direct".to_owned(), 1, 8, true, false);
+    let [never, driven, always] = ["never", "driven", "always"].map(str::to_owned);
+    let paper = ("iterative".to_owned(), 1, 20, false, never.clone());
+    let default = ("direct".to_owned(), 1, 8, true, never.clone());
     assert_eq!(settings(&["passive-bending", "--spine", "rod"]), paper);
     assert_eq!(settings(&["heavy-chain", "--spine", "sockets"]), default);
     let iterated = ["heavy-chain", "--spine", "sockets", "--joints", "iterative"];
@@ -42,7 +43,7 @@ fn a_scene_runs_the_papers_settings_or_the_worlds_default_unless_told() {
     let direct = ["ragdoll-drop", "--spine", "rod", "--joints", "direct"];
     assert_eq!(
         settings(&direct),
-        ("direct".to_owned(), 1, 20, false, false)
+        ("direct".to_owned(), 1, 20, false, never.clone())
     );
     let told = [
         "heavy-chain",
@@ -54,24 +55,34 @@ fn a_scene_runs_the_papers_settings_or_the_worlds_default_unless_told() {
         "2",
         "--relax-contacts",
         "false",
+        "--pin-contacts",
+        "never",
     ];
-    assert_eq!(settings(&told), ("direct".to_owned(), 2, 3, false, false));
+    assert_eq!(
+        settings(&told),
+        ("direct".to_owned(), 2, 3, false, never.clone())
+    );
     let relaxed = ["passive-bending", "--spine", "rod", "--relax-contacts"];
     assert_eq!(
         settings(&relaxed),
-        ("iterative".to_owned(), 1, 20, true, false)
+        ("iterative".to_owned(), 1, 20, true, never.clone())
     );
-    // The stagger stands on pinned feet under the direct solve unless told.
+    // The stagger's driven ragdoll stands on pinned feet under the direct
+    // solve unless told.
     let stagger = ["stagger", "--spine", "rod"];
-    assert_eq!(settings(&stagger), ("direct".to_owned(), 1, 8, true, true));
-    let unpinned = ["stagger", "--spine", "rod", "--pin-contacts", "false"];
+    assert_eq!(
+        settings(&stagger),
+        ("direct".to_owned(), 1, 8, true, driven)
+    );
+    let unpinned = ["stagger", "--spine", "rod", "--pin-contacts", "never"];
     assert_eq!(
         settings(&unpinned),
-        ("direct".to_owned(), 1, 8, true, false)
+        ("direct".to_owned(), 1, 8, true, never)
     );
     let pinned = ["heavy-chain", "--spine", "sockets", "--pin-contacts"];
-    assert_eq!(settings(&pinned), ("direct".to_owned(), 1, 8, true, true));
-    // Pins need the direct solve: asked of the iterated one, refused.
+    assert_eq!(settings(&pinned), ("direct".to_owned(), 1, 8, true, always));
+    // Pinning every ragdoll needs the direct solve: asked of the iterated
+    // one, refused.
     let iterated = [
         "scene",
         "stagger",

@@ -1,7 +1,9 @@
 //! How to run a scene: spine, solver settings, ragdoll, seed.
 
 use vertebra_ragdoll::{DriveSettings, RagdollDesc, RagdollError, SpineMode};
-use vertebra_world::{BackendChoice, JointSolver, SleepSettings, SolverConfig, Spring, World};
+use vertebra_world::{
+    BackendChoice, JointSolver, PinContacts, SleepSettings, SolverConfig, Spring, World,
+};
 
 use crate::Scene;
 
@@ -62,10 +64,10 @@ pub struct SceneConfig {
     /// (`SolverConfig::relax_contacts`): off in [`SceneConfig::new`], as
     /// in the paper; on in the world's default.
     pub relax_contacts: bool,
-    /// Whether a ragdoll's contacts with the static world are solved in
-    /// its direct joint solve (`SolverConfig::pin_contacts`; needs
-    /// [`JointSolver::Direct`]): off in [`SceneConfig::new`].
-    pub pin_contacts: bool,
+    /// Which ragdolls' contacts with the static world are solved in
+    /// their direct joint solve (`SolverConfig::pin_contacts`): never in
+    /// [`SceneConfig::new`], as in the paper.
+    pub pin_contacts: PinContacts,
 }
 
 impl SceneConfig {
@@ -89,7 +91,7 @@ impl SceneConfig {
             measure_residuals: true,
             sleep: None,
             relax_contacts: false,
-            pin_contacts: false,
+            pin_contacts: PinContacts::Never,
         }
     }
 

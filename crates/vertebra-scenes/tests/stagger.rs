@@ -14,13 +14,13 @@ use vertebra_scenes::{
     Activity, FRAME_DT, Gait, Scene, SceneConfig, Side, StaggerSweep, WALK_SPEED, WALK_START, Walk,
     build, stagger_profile, stagger_walk,
 };
-use vertebra_world::{JointSolver, SolverConfig};
+use vertebra_world::{JointSolver, PinContacts, SolverConfig};
 
 const G: f32 = 9.81;
 
 /// The scene under `joints`' solve as `vertebra scene stagger` runs it:
-/// the world's default with its contacts with the ground pinned (its 1 kg
-/// feet need them), or the paper's iterated one.
+/// the world's default with its driven ragdoll's contacts with the ground
+/// pinned (its 1 kg feet need them), or the paper's iterated one.
 fn config(spine: SpineMode, joints: JointSolver) -> SceneConfig {
     let solver = match joints {
         JointSolver::Direct => SolverConfig::default(),
@@ -31,7 +31,10 @@ fn config(spine: SpineMode, joints: JointSolver) -> SceneConfig {
     config.iterations = solver.iterations;
     config.substeps = solver.substeps;
     config.relax_contacts = solver.relax_contacts;
-    config.pin_contacts = joints == JointSolver::Direct;
+    config.pin_contacts = match joints {
+        JointSolver::Direct => PinContacts::Driven,
+        JointSolver::Iterative => PinContacts::Never,
+    };
     config
 }
 

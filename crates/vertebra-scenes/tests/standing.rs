@@ -13,7 +13,7 @@ use vertebra_ragdoll::{
     BuildOptions, DriveSettings, PhysicalAnimation, Pose, Ragdoll, RagdollDesc, SpineMode, Upright,
     WorldDriveSettings,
 };
-use vertebra_world::{BodyDesc, BodyHandle, SolverConfig, Spring, World};
+use vertebra_world::{BodyDesc, BodyHandle, PinContacts, SolverConfig, Spring, World};
 
 const DT: f32 = 1.0 / 60.0;
 const G: f32 = 9.81;
@@ -62,11 +62,12 @@ struct Stand {
 impl Stand {
     /// The anatomical humanoid at its bind pose (standing, arms out), its
     /// lowest point 1 mm above the ground, at the default solver settings
-    /// with its contacts with the ground pinned (its 1 kg feet need them).
+    /// with a driven ragdoll's contacts with the ground pinned
+    /// (`PinContacts::Driven`: its 1 kg feet need them).
     fn new(spine: SpineMode) -> Self {
         let desc = RagdollDesc::anatomical_humanoid();
         let config = SolverConfig {
-            pin_contacts: true,
+            pin_contacts: PinContacts::Driven,
             ..SolverConfig::default()
         };
         let mut world = World::new(config).unwrap();
@@ -197,4 +198,53 @@ fn a_hit_beyond_the_caps_fells_it() {
         low < 0.5,
         "held up at {low} m by drives that should give way"
     );
+}
+
+/// A standing ragdoll beside a pile of limp ones, in one world with a
+/// driven ragdoll's contacts pinned (`PinContacts::Driven`), for 20 s:
+/// the driven one's contacts are pins, so it stands on its 1 kg feet
+/// (iterated, `Never`, they sink and slide, and it falls within 20 s); the
+/// limp ones' stay iterated, so the pile holds its joints within 2
+/// degrees of their limits as it lands and settles (`Always`: this pile's
+/// rod spines go 15.7 degrees past; `docs/direct.md`, "Which trees take
+/// pins").
+#[test]
+fn a_standing_ragdoll_and_a_landing_pile_share_one_world_on_driven_pins() {
+    for spine in [SpineMode::Sockets, SpineMode::Rod] {
+        let mut stand = Stand::new(spine);
+        let desc = RagdollDesc::anatomical_humanoid();
+        for k in 0..8 {
+            // Lying, each turned further about the vertical, one above
+            // another: they land on each other.
+            let turn = Quat::from_rotation_y(2.3 * k as f32) * Quat::from_rotation_x(FRAC_PI_2);
+            let pivot = Vec3::new(0.0, 1.0, 0.0);
+            let to = Vec3::new(2.0, 0.4 + 0.45 * k as f32, 0.0) - pivot;
+            let pose = Pose::bind(&desc).moved(pivot, turn, to);
+            let options = BuildOptions::new(spine);
+            let limp = Ragdoll::build(&mut stand.world, &desc, options, &pose, None).unwrap();
+            stand.collisions.add_ragdoll(&limp).unwrap();
+        }
+        let (mut worst, mut past) = (0.0f32, 0.0f32);
+        for _ in 0..20 * 60 {
+            stand.frame();
+            worst = worst.max((stand.hips() - stand.start).length());
+            let residuals = stand.world.measure_residuals();
+            let joints = residuals.joints.iter().map(|j| j.limit_rad);
+            let limits = joints.chain(residuals.rods.iter().map(|r| r.limit_rad));
+            past = past.max(limits.fold(0.0, f32::max));
+        }
+        let past = past.to_degrees();
+        eprintln!(
+            "{spine:?}: hips within {:.2} cm; a joint at most {past:.2} degrees past its limit",
+            worst * 100.0
+        );
+        assert!(
+            worst < 0.02,
+            "{spine:?}: the standing ragdoll's hips {worst} m off"
+        );
+        assert!(
+            past < 2.0,
+            "{spine:?}: a joint {past} degrees past its limit"
+        );
+    }
 }

@@ -53,6 +53,36 @@ pub enum JointSolver {
     Direct,
 }
 
+/// Which trees' contacts with static and kinematic bodies are pins:
+/// solved in the tree's own direct solve (`docs/direct.md`, "Contacts in
+/// the solve: pins"), so that a light body under a heavy one (a foot
+/// under a ragdoll) holds and rubs with its whole tree's mass, where an
+/// iterated contact keeps its own share of each push (a standing
+/// ragdoll's 1 kg feet sink and slide, and it falls). Needs
+/// [`JointSolver::Direct`] (with iterated joints there are no trees).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PinContacts {
+    /// No contact is a pin. The default, and the paper's.
+    #[default]
+    Never,
+    /// The contacts of a tree with a drive are pins: one of its joints has
+    /// an angular drive, or one of its bodies a world-space or upright
+    /// drive (a powered ragdoll standing, walking, getting up). A limp
+    /// tree's stay iterated: in a pile of ragdolls pins push joints past
+    /// their limits for frames as they land (up to 18 degrees in the
+    /// 30-ragdoll drops, against 2 with iterated contacts; `docs/direct.md`,
+    /// "Pins in a pile, and a limp ragdoll lying on them"). Decided at
+    /// each step from the drives set, so a ragdoll faded limp leaves its
+    /// pins as its last drive goes, and that step is a pop: the pinned
+    /// feet held up to the last step sink to where iterated contacts rest
+    /// (a body of the anatomical humanoid moves 2.4 mm more in that frame
+    /// than with its pins kept; `docs/direct.md`, "Which trees take
+    /// pins"), which keeps this from being the default.
+    Driven,
+    /// Every tree's contacts are pins, driven or not.
+    Always,
+}
+
 /// How the world steps. Games use a fixed iteration count; so does the
 /// paper (20 iterations, 1 substep).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -124,21 +154,14 @@ pub struct SolverConfig {
     pub sleep: Option<SleepSettings>,
     /// How the joints' equality parts are solved ([`JointSolver`]).
     pub joints: JointSolver,
-    /// With the direct joint solve: each contact between a body of a tree
-    /// and a static or kinematic body is solved in the tree's own solve
-    /// (a pin: `docs/direct.md`, "Contacts in the solve: pins"), so that a
-    /// light body under a heavy one (a foot under a ragdoll) holds and
-    /// rubs with its whole tree's mass, where an iterated contact keeps
-    /// its own share of each push. Off by default: in a pile of ragdolls
-    /// it pushes joints past their limits for frames as they land (up to
-    /// 18 degrees in the 30-ragdoll drops, against 2 with iterated
-    /// contacts; `docs/direct.md`, "Why it is not the default yet"), so
-    /// turn it on for a ragdoll that stands or lies on its own. Needs [`JointSolver::Direct`].
-    pub pin_contacts: bool,
+    /// Which trees' contacts with static and kinematic bodies are solved
+    /// in their direct joint solve ([`PinContacts`]): none by default; a
+    /// powered ragdoll that stands needs `Driven` (or `Always`).
+    pub pin_contacts: PinContacts,
 }
 
 /// The default: the direct joint solve at 1 substep of 8 iterations, with
-/// the contacts relaxed. In the 30-ragdoll drop it holds joints about
+/// the contacts relaxed, no contact pinned. In the 30-ragdoll drop it holds joints about
 /// 17,000 times tighter than the paper's iterated 1 x 20 at 0.95x (rod
 /// spines) to 1.02x (sockets) its frame (`docs/direct.md`, "The
 /// default"); 8 iterations are
@@ -177,7 +200,7 @@ impl SolverConfig {
             measure_residuals: false,
             sleep: Some(SleepSettings::default()),
             joints: JointSolver::Iterative,
-            pin_contacts: false,
+            pin_contacts: PinContacts::Never,
         }
     }
 
@@ -229,9 +252,11 @@ impl SolverConfig {
         if let Some(sleep) = &self.sleep {
             sleep.validate()?;
         }
-        if self.pin_contacts && self.joints != JointSolver::Direct {
+        // `Driven` with iterated joints pins nothing, as documented: the
+        // default's pins do not make a valid choice of joints invalid.
+        if self.pin_contacts == PinContacts::Always && self.joints != JointSolver::Direct {
             return Err(Error::InvalidConfig(
-                "pin_contacts needs the direct joint solve (joints: Direct)",
+                "pin_contacts Always needs the direct joint solve (joints: Direct)",
             ));
         }
         check_finite("gravity", self.gravity)

@@ -185,7 +185,8 @@ impl ContactLayout {
             .resize(self.block_keys.len(), ContactBlock::padding());
     }
 
-    /// Gives the trees' solves the contacts between one of their bodies and
+    /// Gives the solves of the trees `takes` marks (by index into
+    /// `trees.members`) the contacts between one of their bodies and
     /// a static or kinematic body (`vertebra_kernels::direct::pin`), in
     /// the order given, up to [`MAX_PINS`] a body (its further contacts
     /// stay iterated), each from its lane here (overlap capped at
@@ -197,6 +198,7 @@ impl ContactLayout {
         contacts: &[Contact],
         bodies: &BodyStore,
         trees: &mut Trees,
+        takes: &[bool],
         max_depth: f32,
     ) {
         for block in &mut trees.blocks {
@@ -226,6 +228,9 @@ impl ContactLayout {
                 (_, Some(p)) if fixed(a) => (p, true),
                 _ => continue,
             };
+            if !takes[place.tree] {
+                continue;
+            }
             let block = &mut trees.blocks[place.block];
             if !block.pinned() {
                 block.take_pins();

@@ -42,6 +42,7 @@ mod lend;
 mod metrics;
 mod parallel;
 mod passes;
+mod pin_choice;
 mod rod;
 mod rollback;
 mod sleep;
@@ -65,7 +66,7 @@ use vertebra_store::Slots;
 pub use body_drive::{UprightDrive, WorldDrive};
 pub use config::{
     JointSolver, MAX_ANGULAR_SPEED_LIMIT, MAX_LINEAR_SPEED_LIMIT, MAX_SOLVER_SWEEPS, MAX_THREADS,
-    SleepSettings, SolverConfig,
+    PinContacts, SleepSettings, SolverConfig,
 };
 pub use contact::Contact;
 pub use drive::AngularDrive;
@@ -111,6 +112,9 @@ pub struct World {
     /// The bodies' drives by slot, no longer than the last driven body's
     /// slot (`body_drive.rs`).
     body_drives: Vec<body_drive::BodyDrives>,
+    /// Scratch of the step: which trees' contacts are pins
+    /// (`pin_choice.rs`).
+    pinned_trees: Vec<bool>,
     colouring: Colouring,
     islands: islands::Islands,
     /// Scratch of the step: this step's solve bins (`bins.rs`).
@@ -183,6 +187,7 @@ impl World {
             rod_slots: Slots::new(lineage),
             rods: Vec::new(),
             body_drives: Vec::new(),
+            pinned_trees: Vec::new(),
             colouring: Colouring::new(),
             islands: islands::Islands::default(),
             bins: bins::Bins::default(),
@@ -775,9 +780,9 @@ impl World {
         let asleep = self.islands.asleep();
         self.contact_layout
             .plan(&self.contacts, &self.bodies, asleep, &self.bins);
-        if self.config.pin_contacts {
-            let trees = &mut self.layout.trees;
-            (self.contact_layout).pin(&self.contacts, &self.bodies, trees, max_depth);
+        let (trees, takes) = (&mut self.layout.trees, &mut self.pinned_trees);
+        if pin_choice::choose(&self.config, trees, &self.joints, &self.body_drives, takes) {
+            (self.contact_layout).pin(&self.contacts, &self.bodies, trees, takes, max_depth);
         }
         // The contacts' lanes and the joints' start of step, on the workers
         // when there are many (step::start_blocks_all).
