@@ -73,11 +73,11 @@ pub enum PinContacts {
     /// 30-ragdoll drops, against 2 with iterated contacts; `docs/direct.md`,
     /// "Pins in a pile, and a limp ragdoll lying on them"). Decided at
     /// each step from the drives set, so a ragdoll faded limp leaves its
-    /// pins as its last drive goes, and that step is a pop: the pinned
-    /// feet held up to the last step sink to where iterated contacts rest
-    /// (a body of the anatomical humanoid moves 2.4 mm more in that frame
-    /// than with its pins kept; `docs/direct.md`, "Which trees take
-    /// pins"), which keeps this from being the default.
+    /// pins as its last drive goes, and that step is a pop: the feet its
+    /// pins held give way under iterated contacts (the standing anatomical
+    /// humanoid drops 2.3 mm in that frame, its feet 1.5 mm into the
+    /// ground; `docs/direct.md`, "Which trees take pins"), which keeps
+    /// this from being the default.
     Driven,
     /// Every tree's contacts are pins, driven or not.
     Always,
