@@ -71,7 +71,10 @@ pub enum PinContacts {
     /// tree's stay iterated: in a pile of ragdolls pins push joints past
     /// their limits for frames as they land (up to 18 degrees in the
     /// 30-ragdoll drops, against 2 with iterated contacts; `docs/direct.md`,
-    /// "Pins in a pile, and a limp ragdoll lying on them"). Decided at
+    /// "Pins in a pile, and a limp ragdoll lying on them"). Give every
+    /// drive on a pinned tree a torque cap: an uncapped one is a hard row
+    /// of the tree's solve and can press the tree through its pins
+    /// (`docs/direct.md`, "Noticed, not done"). Decided at
     /// each step from the drives set, so a ragdoll faded limp leaves its
     /// pins as its last drive goes, and that step is a pop: the feet its
     /// pins held give way under iterated contacts (the standing anatomical
