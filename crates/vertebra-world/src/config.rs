@@ -71,16 +71,16 @@ pub enum PinContacts {
     /// tree's stay iterated: in a pile of ragdolls pins push joints past
     /// their limits for frames as they land (up to 18 degrees in the
     /// 30-ragdoll drops, against 2 with iterated contacts; `docs/direct.md`,
-    /// "Pins in a pile, and a limp ragdoll lying on them"). Give every
-    /// drive on a pinned tree a torque cap: an uncapped one is a hard row
-    /// of the tree's solve and can press the tree through its pins
-    /// (`docs/direct.md`, "Noticed, not done"). Decided at
+    /// "Pins in a pile, and a limp ragdoll lying on them"). Decided at
     /// each step from the drives set, so a ragdoll faded limp leaves its
     /// pins as its last drive goes, and that step is a pop: the feet its
     /// pins held give way under iterated contacts (the standing anatomical
     /// humanoid drops 2.3 mm in that frame, its feet 1.5 mm into the
     /// ground; `docs/direct.md`, "Which trees take pins"), which keeps
-    /// this from being the default.
+    /// this from being the default. Give every drive of a pinned tree a
+    /// torque cap: an uncapped one is a hard row of the tree's solve and
+    /// can press the tree through its pins (`docs/direct.md`, "Noticed,
+    /// not done").
     Driven,
     /// Every tree's contacts are pins, driven or not.
     Always,
@@ -164,14 +164,13 @@ pub struct SolverConfig {
 }
 
 /// The default: the direct joint solve at 1 substep of 8 iterations, with
-/// the contacts relaxed, no contact pinned. In the 30-ragdoll drop it holds joints about
-/// 17,000 times tighter than the paper's iterated 1 x 20 at 0.95x (rod
-/// spines) to 1.02x (sockets) its frame (`docs/direct.md`, "The
-/// default"); 8 iterations are
-/// what the contacts need (fewer let fast bodies through the ground and
-/// leave resting ones deeper in it; at 8 a pile of ragdolls rests 2 to
-/// 5 mm deep, at the paper's 20 about 1 mm). [`SolverConfig::paper`] is
-/// the paper's solver.
+/// the contacts relaxed, no contact pinned. In the 30-ragdoll drop it
+/// holds joints about 17,000 times tighter than the paper's iterated
+/// 1 x 20 at 0.95x (rod spines) to 1.02x (sockets) its frame
+/// (`docs/direct.md`, "The default"); 8 iterations are what the contacts
+/// need (fewer let fast bodies through the ground and leave resting ones
+/// deeper in it; at 8 a pile of ragdolls rests 2 to 5 mm deep, at the
+/// paper's 20 about 1 mm). [`SolverConfig::paper`] is the paper's solver.
 impl Default for SolverConfig {
     fn default() -> Self {
         Self {
@@ -255,8 +254,8 @@ impl SolverConfig {
         if let Some(sleep) = &self.sleep {
             sleep.validate()?;
         }
-        // `Driven` with iterated joints pins nothing, as documented: the
-        // default's pins do not make a valid choice of joints invalid.
+        // `Driven` with iterated joints pins nothing (there are no trees),
+        // as its doc says, and is accepted.
         if self.pin_contacts == PinContacts::Always && self.joints != JointSolver::Direct {
             return Err(Error::InvalidConfig(
                 "pin_contacts Always needs the direct joint solve (joints: Direct)",
