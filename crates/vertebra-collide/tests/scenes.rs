@@ -385,3 +385,123 @@ impl Lying {
         out
     }
 }
+
+/// A drive with no torque cap turning a chain into the ground: two
+/// capsules lying on the ground on sockets, the first to a static anchor,
+/// that joint driven 0.5 rad down at 5 Hz. The ground holds the chain on
+/// its surface whatever the contacts' solve: iterated, or pinned into the
+/// tree's direct solve, where the drive's hard row once overruled the
+/// pins' springs and pressed the chain 0.19 m into the ground.
+#[test]
+fn an_uncapped_drive_does_not_press_a_chain_into_the_ground() {
+    use vertebra_world::{AngularDrive, JointDesc, Spring};
+    let radius = 0.1;
+    for pins in [PinContacts::Never, PinContacts::Driven, PinContacts::Always] {
+        let mut w = World::new(SolverConfig {
+            sleep: None,
+            pin_contacts: pins,
+            ..SolverConfig::default()
+        })
+        .unwrap();
+        let mut c = Collisions::new();
+        ground(&mut w, &mut c);
+        let anchor = w
+            .add_body(BodyDesc::fixed().with_position(Vec3::new(0.0, radius, 0.0)))
+            .unwrap();
+        let shape = Shape::capsule(Vec3::new(-0.2, 0.0, 0.0), Vec3::new(0.2, 0.0, 0.0), radius);
+        let mut chain = Vec::new();
+        let mut parent = anchor;
+        for k in 0..2 {
+            let at = Vec3::new(0.3 + 0.6 * k as f32, radius, 0.0);
+            let desc = BodyDesc::dynamic(shape.mass_properties(1000.0).unwrap()).with_position(at);
+            let body = w.add_body(desc).unwrap();
+            c.add(Collider::new(body, ColliderShape::Solid(shape)))
+                .unwrap();
+            let socket = at - Vec3::new(0.3, 0.0, 0.0);
+            let mut joint =
+                JointDesc::socket_at_world_anchor(w.bodies(), parent, body, socket, Vec3::X)
+                    .unwrap();
+            if k == 0 {
+                let strength = Spring::Frequency {
+                    frequency: 5.0,
+                    damping_ratio: 1.0,
+                };
+                joint = joint.with_drive(AngularDrive::new(Quat::from_rotation_z(-0.5), strength));
+            }
+            w.add_joint(joint).unwrap();
+            chain.push(body);
+            parent = body;
+        }
+        let mut lowest = f32::MAX;
+        for _ in 0..120 {
+            step(&mut w, &c);
+            for &b in &chain {
+                lowest = lowest.min(w.body(b).unwrap().position.y);
+            }
+        }
+        let heights: Vec<f32> = (chain.iter())
+            .map(|&b| w.body(b).unwrap().position.y)
+            .collect();
+        eprintln!("{pins:?}: centres at {heights:?} m, lowest {lowest} m");
+        assert!(lowest > radius - 0.01, "{pins:?}: {lowest} m");
+    }
+}
+
+/// `PinContacts::Driven` pins every tree a driven joint touches: two
+/// capsules falling 2 cm onto the ground, each on a socket to a static anchor
+/// (two trees), joined by a driven joint (which closes a loop between
+/// them, so it joins neither) step bit for bit as with every tree pinned.
+#[test]
+fn a_driven_joint_between_two_trees_pins_both() {
+    use vertebra_world::{AngularDrive, JointDesc, Spring};
+    let radius = 0.1;
+    let run = |pins: PinContacts| {
+        let mut w = World::new(SolverConfig {
+            sleep: None,
+            pin_contacts: pins,
+            ..SolverConfig::default()
+        })
+        .unwrap();
+        let mut c = Collisions::new();
+        ground(&mut w, &mut c);
+        let shape = Shape::capsule(Vec3::new(-0.2, 0.0, 0.0), Vec3::new(0.2, 0.0, 0.0), radius);
+        let mut capsules = Vec::new();
+        for z in [0.0, 0.5] {
+            let anchor = w
+                .add_body(BodyDesc::fixed().with_position(Vec3::new(0.0, radius, z)))
+                .unwrap();
+            let at = Vec3::new(0.3, radius + 0.02, z);
+            let desc = BodyDesc::dynamic(shape.mass_properties(1000.0).unwrap()).with_position(at);
+            let body = w.add_body(desc).unwrap();
+            c.add(Collider::new(body, ColliderShape::Solid(shape)))
+                .unwrap();
+            let socket = Vec3::new(0.0, radius + 0.02, z);
+            let joint =
+                JointDesc::socket_at_world_anchor(w.bodies(), anchor, body, socket, Vec3::X)
+                    .unwrap();
+            w.add_joint(joint).unwrap();
+            capsules.push(body);
+        }
+        let strength = Spring::Frequency {
+            frequency: 2.0,
+            damping_ratio: 1.0,
+        };
+        let drive = AngularDrive::new(Quat::IDENTITY, strength).with_max_torque(50.0);
+        let (a, b) = (capsules[0], capsules[1]);
+        let between = Vec3::new(0.6, radius + 0.02, 0.25);
+        let joint = JointDesc::socket_at_world_anchor(w.bodies(), a, b, between, Vec3::Z)
+            .unwrap()
+            .with_drive(drive);
+        w.add_joint(joint).unwrap();
+        for _ in 0..30 {
+            step(&mut w, &c);
+        }
+        (capsules.iter())
+            .map(|&b| w.body(b).unwrap().position.to_array().map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
+    let [never, driven, always] =
+        [PinContacts::Never, PinContacts::Driven, PinContacts::Always].map(run);
+    assert_ne!(never, always, "the pins change nothing here");
+    assert_eq!(driven, always);
+}

@@ -77,10 +77,11 @@ pub enum PinContacts {
     /// pins held give way under iterated contacts (the standing anatomical
     /// humanoid drops 2.3 mm in that frame, its feet 1.5 mm into the
     /// ground; `docs/direct.md`, "Which trees take pins"), which keeps
-    /// this from being the default. Give every drive of a pinned tree a
-    /// torque cap: an uncapped one is a hard row of the tree's solve and
-    /// can press the tree through its pins (`docs/direct.md`, "Noticed,
-    /// not done").
+    /// this from being the default. An uncapped angular drive of a
+    /// pinned tree is a spring on its own pair's inertia (a hard row would
+    /// overrule the pins' springs), weaker under a load than a capped one:
+    /// give a pinned tree's drives torque caps (`docs/direct.md`, "Drives
+    /// are rows of the solve").
     Driven,
     /// Every tree's contacts are pins, driven or not.
     Always,

@@ -7,8 +7,9 @@ use crate::trees::Trees;
 
 /// Marks in `takes` (by tree, as `trees.members`) the trees whose
 /// contacts are pins under `config`: every tree, none, or (`Driven`) each
-/// tree with a joint's angular drive or a body's world-space or upright
-/// drive. Returns whether the step pins at all; when it does,
+/// tree with a body of a joint's angular drive (both trees of a driven
+/// joint that closes a loop between two) or a body's world-space or
+/// upright drive. Returns whether the step pins at all; when it does,
 /// `ContactLayout::pin` also clears every pin of the step before, so a
 /// tree that stops being driven leaves its pins at once.
 pub(crate) fn choose(
@@ -31,7 +32,8 @@ pub(crate) fn choose(
     let tree = |slot: usize| trees.bodies.get(slot).copied().flatten().map(|p| p.tree);
     let driven_joints = (joints.iter().flatten())
         .filter(|joint| joint.drive.is_some())
-        .filter_map(|joint| tree(joint.body_a.index()).or(tree(joint.body_b.index())));
+        .flat_map(|joint| [tree(joint.body_a.index()), tree(joint.body_b.index())])
+        .flatten();
     let driven_bodies = (body_drives.iter().enumerate())
         .filter(|(_, drives)| drives.any())
         .filter_map(|(slot, _)| tree(slot));

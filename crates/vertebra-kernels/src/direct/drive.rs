@@ -74,6 +74,12 @@
 //! away from it with a spring's force; the limit lets go when the drive
 //! pulls it inside. A soft limit is a spring the hard target rows
 //! overrule.
+//!
+//! **Against pins.** A pin's normal is a stiff spring too, which a hard
+//! row overrules: an uncapped drive turning a limb into the ground would
+//! wind the pins up against it without bound. So in a lane whose tree
+//! takes pins an uncapped drive's rows are soft in the same way. A capped
+//! drive stays hard: its cap is the bound the pins settle against.
 
 use bytemuck::{Pod, Zeroable};
 use vertebra_math::block::BLOCK_LANES;
@@ -171,6 +177,13 @@ impl DriveNode {
         self.settings
             .target
             .store(start, drive::advance(target, velocity, L::splat(h)));
+    }
+
+    /// The lanes from `start` whose drive has no torque cap.
+    #[inline(always)]
+    pub(super) fn uncapped<L: Lane>(&self, start: usize) -> L::Mask {
+        let max_torque = L::load(&self.settings.max_torque[start..]);
+        max_torque.eq(L::splat(f32::INFINITY))
     }
 
     /// Row `row`'s diagonal entry and right-hand side for the lanes from

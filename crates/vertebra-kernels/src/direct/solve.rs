@@ -907,8 +907,8 @@ fn soften<L: Lane, const E: usize, const K: usize>(
 
 /// A joint's drive rows (`super::drive`): each held row's diagonal entry
 /// and right-hand side (`+0` in a lane that does not hold it; soft in a
-/// lane that holds one of the joint's limits), its target recorded for
-/// [`accumulate`].
+/// lane that holds one of the joint's limits, and for an uncapped drive in
+/// a lane whose tree takes pins), its target recorded for [`accumulate`].
 #[inline(always)]
 fn drive_rows<L: Lane, const E: usize, const K: usize>(
     block: &mut TreeBlock,
@@ -921,6 +921,13 @@ fn drive_rows<L: Lane, const E: usize, const K: usize>(
     let mut limited = zero.gt(zero);
     for &lanes in &held.lanes[..limits] {
         limited = limited | lanes;
+    }
+    if block.pinned() {
+        let mut pinned = zero.gt(zero);
+        for pins in &block.pins {
+            pinned = pinned | L::load(&pins.stiffness[start..]).gt(zero);
+        }
+        limited = limited | (pinned & block.joints[index].drive.uncapped::<L>(start));
     }
     let mut out = [(zero, zero); MAX_DRIVE_ROWS];
     for (r, o) in (limits..K).enumerate() {
