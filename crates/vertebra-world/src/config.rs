@@ -69,7 +69,7 @@ pub enum PinContacts {
     /// an angular drive, or one of its bodies a world-space or upright
     /// drive (a powered ragdoll standing, walking, getting up). A limp
     /// tree's stay iterated: in a pile of ragdolls pins push joints past
-    /// their limits for frames as they land (up to 18 degrees in the
+    /// their limits for frames as they land (up to 43 degrees in the
     /// 30-ragdoll drops, against 2 with iterated contacts; `docs/direct.md`,
     /// "Pins in a pile, and a limp ragdoll lying on them"). Decided at
     /// each step from the drives set, so a ragdoll faded limp leaves its
