@@ -60,6 +60,9 @@ pub enum JointSolver {
 /// iterated contact keeps its own share of each push (a standing
 /// ragdoll's 1 kg feet sink and slide, and it falls). Needs
 /// [`JointSolver::Direct`] (with iterated joints there are no trees).
+/// A known failure: with pins, a world that lays its trees out over two
+/// threads can step to other bits than on one, on the SIMD backends
+/// (`docs/direct.md`, "Noticed, not done").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PinContacts {
     /// No contact is a pin. The default, and the paper's.
@@ -69,7 +72,7 @@ pub enum PinContacts {
     /// an angular drive, or one of its bodies a world-space or upright
     /// drive (a powered ragdoll standing, walking, getting up). A limp
     /// tree's stay iterated: in a pile of ragdolls pins push joints past
-    /// their limits for frames as they land (up to 43 degrees in the
+    /// their limits for frames as they land (up to 18 degrees in the
     /// 30-ragdoll drops, against 2 with iterated contacts; `docs/direct.md`,
     /// "Pins in a pile, and a limp ragdoll lying on them"). Decided at
     /// each step from the drives set, so a ragdoll faded limp leaves its
