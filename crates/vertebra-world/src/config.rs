@@ -60,9 +60,6 @@ pub enum JointSolver {
 /// iterated contact keeps its own share of each push (a standing
 /// ragdoll's 1 kg feet sink and slide, and it falls). Needs
 /// [`JointSolver::Direct`] (with iterated joints there are no trees).
-/// A known failure: with pins, a world that lays its trees out over two
-/// threads can step to other bits than on one, on the SIMD backends
-/// (`docs/direct.md`, "Noticed, not done").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PinContacts {
     /// No contact is a pin. The default, and the paper's.

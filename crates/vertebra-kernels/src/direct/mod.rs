@@ -715,8 +715,9 @@ pub struct TreeBlock {
     /// The lanes whose pins had not settled when their passes ran out
     /// (`end_unsettled`).
     pub unsettled: u8,
-    /// Each lane's largest body step in the solve's first pass
-    /// (`step_sizes`; set in solves where some block takes pins).
+    /// Each lane's tree's largest body step in the solve's first pass
+    /// (`step_sizes`, the largest over the tree's pieces; set in solves
+    /// where some block takes pins).
     pub first_step: [f32; BLOCK_LANES],
     /// The topology's ports, each lane's subtree.
     pub ports: Vec<Port>,
@@ -845,6 +846,7 @@ impl PositionPass<'_> {
                 for block in blocks.iter_mut() {
                     block.first_step = step_sizes(block, topologies);
                 }
+                solve::join_across_pieces(blocks, first_step_of, larger);
             }
             let bounds = solve::Bounds { pass, passes, most };
             if !solve::join_crossings(blocks, bounds) || pass >= last {
@@ -894,9 +896,10 @@ fn solve_pass(on: PhaseOn<'_>, blocks: &mut [TreeBlock], first_pass: bool) {
 
 /// Where a tree's pins had not settled when their passes ran out and its
 /// last pass moves it further than its first by more than [`WILD_STEP`]
-/// ([`step_sizes`], in any of its pieces), the tree starts again from its
-/// first pass's active set (`solve::start_again`) for one pass more, the
-/// solve's last. Returns whether any tree did.
+/// ([`step_sizes`] over the whole tree: the largest of its pieces', so a
+/// tree cut into pieces decides as it would whole), the tree starts again
+/// from its first pass's active set (`solve::start_again`) for one pass
+/// more, the solve's last. Returns whether any tree did.
 ///
 /// The passes between are steps of a search that had not converged, and
 /// one can move a tree far more than the solve asks: a sliding pin pushes
@@ -910,14 +913,15 @@ fn solve_pass(on: PhaseOn<'_>, blocks: &mut [TreeBlock], first_pass: bool) {
 /// about as far as its first.
 fn end_unsettled(blocks: &mut [TreeBlock], topologies: &[Topology]) -> bool {
     for block in blocks.iter_mut() {
-        let last = step_sizes(block, topologies);
-        for (lane, &last) in last.iter().enumerate() {
-            let further = last > block.first_step[lane] + WILD_STEP;
-            block.crossing[lane] = f32::from(u8::from(further));
+        block.crossing = step_sizes(block, topologies);
+    }
+    solve::join_across_pieces(blocks, solve::crossing_of, larger);
+    for block in blocks.iter_mut() {
+        for (lane, c) in block.crossing.iter_mut().enumerate() {
+            let further = *c > block.first_step[lane] + WILD_STEP;
+            *c = f32::from(u8::from(further));
         }
     }
-    // A tree goes back where any of its pieces moved further.
-    solve::join_pieces(blocks);
     let mut again = false;
     for block in blocks.iter_mut() {
         for (lane, c) in block.crossing.iter_mut().enumerate() {
@@ -950,6 +954,16 @@ fn step_sizes(block: &TreeBlock, topologies: &[Topology]) -> [f32; BLOCK_LANES] 
         }
     }
     sizes
+}
+
+/// A block's [`TreeBlock::first_step`].
+fn first_step_of(block: &mut TreeBlock) -> &mut [f32; BLOCK_LANES] {
+    &mut block.first_step
+}
+
+/// Keeps the larger of `mine` and `theirs` in `mine`.
+fn larger(mine: &mut f32, theirs: f32) {
+    *mine = mine.max(theirs);
 }
 
 /// The length of `(x, y, z)`.

@@ -482,16 +482,31 @@ pub(super) fn join_crossings(blocks: &mut [TreeBlock], bounds: Bounds) -> bool {
 /// pieces take: a trunk gets those of every piece hanging from it, then
 /// every piece its trunk's.
 pub(super) fn join_pieces(blocks: &mut [TreeBlock]) {
+    join_across_pieces(blocks, crossing_of, join);
+}
+
+/// A block's [`TreeBlock::crossing`].
+pub(super) fn crossing_of(block: &mut TreeBlock) -> &mut [f32; BLOCK_LANES] {
+    &mut block.crossing
+}
+
+/// Joins a per-lane value of each tree (`value` of a block) across the
+/// blocks its pieces take with `join(mine, theirs)`: a trunk takes in
+/// every piece hanging from it, then every piece its trunk. So a tree cut
+/// into pieces reaches the value it would have whole.
+pub(super) fn join_across_pieces(
+    blocks: &mut [TreeBlock],
+    value: fn(&mut TreeBlock) -> &mut [f32; BLOCK_LANES],
+    join: fn(&mut f32, f32),
+) {
     for k in 0..blocks.len() {
         let (before, rest) = blocks.split_at_mut(k);
         let block = &mut rest[0];
-        for port in &block.ports {
-            for (lane, source) in port.source.iter().enumerate() {
-                if let Some(s) = source {
-                    join(
-                        &mut block.crossing[lane],
-                        before[s.block as usize].crossing[s.lane as usize],
-                    );
+        for p in 0..block.ports.len() {
+            for lane in 0..BLOCK_LANES {
+                if let Some(s) = block.ports[p].source[lane] {
+                    let theirs = value(&mut before[s.block as usize])[s.lane as usize];
+                    join(&mut value(block)[lane], theirs);
                 }
             }
         }
@@ -499,10 +514,10 @@ pub(super) fn join_pieces(blocks: &mut [TreeBlock]) {
     for k in (0..blocks.len()).rev() {
         let (head, after) = blocks.split_at_mut(k + 1);
         let block = &mut head[k];
-        for (lane, source) in block.parent.iter().enumerate() {
-            if let Some(s) = source {
-                let parent = &after[s.block as usize - k - 1];
-                join(&mut block.crossing[lane], parent.crossing[s.lane as usize]);
+        for lane in 0..BLOCK_LANES {
+            if let Some(s) = block.parent[lane] {
+                let theirs = value(&mut after[s.block as usize - k - 1])[s.lane as usize];
+                join(&mut value(block)[lane], theirs);
             }
         }
     }
