@@ -386,6 +386,20 @@ impl Lying {
     }
 }
 
+/// A world with the ground, its contacts pinned as `pins` says, sleeping
+/// off.
+fn on_ground(pins: PinContacts) -> (World, Collisions) {
+    let mut w = World::new(SolverConfig {
+        sleep: None,
+        pin_contacts: pins,
+        ..SolverConfig::default()
+    })
+    .unwrap();
+    let mut c = Collisions::new();
+    ground(&mut w, &mut c);
+    (w, c)
+}
+
 /// A drive with no torque cap turning a chain into the ground: two
 /// capsules lying on the ground on sockets, the first to a static anchor,
 /// that joint driven 0.5 rad down at 5 Hz. The ground holds the chain on
@@ -397,14 +411,7 @@ fn an_uncapped_drive_does_not_press_a_chain_into_the_ground() {
     use vertebra_world::{AngularDrive, JointDesc, Spring};
     let radius = 0.1;
     for pins in [PinContacts::Never, PinContacts::Driven, PinContacts::Always] {
-        let mut w = World::new(SolverConfig {
-            sleep: None,
-            pin_contacts: pins,
-            ..SolverConfig::default()
-        })
-        .unwrap();
-        let mut c = Collisions::new();
-        ground(&mut w, &mut c);
+        let (mut w, mut c) = on_ground(pins);
         let anchor = w
             .add_body(BodyDesc::fixed().with_position(Vec3::new(0.0, radius, 0.0)))
             .unwrap();
@@ -456,14 +463,7 @@ fn a_driven_joint_between_two_trees_pins_both() {
     use vertebra_world::{AngularDrive, JointDesc, Spring};
     let radius = 0.1;
     let run = |pins: PinContacts| {
-        let mut w = World::new(SolverConfig {
-            sleep: None,
-            pin_contacts: pins,
-            ..SolverConfig::default()
-        })
-        .unwrap();
-        let mut c = Collisions::new();
-        ground(&mut w, &mut c);
+        let (mut w, mut c) = on_ground(pins);
         let shape = Shape::capsule(Vec3::new(-0.2, 0.0, 0.0), Vec3::new(0.2, 0.0, 0.0), radius);
         let mut capsules = Vec::new();
         for z in [0.0, 0.5] {
